@@ -1,0 +1,216 @@
+"""The thesis's two shared-memory patterns on iceoryx2: Queue and Latest.
+
+Both are a publish-subscribe service plus an event service of the same name: a writer
+sends the sample and then notifies, a reader sleeps on the event with a timeout. Each
+sample carries a small header (writer id, sequence number) so a reader can count what a
+full buffer made it lose.
+
+- Queue: every sample in order to every reader; a reader that falls behind loses the
+  oldest samples (iceoryx2 "safe overflow"), the writer never blocks, the loss is counted.
+- Latest: a buffer of one with history one, so a reader always sees the newest value,
+  including one published before it connected.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import logging
+import random
+import time
+from collections.abc import Iterator
+from typing import Generic, TypeVar
+
+import iceoryx2 as iox2
+
+from companion.messages import Message
+
+log = logging.getLogger(__name__)
+
+M = TypeVar("M", bound=Message)
+
+_MAX_WAIT_S = 3600.0
+
+
+class SampleHeader(ctypes.Structure):
+    """Prepended to every bus sample: which writer sent it, and its running number."""
+
+    _fields_ = [("writer_id", ctypes.c_uint64), ("seq", ctypes.c_uint64)]
+
+
+def duration(timeout_s: float) -> iox2.Duration:
+    """An iceoryx2 Duration from seconds (clamped to [0, 1 h])."""
+    return iox2.Duration.from_secs_f64(min(max(timeout_s, 0.0), _MAX_WAIT_S))
+
+
+class IdleTally:
+    """Time a process spent asleep in bus waits, so step time can exclude it."""
+
+    def __init__(self) -> None:
+        self.seconds = 0.0
+        self._since = 0.0
+
+    def __enter__(self) -> IdleTally:
+        self._since = time.perf_counter()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.seconds += time.perf_counter() - self._since
+
+
+class Writer(Generic[M]):
+    """Publishes samples of one channel and wakes its readers."""
+
+    def __init__(self, name: str, publisher: iox2.Publisher, notifier: iox2.Notifier) -> None:
+        self.name = name
+        self._publisher = publisher
+        self._notifier = notifier
+        self._writer_id = random.getrandbits(63)
+        self._seq = 0
+        self.sent = 0
+
+    def publish(self, msg: M) -> None:
+        """Copy the message into shared memory, send it, and notify readers."""
+        sample = self._publisher.loan_uninit()
+        header = sample.user_header().contents
+        header.writer_id = self._writer_id
+        header.seq = self._seq
+        self._seq += 1
+        sample.write_payload(msg).send()
+        self._notifier.notify()
+        self.sent += 1
+
+    def close(self) -> None:
+        """Release the iceoryx2 ports."""
+        self._notifier.delete()
+        self._publisher.delete()
+
+
+class Reader(Generic[M]):
+    """Receives samples of one channel; waits on its event without polling."""
+
+    def __init__(
+        self,
+        name: str,
+        msg_type: type[M],
+        subscriber: iox2.Subscriber,
+        listener: iox2.Listener,
+        idle: IdleTally | None = None,
+    ) -> None:
+        self.name = name
+        self._idle = idle or IdleTally()
+        self.msg_type = msg_type
+        self._subscriber = subscriber
+        self.listener = listener
+        # Losses are counted from the first sample seen of each writer onwards.
+        self._last_seq: dict[int, int] = {}
+        self.received = 0
+        self.lost = 0
+
+    def _receive_one(self) -> M | None:
+        sample = self._subscriber.receive()
+        if sample is None:
+            return None
+        header = sample.user_header().contents
+        self._count_gap(int(header.writer_id), int(header.seq))
+        msg = self.msg_type()
+        ctypes.memmove(ctypes.byref(msg), sample.payload_ptr, ctypes.sizeof(msg))
+        sample.delete()
+        self.received += 1
+        return msg
+
+    def _count_gap(self, writer_id: int, seq: int) -> None:
+        last = self._last_seq.get(writer_id)
+        if last is not None and seq > last + 1:
+            self.lost += seq - last - 1
+        self._last_seq[writer_id] = seq
+
+    def drain(self) -> Iterator[M]:
+        """Every sample available now, oldest first, without waiting."""
+        while (msg := self._receive_one()) is not None:
+            yield msg
+
+    def wait_event(self, timeout_s: float) -> bool:
+        """Sleep until a writer notifies or the timeout passes; True when woken by data.
+
+        A signal (SIGINT/SIGTERM) ends the wait early and returns False, so a plug-in's
+        step() returns promptly and its runner can stop.
+        """
+        if self._subscriber.has_samples():
+            self.consume_events()
+            return True
+        try:
+            with self._idle:
+                events = self.listener.timed_wait(duration(timeout_s))
+        except iox2.ListenerWaitError:
+            return False
+        self.consume_events()
+        return bool(events) or self._subscriber.has_samples()
+
+    def consume_events(self) -> None:
+        """Clear pending notifications (they are only wake-ups; data is in the queue)."""
+        try:
+            self.listener.try_wait()
+        except iox2.ListenerWaitError:
+            pass
+
+    def has_samples(self) -> bool:
+        """True when a sample is waiting."""
+        return bool(self._subscriber.has_samples())
+
+    def close(self) -> None:
+        """Release the iceoryx2 ports."""
+        self.listener.delete()
+        self._subscriber.delete()
+
+
+class QueueReader(Reader[M]):
+    """Reader of a Queue channel: ordered samples, losses counted in ``lost``."""
+
+    def take(self, timeout_s: float = 0.0) -> list[M]:
+        """All pending samples, waiting up to ``timeout_s`` for the first one."""
+        msgs = list(self.drain())
+        if msgs or timeout_s <= 0:
+            return msgs
+        if self.wait_event(timeout_s):
+            msgs = list(self.drain())
+        return msgs
+
+
+class LatestReader(Reader[M]):
+    """Reader of a Latest channel: the newest value, cached between updates."""
+
+    def __init__(
+        self,
+        name: str,
+        msg_type: type[M],
+        subscriber: iox2.Subscriber,
+        listener: iox2.Listener,
+        idle: IdleTally | None = None,
+    ) -> None:
+        super().__init__(name, msg_type, subscriber, listener, idle)
+        self._latest: M | None = None
+
+    def _count_gap(self, writer_id: int, seq: int) -> None:
+        """Skipping superseded values is what Latest is for: nothing counts as lost."""
+
+    def get(self) -> M | None:
+        """The newest value published so far, or None if nothing has been seen yet."""
+        for msg in self.drain():
+            self._latest = msg
+        return self._latest
+
+    def wait(self, timeout_s: float) -> M | None:
+        """Wait up to ``timeout_s`` for a NEW value; None if none arrived."""
+        fresh: M | None = None
+        for msg in self.drain():
+            fresh = msg
+        if fresh is None and self.wait_event(timeout_s):
+            for msg in self.drain():
+                fresh = msg
+        if fresh is not None:
+            self._latest = fresh
+        return fresh
+
+
+LatestWriter = Writer
+QueueWriter = Writer

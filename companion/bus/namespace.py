@@ -1,0 +1,113 @@
+"""Bus namespaces: each vehicle (and each test) gets its own iceoryx2 resource prefix.
+
+Channels of one namespace are invisible to every other one, so two vehicles, or two
+tests running at once, never collide. The namespace comes from the vehicle config or
+the ``COMPANION_BUS`` environment variable (default ``companion``).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import re
+import shutil
+from pathlib import Path
+
+import iceoryx2 as iox2
+
+log = logging.getLogger(__name__)
+
+ENV_VAR = "COMPANION_BUS"
+DEFAULT_NAMESPACE = "companion"
+_VALID = re.compile(r"^[A-Za-z0-9_.-]{1,40}$")
+SHM_DIR = Path("/dev/shm")
+IOX_DIR = Path("/tmp/iceoryx2")
+
+_log_level_set = False
+
+
+def quiet_iceoryx() -> None:
+    """Keep iceoryx2's own console logging to errors (once per process)."""
+    global _log_level_set
+    if not _log_level_set:
+        iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
+        _log_level_set = True
+
+
+def default_namespace() -> str:
+    """The namespace from the environment, or the default one."""
+    return os.environ.get(ENV_VAR, DEFAULT_NAMESPACE)
+
+
+def validate_namespace(namespace: str) -> str:
+    """Return the namespace if usable as a file-name prefix, else raise ValueError."""
+    if not _VALID.match(namespace):
+        raise ValueError(
+            f"bus namespace {namespace!r} must be 1-40 characters of letters, digits, '_', '-', '.'"
+        )
+    return namespace
+
+
+def prefix_of(namespace: str) -> str:
+    """The iceoryx2 resource prefix of a namespace."""
+    return f"cmp_{validate_namespace(namespace)}_"
+
+
+def make_config(namespace: str) -> iox2.config.Config:
+    """An iceoryx2 config whose every resource carries the namespace's prefix."""
+    quiet_iceoryx()
+    cfg = iox2.config.global_config()
+    cfg.global_cfg.prefix = iox2.FileName.new(prefix_of(namespace))
+    return cfg
+
+
+def alive_nodes(namespace: str) -> int:
+    """How many iceoryx2 nodes of this namespace belong to living processes."""
+    cfg = make_config(namespace)
+    states = iox2.Node.list(iox2.ServiceType.Ipc, cfg)
+    return sum(1 for s in states if isinstance(s, iox2.NodeState.Alive))
+
+
+def cleanup_namespace(namespace: str) -> int:
+    """Remove what dead processes of this namespace left behind; return files removed.
+
+    Dead nodes (a plug-in killed with SIGKILL) are cleaned through iceoryx2 itself. When
+    no node of the namespace is alive any more, the remaining prefixed files (the global
+    management segment iceoryx2 keeps, and any orphaned segment) are deleted too, so
+    nothing is left in /dev/shm.
+    """
+    cfg = make_config(namespace)
+    try:
+        iox2.Node.try_cleanup_dead_nodes(iox2.ServiceType.Ipc, cfg)
+    except Exception as exc:  # a half-written node of a process killed mid-start
+        log.debug("iceoryx2 dead-node cleanup: %s", exc)
+    if alive_nodes(namespace):
+        return 0
+    return _remove_prefixed_files(prefix_of(namespace))
+
+
+def _remove_prefixed_files(prefix: str) -> int:
+    removed = 0
+    for base in (SHM_DIR, IOX_DIR):
+        if not base.exists():
+            continue
+        for path in base.rglob(f"{prefix}*"):
+            try:
+                if path.is_dir():
+                    shutil.rmtree(path)
+                else:
+                    path.unlink()
+                removed += 1
+            except FileNotFoundError:
+                pass
+            except OSError as exc:
+                log.warning("cannot remove %s: %s", path, exc)
+    return removed
+
+
+def leftover_files(namespace: str) -> list[Path]:
+    """Files of this namespace still present in /dev/shm (for tests and diagnostics)."""
+    prefix = prefix_of(namespace)
+    if not SHM_DIR.exists():
+        return []
+    return sorted(SHM_DIR.glob(f"{prefix}*"))

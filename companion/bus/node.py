@@ -1,0 +1,179 @@
+"""One process's connection to the bus: opens channels by their registered names."""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Sequence
+from typing import Any
+
+import iceoryx2 as iox2
+
+from companion.bus.channels import (
+    IdleTally,
+    LatestReader,
+    QueueReader,
+    Reader,
+    SampleHeader,
+    Writer,
+    duration,
+)
+from companion.bus.namespace import default_namespace, make_config
+from companion.messages import MAX_PLUGINS, Channel, channel
+
+log = logging.getLogger(__name__)
+
+# Limits are part of a service's identity in iceoryx2: every process must open a
+# channel with the same numbers, so they are fixed here rather than per caller.
+MAX_PUBLISHERS = 8
+MAX_SUBSCRIBERS = 16
+MAX_NODES = 2 * MAX_PLUGINS + 8
+MAX_NOTIFIERS = MAX_PLUGINS + 8
+MAX_LISTENERS = MAX_SUBSCRIBERS + 4
+
+
+class BusNode:
+    """A process's node on the bus of one namespace.
+
+    >>> bus = BusNode("test")                       # doctest: +SKIP
+    >>> imu = bus.writer("sensors/imu")             # doctest: +SKIP
+    >>> nav = bus.latest_reader("nav/state")        # doctest: +SKIP
+    """
+
+    def __init__(self, namespace: str | None = None, name: str = "") -> None:
+        self.namespace = namespace or default_namespace()
+        self._config = make_config(self.namespace)
+        # Signals belong to the Python process (the plug-in runner and supervisor install
+        # their own SIGTERM/SIGINT handlers); iceoryx2 must not swallow them.
+        builder = (
+            iox2.NodeBuilder.new()
+            .config(self._config)
+            .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
+        )
+        if name:
+            builder = builder.name(iox2.NodeName.new(f"{name}.{os.getpid()}"))
+        self._node = builder.create(iox2.ServiceType.Ipc)
+        self._ports: list[Writer[Any] | Reader[Any]] = []
+        self.idle = IdleTally()
+
+    def _pubsub(self, chan: Channel) -> Any:
+        builder = (
+            self._node.service_builder(iox2.ServiceName.new(chan.name))
+            .publish_subscribe(chan.type)
+            .user_header(SampleHeader)
+            .max_publishers(MAX_PLUGINS + 8 if chan.many_producers else MAX_PUBLISHERS)
+            .max_subscribers(MAX_SUBSCRIBERS)
+            .max_nodes(MAX_NODES)
+            .enable_safe_overflow(True)
+        )
+        if chan.pattern == "latest":
+            builder = builder.history_size(1).subscriber_max_buffer_size(1)
+        else:
+            builder = builder.history_size(0).subscriber_max_buffer_size(chan.depth)
+        return builder.open_or_create()
+
+    def _event(self, chan: Channel) -> Any:
+        return (
+            self._node.service_builder(iox2.ServiceName.new(chan.name))
+            .event()
+            .max_notifiers(MAX_NOTIFIERS)
+            .max_listeners(MAX_LISTENERS)
+            .max_nodes(MAX_NODES)
+            .open_or_create()
+        )
+
+    def writer(self, name: str) -> Writer[Any]:
+        """A writer for the registered channel ``name`` (Queue or Latest alike)."""
+        chan = channel(name)
+        pub = self._pubsub(chan).publisher_builder().create()
+        notifier = self._event(chan).notifier_builder().create()
+        port: Writer[Any] = Writer(name, pub, notifier)
+        self._ports.append(port)
+        return port
+
+    def queue_reader(self, name: str) -> QueueReader[Any]:
+        """A reader of the Queue channel ``name``."""
+        chan = channel(name)
+        if chan.pattern != "queue":
+            raise ValueError(f"channel {name!r} is a Latest channel; use latest_reader()")
+        sub = self._pubsub(chan).subscriber_builder().buffer_size(chan.depth).create()
+        listener = self._event(chan).listener_builder().create()
+        port: QueueReader[Any] = QueueReader(name, chan.type, sub, listener, self.idle)
+        self._ports.append(port)
+        return port
+
+    def latest_reader(self, name: str) -> LatestReader[Any]:
+        """A reader of the Latest channel ``name``."""
+        chan = channel(name)
+        if chan.pattern != "latest":
+            raise ValueError(f"channel {name!r} is a Queue channel; use queue_reader()")
+        sub = self._pubsub(chan).subscriber_builder().create()
+        listener = self._event(chan).listener_builder().create()
+        port: LatestReader[Any] = LatestReader(name, chan.type, sub, listener, self.idle)
+        self._ports.append(port)
+        return port
+
+    def reader(self, name: str) -> Reader[Any]:
+        """A reader of either pattern, chosen by the channel's registration."""
+        if channel(name).pattern == "queue":
+            return self.queue_reader(name)
+        return self.latest_reader(name)
+
+    def waiter(self, readers: Sequence[Reader[Any]]) -> Waiter:
+        """A reusable wait over several readers (one iceoryx2 WaitSet)."""
+        return Waiter(readers, self.idle)
+
+    def total_lost(self) -> int:
+        """Samples this node's Queue readers lost to overflow, all channels together."""
+        return sum(p.lost for p in self._ports if isinstance(p, Reader))
+
+    def close(self) -> None:
+        """Release every port and the node."""
+        for port in reversed(self._ports):
+            try:
+                port.close()
+            except Exception as exc:  # closing twice, or after iceoryx2 already did
+                log.debug("closing %s: %s", port.name, exc)
+        self._ports.clear()
+        del self._node
+
+    def __enter__(self) -> BusNode:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+
+class Waiter:
+    """Sleeps until any of several readers has data, or a timeout passes."""
+
+    def __init__(self, readers: Sequence[Reader[Any]], idle: IdleTally | None = None) -> None:
+        self.readers = list(readers)
+        self._idle = idle or IdleTally()
+        self._waitset = (
+            iox2.WaitSetBuilder.new()
+            .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
+            .create(iox2.ServiceType.Ipc)
+        )
+        self._guards = [self._waitset.attach_notification(r.listener) for r in self.readers]
+
+    def wait(self, timeout_s: float) -> list[Reader[Any]]:
+        """The readers with data, after sleeping at most ``timeout_s`` for the first."""
+        ready = [r for r in self.readers if r.has_samples()]
+        if not ready:
+            with self._idle:
+                try:
+                    self._waitset.wait_and_process_with_timeout(duration(timeout_s))
+                except iox2.WaitSetRunError:
+                    pass  # interrupted by a signal: the caller checks its stop flag
+            ready = [r for r in self.readers if r.has_samples()]
+        for r in self.readers:
+            r.consume_events()
+        return ready
+
+    def close(self) -> None:
+        """Detach from the readers."""
+        for guard in self._guards:
+            guard.delete()
+        self._guards.clear()

@@ -1,0 +1,98 @@
+"""The ``companion`` command: run a vehicle, look at it, check its config."""
+
+from __future__ import annotations
+
+import json
+import logging
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="On-board software of a MAVLink-speaking fixed-wing UAV companion computer.",
+)
+err = Console(stderr=True)
+# A pipe gets a wide console so the status table is not folded into unreadable columns.
+out = Console() if sys.stdout.isatty() else Console(width=200)
+
+CONFIG_OPT = typer.Option("--config", "-c", help="vehicle config (TOML)")
+NS_OPT = typer.Option("--namespace", "-n", help="bus namespace (default: config or $COMPANION_BUS)")
+EXIT_CONFIG = 2
+
+
+def _load_checked(config: Path, namespace: str | None):  # noqa: ANN202 - internal helper
+    from companion.exec_control.config import ConfigError, load_config
+    from companion.exec_control.topology import check_topology
+
+    try:
+        cfg = load_config(config, namespace)
+        check_topology(cfg)
+    except ConfigError as exc:
+        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+    return cfg
+
+
+@app.command()
+def run(
+    config: Annotated[Path, CONFIG_OPT],
+    namespace: Annotated[str | None, NS_OPT] = None,
+    log_level: Annotated[str, typer.Option(help="DEBUG, INFO, WARNING")] = "INFO",
+) -> None:
+    """Run the vehicle: every plug-in of the config in its own process, supervised."""
+    from companion.exec_control.supervisor import Supervisor
+
+    logging.basicConfig(level=log_level, format="%(asctime)s exec_control %(levelname)s %(message)s")
+    cfg = _load_checked(config, namespace)
+    raise typer.Exit(Supervisor(cfg, log_level).run())
+
+
+@app.command()
+def graph(
+    config: Annotated[Path, CONFIG_OPT],
+    namespace: Annotated[str | None, NS_OPT] = None,
+) -> None:
+    """Check a config and print its channel graph (who writes and reads each channel)."""
+    from companion.exec_control.topology import graph_lines
+
+    cfg = _load_checked(config, namespace)
+    out.print(f"{cfg.path}: vehicle {cfg.name!r}, sysid {cfg.sysid}, bus {cfg.namespace!r}")
+    for spec in cfg.plugins:
+        out.print(f"  {spec.name:16} {spec.kind:28} {spec.group}")
+    for line in graph_lines(cfg):
+        out.print(line, highlight=False)
+
+
+@app.command()
+def status(
+    namespace: Annotated[str | None, NS_OPT] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="machine-readable output")] = False,
+    timeout: Annotated[float, typer.Option(help="seconds to wait for the table")] = 3.0,
+) -> None:
+    """Print the health table of a running vehicle (read from its bus)."""
+    from companion.bus import default_namespace
+    from companion.status_view import health_dict, health_table, read_health
+
+    ns = namespace or default_namespace()
+    msg = read_health(ns, timeout)
+    if msg is None:
+        err.print(f"no vehicle is publishing system/health on bus {ns!r}")
+        raise typer.Exit(1)
+    if as_json:
+        sys.stdout.write(json.dumps(health_dict(msg), indent=2) + "\n")
+    else:
+        out.print(health_table(msg))
+
+
+def main() -> None:
+    """Console-script entry point."""
+    app()
+
+
+if __name__ == "__main__":
+    main()

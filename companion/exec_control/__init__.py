@@ -1,0 +1,1 @@
+"""The execution-control process: config, spawning, supervision, START/STOP."""

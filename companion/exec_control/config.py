@@ -1,0 +1,198 @@
+"""Load and check a vehicle config (TOML) before anything starts.
+
+Every refusal is a ConfigError naming the file, the line and the key, with the close
+match when a name looks misspelt. The CLI turns it into exit status 2.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from difflib import get_close_matches
+from pathlib import Path
+from typing import Any
+
+from companion.bus.namespace import default_namespace, validate_namespace
+from companion.exec_control.config_locator import KeyPath, line_of, locate
+from companion.exec_control.registry import PluginLoadError, load
+from companion.plugin import Plugin, Ports, Setting
+
+GROUPS = ("core", "flight")
+CLOCKS = ("monotonic", "sim")
+
+
+class ConfigError(Exception):
+    """A config the vehicle refuses to start with."""
+
+    def __init__(self, file: Path, line: int | None, key: str, message: str) -> None:
+        self.file, self.line, self.key, self.message = file, line, key, message
+        where = f"{file}:{line}" if line else f"{file}"
+        super().__init__(f"{where}: {key}: {message}" if key else f"{where}: {message}")
+
+
+@dataclass(frozen=True)
+class PluginSpec:
+    """One plug-in instance as the config declares it, settings validated."""
+
+    name: str
+    kind: str  # the plug-in name as written: short name or module:Class
+    group: str
+    settings: dict[str, Any]
+    ports: Ports
+    line: int | None = None
+
+
+@dataclass(frozen=True)
+class VehicleConfig:
+    """The whole checked config."""
+
+    path: Path
+    name: str
+    sysid: int
+    namespace: str
+    clock: str
+    plugins: list[PluginSpec] = field(default_factory=list)
+    vehicle: dict[str, Any] = field(default_factory=dict)
+
+
+_VEHICLE_KEYS: dict[str, Setting] = {
+    "name": Setting(str, "vehicle", "a name for logs and the status table"),
+    "sysid": Setting(int, 1, "MAVLink system id", min=1, max=255),
+    "namespace": Setting(str, "", "bus namespace (default: $COMPANION_BUS or 'companion')"),
+    "clock": Setting(str, "monotonic", "vehicle time base", choices=CLOCKS),
+}
+_PLUGIN_KEYS = ("name", "plugin", "group", "settings")
+
+
+class _Checker:
+    """Validation helpers bound to one file, so every error carries its position."""
+
+    def __init__(self, path: Path, text: str) -> None:
+        self.path = path
+        self.lines = locate(text)
+
+    def error(self, key_path: KeyPath, message: str) -> ConfigError:
+        key = ".".join(str(p) if isinstance(p, str) else f"[{p}]" for p in key_path)
+        return ConfigError(self.path, line_of(self.lines, key_path), key.replace(".[", "["), message)
+
+    def unknown_keys(self, table: dict[str, Any], known: list[str], where: KeyPath) -> None:
+        for key in table:
+            if key not in known:
+                hint = get_close_matches(key, known, n=1)
+                tip = f"; did you mean {hint[0]!r}?" if hint else f" (known: {', '.join(known)})"
+                raise self.error(where + (key,), f"unknown key {key!r}{tip}")
+
+    def values(self, table: dict[str, Any], decl: dict[str, Setting], where: KeyPath) -> dict:
+        """Check a table against declared settings; return it with defaults filled in."""
+        self.unknown_keys(table, list(decl), where)
+        out: dict[str, Any] = {}
+        for key, setting in decl.items():
+            if key not in table:
+                if setting.required:
+                    raise self.error(where + (key,), f"missing required setting {key!r}")
+                out[key] = setting.default
+                continue
+            out[key] = self.value(table[key], setting, where + (key,))
+        return out
+
+    def value(self, value: Any, setting: Setting, where: KeyPath) -> Any:
+        want = setting.type
+        if want is float and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        if not isinstance(value, want) or (want is int and isinstance(value, bool)):
+            got = type(value).__name__
+            raise self.error(where, f"expected {want.__name__}, got {got} {value!r}")
+        if setting.choices is not None and value not in setting.choices:
+            hint = get_close_matches(str(value), [str(c) for c in setting.choices], n=1)
+            tip = f"; did you mean {hint[0]!r}?" if hint else ""
+            raise self.error(where, f"{value!r} is not one of {list(setting.choices)}{tip}")
+        if setting.min is not None and value < setting.min:
+            raise self.error(where, f"{value!r} is below the minimum {setting.min}")
+        if setting.max is not None and value > setting.max:
+            raise self.error(where, f"{value!r} is above the maximum {setting.max}")
+        return value
+
+
+def load_config(path: str | Path, namespace: str | None = None) -> VehicleConfig:
+    """Read, parse and check the config; raise ConfigError on the first problem."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except FileNotFoundError:
+        raise ConfigError(path, None, "", "config file not found") from None
+    except OSError as exc:
+        raise ConfigError(path, None, "", f"cannot read config: {exc.strerror}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        line = getattr(exc, "lineno", None)
+        raise ConfigError(path, line, "", f"not valid TOML: {exc}") from None
+    check = _Checker(path, text)
+    check.unknown_keys(data, ["vehicle", "plugins"], ())
+    vehicle = data.get("vehicle", {})
+    if not isinstance(vehicle, dict):
+        raise check.error(("vehicle",), "must be a table: [vehicle]")
+    vehicle = check.values(vehicle, _VEHICLE_KEYS, ("vehicle",))
+    ns = namespace or vehicle["namespace"] or None
+    if ns is not None:
+        try:
+            validate_namespace(ns)
+        except ValueError as exc:
+            raise check.error(("vehicle", "namespace"), str(exc)) from None
+    specs = _plugin_specs(check, data.get("plugins", []))
+    return VehicleConfig(
+        path=path,
+        name=vehicle["name"],
+        sysid=vehicle["sysid"],
+        namespace=ns or default_namespace(),
+        clock=vehicle["clock"],
+        plugins=specs,
+        vehicle=vehicle,
+    )
+
+
+def _plugin_specs(check: _Checker, entries: Any) -> list[PluginSpec]:
+    if not isinstance(entries, list):
+        raise check.error(("plugins",), "must be an array of tables: [[plugins]]")
+    specs: list[PluginSpec] = []
+    seen: set[str] = set()
+    for index, entry in enumerate(entries):
+        where: KeyPath = ("plugins", index)
+        spec = _plugin_spec(check, entry, where)
+        if spec.name in seen:
+            raise check.error(where + ("name",), f"plug-in name {spec.name!r} is used twice")
+        seen.add(spec.name)
+        specs.append(spec)
+    return specs
+
+
+def _plugin_spec(check: _Checker, entry: Any, where: KeyPath) -> PluginSpec:
+    if not isinstance(entry, dict):
+        raise check.error(where, "each plug-in must be a table")
+    check.unknown_keys(entry, list(_PLUGIN_KEYS), where)
+    for key in ("name", "plugin"):
+        if key not in entry:
+            raise check.error(where + (key,), f"missing required key {key!r}")
+        if not isinstance(entry[key], str) or not entry[key]:
+            raise check.error(where + (key,), "expected a non-empty string")
+    group = entry.get("group", "core")
+    if group not in GROUPS:
+        hint = get_close_matches(str(group), GROUPS, n=1)
+        tip = f"; did you mean {hint[0]!r}?" if hint else ""
+        raise check.error(where + ("group",), f"{group!r} is not one of {list(GROUPS)}{tip}")
+    try:
+        cls: type[Plugin] = load(entry["plugin"])
+    except PluginLoadError as exc:
+        raise check.error(where + ("plugin",), str(exc)) from None
+    raw_settings = entry.get("settings", {})
+    if not isinstance(raw_settings, dict):
+        raise check.error(where + ("settings",), "must be a table")
+    settings = check.values(raw_settings, cls.settings, where + ("settings",))
+    return PluginSpec(
+        name=entry["name"],
+        kind=entry["plugin"],
+        group=group,
+        settings=settings,
+        ports=cls.ports(settings),
+        line=line_of(check.lines, where),
+    )

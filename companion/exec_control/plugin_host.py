@@ -1,0 +1,150 @@
+"""The process a plug-in runs in: ``python -m companion.exec_control.plugin_host SPEC``.
+
+It imports the plug-in by name, gives it its context, calls step() until told to stop
+(SIGTERM/SIGINT), and publishes the plug-in's counters and step-time percentiles on
+``system/plugin_stats`` once a second. A plug-in that raises ends the process with a
+non-zero status; the supervisor restarts it.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import json
+import logging
+import os
+import signal
+import sys
+import time
+from collections import deque
+from typing import Any
+
+from companion.bus import BusNode, MonotonicClock, SimulationClock, VehicleClock
+from companion.exec_control.registry import load
+from companion.messages import NAME_LEN, PluginStats
+from companion.plugin import Plugin, PluginContext
+
+EXIT_INIT_FAILED = 3
+EXIT_STEP_FAILED = 4
+STATS_PERIOD_S = 1.0
+_PR_SET_PDEATHSIG = 1
+
+log = logging.getLogger("companion.plugin_host")
+
+
+def die_with_parent() -> None:
+    """Ask Linux to SIGTERM this process when the supervisor dies, even by SIGKILL."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+    except (OSError, AttributeError):  # not Linux: the supervisor's own shutdown still works
+        return
+    if os.getppid() == 1:  # the parent died before prctl took effect
+        sys.exit(0)
+
+
+class StepTimer:
+    """Step durations of the last few hundred steps, for p50/p99."""
+
+    def __init__(self, size: int = 512) -> None:
+        self._us: deque[float] = deque(maxlen=size)
+        self.steps = 0
+
+    def add(self, seconds: float) -> None:
+        self._us.append(seconds * 1e6)
+        self.steps += 1
+
+    def percentile(self, q: float) -> float:
+        if not self._us:
+            return float("nan")
+        ordered = sorted(self._us)
+        return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
+
+
+class PluginHost:
+    """Runs one plug-in instance until stopped."""
+
+    def __init__(self, spec: dict[str, Any]) -> None:
+        self.spec = spec
+        self.stopping = False
+        self.bus = BusNode(spec["namespace"], spec["name"])
+        self.timer = StepTimer()
+        self.stats = self.bus.writer("system/plugin_stats")
+        self.clock = self._clock(spec["vehicle"].get("clock", "monotonic"))
+        self.ctx = PluginContext(
+            name=spec["name"],
+            settings=spec["settings"],
+            log=logging.getLogger(f"plugin.{spec['name']}"),
+            bus=self.bus,
+            clock=self.clock,
+            vehicle=spec["vehicle"],
+        )
+
+    def _clock(self, kind: str) -> VehicleClock:
+        if kind == "sim":
+            return SimulationClock(self.bus.latest_reader("sim/clock"))
+        return MonotonicClock()
+
+    def request_stop(self, signum: int, _frame: object) -> None:
+        self.stopping = True
+
+    def publish_stats(self) -> None:
+        msg = PluginStats(t_us=self.clock.now_us(), pid=os.getpid(), steps=self.timer.steps)
+        msg.name = self.spec["name"].encode()[: NAME_LEN - 1]
+        health = self.ctx.health
+        msg.frames_ok, msg.frames_bad = health.frames_ok, health.frames_bad
+        msg.dropped = health.dropped + self.bus.total_lost()
+        msg.step_p50_us = self.timer.percentile(0.5)
+        msg.step_p99_us = self.timer.percentile(0.99)
+        self.stats.publish(msg)
+
+    def run(self, plugin: Plugin) -> int:
+        try:
+            plugin.init(self.ctx)
+        except Exception:
+            log.exception("%s: init failed", self.spec["name"])
+            return EXIT_INIT_FAILED
+        code = 0
+        next_stats = time.monotonic()
+        try:
+            while not self.stopping:
+                started, idle_before = time.perf_counter(), self.bus.idle.seconds
+                plugin.step()
+                # Busy time only: the wait for input is not the plug-in's cost.
+                idle = self.bus.idle.seconds - idle_before
+                self.timer.add(time.perf_counter() - started - idle)
+                if time.monotonic() >= next_stats:
+                    self.publish_stats()
+                    next_stats = time.monotonic() + STATS_PERIOD_S
+        except Exception:
+            log.exception("%s: step failed", self.spec["name"])
+            code = EXIT_STEP_FAILED
+        finally:
+            try:
+                plugin.close()
+            except Exception:
+                log.exception("%s: close failed", self.spec["name"])
+            self.publish_stats()
+        return code
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of a plug-in process; argv[0] is the JSON spec from the supervisor."""
+    args = sys.argv[1:] if argv is None else argv
+    spec = json.loads(args[0])
+    logging.basicConfig(
+        level=spec.get("log_level", "INFO"),
+        format=f"%(asctime)s {spec['name']}[%(process)d] %(levelname)s %(message)s",
+    )
+    die_with_parent()
+    host = PluginHost(spec)
+    signal.signal(signal.SIGTERM, host.request_stop)
+    signal.signal(signal.SIGINT, host.request_stop)
+    try:
+        plugin = load(spec["kind"])()
+        return host.run(plugin)
+    finally:
+        host.bus.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

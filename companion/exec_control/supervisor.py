@@ -1,0 +1,163 @@
+"""The execution-control process: run the config's plug-ins and keep them running.
+
+Starts the ``core`` group at once and the ``flight`` group on START (arm), stops the
+flight group on STOP (disarm), restarts any plug-in that dies, publishes the health table
+on ``system/health`` once a second, and stops everything on SIGINT/SIGTERM.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import time
+
+from companion.bus import BusNode, MonotonicClock, Reader, cleanup_namespace
+from companion.exec_control.child import Child
+from companion.exec_control.config import VehicleConfig
+from companion.messages import (
+    NAME_LEN,
+    CommandAck,
+    CommandId,
+    CommandResult,
+    PluginStats,
+    SystemHealth,
+    VehicleCommand,
+)
+
+log = logging.getLogger(__name__)
+
+HEALTH_PERIOD_S = 1.0
+REAP_PERIOD_S = 0.1  # how soon a dead plug-in is noticed (restart target: within 1 s)
+STOP_GRACE_S = 1.2  # SIGTERM, then SIGKILL: total shutdown stays under 2 s
+
+
+class Supervisor:
+    """Runs one vehicle config until a stop signal."""
+
+    def __init__(self, cfg: VehicleConfig, log_level: str = "INFO") -> None:
+        self.cfg = cfg
+        base = {"namespace": cfg.namespace, "vehicle": cfg.vehicle, "log_level": log_level}
+        self.children = [Child(spec, base) for spec in cfg.plugins]
+        self.flight_running = False
+        self.stopping = False
+        self.clock = MonotonicClock()
+
+    def request_stop(self, signum: int, _frame: object) -> None:
+        log.info("received %s: stopping", signal.Signals(signum).name)
+        self.stopping = True
+
+    def group(self, name: str) -> list[Child]:
+        return [c for c in self.children if c.spec.group == name]
+
+    def start_group(self, name: str) -> None:
+        for child in self.group(name):
+            if not child.wanted:
+                child.wanted = True
+                child.backoff_s = 0.1
+                if child.proc is None:
+                    child.start()
+
+    def stop_children(self, children: list[Child]) -> None:
+        """SIGTERM, wait for a clean exit, SIGKILL what is left."""
+        for child in children:
+            child.signal_stop()
+        deadline = time.monotonic() + STOP_GRACE_S
+        for child in children:
+            if not child.wait_stopped(deadline):
+                log.warning("%s did not stop in time: killing it", child.spec.name)
+                child.kill()
+                child.wait_stopped(time.monotonic() + 0.5)
+
+    def handle_command(self, cmd: VehicleCommand) -> CommandResult | None:
+        """Act on the commands that belong to execution control; None for the others."""
+        kind = cmd.command
+        if kind == CommandId.START:
+            self.start_group("flight")
+            self.flight_running = True
+        elif kind == CommandId.STOP:
+            self.stop_children(self.group("flight"))
+            self.flight_running = False
+        elif kind == CommandId.RESTART_PLUGINS:
+            wanted = [c for c in self.children if c.wanted]
+            self.stop_children(wanted)
+            for child in wanted:
+                child.wanted = True
+                child.restarts += 1
+                child.start()
+        else:
+            return None
+        return CommandResult.ACCEPTED
+
+    def publish_health(self, writer: object) -> None:
+        msg = SystemHealth(t_us=self.clock.now_us(), supervisor_pid=os.getpid())
+        msg.flight_running = int(self.flight_running)
+        msg.count = len(self.children)
+        for i, child in enumerate(self.children):
+            child.sample_usage()
+            msg.plugins[i] = child.health_row()
+        writer.publish(msg)  # type: ignore[attr-defined]
+
+    def absorb_stats(self, stats: Reader[PluginStats]) -> None:
+        by_name = {c.spec.name: c for c in self.children}
+        for msg in stats.drain():
+            child = by_name.get(msg.name.decode(errors="replace"))
+            if child is not None and child.pid == msg.pid:
+                child.stats = msg
+
+    def restart_dead(self) -> None:
+        now = time.monotonic()
+        for child in self.children:
+            child.reap(now)
+            if child.restart_due(now):
+                child.restarts += 1
+                child.start()
+
+    def next_timeout(self, next_health: float) -> float:
+        now = time.monotonic()
+        due = [next_health, now + REAP_PERIOD_S]
+        due += [c.next_start_at for c in self.children if c.wanted and c.proc is None]
+        return max(0.0, min(due) - now)
+
+    def run(self) -> int:
+        """Supervise until SIGINT/SIGTERM; return the process exit status."""
+        signal.signal(signal.SIGTERM, self.request_stop)
+        signal.signal(signal.SIGINT, self.request_stop)
+        cleanup_namespace(self.cfg.namespace)  # leftovers of a crashed earlier run
+        bus = BusNode(self.cfg.namespace, "exec_control")
+        try:
+            self._loop(bus)
+        finally:
+            self.stop_children([c for c in self.children if c.spec.group == "flight"])
+            self.stop_children(self.children)
+            bus.close()
+            cleanup_namespace(self.cfg.namespace)
+        log.info("stopped")
+        return 0
+
+    def _loop(self, bus: BusNode) -> None:
+        health = bus.writer("system/health")
+        acks = bus.writer("link/command_acks")
+        commands = bus.queue_reader("link/commands")
+        stats = bus.queue_reader("system/plugin_stats")
+        waiter = bus.waiter([commands, stats])
+        self.start_group("core")
+        next_health = time.monotonic()
+        while not self.stopping:
+            waiter.wait(self.next_timeout(next_health))
+            for cmd in commands.drain():
+                result = self.handle_command(cmd)
+                if result is not None:
+                    acks.publish(self._ack(cmd, result))
+            self.absorb_stats(stats)
+            self.restart_dead()
+            if time.monotonic() >= next_health:
+                self.publish_health(health)
+                next_health = time.monotonic() + HEALTH_PERIOD_S
+        waiter.close()
+
+    def _ack(self, cmd: VehicleCommand, result: CommandResult) -> CommandAck:
+        ack = CommandAck(t_us=self.clock.now_us(), seq=cmd.seq, command=cmd.command)
+        ack.result = int(result)
+        ack.source = b"exec_control"[: NAME_LEN - 1]
+        return ack

@@ -1,0 +1,107 @@
+"""The plug-in contract: what every plug-in is given and what it must provide.
+
+A plug-in is the thesis's shared library run in its own process: ``init(ctx)`` once,
+then ``step()`` over and over (each call blocks on the plug-in's inputs or device and
+returns after one unit of work), then ``close()``. It talks only to the bus and its own
+device. The execution control finds a plug-in by the name in the config: a registered
+short name (entry-point group ``companion.plugins``) or ``"package.module:ClassName"``.
+"""
+
+from __future__ import annotations
+
+import logging
+from abc import ABC, abstractmethod
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, ClassVar
+
+if TYPE_CHECKING:
+    from companion.bus import BusNode, VehicleClock
+
+REQUIRED: Any = object()
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One declared setting of a plug-in: its type, default and meaning."""
+
+    type: type
+    default: Any = REQUIRED
+    doc: str = ""
+    choices: tuple[Any, ...] | None = None
+    min: float | None = None
+    max: float | None = None
+
+    @property
+    def required(self) -> bool:
+        """True when the config must give a value."""
+        return self.default is REQUIRED
+
+
+@dataclass(frozen=True)
+class Ports:
+    """The bus channels a plug-in instance reads and writes (checked before start)."""
+
+    inputs: tuple[str, ...] = ()  # channels that must have a producer
+    optional_inputs: tuple[str, ...] = ()  # read when present (e.g. telemetry for the link)
+    outputs: tuple[str, ...] = ()
+
+
+@dataclass
+class HealthCounters:
+    """Counters every plug-in keeps; the runner publishes them on system/plugin_stats."""
+
+    frames_ok: int = 0
+    frames_bad: int = 0
+    dropped: int = 0
+
+    def ok(self, n: int = 1) -> None:
+        """Count good frames (or samples) accepted."""
+        self.frames_ok += n
+
+    def bad(self, n: int = 1) -> None:
+        """Count rejected frames: bad checksums, garbage, invalid values."""
+        self.frames_bad += n
+
+
+@dataclass
+class PluginContext:
+    """Everything a plug-in gets from the execution control."""
+
+    name: str  # the instance name from the config
+    settings: Mapping[str, Any]  # validated, defaults filled in
+    log: logging.Logger
+    bus: BusNode
+    clock: VehicleClock
+    vehicle: Mapping[str, Any] = field(default_factory=dict)  # the config's [vehicle] table
+    health: HealthCounters = field(default_factory=HealthCounters)
+
+
+class Plugin(ABC):
+    """Base class of every plug-in.
+
+    Subclasses declare ``settings`` (name → Setting), and their bus channels either as the
+    class attributes ``inputs``/``optional_inputs``/``outputs`` or, when they depend on the
+    settings, by overriding ``ports()``.
+    """
+
+    settings: ClassVar[dict[str, Setting]] = {}
+    inputs: ClassVar[tuple[str, ...]] = ()
+    optional_inputs: ClassVar[tuple[str, ...]] = ()
+    outputs: ClassVar[tuple[str, ...]] = ()
+
+    @classmethod
+    def ports(cls, settings: Mapping[str, Any]) -> Ports:
+        """The channels this instance will read and write, given its settings."""
+        return Ports(cls.inputs, cls.optional_inputs, cls.outputs)
+
+    def init(self, ctx: PluginContext) -> None:
+        """Open the device and the bus ports. Raising here counts as a crash."""
+        self.ctx = ctx
+
+    @abstractmethod
+    def step(self) -> None:
+        """Block on inputs (at most about half a second) and do one unit of work."""
+
+    def close(self) -> None:  # noqa: B027 - optional hook, empty by design
+        """Release the device. Bus ports are released by the runner."""

@@ -1,0 +1,79 @@
+"""Small plug-ins that exercise the runtime, named in test configs as module:Class.
+
+They stand in for devices the way a third-party plug-in would: not registered, found by
+``"tests.support.plugins:ClassName"``.
+"""
+
+from __future__ import annotations
+
+import threading
+
+from companion.messages import Imu, NavState
+from companion.plugin import Plugin, PluginContext, Setting
+
+
+class Ticker(Plugin):
+    """A pretend IMU: one sample every 1/rate_hz seconds on sensors/imu, counting up."""
+
+    settings = {"rate_hz": Setting(float, 50.0, "samples per second", min=0.1, max=10000)}
+    outputs = ("sensors/imu",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.writer = ctx.bus.writer("sensors/imu")
+        self.period_s = 1.0 / ctx.settings["rate_hz"]
+        self.count = 0
+        self._pace = threading.Event()  # stands in for a device's read timing
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:  # pacing stands in for a device read: not busy time
+            self._pace.wait(self.period_s)
+        self.count += 1
+        self.writer.publish(Imu(t_us=self.ctx.clock.now_us(), ax_m_s2=float(self.count)))
+        self.ctx.health.ok()
+
+
+class Relay(Plugin):
+    """Turns every IMU sample into a nav/state value (roll_rad = the sample's ax)."""
+
+    inputs = ("sensors/imu",)
+    outputs = ("nav/state",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.imu = ctx.bus.queue_reader("sensors/imu")
+        self.nav = ctx.bus.writer("nav/state")
+
+    def step(self) -> None:
+        for sample in self.imu.take(timeout_s=0.5):
+            self.nav.publish(NavState(t_us=sample.t_us, roll_rad=sample.ax_m_s2))
+            self.ctx.health.ok()
+
+
+class Waiting(Plugin):
+    """Waits on a channel nobody writes: its CPU use is the cost of an idle wait."""
+
+    optional_inputs = ("sensors/mag",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.mag = ctx.bus.queue_reader("sensors/mag")
+
+    def step(self) -> None:
+        self.mag.take(timeout_s=0.5)
+
+
+class CrashAfter(Plugin):
+    """Raises after a number of steps (each step waits 10 ms)."""
+
+    settings = {"steps": Setting(int, 5, "steps before the crash", min=0)}
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.left = ctx.settings["steps"]
+
+    def step(self) -> None:
+        if self.left <= 0:
+            raise RuntimeError("deliberate crash for the restart test")
+        self.left -= 1
+        threading.Event().wait(0.01)

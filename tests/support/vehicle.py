@@ -1,0 +1,137 @@
+"""Run a real vehicle (``companion run``) in a subprocess for a test, and clean up after.
+
+Each vehicle gets its own bus namespace, so tests never see each other's channels, and
+teardown checks that nothing is left running or in /dev/shm.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+import psutil
+
+from companion.bus import BusNode, cleanup_namespace, leftover_files
+from companion.messages import SystemHealth
+
+REPO = Path(__file__).resolve().parents[2]
+_counter = itertools.count()
+T = TypeVar("T")
+
+
+def unique_namespace(tag: str = "t") -> str:
+    """A bus namespace no other test (or test run) uses."""
+    return f"{tag}{os.getpid()}_{next(_counter)}"
+
+
+def wait_for(predicate: Callable[[], T], timeout_s: float, what: str, period_s: float = 0.05) -> T:
+    """Poll a test condition until it is truthy (tests may poll; the vehicle never does)."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        value = predicate()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+        time.sleep(period_s)
+
+
+def companion_env(namespace: str) -> dict[str, str]:
+    env = dict(os.environ)
+    env["COMPANION_BUS"] = namespace
+    env["PYTHONPATH"] = os.pathsep.join([str(REPO), env.get("PYTHONPATH", "")])
+    return env
+
+
+class Vehicle:
+    """A ``companion run`` process and a bus node to watch it from the test."""
+
+    def __init__(self, config_text: str, tmp: Path, namespace: str | None = None) -> None:
+        self.namespace = namespace or unique_namespace()
+        self.config = tmp / "vehicle.toml"
+        self.config.write_text(textwrap.dedent(config_text))
+        self.proc: subprocess.Popen[str] | None = None
+        self.bus: BusNode | None = None
+        self._health: Any = None
+
+    def start(self) -> Vehicle:
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "companion", "run", "-c", str(self.config)],
+            env=companion_env(self.namespace),
+            cwd=REPO,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        self.bus = BusNode(self.namespace, "test")
+        self._health = self.bus.latest_reader("system/health")
+        return self
+
+    def health(self) -> SystemHealth | None:
+        return self._health.get()
+
+    def row(self, name: str) -> Any:
+        health = self.health()
+        if health is None:
+            return None
+        return next((r for r in health.rows() if r.name.decode() == name), None)
+
+    def wait_running(self, name: str, timeout_s: float = 10.0) -> int:
+        """Wait until the plug-in reports a pid in a fresh health table; return it."""
+        return wait_for(lambda: (r := self.row(name)) is not None and r.pid, timeout_s, name)
+
+    def all_pids(self) -> list[int]:
+        if self.proc is None:
+            return []
+        try:
+            kids = psutil.Process(self.proc.pid).children(recursive=True)
+        except psutil.NoSuchProcess:
+            return []
+        return [self.proc.pid, *(k.pid for k in kids)]
+
+    def stop(self, sig: int = signal.SIGTERM, timeout_s: float = 5.0) -> float:
+        """Signal the supervisor and wait for it; return how long the shutdown took."""
+        assert self.proc is not None
+        started = time.monotonic()
+        self.proc.send_signal(sig)
+        self.proc.wait(timeout=timeout_s)
+        return time.monotonic() - started
+
+    def output(self) -> str:
+        if self.proc is None or self.proc.stdout is None or self.proc.poll() is None:
+            return ""
+        return self.proc.stdout.read()
+
+    def close(self) -> None:
+        """Stop everything the test started, whatever state the test left it in."""
+        pids = self.all_pids()
+        if self.proc is not None and self.proc.poll() is None:
+            try:
+                self.stop()
+            except subprocess.TimeoutExpired:
+                pass
+        for pid in pids:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        if self.proc is not None and self.proc.stdout is not None:
+            self.proc.stdout.close()
+        if self.bus is not None:
+            self.bus.close()
+            self.bus = None
+        cleanup_namespace(self.namespace)
+
+
+def assert_clean(namespace: str) -> None:
+    """Nothing of the namespace may remain in /dev/shm."""
+    left = leftover_files(namespace)
+    assert not left, f"stale shared memory left behind: {[p.name for p in left]}"
