@@ -25,7 +25,7 @@ NS_OPT = typer.Option("--namespace", "-n", help="bus namespace (default: config 
 EXIT_CONFIG = 2
 
 
-def _load_checked(config: Path, namespace: str | None):  # noqa: ANN202 - internal helper
+def _load_checked(config: Path, namespace: str | None):
     from companion.exec_control.config import ConfigError, load_config
     from companion.exec_control.topology import check_topology
 
@@ -47,9 +47,32 @@ def run(
     """Run the vehicle: every plug-in of the config in its own process, supervised."""
     from companion.exec_control.supervisor import Supervisor
 
-    logging.basicConfig(level=log_level, format="%(asctime)s exec_control %(levelname)s %(message)s")
+    logging.basicConfig(
+        level=log_level, format="%(asctime)s exec_control %(levelname)s %(message)s"
+    )
     cfg = _load_checked(config, namespace)
     raise typer.Exit(Supervisor(cfg, log_level).run())
+
+
+CONFIGS = Path(__file__).resolve().parent / "configs"
+
+
+@app.command()
+def sim(
+    config: Annotated[Path, CONFIG_OPT] = CONFIGS / "sim.toml",
+    namespace: Annotated[str | None, NS_OPT] = None,
+    duration: Annotated[
+        float | None, typer.Option(help="stop after this many seconds (default: run until Ctrl-C)")
+    ] = None,
+    log_level: Annotated[str, typer.Option(help="DEBUG, INFO, WARNING")] = "INFO",
+) -> None:
+    """Run the whole vehicle in simulation (today: the shipped sim config; see README)."""
+    from companion.exec_control.supervisor import Supervisor
+
+    logging.basicConfig(level=log_level, format="%(asctime)s exec_control %(levelname)s %(message)s")
+    cfg = _load_checked(config, namespace)
+    err.print(f"vehicle {cfg.name!r}: {len(cfg.plugins)} plug-ins on bus {cfg.namespace!r}")
+    raise typer.Exit(Supervisor(cfg, log_level).run(duration_s=duration))
 
 
 @app.command()

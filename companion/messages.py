@@ -25,7 +25,7 @@ class Message(ctypes.Structure):
     def as_dict(self) -> dict[str, object]:
         """Plain-Python view of the fields (arrays become lists, names become str)."""
         out: dict[str, object] = {}
-        for field_name, field_type, *_ in self._fields_:
+        for field_name, _field_type, *_ in self._fields_:
             value = getattr(self, field_name)
             if isinstance(value, bytes):
                 value = value.decode(errors="replace")

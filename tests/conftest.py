@@ -11,14 +11,14 @@ from tests.support.vehicle import Vehicle
 
 
 @pytest.fixture
-def vehicle_factory(tmp_path: Path) -> Iterator[Callable[[str], Vehicle]]:
+def vehicle_factory(tmp_path: Path) -> Iterator[Callable[..., Vehicle]]:
     """Start ``companion run`` on a config text; everything is stopped afterwards."""
     made: list[Vehicle] = []
 
-    def make(config_text: str) -> Vehicle:
+    def make(config_text: str, namespace: str | None = None) -> Vehicle:
         sub = tmp_path / f"v{len(made)}"
         sub.mkdir()
-        vehicle = Vehicle(config_text, sub).start()
+        vehicle = Vehicle(config_text, sub, namespace).start()
         made.append(vehicle)
         return vehicle
 

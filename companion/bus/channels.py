@@ -13,6 +13,7 @@ full buffer made it lose.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import logging
 import random
@@ -148,10 +149,8 @@ class Reader(Generic[M]):
 
     def consume_events(self) -> None:
         """Clear pending notifications (they are only wake-ups; data is in the queue)."""
-        try:
+        with contextlib.suppress(iox2.ListenerWaitError):
             self.listener.try_wait()
-        except iox2.ListenerWaitError:
-            pass
 
     def has_samples(self) -> bool:
         """True when a sample is waiting."""
@@ -168,10 +167,11 @@ class QueueReader(Reader[M]):
 
     def take(self, timeout_s: float = 0.0) -> list[M]:
         """All pending samples, waiting up to ``timeout_s`` for the first one."""
+        deadline = time.monotonic() + timeout_s
         msgs = list(self.drain())
-        if msgs or timeout_s <= 0:
-            return msgs
-        if self.wait_event(timeout_s):
+        # A wake-up can be stale (its sample already taken): sleep again until the deadline.
+        while not msgs and (left := deadline - time.monotonic()) > 0:
+            self.wait_event(left)
             msgs = list(self.drain())
         return msgs
 
@@ -201,10 +201,12 @@ class LatestReader(Reader[M]):
 
     def wait(self, timeout_s: float) -> M | None:
         """Wait up to ``timeout_s`` for a NEW value; None if none arrived."""
+        deadline = time.monotonic() + timeout_s
         fresh: M | None = None
         for msg in self.drain():
             fresh = msg
-        if fresh is None and self.wait_event(timeout_s):
+        while fresh is None and (left := deadline - time.monotonic()) > 0:
+            self.wait_event(left)
             for msg in self.drain():
                 fresh = msg
         if fresh is not None:

@@ -144,7 +144,6 @@ class BusNode:
         self.close()
 
 
-
 class Waiter:
     """Sleeps until any of several readers has data, or a timeout passes."""
 

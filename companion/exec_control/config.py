@@ -73,14 +73,16 @@ class _Checker:
 
     def error(self, key_path: KeyPath, message: str) -> ConfigError:
         key = ".".join(str(p) if isinstance(p, str) else f"[{p}]" for p in key_path)
-        return ConfigError(self.path, line_of(self.lines, key_path), key.replace(".[", "["), message)
+        return ConfigError(
+            self.path, line_of(self.lines, key_path), key.replace(".[", "["), message
+        )
 
     def unknown_keys(self, table: dict[str, Any], known: list[str], where: KeyPath) -> None:
         for key in table:
             if key not in known:
                 hint = get_close_matches(key, known, n=1)
                 tip = f"; did you mean {hint[0]!r}?" if hint else f" (known: {', '.join(known)})"
-                raise self.error(where + (key,), f"unknown key {key!r}{tip}")
+                raise self.error((*where, key), f"unknown key {key!r}{tip}")
 
     def values(self, table: dict[str, Any], decl: dict[str, Setting], where: KeyPath) -> dict:
         """Check a table against declared settings; return it with defaults filled in."""
@@ -89,10 +91,10 @@ class _Checker:
         for key, setting in decl.items():
             if key not in table:
                 if setting.required:
-                    raise self.error(where + (key,), f"missing required setting {key!r}")
+                    raise self.error((*where, key), f"missing required setting {key!r}")
                 out[key] = setting.default
                 continue
-            out[key] = self.value(table[key], setting, where + (key,))
+            out[key] = self.value(table[key], setting, (*where, key))
         return out
 
     def value(self, value: Any, setting: Setting, where: KeyPath) -> Any:
@@ -160,7 +162,7 @@ def _plugin_specs(check: _Checker, entries: Any) -> list[PluginSpec]:
         where: KeyPath = ("plugins", index)
         spec = _plugin_spec(check, entry, where)
         if spec.name in seen:
-            raise check.error(where + ("name",), f"plug-in name {spec.name!r} is used twice")
+            raise check.error((*where, "name"), f"plug-in name {spec.name!r} is used twice")
         seen.add(spec.name)
         specs.append(spec)
     return specs
@@ -172,22 +174,22 @@ def _plugin_spec(check: _Checker, entry: Any, where: KeyPath) -> PluginSpec:
     check.unknown_keys(entry, list(_PLUGIN_KEYS), where)
     for key in ("name", "plugin"):
         if key not in entry:
-            raise check.error(where + (key,), f"missing required key {key!r}")
+            raise check.error((*where, key), f"missing required key {key!r}")
         if not isinstance(entry[key], str) or not entry[key]:
-            raise check.error(where + (key,), "expected a non-empty string")
+            raise check.error((*where, key), "expected a non-empty string")
     group = entry.get("group", "core")
     if group not in GROUPS:
         hint = get_close_matches(str(group), GROUPS, n=1)
         tip = f"; did you mean {hint[0]!r}?" if hint else ""
-        raise check.error(where + ("group",), f"{group!r} is not one of {list(GROUPS)}{tip}")
+        raise check.error((*where, "group"), f"{group!r} is not one of {list(GROUPS)}{tip}")
     try:
         cls: type[Plugin] = load(entry["plugin"])
     except PluginLoadError as exc:
-        raise check.error(where + ("plugin",), str(exc)) from None
+        raise check.error((*where, "plugin"), str(exc)) from None
     raw_settings = entry.get("settings", {})
     if not isinstance(raw_settings, dict):
-        raise check.error(where + ("settings",), "must be a table")
-    settings = check.values(raw_settings, cls.settings, where + ("settings",))
+        raise check.error((*where, "settings"), "must be a table")
+    settings = check.values(raw_settings, cls.settings, (*where, "settings"))
     return PluginSpec(
         name=entry["name"],
         kind=entry["plugin"],

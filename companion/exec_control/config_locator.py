@@ -55,7 +55,7 @@ class _Scanner:
             value = m.group(2).strip()
             if value.startswith("{"):
                 for inner in _INLINE_KEY.findall(value):
-                    self.lines.setdefault(path + (inner,), lineno)
+                    self.lines.setdefault((*path, inner), lineno)
 
 
 def locate(text: str) -> dict[KeyPath, int]:

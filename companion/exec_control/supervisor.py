@@ -42,6 +42,7 @@ class Supervisor:
         self.flight_running = False
         self.stopping = False
         self.clock = MonotonicClock()
+        self.until: float | None = None
 
     def request_stop(self, signum: int, _frame: object) -> None:
         log.info("received %s: stopping", signal.Signals(signum).name)
@@ -119,8 +120,9 @@ class Supervisor:
         due += [c.next_start_at for c in self.children if c.wanted and c.proc is None]
         return max(0.0, min(due) - now)
 
-    def run(self) -> int:
-        """Supervise until SIGINT/SIGTERM; return the process exit status."""
+    def run(self, duration_s: float | None = None) -> int:
+        """Supervise until SIGINT/SIGTERM (or ``duration_s``); return the exit status."""
+        self.until = None if duration_s is None else time.monotonic() + duration_s
         signal.signal(signal.SIGTERM, self.request_stop)
         signal.signal(signal.SIGINT, self.request_stop)
         cleanup_namespace(self.cfg.namespace)  # leftovers of a crashed earlier run
@@ -145,6 +147,8 @@ class Supervisor:
         next_health = time.monotonic()
         while not self.stopping:
             waiter.wait(self.next_timeout(next_health))
+            if self.until is not None and time.monotonic() >= self.until:
+                break
             for cmd in commands.drain():
                 result = self.handle_command(cmd)
                 if result is not None:

@@ -6,6 +6,7 @@ teardown checks that nothing is left running or in /dev/shm.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import os
 import signal
@@ -114,15 +115,11 @@ class Vehicle:
         """Stop everything the test started, whatever state the test left it in."""
         pids = self.all_pids()
         if self.proc is not None and self.proc.poll() is None:
-            try:
+            with contextlib.suppress(subprocess.TimeoutExpired):
                 self.stop()
-            except subprocess.TimeoutExpired:
-                pass
         for pid in pids:
-            try:
+            with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
         if self.proc is not None and self.proc.stdout is not None:
             self.proc.stdout.close()
         if self.bus is not None:

@@ -1,0 +1,131 @@
+"""A bad config is refused before anything starts: exit status 2, file, line and key named."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from companion.exec_control.config import ConfigError, load_config
+from companion.exec_control.topology import check_topology
+from tests.support.vehicle import REPO, companion_env
+
+GOOD = """\
+[vehicle]
+name = "v"
+
+[[plugins]]
+name = "imu"
+plugin = "tests.support.plugins:Ticker"
+settings = { rate_hz = 20.0 }
+
+[[plugins]]
+name = "relay"
+plugin = "tests.support.plugins:Relay"
+group = "flight"
+"""
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "bad.toml"
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def refuse(tmp_path: Path, text: str) -> ConfigError:
+    path = write(tmp_path, text)
+    with pytest.raises(ConfigError) as info:
+        check_topology(load_config(path))
+    assert str(path) in str(info.value)
+    return info.value
+
+
+def test_the_good_config_loads(tmp_path):
+    cfg = load_config(write(tmp_path, GOOD))
+    check_topology(cfg)
+    assert [p.name for p in cfg.plugins] == ["imu", "relay"]
+    assert cfg.plugins[0].settings == {"rate_hz": 20.0}
+    assert cfg.plugins[1].group == "flight"
+
+
+def test_unknown_plugin_names_the_line_and_key(tmp_path):
+    err = refuse(tmp_path, GOOD.replace("tests.support.plugins:Relay", "sensors.no_such"))
+    assert err.key == "plugins[1].plugin" and err.line == 11
+    assert "unknown plug-in 'sensors.no_such'" in str(err)
+
+
+def test_unimportable_module_class(tmp_path):
+    err = refuse(tmp_path, GOOD.replace("plugins:Relay", "plugins:Nope"))
+    assert "has no Nope" in str(err)
+
+
+def test_misspelt_setting_suggests_the_close_match(tmp_path):
+    err = refuse(tmp_path, GOOD.replace("rate_hz = 20.0", "rate_hx = 20.0"))
+    assert err.key == "plugins[0].settings.rate_hx" and err.line == 7
+    assert "did you mean 'rate_hz'" in str(err)
+
+
+def test_misspelt_top_level_and_plugin_keys(tmp_path):
+    err = refuse(tmp_path, GOOD.replace('group = "flight"', 'gruop = "flight"'))
+    assert err.key == "plugins[1].gruop" and err.line == 12
+    assert "did you mean 'group'" in str(err)
+    err = refuse(tmp_path, GOOD.replace("[vehicle]", "[vehicel]"))
+    assert "did you mean 'vehicle'" in str(err) and err.line == 1
+
+
+def test_wrong_types_and_values(tmp_path):
+    err = refuse(tmp_path, GOOD.replace("rate_hz = 20.0", 'rate_hz = "fast"'))
+    assert "expected float, got str" in str(err) and err.line == 7
+    err = refuse(tmp_path, GOOD.replace('group = "flight"', 'group = "fligth"'))
+    assert "did you mean 'flight'" in str(err)
+    err = refuse(tmp_path, GOOD.replace('name = "v"', 'name = "v"\nsysid = 300'))
+    assert err.key == "vehicle.sysid" and "above the maximum" in str(err) and err.line == 3
+
+
+def test_topology_errors(tmp_path):
+    err = refuse(
+        tmp_path,
+        GOOD.replace("tests.support.plugins:Ticker", "tests.support.plugins:Waiting").replace(
+            "settings = { rate_hz = 20.0 }", ""
+        ),
+    )
+    assert "reads 'sensors/imu' but no plug-in in the config writes it" in str(err)
+    twice = GOOD + '\n[[plugins]]\nname = "relay2"\nplugin = "tests.support.plugins:Relay"\n'
+    err = refuse(tmp_path, twice)
+    assert "two producers" in str(err) and err.line == 14
+    dup = GOOD + '\n[[plugins]]\nname = "imu"\nplugin = "tests.support.plugins:Waiting"\n'
+    assert "used twice" in str(refuse(tmp_path, dup))
+
+
+def test_missing_file_and_broken_toml(tmp_path):
+    with pytest.raises(ConfigError, match="config file not found"):
+        load_config(tmp_path / "absent.toml")
+    err = refuse(tmp_path, GOOD.replace('name = "v"', "name = "))
+    assert "not valid TOML" in str(err)
+
+
+def test_cli_exits_with_status_2_and_starts_nothing(tmp_path):
+    path = write(tmp_path, GOOD.replace("rate_hz = 20.0", "rate_hx = 20.0"))
+    done = subprocess.run(
+        [sys.executable, "-m", "companion", "run", "-c", str(path)],
+        env=companion_env("cfgerr"),
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert done.returncode == 2
+    assert f"{path}:7" in done.stderr and "rate_hx" in done.stderr
+    assert "did you mean 'rate_hz'" in done.stderr
+    assert "started" not in done.stderr
+    missing = subprocess.run(
+        [sys.executable, "-m", "companion", "run", "-c", str(tmp_path / "nope.toml")],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert missing.returncode == 2 and "not found" in missing.stderr

@@ -1,0 +1,74 @@
+"""A plug-in that dies (kill -9, exception) is restarted within a second and data flows again."""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+
+from tests.runtime.configs import pipeline
+from tests.support.vehicle import wait_for
+
+
+def newest_nav_t(vehicle) -> int:
+    reader = vehicle.nav
+    value = reader.get()
+    return -1 if value is None else value.t_us
+
+
+def test_kill_9_of_a_plugin_is_restarted_within_one_second_and_data_flows(vehicle_factory):
+    vehicle = vehicle_factory(pipeline())
+    vehicle.nav = vehicle.bus.latest_reader("nav/state")
+    old_pid = vehicle.wait_running("imu")
+    wait_for(lambda: newest_nav_t(vehicle) > 0, 10, "nav/state from the relay")
+
+    killed_at = time.monotonic()
+    os.kill(old_pid, signal.SIGKILL)
+    new_pid = wait_for(
+        lambda: (r := vehicle.row("imu")) and r.pid not in (0, old_pid) and r.pid,
+        5,
+        "a new imu process",
+        period_s=0.01,
+    )
+    restart_s = time.monotonic() - killed_at
+    # The health table is published once a second, so the restart itself is faster than
+    # what this measures; psutil sees the new process directly.
+    assert new_pid != old_pid
+    assert restart_s < 2.0, f"restart noticed after {restart_s:.2f} s"
+    assert vehicle.row("imu").restarts == 1
+
+    before = newest_nav_t(vehicle)
+    wait_for(lambda: newest_nav_t(vehicle) > before, 5, "data flowing after the restart")
+
+
+def test_restart_happens_within_one_second_of_the_death(vehicle_factory):
+    vehicle = vehicle_factory(pipeline())
+    old_pid = vehicle.wait_running("relay")
+    import psutil
+
+    supervisor = psutil.Process(vehicle.proc.pid)
+    killed_at = time.monotonic()
+    os.kill(old_pid, signal.SIGKILL)
+
+    def new_child() -> int:
+        names = {c.pid for c in supervisor.children()}
+        fresh = names - {vehicle.row("imu").pid, vehicle.row("idle").pid, old_pid}
+        return next(iter(fresh), 0)
+
+    wait_for(new_child, 3, "the relay's new process", period_s=0.005)
+    assert time.monotonic() - killed_at < 1.0
+
+
+def test_a_plugin_that_raises_is_restarted_with_back_off(vehicle_factory):
+    vehicle = vehicle_factory(
+        """
+        [vehicle]
+        name = "crashy"
+        [[plugins]]
+        name = "crash"
+        plugin = "tests.support.plugins:CrashAfter"
+        settings = { steps = 3 }
+        """
+    )
+    wait_for(lambda: (r := vehicle.row("crash")) and r.restarts >= 3, 15, "three restarts")
+    assert vehicle.proc.poll() is None, "the supervisor must survive its plug-ins"
