@@ -25,6 +25,10 @@ NS_OPT = typer.Option("--namespace", "-n", help="bus namespace (default: config 
 EXIT_CONFIG = 2
 
 
+def _setup_logging(level: str) -> None:
+    logging.basicConfig(level=level, format="%(asctime)s exec_control %(levelname)s %(message)s")
+
+
 def _load_checked(config: Path, namespace: str | None):
     from companion.exec_control.config import ConfigError, load_config
     from companion.exec_control.topology import check_topology
@@ -47,9 +51,7 @@ def run(
     """Run the vehicle: every plug-in of the config in its own process, supervised."""
     from companion.exec_control.supervisor import Supervisor
 
-    logging.basicConfig(
-        level=log_level, format="%(asctime)s exec_control %(levelname)s %(message)s"
-    )
+    _setup_logging(log_level)
     cfg = _load_checked(config, namespace)
     raise typer.Exit(Supervisor(cfg, log_level).run())
 
@@ -69,7 +71,7 @@ def sim(
     """Run the whole vehicle in simulation (today: the shipped sim config; see README)."""
     from companion.exec_control.supervisor import Supervisor
 
-    logging.basicConfig(level=log_level, format="%(asctime)s exec_control %(levelname)s %(message)s")
+    _setup_logging(log_level)
     cfg = _load_checked(config, namespace)
     err.print(f"vehicle {cfg.name!r}: {len(cfg.plugins)} plug-ins on bus {cfg.namespace!r}")
     raise typer.Exit(Supervisor(cfg, log_level).run(duration_s=duration))
