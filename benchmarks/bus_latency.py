@@ -33,7 +33,10 @@ ECHO = textwrap.dedent(
             rx, tx = bus.queue_reader("sensors/imu"), bus.writer("sensors/mag")
             done = 0
             while done < count:
-                for m in rx.take(timeout_s=5.0):
+                got = rx.take(timeout_s=5.0)
+                if not got:
+                    break  # the benchmark went away
+                for m in got:
                     tx.publish(Magnetometer(t_us=m.t_us))
                     done += 1
         elif pattern == "latest":
@@ -62,6 +65,14 @@ def round_trips(bus: BusNode, ns: str, pattern: str, samples: int) -> np.ndarray
     else:
         tx, rx = bus.writer("nav/state"), bus.latest_reader("sim/truth")
     echo = spawn(ns, pattern, samples + warmup)
+    try:
+        return _measure(tx, rx, pattern, samples, warmup)
+    finally:
+        echo.kill()
+        echo.wait()
+
+
+def _measure(tx, rx, pattern: str, samples: int, warmup: int) -> np.ndarray:
     time.sleep(1.0)  # let the echo process connect
     rtt = []
     for i in range(samples + warmup):
@@ -73,7 +84,6 @@ def round_trips(bus: BusNode, ns: str, pattern: str, samples: int) -> np.ndarray
             raise RuntimeError(f"{pattern}: echo {i} lost")
         if i >= warmup:
             rtt.append((t1 - t0) / 1000.0)
-    echo.wait(timeout=10)
     return np.array(rtt)
 
 

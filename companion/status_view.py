@@ -7,7 +7,7 @@ from typing import Any
 
 from rich.table import Table
 
-from companion.bus import BusNode
+from companion.bus import BusNode, cleanup_namespace
 from companion.messages import PluginState, SystemHealth
 
 
@@ -18,7 +18,8 @@ def read_health(namespace: str, timeout_s: float) -> SystemHealth | None:
         latest = reader.get()
         if latest is None:
             latest = reader.wait(timeout_s)
-        return latest
+    cleanup_namespace(namespace)  # no-op while a vehicle runs; tidies an empty namespace
+    return latest
 
 
 def health_dict(msg: SystemHealth) -> dict[str, Any]:

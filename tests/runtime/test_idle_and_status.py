@@ -10,7 +10,7 @@ import time
 import psutil
 
 from tests.runtime.configs import pipeline
-from tests.support.vehicle import REPO, companion_env, wait_for
+from tests.support.vehicle import REPO, assert_clean, companion_env, unique_namespace, wait_for
 
 
 def test_a_waiting_plugin_uses_under_one_percent_of_a_core(vehicle_factory):
@@ -64,9 +64,10 @@ def test_status_human_table_and_silence(vehicle_factory, tmp_path):
     )
     assert shown.returncode == 0
     assert "imu" in shown.stdout and "running" in shown.stdout
+    nobody = unique_namespace("nobody")
     silent = subprocess.run(
         [sys.executable, "-m", "companion", "status", "--timeout", "0.5"],
-        env=companion_env("nobody_here"),
+        env=companion_env(nobody),
         cwd=REPO,
         capture_output=True,
         text=True,
@@ -74,3 +75,4 @@ def test_status_human_table_and_silence(vehicle_factory, tmp_path):
     )
     assert silent.returncode == 1
     assert "no vehicle" in silent.stderr
+    assert_clean(nobody)
