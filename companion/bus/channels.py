@@ -144,7 +144,7 @@ class Reader(Generic[M]):
                 events = self.listener.timed_wait(duration(timeout_s))
         except iox2.ListenerWaitError:
             return False
-        self.consume_events()
+        # timed_wait has consumed the notifications it returned.
         return bool(events) or self._subscriber.has_samples()
 
     def consume_events(self) -> None:
