@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import threading
 
-from companion.messages import Imu, NavState
+from companion.messages import Imu, NavFlags, NavState
 from companion.plugin import Plugin, PluginContext, Setting
 
 
@@ -77,3 +77,32 @@ class CrashAfter(Plugin):
             raise RuntimeError("deliberate crash for the restart test")
         self.left -= 1
         threading.Event().wait(0.01)
+
+
+class FakeNav(Plugin):
+    """A navigator stand-in: a known, valid solution on nav/state at 20 Hz."""
+
+    outputs = ("nav/state",)
+    ROLL, PITCH, YAW = 0.1, -0.05, 1.2
+    LAT, LON, ALT = -37.9105, 145.1340, 120.0
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.nav = ctx.bus.writer("nav/state")
+        self._pace = threading.Event()
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:
+            self._pace.wait(0.05)
+        msg = NavState(t_us=self.ctx.clock.now_us())
+        msg.roll_rad, msg.pitch_rad, msg.yaw_rad = self.ROLL, self.PITCH, self.YAW
+        msg.lat_deg, msg.lon_deg, msg.alt_msl_m = self.LAT, self.LON, self.ALT
+        msg.vn_m_s, msg.ve_m_s, msg.vd_m_s = 20.0, 5.0, -1.0
+        msg.q[0] = 1.0
+        msg.flags = int(
+            NavFlags.ATTITUDE_VALID
+            | NavFlags.HEADING_VALID
+            | NavFlags.POSITION_VALID
+            | NavFlags.VELOCITY_VALID
+        )
+        self.nav.publish(msg)

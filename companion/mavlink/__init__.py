@@ -1,0 +1,1 @@
+"""Vehicle-side MAVLink: endpoints, the codec, and one state machine per microservice."""

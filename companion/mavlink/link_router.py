@@ -1,0 +1,125 @@
+"""Frames in, messages routed: parsers per remote, forwarding, dispatch, sending.
+
+Messages addressed to another system are forwarded to the endpoints where that system
+was heard (every other endpoint if unknown), as mavlink-router does; broadcasts are both
+forwarded and handled. Replies go to the endpoint of the peer that asked.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from typing import Any
+
+from companion.mavlink.codec import discard_partial, new_parser
+from companion.mavlink.endpoints import Endpoint, Remote, UdpOut
+from companion.mavlink.service import Outgoing, Peer, Service
+from companion.mavlink.telemetry import STREAMS, Snapshot, StreamSchedule
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class LinkCounters:
+    ok: int = 0  # frames decoded
+    bad: int = 0  # CRC failures, truncated frames, garbage
+    forwarded: int = 0
+    foreign: int = 0  # addressed to another system
+
+
+class LinkRouter:
+    """Routing and dispatch for all endpoints of the link."""
+
+    def __init__(self, mav: Any, endpoints: list[Endpoint], services: list[Service]) -> None:
+        self.mav = mav
+        self.endpoints = endpoints
+        self.services = list(services)
+        self.parsers: dict[tuple[int, Remote], Any] = {}
+        self.routes: dict[int, set[int]] = {}  # sysid → endpoint indexes it was heard on
+        self.schedules = [StreamSchedule() for _ in endpoints]
+        self.counters = LinkCounters()
+        self.by_type: dict[str, list[Service]] = {}
+        for service in self.services:
+            self.add_service(service)
+
+    def add_service(self, service: Service) -> None:
+        if service not in self.services:
+            self.services.append(service)
+        for name in service.handles:
+            self.by_type.setdefault(name, []).append(service)
+
+    def receive(self, endpoint: Endpoint, fd: int, now_s: float) -> None:
+        index = self.endpoints.index(endpoint)
+        for remote, data in endpoint.read_ready(fd):
+            parser = self.parsers.get((index, remote))
+            if parser is None:
+                parser = self.parsers[(index, remote)] = new_parser()
+            try:
+                messages = parser.parse_buffer(data) or []
+            except Exception:  # pymavlink raises on some malformed input even when robust
+                self.counters.bad += 1
+                discard_partial(parser)
+                continue
+            if isinstance(endpoint, UdpOut) and discard_partial(parser):
+                self.counters.bad += 1
+            for msg in messages:
+                self._route(msg, index, now_s)
+
+    def _route(self, msg: Any, index: int, now_s: float) -> None:
+        if msg.get_type() == "BAD_DATA":
+            self.counters.bad += 1
+            return
+        self.counters.ok += 1
+        sysid, compid = msg.get_srcSystem(), msg.get_srcComponent()
+        if sysid == self.mav.srcSystem:
+            return  # our own traffic looped back by another router
+        self.routes.setdefault(sysid, set()).add(index)
+        target = getattr(msg, "target_system", 0)
+        if target not in (0, self.mav.srcSystem):
+            self.counters.foreign += 1
+            self._forward(msg, index, self.routes.get(target))
+            return
+        if target == 0:
+            self._forward(msg, index, None)
+        peer = Peer(sysid, compid, index)
+        out: list[Outgoing] = []
+        for service in self.by_type.get(msg.get_type(), []):
+            out += service.handle(msg, peer, now_s)
+        self.send(out)
+
+    def _forward(self, msg: Any, came_from: int, to: set[int] | None) -> None:
+        raw = bytes(msg.get_msgbuf())
+        for i, endpoint in enumerate(self.endpoints):
+            if i != came_from and (to is None or i in to):
+                endpoint.send(raw)
+                self.counters.forwarded += 1
+
+    def send(self, out: list[Outgoing]) -> None:
+        for item in out:
+            raw = item.msg.pack(self.mav)
+            self.mav.seq = (self.mav.seq + 1) % 256
+            if item.to is None:
+                for endpoint in self.endpoints:
+                    endpoint.send(raw)
+            else:
+                self.endpoints[item.to.endpoint].send(raw)
+
+    def tick(self, now_s: float) -> list[Outgoing]:
+        out: list[Outgoing] = []
+        for service in self.services:
+            out += service.tick(now_s)
+        return out
+
+    def stream_telemetry(self, snapshot: Snapshot, now_s: float) -> None:
+        for index, endpoint in enumerate(self.endpoints):
+            if not endpoint.has_remote():
+                continue
+            for msg_id in self.schedules[index].due(now_s):
+                msg = STREAMS[msg_id].build(self.mav, snapshot)
+                if msg is not None:
+                    self.send([Outgoing(msg, Peer(0, 0, index), priority=False)])
+
+    def next_due(self) -> float:
+        times = [s.next_time() for s in self.schedules]
+        nexts = [getattr(s, "next_due", lambda: float("inf"))() for s in self.services]
+        return min([*times, *nexts, float("inf")])

@@ -1,0 +1,253 @@
+"""Telemetry streams: each a small named mapping from bus values to one MAVLink message.
+
+The vehicle streams from boot (ground stations do not ask), at default rates that a
+ground station changes per endpoint with MAV_CMD_SET_MESSAGE_INTERVAL.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from companion.mavlink.codec import dialect as d
+from companion.messages import GpsFix, Imu, NavFlags, NavState, ServoOutput, SystemHealth
+
+
+@dataclass
+class Snapshot:
+    """The newest bus values the streams are built from."""
+
+    time_boot_ms: int = 0
+    unix_us: int = 0
+    nav: NavState | None = None
+    gps: GpsFix | None = None
+    imu: Imu | None = None
+    health: SystemHealth | None = None
+    servos: ServoOutput | None = None
+    home_alt_m: float = math.nan
+
+
+Builder = Callable[[Any, Snapshot], Any]
+
+
+def _finite(x: float, fallback: float = 0.0) -> float:
+    return x if math.isfinite(x) else fallback
+
+
+def _attitude(mav: Any, s: Snapshot) -> Any:
+    n = s.nav
+    if n is None or not n.flags & NavFlags.ATTITUDE_VALID:
+        return None
+    return mav.attitude_encode(
+        s.time_boot_ms,
+        n.roll_rad,
+        n.pitch_rad,
+        n.yaw_rad,
+        _finite(n.roll_rate_rad_s),
+        _finite(n.pitch_rate_rad_s),
+        _finite(n.yaw_rate_rad_s),
+    )
+
+
+def _attitude_quaternion(mav: Any, s: Snapshot) -> Any:
+    n = s.nav
+    if n is None or not n.flags & NavFlags.ATTITUDE_VALID:
+        return None
+    q = list(n.q)
+    rates = (_finite(n.roll_rate_rad_s), _finite(n.pitch_rate_rad_s), _finite(n.yaw_rate_rad_s))
+    return mav.attitude_quaternion_encode(s.time_boot_ms, *q, *rates, [0.0] * 4)
+
+
+def _global_position(mav: Any, s: Snapshot) -> Any:
+    n = s.nav
+    if n is None or not n.flags & NavFlags.POSITION_VALID:
+        return None
+    rel = n.alt_msl_m - s.home_alt_m if math.isfinite(s.home_alt_m) else 0.0
+    heading = math.degrees(n.yaw_rad) % 360.0
+    return mav.global_position_int_encode(
+        s.time_boot_ms,
+        round(n.lat_deg * 1e7),
+        round(n.lon_deg * 1e7),
+        round(n.alt_msl_m * 1000),
+        round(rel * 1000),
+        round(_finite(n.vn_m_s) * 100),
+        round(_finite(n.ve_m_s) * 100),
+        round(_finite(n.vd_m_s) * 100),
+        round(heading * 100) % 36000,
+    )
+
+
+def _gps_raw(mav: Any, s: Snapshot) -> Any:
+    g = s.gps
+    if g is None:
+        return mav.gps_raw_int_encode(
+            s.time_boot_ms * 1000, d.GPS_FIX_TYPE_NO_GPS, 0, 0, 0, 65535, 65535, 65535, 65535, 255
+        )
+    dop = lambda v: 65535 if not math.isfinite(v) else min(65534, round(v * 100))  # noqa: E731
+    cog = (
+        65535
+        if not math.isfinite(g.course_rad)
+        else round(math.degrees(g.course_rad) * 100) % 36000
+    )
+    return mav.gps_raw_int_encode(
+        g.t_us,
+        g.fix_type,
+        round(g.lat_deg * 1e7),
+        round(g.lon_deg * 1e7),
+        round(_finite(g.alt_msl_m) * 1000),
+        dop(g.hdop),
+        dop(g.vdop),
+        65535 if not math.isfinite(g.ground_speed_m_s) else round(g.ground_speed_m_s * 100),
+        cog,
+        g.satellites,
+    )
+
+
+def _vfr_hud(mav: Any, s: Snapshot) -> Any:
+    n = s.nav
+    if n is None:
+        return None
+    ground = math.hypot(_finite(n.vn_m_s), _finite(n.ve_m_s))
+    heading = round(math.degrees(n.yaw_rad)) % 360
+    throttle = 0
+    return mav.vfr_hud_encode(
+        ground, ground, heading, throttle, _finite(n.alt_msl_m), -_finite(n.vd_m_s)
+    )
+
+
+def _sys_status(mav: Any, s: Snapshot) -> Any:
+    present, healthy = sensor_bits(s)
+    load = 0
+    if s.health is not None:
+        load = min(1000, round(sum(r.cpu_pct for r in s.health.rows()) * 10 / 2))
+    return mav.sys_status_encode(present, present, healthy, load, 0, -1, -1, 0, 0, 0, 0, 0, 0)
+
+
+def sensor_bits(s: Snapshot) -> tuple[int, int]:
+    """SYS_STATUS present and healthy bits, true to what the bus shows."""
+    present = healthy = 0
+    if s.imu is not None:
+        bits = d.MAV_SYS_STATUS_SENSOR_3D_ACCEL | d.MAV_SYS_STATUS_SENSOR_3D_GYRO
+        present |= bits
+        healthy |= bits
+    if s.gps is not None:
+        present |= d.MAV_SYS_STATUS_SENSOR_GPS
+        if s.gps.fix_type >= 3:
+            healthy |= d.MAV_SYS_STATUS_SENSOR_GPS
+    if s.nav is not None:
+        bits = d.MAV_SYS_STATUS_AHRS
+        present |= bits
+        if s.nav.flags & NavFlags.ATTITUDE_VALID:
+            healthy |= bits
+    return present, healthy
+
+
+def _system_time(mav: Any, s: Snapshot) -> Any:
+    return mav.system_time_encode(s.unix_us, s.time_boot_ms)
+
+
+def _servo_output(mav: Any, s: Snapshot) -> Any:
+    if s.servos is None:
+        return None
+    return mav.servo_output_raw_encode(s.servos.t_us & 0xFFFFFFFF, 0, *list(s.servos.pulse_us))
+
+
+def _scaled_imu(mav: Any, s: Snapshot) -> Any:
+    i = s.imu
+    if i is None:
+        return None
+    mg = lambda a: round(a / 9.80665 * 1000)  # noqa: E731
+    mrad = lambda w: round(w * 1000)  # noqa: E731
+    return mav.scaled_imu_encode(
+        s.time_boot_ms,
+        mg(i.ax_m_s2),
+        mg(i.ay_m_s2),
+        mg(i.az_m_s2),
+        mrad(i.gx_rad_s),
+        mrad(i.gy_rad_s),
+        mrad(i.gz_rad_s),
+        0,
+        0,
+        0,
+    )
+
+
+def _extended_sys_state(mav: Any, s: Snapshot) -> Any:
+    landed = d.MAV_LANDED_STATE_UNDEFINED
+    if s.nav is not None and s.nav.flags & NavFlags.VELOCITY_VALID:
+        moving = math.hypot(_finite(s.nav.vn_m_s), _finite(s.nav.ve_m_s)) > 5.0
+        landed = d.MAV_LANDED_STATE_IN_AIR if moving else d.MAV_LANDED_STATE_ON_GROUND
+    return mav.extended_sys_state_encode(d.MAV_VTOL_STATE_UNDEFINED, landed)
+
+
+@dataclass(frozen=True)
+class Stream:
+    name: str
+    msg_id: int
+    default_hz: float
+    build: Builder
+
+
+STREAMS: dict[int, Stream] = {
+    s.msg_id: s
+    for s in (
+        Stream("ATTITUDE", d.MAVLINK_MSG_ID_ATTITUDE, 10.0, _attitude),
+        Stream(
+            "ATTITUDE_QUATERNION", d.MAVLINK_MSG_ID_ATTITUDE_QUATERNION, 0.0, _attitude_quaternion
+        ),
+        Stream("GLOBAL_POSITION_INT", d.MAVLINK_MSG_ID_GLOBAL_POSITION_INT, 5.0, _global_position),
+        Stream("GPS_RAW_INT", d.MAVLINK_MSG_ID_GPS_RAW_INT, 2.0, _gps_raw),
+        Stream("VFR_HUD", d.MAVLINK_MSG_ID_VFR_HUD, 4.0, _vfr_hud),
+        Stream("SYS_STATUS", d.MAVLINK_MSG_ID_SYS_STATUS, 1.0, _sys_status),
+        Stream("SYSTEM_TIME", d.MAVLINK_MSG_ID_SYSTEM_TIME, 0.5, _system_time),
+        Stream("SERVO_OUTPUT_RAW", d.MAVLINK_MSG_ID_SERVO_OUTPUT_RAW, 2.0, _servo_output),
+        Stream("SCALED_IMU", d.MAVLINK_MSG_ID_SCALED_IMU, 2.0, _scaled_imu),
+        Stream("EXTENDED_SYS_STATE", d.MAVLINK_MSG_ID_EXTENDED_SYS_STATE, 1.0, _extended_sys_state),
+    )
+}
+
+
+class StreamSchedule:
+    """Per-endpoint rates and due times of every stream."""
+
+    def __init__(self) -> None:
+        self.period_s = {
+            mid: (1.0 / s.default_hz if s.default_hz > 0 else 0.0) for mid, s in STREAMS.items()
+        }
+        self.next_due = dict.fromkeys(STREAMS, 0.0)
+
+    def set_interval(self, msg_id: int, interval_us: float) -> bool:
+        """MAV_CMD_SET_MESSAGE_INTERVAL semantics: -1 off, 0 default, else µs."""
+        if msg_id not in STREAMS:
+            return False
+        if interval_us < 0:
+            self.period_s[msg_id] = 0.0
+        elif interval_us == 0:
+            hz = STREAMS[msg_id].default_hz
+            self.period_s[msg_id] = 1.0 / hz if hz > 0 else 0.0
+        else:
+            self.period_s[msg_id] = interval_us / 1e6
+        self.next_due[msg_id] = 0.0
+        return True
+
+    def interval_us(self, msg_id: int) -> int:
+        """The current interval (MESSAGE_INTERVAL): -1 when off, 0 when unknown."""
+        if msg_id not in STREAMS:
+            return 0
+        period = self.period_s[msg_id]
+        return -1 if period <= 0 else round(period * 1e6)
+
+    def due(self, now_s: float) -> list[int]:
+        """The streams to send now; schedules their next time."""
+        out = []
+        for mid, period in self.period_s.items():
+            if period > 0 and now_s >= self.next_due[mid]:
+                out.append(mid)
+                self.next_due[mid] = max(self.next_due[mid] + period, now_s - period)
+        return out
+
+    def next_time(self) -> float:
+        times = [self.next_due[m] for m, p in self.period_s.items() if p > 0]
+        return min(times) if times else float("inf")

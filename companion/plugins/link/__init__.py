@@ -1,0 +1,1 @@
+"""The MAVLink link plug-in."""

@@ -1,0 +1,140 @@
+"""``link.mavlink``: the vehicle's MAVLink endpoints (group ``core``).
+
+Reads bytes from every endpoint, lets pymavlink frame them, routes messages addressed to
+other systems between endpoints (as mavlink-router does), dispatches the vehicle's own to
+one service per microservice, and streams telemetry built from the bus. Commands other
+plug-ins act on go onto ``link/commands``; their answers come back on
+``link/command_acks`` and become COMMAND_ACKs.
+"""
+
+from __future__ import annotations
+
+import select
+import time
+
+from companion.mavlink.codec import dialect as d
+from companion.mavlink.codec import new_encoder
+from companion.mavlink.command_service import CommandService
+from companion.mavlink.endpoints import Endpoint, EndpointError, open_endpoint
+from companion.mavlink.identity import IdentityService
+from companion.mavlink.link_router import LinkRouter
+from companion.mavlink.service import Outgoing
+from companion.mavlink.telemetry import Snapshot
+from companion.messages import VehicleCommand
+from companion.plugin import Plugin, PluginContext, Setting
+from companion.plugins.link.commands import register_commands
+
+MAX_WAIT_S = 0.02  # telemetry and acks from the bus are looked at this often at least
+AUTOPILOTS = {"generic": d.MAV_AUTOPILOT_GENERIC, "px4": d.MAV_AUTOPILOT_PX4}
+CAPABILITIES = (
+    d.MAV_PROTOCOL_CAPABILITY_MISSION_INT
+    | d.MAV_PROTOCOL_CAPABILITY_COMMAND_INT
+    | d.MAV_PROTOCOL_CAPABILITY_MAVLINK2
+    | d.MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_C_CAST
+)
+
+
+class MavlinkLink(Plugin):
+    """The MAVLink side of the vehicle."""
+
+    settings = {
+        "endpoints": Setting(
+            list,
+            ["udpout://127.0.0.1:14550", "udpout://127.0.0.1:14540"],
+            "endpoint URLs: udpout://, udpin://, tcpin://, serial:///dev/X:BAUD",
+        ),
+        "compid": Setting(int, 1, "MAVLink component id of the autopilot", min=1, max=255),
+        "autopilot": Setting(str, "generic", "MAV_AUTOPILOT reported", choices=tuple(AUTOPILOTS)),
+    }
+    optional_inputs = (
+        "nav/state",
+        "sensors/gps",
+        "sensors/imu",
+        "actuators/servos",
+        "system/health",
+        "link/command_acks",
+    )
+    outputs = ("link/commands",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        sysid = int(ctx.vehicle.get("sysid", 1))
+        self.mav = new_encoder(sysid, ctx.settings["compid"])
+        self.endpoints: list[Endpoint] = []
+        for url in ctx.settings["endpoints"]:
+            try:
+                self.endpoints.append(open_endpoint(url))
+            except (EndpointError, OSError) as exc:
+                raise RuntimeError(f"endpoint {url}: {exc}") from exc
+        autopilot = AUTOPILOTS[ctx.settings["autopilot"]]
+        self.identity = IdentityService(self.mav, sysid, autopilot, CAPABILITIES)
+        self.commands = CommandService(self.mav, sysid, ctx.settings["compid"])
+        self.snapshot = Snapshot()
+        self.boot_us = ctx.clock.now_us()
+        bus = ctx.bus
+        self.readers = {
+            "nav": bus.latest_reader("nav/state"),
+            "health": bus.latest_reader("system/health"),
+            "servos": bus.latest_reader("actuators/servos"),
+            "gps": bus.queue_reader("sensors/gps"),
+            "imu": bus.queue_reader("sensors/imu"),
+        }
+        self.acks = bus.queue_reader("link/command_acks")
+        self.to_vehicle = bus.writer("link/commands")
+        self.router = LinkRouter(self.mav, self.endpoints, [self.identity, self.commands])
+        register_commands(self)
+        self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
+        self._seq = 0
+
+    def _refresh_snapshot(self) -> None:
+        s, r = self.snapshot, self.readers
+        s.nav, s.health, s.servos = r["nav"].get(), r["health"].get(), r["servos"].get()
+        for key in ("gps", "imu"):
+            latest = None
+            for latest in r[key].drain():  # noqa: B007 - only the newest matters here
+                pass
+            if latest is not None:
+                setattr(s, key, latest)
+        s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
+        s.unix_us = time.time_ns() // 1000
+        if s.health is not None:
+            self.identity.state.armed = bool(s.health.flight_running)
+            active = d.MAV_STATE_ACTIVE if s.health.flight_running else d.MAV_STATE_STANDBY
+            self.identity.state.system_status = active
+
+    def _wait_input(self, now_s: float) -> None:
+        timeout = max(0.0, min(MAX_WAIT_S, self.router.next_due() - now_s))
+        fds = list(self.fd_owner)
+        with self.ctx.bus.idle:
+            ready, _, _ = select.select(fds, [], [], timeout) if fds else ([], [], [])
+        for fd in ready:
+            endpoint = self.fd_owner.get(fd)
+            if endpoint is not None:
+                self.router.receive(endpoint, fd, time.monotonic())
+        self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
+
+    def step(self) -> None:
+        self._wait_input(time.monotonic())
+        now_s = time.monotonic()
+        out: list[Outgoing] = []
+        for ack in self.acks.drain():
+            out += self.commands.complete(ack.seq, ack.result, now_s)
+        self._refresh_snapshot()
+        out += self.router.tick(now_s)
+        self.router.send(out)
+        self.router.stream_telemetry(self.snapshot, now_s)
+        counts = self.router.counters
+        self.ctx.health.frames_ok, self.ctx.health.frames_bad = counts.ok, counts.bad
+
+    def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
+        """Put a VehicleCommand on the bus; returns its sequence number for the ack."""
+        self._seq += 1
+        msg = VehicleCommand(t_us=self.ctx.clock.now_us(), seq=self._seq, command=command)
+        for i, value in enumerate(params[:7]):
+            msg.param[i] = value
+        self.to_vehicle.publish(msg)
+        return self._seq
+
+    def close(self) -> None:
+        for endpoint in self.endpoints:
+            endpoint.close()

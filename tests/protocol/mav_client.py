@@ -1,0 +1,86 @@
+"""A pymavlink ground station on loopback UDP, for the protocol tests."""
+
+from __future__ import annotations
+
+import os
+import socket
+import time
+from typing import Any
+
+os.environ.setdefault("MAVLINK20", "1")
+
+from pymavlink import mavutil  # noqa: E402 - MAVLINK20 must be set before the import
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+LINK_VEHICLE = """
+[vehicle]
+name = "linktest"
+sysid = 1
+
+[[plugins]]
+name = "link"
+plugin = "link.mavlink"
+settings = {{ endpoints = ["udpin://127.0.0.1:{port}"] }}
+
+[[plugins]]
+name = "nav"
+plugin = "tests.support.plugins:FakeNav"
+
+[[plugins]]
+name = "imu"
+plugin = "tests.support.plugins:Ticker"
+
+[[plugins]]
+name = "relay_in_flight"
+plugin = "tests.support.plugins:Waiting"
+group = "flight"
+"""
+
+
+class GroundStation:
+    """QGroundControl's identity (sysid 255, compid 190) speaking to the vehicle's udpin."""
+
+    def __init__(self, port: int, sysid: int = 255, compid: int = 190) -> None:
+        self.conn = mavutil.mavlink_connection(
+            f"udpout:127.0.0.1:{port}", source_system=sysid, source_component=compid
+        )
+        self.mav = self.conn.mav
+
+    def heartbeat(self) -> None:
+        self.mav.heartbeat_send(6, 8, 192, 0, 4)  # GCS, INVALID autopilot, as QGC sends
+
+    def connect(self, timeout_s: float = 15.0) -> Any:
+        """Send heartbeats until the vehicle's heartbeat comes back."""
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            self.heartbeat()
+            msg = self.conn.recv_match(type="HEARTBEAT", blocking=True, timeout=0.5)
+            if msg is not None and msg.get_srcSystem() == 1:
+                return msg
+        raise AssertionError("no HEARTBEAT from the vehicle")
+
+    def recv(self, type_: str | list[str], timeout_s: float = 5.0, **match: Any) -> Any:
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            msg = self.conn.recv_match(type=type_, blocking=True, timeout=0.2)
+            if msg is None:
+                continue
+            if all(getattr(msg, k) == v for k, v in match.items()):
+                return msg
+        raise AssertionError(f"no {type_} {match} within {timeout_s} s")
+
+    def command(self, command: int, *params: float, confirmation: int = 0, target=(1, 1)) -> None:
+        values = [*params, 0, 0, 0, 0, 0, 0, 0][:7]
+        self.mav.command_long_send(target[0], target[1], command, confirmation, *values)
+
+    def ack(self, command: int, timeout_s: float = 5.0) -> Any:
+        return self.recv("COMMAND_ACK", timeout_s, command=command)
+
+    def close(self) -> None:
+        self.conn.close()

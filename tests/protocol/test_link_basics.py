@@ -1,0 +1,117 @@
+"""The link plug-in against a pymavlink ground station on loopback UDP."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+from pymavlink.dialects.v20 import common as m
+
+from tests.protocol.mav_client import LINK_VEHICLE, GroundStation, free_udp_port
+from tests.support.plugins import FakeNav
+from tests.support.vehicle import wait_for
+
+
+@pytest.fixture
+def link(vehicle_factory):
+    port = free_udp_port()
+    vehicle = vehicle_factory(LINK_VEHICLE.format(port=port))
+    gcs = GroundStation(port)
+    heartbeat = gcs.connect()
+    yield vehicle, gcs, heartbeat
+    gcs.close()
+
+
+def test_heartbeat_identifies_a_fixed_wing_in_mavlink2_at_1hz(link):
+    _, gcs, first = link
+    assert first.type == m.MAV_TYPE_FIXED_WING
+    assert first.autopilot == m.MAV_AUTOPILOT_GENERIC
+    assert first.get_srcComponent() == 1
+    assert first.get_msgbuf()[0] == 0xFD  # a MAVLink 2 frame
+    t0 = time.monotonic()
+    beats = 0
+    while time.monotonic() - t0 < 3.2:
+        gcs.heartbeat()
+        if gcs.conn.recv_match(type="HEARTBEAT", blocking=True, timeout=0.3):
+            beats += 1
+    assert 2 <= beats <= 5
+
+
+def test_autopilot_version_on_request_with_honest_capabilities(link):
+    _, gcs, _ = link
+    gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AUTOPILOT_VERSION)
+    ack = gcs.ack(m.MAV_CMD_REQUEST_MESSAGE)
+    assert ack.result == m.MAV_RESULT_ACCEPTED
+    assert (ack.target_system, ack.target_component) == (255, 190)
+    version = gcs.recv("AUTOPILOT_VERSION")
+    caps = version.capabilities
+    assert caps & m.MAV_PROTOCOL_CAPABILITY_MAVLINK2
+    assert caps & m.MAV_PROTOCOL_CAPABILITY_MISSION_INT
+    assert not caps & m.MAV_PROTOCOL_CAPABILITY_FTP
+    assert version.flight_sw_version >> 16 == 0x0001  # companion 0.1.x
+    assert version.uid != 0
+
+
+def test_unknown_commands_are_unsupported_at_once(link):
+    _, gcs, _ = link
+    for cmd, msg_id in ((m.MAV_CMD_REQUEST_MESSAGE, 397), (m.MAV_CMD_REQUEST_MESSAGE, 395)):
+        gcs.command(cmd, msg_id)
+        assert gcs.ack(cmd, timeout_s=1.0).result == m.MAV_RESULT_UNSUPPORTED
+    t0 = time.monotonic()
+    gcs.command(31000)  # MAV_CMD_USER_1
+    assert gcs.ack(31000, timeout_s=1.0).result == m.MAV_RESULT_UNSUPPORTED
+    assert time.monotonic() - t0 < 0.5
+
+
+def test_arm_starts_the_flight_group_and_disarm_stops_it(link):
+    vehicle, gcs, _ = link
+    gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 1)
+    assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_ACCEPTED
+    wait_for(lambda: vehicle.row("relay_in_flight").pid, 5, "flight group running")
+    gcs.recv(
+        "HEARTBEAT", 3, base_mode=m.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | m.MAV_MODE_FLAG_SAFETY_ARMED
+    )
+    # A retransmission of the same command is answered, not executed again.
+    restarts = vehicle.row("relay_in_flight").restarts
+    gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 1, confirmation=1)
+    assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_ACCEPTED
+    gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 0)
+    assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_ACCEPTED
+    wait_for(lambda: vehicle.row("relay_in_flight").pid == 0, 5, "flight group stopped")
+    assert vehicle.row("relay_in_flight").restarts == restarts
+    gcs.recv("HEARTBEAT", 3, base_mode=m.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED)
+
+
+def test_telemetry_reflects_the_bus_and_rates_can_be_changed(link):
+    _, gcs, _ = link
+    att = gcs.recv("ATTITUDE")
+    assert att.roll == pytest.approx(FakeNav.ROLL) and att.yaw == pytest.approx(FakeNav.YAW)
+    pos = gcs.recv("GLOBAL_POSITION_INT")
+    assert pos.lat == round(FakeNav.LAT * 1e7) and pos.lon == round(FakeNav.LON * 1e7)
+    assert pos.alt == 120000 and pos.vx == 2000 and pos.vz == -100
+    status = gcs.recv("SYS_STATUS")
+    assert status.onboard_control_sensors_present & m.MAV_SYS_STATUS_SENSOR_3D_GYRO
+    assert not status.onboard_control_sensors_present & m.MAV_SYS_STATUS_SENSOR_GPS
+
+    gcs.command(m.MAV_CMD_SET_MESSAGE_INTERVAL, m.MAVLINK_MSG_ID_ATTITUDE, 20000)  # 50 Hz
+    assert gcs.ack(m.MAV_CMD_SET_MESSAGE_INTERVAL).result == m.MAV_RESULT_ACCEPTED
+    gcs.command(m.MAV_CMD_GET_MESSAGE_INTERVAL, m.MAVLINK_MSG_ID_ATTITUDE)
+    assert gcs.recv("MESSAGE_INTERVAL", message_id=m.MAVLINK_MSG_ID_ATTITUDE).interval_us == 20000
+    count, t0 = 0, time.monotonic()
+    while time.monotonic() - t0 < 2.0:
+        if gcs.conn.recv_match(type="ATTITUDE", blocking=True, timeout=0.1):
+            count += 1
+    assert count >= 60, f"only {count} ATTITUDE in 2 s at a requested 50 Hz"
+
+
+def test_garbage_and_bad_crc_are_counted_and_the_link_survives(link):
+    vehicle, gcs, _ = link
+    sock_send = gcs.conn.port.sendto
+    frame = bytearray(gcs.mav.heartbeat_encode(6, 8, 0, 0, 4).pack(gcs.mav))
+    frame[-1] ^= 0xFF  # break the CRC
+    sock_send(bytes(frame), gcs.conn.destination_addr)
+    sock_send(b"\xfd\x09garbage" + bytes(range(256)), gcs.conn.destination_addr)
+    wait_for(lambda: vehicle.row("link").frames_bad > 0, 5, "bad frames counted")
+    gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AUTOPILOT_VERSION)
+    assert gcs.ack(m.MAV_CMD_REQUEST_MESSAGE).result == m.MAV_RESULT_ACCEPTED
+    assert gcs.recv("AUTOPILOT_VERSION").capabilities != 0
