@@ -9,7 +9,7 @@ from typing import Any
 
 os.environ.setdefault("MAVLINK20", "1")
 
-from pymavlink import mavutil  # noqa: E402 - MAVLINK20 must be set before the import
+from pymavlink import mavutil
 
 
 def free_udp_port() -> int:
