@@ -129,3 +129,12 @@ def test_cli_exits_with_status_2_and_starts_nothing(tmp_path):
         timeout=30,
     )
     assert missing.returncode == 2 and "not found" in missing.stderr
+
+
+def test_registered_short_names_resolve_and_misspellings_get_a_suggestion(tmp_path):
+    from companion.exec_control.registry import load, registered
+
+    assert registered()["link.mavlink"] == "companion.plugins.link.mavlink_link:MavlinkLink"
+    assert load("link.mavlink").__name__ == "MavlinkLink"
+    err = refuse(tmp_path, GOOD.replace("tests.support.plugins:Relay", "link.mavlnk"))
+    assert "did you mean 'link.mavlink'" in str(err)
