@@ -11,7 +11,8 @@ from __future__ import annotations
 import logging
 import socket
 from abc import ABC, abstractmethod
-from urllib.parse import urlparse
+from dataclasses import dataclass
+from urllib.parse import parse_qs, urlparse
 
 import serial
 
@@ -28,8 +29,11 @@ class EndpointError(ValueError):
 class Endpoint(ABC):
     """One transport. ``read_ready`` returns what arrived, keyed by the remote it came from."""
 
+    options: EndpointOptions
+
     def __init__(self, url: str) -> None:
         self.url = url
+        self.options = EndpointOptions()
         self.bytes_in = 0
         self.bytes_out = 0
         self.write_errors = 0
@@ -239,10 +243,55 @@ def parse_serial_url(url: str) -> tuple[str, int]:
     return path, int(baud)
 
 
+DEFAULT_NETWORK_BYTES_S = 1_000_000.0
+
+
+@dataclass(frozen=True)
+class EndpointOptions:
+    """Per-endpoint options, given as a URL query: ``udpin://0.0.0.0:14550?budget=20000``.
+
+    budget: bytes per second for this endpoint (serial default: baud / 10);
+    tlog: path of a .tlog recording of this endpoint's traffic.
+    """
+
+    budget_bytes_s: float | None = None
+    tlog: str | None = None
+
+
+def split_options(url: str) -> tuple[str, EndpointOptions]:
+    """The URL without its query, and the options the query sets."""
+    base, _, query = url.partition("?")
+    known = {"budget", "tlog"}
+    fields = parse_qs(query, keep_blank_values=True) if query else {}
+    unknown = set(fields) - known
+    if unknown:
+        raise EndpointError(f"{url!r}: unknown option(s) {sorted(unknown)}; known: {sorted(known)}")
+    budget = None
+    if "budget" in fields:
+        try:
+            budget = float(fields["budget"][-1])
+        except ValueError:
+            raise EndpointError(f"{url!r}: budget must be bytes per second") from None
+    tlog = fields["tlog"][-1] if "tlog" in fields else None
+    return base, EndpointOptions(budget, tlog)
+
+
 def open_endpoint(url: str) -> Endpoint:
-    """Open the endpoint a URL names; EndpointError for an unknown scheme."""
-    scheme = url.split("://", 1)[0] if "://" in url else ""
+    """Open the endpoint a URL names; EndpointError for an unknown scheme or option."""
+    base, options = split_options(url)
+    scheme = base.split("://", 1)[0] if "://" in base else ""
     kinds = {"udpout": UdpOut, "udpin": UdpIn, "tcpin": TcpIn, "serial": SerialEndpoint}
     if scheme not in kinds:
         raise EndpointError(f"{url!r}: scheme must be one of {sorted(kinds)}")
-    return kinds[scheme](url)
+    endpoint = kinds[scheme](base)
+    endpoint.options = options
+    return endpoint
+
+
+def default_budget(endpoint: Endpoint) -> float:
+    """Bytes per second the endpoint may carry."""
+    if endpoint.options.budget_bytes_s is not None:
+        return endpoint.options.budget_bytes_s
+    if isinstance(endpoint, SerialEndpoint):
+        return endpoint.baud / 10.0  # 8N1: ten bits a byte
+    return DEFAULT_NETWORK_BYTES_S

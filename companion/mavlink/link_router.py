@@ -12,9 +12,11 @@ from dataclasses import dataclass
 from typing import Any
 
 from companion.mavlink.codec import discard_partial, new_parser
-from companion.mavlink.endpoints import Endpoint, Remote, UdpOut
+from companion.mavlink.endpoints import Endpoint, Remote, UdpOut, default_budget
+from companion.mavlink.link_budget import LinkBudget
 from companion.mavlink.service import Outgoing, Peer, Service
 from companion.mavlink.telemetry import STREAMS, Snapshot, StreamSchedule
+from companion.mavlink.tlog import TlogWriter
 
 log = logging.getLogger(__name__)
 
@@ -37,6 +39,8 @@ class LinkRouter:
         self.parsers: dict[tuple[int, Remote], Any] = {}
         self.routes: dict[int, set[int]] = {}  # sysid → endpoint indexes it was heard on
         self.schedules = [StreamSchedule() for _ in endpoints]
+        self.budgets = [LinkBudget(default_budget(e)) for e in endpoints]
+        self.tlogs = [TlogWriter(e.options.tlog) if e.options.tlog else None for e in endpoints]
         self.counters = LinkCounters()
         self.by_type: dict[str, list[Service]] = {}
         for service in self.services:
@@ -70,6 +74,11 @@ class LinkRouter:
             self.counters.bad += 1
             return
         self.counters.ok += 1
+        tlog = self.tlogs[index]
+        if tlog is not None:
+            tlog.write(bytes(msg.get_msgbuf()))
+        if msg.get_type() == "RADIO_STATUS":
+            self.budgets[index].radio_status(msg.txbuf)
         sysid, compid = msg.get_srcSystem(), msg.get_srcComponent()
         if sysid == self.mav.srcSystem:
             return  # our own traffic looped back by another router
@@ -85,7 +94,7 @@ class LinkRouter:
         out: list[Outgoing] = []
         for service in self.by_type.get(msg.get_type(), []):
             out += service.handle(msg, peer, now_s)
-        self.send(out)
+        self.send(out, now_s)
 
     def _forward(self, msg: Any, came_from: int, to: set[int] | None) -> None:
         raw = bytes(msg.get_msgbuf())
@@ -94,15 +103,25 @@ class LinkRouter:
                 endpoint.send(raw)
                 self.counters.forwarded += 1
 
-    def send(self, out: list[Outgoing]) -> None:
+    def _emit(self, index: int, raw: bytes, priority: bool, now_s: float) -> None:
+        budget = self.budgets[index]
+        if priority:
+            budget.take_priority(len(raw), now_s)
+        elif not budget.take_telemetry(len(raw), now_s):
+            return
+        self.endpoints[index].send(raw)
+        tlog = self.tlogs[index]
+        if tlog is not None:
+            tlog.write(raw)
+
+    def send(self, out: list[Outgoing], now_s: float) -> None:
+        """Frame and send; telemetry only where the endpoint's budget allows."""
         for item in out:
             raw = item.msg.pack(self.mav)
             self.mav.seq = (self.mav.seq + 1) % 256
-            if item.to is None:
-                for endpoint in self.endpoints:
-                    endpoint.send(raw)
-            else:
-                self.endpoints[item.to.endpoint].send(raw)
+            targets = range(len(self.endpoints)) if item.to is None else [item.to.endpoint]
+            for index in targets:
+                self._emit(index, raw, item.priority, now_s)
 
     def tick(self, now_s: float) -> list[Outgoing]:
         out: list[Outgoing] = []
@@ -117,9 +136,14 @@ class LinkRouter:
             for msg_id in self.schedules[index].due(now_s):
                 msg = STREAMS[msg_id].build(self.mav, snapshot)
                 if msg is not None:
-                    self.send([Outgoing(msg, Peer(0, 0, index), priority=False)])
+                    self.send([Outgoing(msg, Peer(0, 0, index), priority=False)], now_s)
 
     def next_due(self) -> float:
         times = [s.next_time() for s in self.schedules]
         nexts = [getattr(s, "next_due", lambda: float("inf"))() for s in self.services]
         return min([*times, *nexts, float("inf")])
+
+    def close(self) -> None:
+        for tlog in self.tlogs:
+            if tlog is not None:
+                tlog.close()

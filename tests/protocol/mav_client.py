@@ -26,7 +26,7 @@ sysid = 1
 [[plugins]]
 name = "link"
 plugin = "link.mavlink"
-settings = {{ endpoints = ["udpin://127.0.0.1:{port}"] }}
+settings = {{ endpoints = ["udpin://127.0.0.1:{port}{query}"] }}
 
 [[plugins]]
 name = "nav"

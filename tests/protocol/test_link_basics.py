@@ -15,7 +15,7 @@ from tests.support.vehicle import wait_for
 @pytest.fixture
 def link(vehicle_factory):
     port = free_udp_port()
-    vehicle = vehicle_factory(LINK_VEHICLE.format(port=port))
+    vehicle = vehicle_factory(LINK_VEHICLE.format(port=port, query=""))
     gcs = GroundStation(port)
     heartbeat = gcs.connect()
     yield vehicle, gcs, heartbeat

@@ -20,6 +20,7 @@ from companion.mavlink.identity import IdentityService
 from companion.mavlink.link_router import LinkRouter
 from companion.mavlink.service import Outgoing
 from companion.mavlink.telemetry import Snapshot
+from companion.mavlink.timesync import TimesyncService
 from companion.messages import VehicleCommand
 from companion.plugin import Plugin, PluginContext, Setting
 from companion.plugins.link.commands import register_commands
@@ -41,7 +42,8 @@ class MavlinkLink(Plugin):
         "endpoints": Setting(
             list,
             ["udpout://127.0.0.1:14550", "udpout://127.0.0.1:14540"],
-            "endpoint URLs: udpout://, udpin://, tcpin://, serial:///dev/X:BAUD",
+            "endpoint URLs: udpout://, udpin://, tcpin://, serial:///dev/X:BAUD;"
+            " options as a query: ?budget=BYTES_PER_S&tlog=PATH",
         ),
         "compid": Setting(int, 1, "MAVLink component id of the autopilot", min=1, max=255),
         "autopilot": Setting(str, "generic", "MAV_AUTOPILOT reported", choices=tuple(AUTOPILOTS)),
@@ -81,7 +83,9 @@ class MavlinkLink(Plugin):
         }
         self.acks = bus.queue_reader("link/command_acks")
         self.to_vehicle = bus.writer("link/commands")
-        self.router = LinkRouter(self.mav, self.endpoints, [self.identity, self.commands])
+        timesync = TimesyncService(self.mav, lambda: ctx.clock.now_us() * 1000)
+        services = [self.identity, self.commands, timesync]
+        self.router = LinkRouter(self.mav, self.endpoints, services)
         register_commands(self)
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         self._seq = 0
@@ -121,7 +125,7 @@ class MavlinkLink(Plugin):
             out += self.commands.complete(ack.seq, ack.result, now_s)
         self._refresh_snapshot()
         out += self.router.tick(now_s)
-        self.router.send(out)
+        self.router.send(out, now_s)
         self.router.stream_telemetry(self.snapshot, now_s)
         counts = self.router.counters
         self.ctx.health.frames_ok, self.ctx.health.frames_bad = counts.ok, counts.bad
@@ -136,5 +140,6 @@ class MavlinkLink(Plugin):
         return self._seq
 
     def close(self) -> None:
+        self.router.close()
         for endpoint in self.endpoints:
             endpoint.close()
