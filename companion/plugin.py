@@ -95,6 +95,11 @@ class Plugin(ABC):
         """The channels this instance will read and write, given its settings."""
         return Ports(cls.inputs, cls.optional_inputs, cls.outputs)
 
+    @classmethod
+    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
+        """Problems with the settings taken together (checked before anything starts)."""
+        return []
+
     def init(self, ctx: PluginContext) -> None:
         """Open the device and the bus ports. Raising here counts as a crash."""
         self.ctx = ctx

@@ -244,6 +244,7 @@ def parse_serial_url(url: str) -> tuple[str, int]:
 
 
 DEFAULT_NETWORK_BYTES_S = 1_000_000.0
+SCHEMES = frozenset({"udpout", "udpin", "tcpin", "serial"})
 
 
 @dataclass(frozen=True)
@@ -251,17 +252,19 @@ class EndpointOptions:
     """Per-endpoint options, given as a URL query: ``udpin://0.0.0.0:14550?budget=20000``.
 
     budget: bytes per second for this endpoint (serial default: baud / 10);
-    tlog: path of a .tlog recording of this endpoint's traffic.
+    tlog: path of a .tlog recording of this endpoint's traffic;
+    signing: off, optional or required (see companion.mavlink.signing).
     """
 
     budget_bytes_s: float | None = None
     tlog: str | None = None
+    signing: str = "off"
 
 
 def split_options(url: str) -> tuple[str, EndpointOptions]:
     """The URL without its query, and the options the query sets."""
     base, _, query = url.partition("?")
-    known = {"budget", "tlog"}
+    known = {"budget", "tlog", "signing"}
     fields = parse_qs(query, keep_blank_values=True) if query else {}
     unknown = set(fields) - known
     if unknown:
@@ -273,7 +276,10 @@ def split_options(url: str) -> tuple[str, EndpointOptions]:
         except ValueError:
             raise EndpointError(f"{url!r}: budget must be bytes per second") from None
     tlog = fields["tlog"][-1] if "tlog" in fields else None
-    return base, EndpointOptions(budget, tlog)
+    signing = fields["signing"][-1] if "signing" in fields else "off"
+    if signing not in ("off", "optional", "required"):
+        raise EndpointError(f"{url!r}: signing must be off, optional or required")
+    return base, EndpointOptions(budget, tlog, signing)
 
 
 def open_endpoint(url: str) -> Endpoint:
@@ -282,7 +288,7 @@ def open_endpoint(url: str) -> Endpoint:
     scheme = base.split("://", 1)[0] if "://" in base else ""
     kinds = {"udpout": UdpOut, "udpin": UdpIn, "tcpin": TcpIn, "serial": SerialEndpoint}
     if scheme not in kinds:
-        raise EndpointError(f"{url!r}: scheme must be one of {sorted(kinds)}")
+        raise EndpointError(f"{url!r}: scheme must be one of {sorted(SCHEMES)}")
     endpoint = kinds[scheme](base)
     endpoint.options = options
     return endpoint

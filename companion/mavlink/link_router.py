@@ -11,10 +11,11 @@ import logging
 from dataclasses import dataclass
 from typing import Any
 
-from companion.mavlink.codec import discard_partial, new_parser
+from companion.mavlink.codec import discard_partial, new_encoder, new_parser
 from companion.mavlink.endpoints import Endpoint, Remote, UdpOut, default_budget
 from companion.mavlink.link_budget import LinkBudget
 from companion.mavlink.service import Outgoing, Peer, Service
+from companion.mavlink.signing import configure_parser, shared_state, signing_encoder
 from companion.mavlink.telemetry import STREAMS, Snapshot, StreamSchedule
 from companion.mavlink.tlog import TlogWriter
 
@@ -32,7 +33,13 @@ class LinkCounters:
 class LinkRouter:
     """Routing and dispatch for all endpoints of the link."""
 
-    def __init__(self, mav: Any, endpoints: list[Endpoint], services: list[Service]) -> None:
+    def __init__(
+        self,
+        mav: Any,
+        endpoints: list[Endpoint],
+        services: list[Service],
+        signing_key: bytes | None = None,
+    ) -> None:
         self.mav = mav
         self.endpoints = endpoints
         self.services = list(services)
@@ -42,9 +49,19 @@ class LinkRouter:
         self.budgets = [LinkBudget(default_budget(e)) for e in endpoints]
         self.tlogs = [TlogWriter(e.options.tlog) if e.options.tlog else None for e in endpoints]
         self.counters = LinkCounters()
+        self.signing = shared_state(signing_key) if signing_key else None
+        self.packers = [self._packer(i, e, signing_key) for i, e in enumerate(endpoints)]
         self.by_type: dict[str, list[Service]] = {}
         for service in self.services:
             self.add_service(service)
+
+    def _packer(self, index: int, endpoint: Endpoint, key: bytes | None) -> Any:
+        """The encoder that frames what goes out of an endpoint (signed or not)."""
+        if endpoint.options.signing == "off" or key is None:
+            return self.mav
+        packer = new_encoder(self.mav.srcSystem, self.mav.srcComponent)
+        signing_encoder(packer, key, link_id=index + 1)
+        return packer
 
     def add_service(self, service: Service) -> None:
         if service not in self.services:
@@ -58,6 +75,7 @@ class LinkRouter:
             parser = self.parsers.get((index, remote))
             if parser is None:
                 parser = self.parsers[(index, remote)] = new_parser()
+                configure_parser(parser, self.signing, endpoint.options.signing)
             try:
                 messages = parser.parse_buffer(data) or []
             except Exception:  # pymavlink raises on some malformed input even when robust
@@ -117,11 +135,15 @@ class LinkRouter:
     def send(self, out: list[Outgoing], now_s: float) -> None:
         """Frame and send; telemetry only where the endpoint's budget allows."""
         for item in out:
-            raw = item.msg.pack(self.mav)
-            self.mav.seq = (self.mav.seq + 1) % 256
             targets = range(len(self.endpoints)) if item.to is None else [item.to.endpoint]
+            frames: dict[int, bytes] = {}
             for index in targets:
-                self._emit(index, raw, item.priority, now_s)
+                packer = self.packers[index]
+                if id(packer) not in frames:
+                    packer.seq = self.mav.seq  # one sequence for the vehicle, signed or not
+                    frames[id(packer)] = item.msg.pack(packer)
+                self._emit(index, frames[id(packer)], item.priority, now_s)
+            self.mav.seq = (self.mav.seq + 1) % 256
 
     def tick(self, now_s: float) -> list[Outgoing]:
         out: list[Outgoing] = []

@@ -11,14 +11,23 @@ from __future__ import annotations
 
 import select
 import time
+from collections.abc import Mapping
+from typing import Any
 
 from companion.mavlink.codec import dialect as d
 from companion.mavlink.codec import new_encoder
 from companion.mavlink.command_service import CommandService
-from companion.mavlink.endpoints import Endpoint, EndpointError, open_endpoint
+from companion.mavlink.endpoints import (
+    SCHEMES,
+    Endpoint,
+    EndpointError,
+    open_endpoint,
+    split_options,
+)
 from companion.mavlink.identity import IdentityService
 from companion.mavlink.link_router import LinkRouter
 from companion.mavlink.service import Outgoing
+from companion.mavlink.signing import key_from
 from companion.mavlink.telemetry import Snapshot
 from companion.mavlink.timesync import TimesyncService
 from companion.messages import VehicleCommand
@@ -47,6 +56,9 @@ class MavlinkLink(Plugin):
         ),
         "compid": Setting(int, 1, "MAVLink component id of the autopilot", min=1, max=255),
         "autopilot": Setting(str, "generic", "MAV_AUTOPILOT reported", choices=tuple(AUTOPILOTS)),
+        "signing_key": Setting(
+            str, "", "signing key: 64 hex digits, or a passphrase (SHA-256, as MAVProxy)"
+        ),
     }
     optional_inputs = (
         "nav/state",
@@ -57,6 +69,20 @@ class MavlinkLink(Plugin):
         "link/command_acks",
     )
     outputs = ("link/commands",)
+
+    @classmethod
+    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
+        problems = []
+        for url in settings["endpoints"]:
+            try:
+                base, options = split_options(str(url))
+                if base.split("://", 1)[0] not in SCHEMES:
+                    problems.append(f"endpoint {url!r}: scheme must be one of {sorted(SCHEMES)}")
+                if options.signing != "off" and not settings["signing_key"]:
+                    problems.append(f"endpoint {url!r} asks for signing but signing_key is empty")
+            except EndpointError as exc:
+                problems.append(str(exc))
+        return problems
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
@@ -85,7 +111,9 @@ class MavlinkLink(Plugin):
         self.to_vehicle = bus.writer("link/commands")
         timesync = TimesyncService(self.mav, lambda: ctx.clock.now_us() * 1000)
         services = [self.identity, self.commands, timesync]
-        self.router = LinkRouter(self.mav, self.endpoints, services)
+        secret = ctx.settings["signing_key"]
+        key = key_from(secret) if secret else None
+        self.router = LinkRouter(self.mav, self.endpoints, services, key)
         register_commands(self)
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         self._seq = 0
