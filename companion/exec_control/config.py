@@ -190,6 +190,8 @@ def _plugin_spec(check: _Checker, entry: Any, where: KeyPath) -> PluginSpec:
     if not isinstance(raw_settings, dict):
         raise check.error((*where, "settings"), "must be a table")
     settings = check.values(raw_settings, cls.settings, (*where, "settings"))
+    for problem in cls.validate(settings):
+        raise check.error((*where, "settings"), problem)
     return PluginSpec(
         name=entry["name"],
         kind=entry["plugin"],
