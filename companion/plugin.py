@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 if TYPE_CHECKING:
     from companion.bus import BusNode, VehicleClock
+    from companion.params import ParamDecl
 
 REQUIRED: Any = object()
 
@@ -75,6 +76,8 @@ class PluginContext:
     clock: VehicleClock
     vehicle: Mapping[str, Any] = field(default_factory=dict)  # the config's [vehicle] table
     health: HealthCounters = field(default_factory=HealthCounters)
+    # Every parameter declared by the config's plug-ins (what the parameter server serves).
+    param_decls: tuple[ParamDecl, ...] = ()
 
 
 class Plugin(ABC):
@@ -86,6 +89,7 @@ class Plugin(ABC):
     """
 
     settings: ClassVar[dict[str, Setting]] = {}
+    params: ClassVar[tuple[ParamDecl, ...]] = ()  # served to ground stations by the link
     inputs: ClassVar[tuple[str, ...]] = ()
     optional_inputs: ClassVar[tuple[str, ...]] = ()
     outputs: ClassVar[tuple[str, ...]] = ()

@@ -40,6 +40,7 @@ class PluginSpec:
     settings: dict[str, Any]
     ports: Ports
     line: int | None = None
+    params: tuple[Any, ...] = ()  # the plug-in class's ParamDecl declarations
 
 
 @dataclass(frozen=True)
@@ -60,6 +61,9 @@ _VEHICLE_KEYS: dict[str, Setting] = {
     "sysid": Setting(int, 1, "MAVLink system id", min=1, max=255),
     "namespace": Setting(str, "", "bus namespace (default: $COMPANION_BUS or 'companion')"),
     "clock": Setting(str, "monotonic", "vehicle time base", choices=CLOCKS),
+    "state_dir": Setting(
+        str, "", "where parameters and missions persist (default ~/.local/state/companion/NAME)"
+    ),
 }
 _PLUGIN_KEYS = ("name", "plugin", "group", "settings")
 
@@ -135,6 +139,8 @@ def load_config(path: str | Path, namespace: str | None = None) -> VehicleConfig
     if not isinstance(vehicle, dict):
         raise check.error(("vehicle",), "must be a table: [vehicle]")
     vehicle = check.values(vehicle, _VEHICLE_KEYS, ("vehicle",))
+    if not vehicle["state_dir"]:
+        vehicle["state_dir"] = str(Path("~/.local/state/companion").expanduser() / vehicle["name"])
     ns = namespace or vehicle["namespace"] or None
     if ns is not None:
         try:
@@ -199,4 +205,5 @@ def _plugin_spec(check: _Checker, entry: Any, where: KeyPath) -> PluginSpec:
         settings=settings,
         ports=cls.ports(settings),
         line=line_of(check.lines, where),
+        params=tuple(cls.params),
     )

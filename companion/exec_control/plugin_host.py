@@ -21,6 +21,7 @@ from typing import Any
 from companion.bus import BusNode, MonotonicClock, SimulationClock, VehicleClock
 from companion.exec_control.registry import load
 from companion.messages import NAME_LEN, PluginStats
+from companion.params import ParamDecl
 from companion.plugin import Plugin, PluginContext
 
 EXIT_INIT_FAILED = 3
@@ -77,6 +78,7 @@ class PluginHost:
             bus=self.bus,
             clock=self.clock,
             vehicle=spec["vehicle"],
+            param_decls=tuple(ParamDecl(**d) for d in spec.get("param_decls", [])),
         )
 
     def _clock(self, kind: str) -> VehicleClock:

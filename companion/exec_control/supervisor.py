@@ -11,6 +11,7 @@ import logging
 import os
 import signal
 import time
+from dataclasses import asdict
 
 from companion.bus import BusNode, MonotonicClock, Reader, cleanup_namespace
 from companion.exec_control.child import Child
@@ -37,7 +38,13 @@ class Supervisor:
 
     def __init__(self, cfg: VehicleConfig, log_level: str = "INFO") -> None:
         self.cfg = cfg
-        base = {"namespace": cfg.namespace, "vehicle": cfg.vehicle, "log_level": log_level}
+        decls = [asdict(d) for spec in cfg.plugins for d in spec.params]
+        base = {
+            "namespace": cfg.namespace,
+            "vehicle": cfg.vehicle,
+            "log_level": log_level,
+            "param_decls": decls,
+        }
         self.children = [Child(spec, base) for spec in cfg.plugins]
         self.flight_running = False
         self.stopping = False

@@ -22,6 +22,7 @@ LINK_VEHICLE = """
 [vehicle]
 name = "linktest"
 sysid = 1
+state_dir = "{state}"
 
 [[plugins]]
 name = "link"

@@ -13,9 +13,9 @@ from tests.support.vehicle import wait_for
 
 
 @pytest.fixture
-def link(vehicle_factory):
+def link(vehicle_factory, tmp_path):
     port = free_udp_port()
-    vehicle = vehicle_factory(LINK_VEHICLE.format(port=port, query=""))
+    vehicle = vehicle_factory(LINK_VEHICLE.format(port=port, query="", state=tmp_path))
     gcs = GroundStation(port)
     heartbeat = gcs.connect()
     yield vehicle, gcs, heartbeat

@@ -11,9 +11,9 @@ from companion.mavlink.link_budget import LinkBudget
 from tests.protocol.mav_client import LINK_VEHICLE, GroundStation, free_udp_port
 
 
-def start(vehicle_factory, query: str) -> GroundStation:
+def start(vehicle_factory, query: str, tmp_path) -> GroundStation:
     port = free_udp_port()
-    vehicle_factory(LINK_VEHICLE.format(port=port, query=query))
+    vehicle_factory(LINK_VEHICLE.format(port=port, query=query, state=tmp_path))
     gcs = GroundStation(port)
     gcs.connect()
     return gcs
@@ -30,8 +30,8 @@ def test_budget_bucket_lets_priority_overdraw_and_skips_telemetry():
     assert budget.scale < 1.0
 
 
-def test_a_slow_link_decimates_telemetry_but_answers_commands_first(vehicle_factory):
-    gcs = start(vehicle_factory, "?budget=1500")  # ~1.5 kB/s: about a 14400-baud radio
+def test_a_slow_link_decimates_telemetry_but_answers_commands_first(vehicle_factory, tmp_path):
+    gcs = start(vehicle_factory, "?budget=1500", tmp_path)  # ~1.5 kB/s: about a 14400-baud radio
     gcs.command(m.MAV_CMD_SET_MESSAGE_INTERVAL, m.MAVLINK_MSG_ID_ATTITUDE, 10000)  # 100 Hz asked
     gcs.ack(m.MAV_CMD_SET_MESSAGE_INTERVAL)
     counts = {"ATTITUDE": 0, "bytes": 0}
@@ -61,7 +61,7 @@ def test_a_slow_link_decimates_telemetry_but_answers_commands_first(vehicle_fact
 
 def test_tlog_records_both_directions_readable_by_pymavlink(vehicle_factory, tmp_path):
     tlog = tmp_path / "link.tlog"
-    gcs = start(vehicle_factory, f"?tlog={tlog}")
+    gcs = start(vehicle_factory, f"?tlog={tlog}", tmp_path)
     gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AUTOPILOT_VERSION)
     gcs.ack(m.MAV_CMD_REQUEST_MESSAGE)
     time.sleep(1.5)
@@ -76,8 +76,8 @@ def test_tlog_records_both_directions_readable_by_pymavlink(vehicle_factory, tmp
     assert types.get(("ATTITUDE", 1), 0) >= 5
 
 
-def test_timesync_request_is_answered_with_the_request_echoed(vehicle_factory):
-    gcs = start(vehicle_factory, "")
+def test_timesync_request_is_answered_with_the_request_echoed(vehicle_factory, tmp_path):
+    gcs = start(vehicle_factory, "", tmp_path)
     gcs.mav.timesync_send(0, 123456789)
     reply = gcs.recv("TIMESYNC", 3, ts1=123456789)
     assert reply.tc1 > 0

@@ -12,6 +12,7 @@ from __future__ import annotations
 import select
 import time
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 from companion.mavlink.codec import dialect as d
@@ -26,15 +27,22 @@ from companion.mavlink.endpoints import (
 )
 from companion.mavlink.identity import IdentityService
 from companion.mavlink.link_router import LinkRouter
+from companion.mavlink.params_service import ParamsService
 from companion.mavlink.service import Outgoing
 from companion.mavlink.signing import key_from
 from companion.mavlink.telemetry import Snapshot
 from companion.mavlink.timesync import TimesyncService
 from companion.messages import VehicleCommand
+from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 from companion.plugins.link.commands import register_commands
 
-MAX_WAIT_S = 0.02  # telemetry and acks from the bus are looked at this often at least
+MAX_WAIT_S = 0.02
+STREAM_PARAMS = {
+    "SR_ATTITUDE": (d.MAVLINK_MSG_ID_ATTITUDE,),
+    "SR_POSITION": (d.MAVLINK_MSG_ID_GLOBAL_POSITION_INT, d.MAVLINK_MSG_ID_VFR_HUD),
+    "SR_GPS": (d.MAVLINK_MSG_ID_GPS_RAW_INT,),
+}  # telemetry and acks from the bus are looked at this often at least
 AUTOPILOTS = {"generic": d.MAV_AUTOPILOT_GENERIC, "px4": d.MAV_AUTOPILOT_PX4}
 CAPABILITIES = (
     d.MAV_PROTOCOL_CAPABILITY_MISSION_INT
@@ -60,6 +68,11 @@ class MavlinkLink(Plugin):
             str, "", "signing key: 64 hex digits, or a passphrase (SHA-256, as MAVProxy)"
         ),
     }
+    params = (
+        ParamDecl("SR_ATTITUDE", 10.0, 0.0, 100.0, "Hz", "ATTITUDE rate on every endpoint"),
+        ParamDecl("SR_POSITION", 5.0, 0.0, 50.0, "Hz", "GLOBAL_POSITION_INT and VFR_HUD rate"),
+        ParamDecl("SR_GPS", 2.0, 0.0, 10.0, "Hz", "GPS_RAW_INT rate"),
+    )
     optional_inputs = (
         "nav/state",
         "sensors/gps",
@@ -114,9 +127,35 @@ class MavlinkLink(Plugin):
         secret = ctx.settings["signing_key"]
         key = key_from(secret) if secret else None
         self.router = LinkRouter(self.mav, self.endpoints, services, key)
+        self._serve_params(ctx, sysid)
         register_commands(self)
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         self._seq = 0
+
+    def _serve_params(self, ctx: PluginContext, sysid: int) -> None:
+        path = Path(ctx.vehicle.get("state_dir", ".")) / "params.json"
+        self.store = ParamStore(ctx.param_decls or self.params, path)
+        service = ParamsService(self.mav, self.store, sysid, ctx.settings["compid"])
+        service.on_refusal = self.statustext
+        service.on_change = lambda name, value: self._apply_rates()
+        self.router.add_service(service)
+        self._apply_rates()
+        self._params_service = service
+
+    def _apply_rates(self) -> None:
+        """The SR_* parameters set every endpoint's default stream rates."""
+        for name, streams in STREAM_PARAMS.items():
+            if name not in self.store.decls:
+                continue
+            hz = self.store.get(name)
+            for schedule in self.router.schedules:
+                for msg_id in streams:
+                    schedule.set_interval(msg_id, 1e6 / hz if hz > 0 else -1)
+
+    def statustext(self, text: str, severity: int = d.MAV_SEVERITY_WARNING) -> None:
+        """Tell every ground station (refusals, failsafes)."""
+        msg = self.mav.statustext_encode(severity, text.encode()[:50])
+        self.router.send([Outgoing(msg, None)], time.monotonic())
 
     def _refresh_snapshot(self) -> None:
         s, r = self.snapshot, self.readers

@@ -1,0 +1,47 @@
+"""QGroundControl ``.params`` files: ``vehicle-id component-id name value type`` per line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from companion.params.store import ParamError, ParamStore
+
+MAV_PARAM_TYPE_REAL32 = 9
+
+
+def save_params(store: ParamStore, path: Path, sysid: int = 1, compid: int = 1) -> None:
+    """Write every parameter in QGroundControl's tab-separated format."""
+    lines = ["# Onboard parameters for companion", "#", "# Vehicle-Id Component-Id Name Value Type"]
+    for name in store.names:
+        lines.append(f"{sysid}\t{compid}\t{name}\t{store.get(name)!r}\t{MAV_PARAM_TYPE_REAL32}")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def load_params(store: ParamStore, path: Path) -> int:
+    """Apply a .params file; ParamError names the line and parameter of the first bad line.
+
+    Nothing is applied unless every line is good.
+    """
+    updates: list[tuple[str, float]] = []
+    for lineno, raw in enumerate(path.read_text().splitlines(), start=1):
+        line = raw.strip()
+        if not line or line.startswith("#"):
+            continue
+        fields = line.split()
+        if len(fields) < 4:
+            raise ParamError(f"{path}:{lineno}: expected 'sysid compid name value type'")
+        name, text = fields[2], fields[3]
+        try:
+            value = float(text)
+        except ValueError:
+            raise ParamError(f"{path}:{lineno}: {name}: {text!r} is not a number") from None
+        decl = store.decls.get(name)
+        if decl is None:
+            raise ParamError(f"{path}:{lineno}: {name}: unknown parameter")
+        if (problem := decl.check(value)) is not None:
+            raise ParamError(f"{path}:{lineno}: {problem}")
+        updates.append((name, value))
+    for name, value in updates:
+        store.values[name] = value
+    store.save()
+    return len(updates)

@@ -1,0 +1,70 @@
+"""The parameter store: ranges, atomic persistence, restore, QGroundControl .params files."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from companion.params import ParamDecl, ParamError, ParamStore
+from companion.params.qgc_file import load_params, save_params
+
+DECLS = (
+    ParamDecl("FW_AIRSPD_TRIM", 22.0, 10.0, 40.0, "m/s", "cruise airspeed"),
+    ParamDecl("FW_R_LIM", 45.0, 10.0, 70.0, "deg", "roll limit"),
+)
+
+
+def test_defaults_order_and_range_refusal_keeps_the_old_value(tmp_path):
+    store = ParamStore(DECLS, tmp_path / "p.json")
+    assert store.names == ["FW_AIRSPD_TRIM", "FW_R_LIM"] and len(store) == 2
+    assert store.set("FW_R_LIM", 50) == 50.0
+    with pytest.raises(ParamError, match="outside"):
+        store.set("FW_R_LIM", 90)
+    with pytest.raises(ParamError, match="unknown"):
+        store.set("NOPE", 1)
+    assert store.get("FW_R_LIM") == 50.0
+
+
+def test_values_persist_and_bad_stored_values_are_ignored(tmp_path):
+    path = tmp_path / "p.json"
+    ParamStore(DECLS, path).set("FW_AIRSPD_TRIM", 25.0)
+    assert ParamStore(DECLS, path).get("FW_AIRSPD_TRIM") == 25.0
+    path.write_text(json.dumps({"FW_AIRSPD_TRIM": 99.0, "GONE": 1.0, "FW_R_LIM": 30}))
+    store = ParamStore(DECLS, path)
+    assert store.get("FW_AIRSPD_TRIM") == 22.0 and store.get("FW_R_LIM") == 30.0
+
+
+def test_a_torn_file_falls_back_to_defaults_and_temp_leftovers_do_no_harm(tmp_path):
+    path = tmp_path / "p.json"
+    ParamStore(DECLS, path).set("FW_R_LIM", 33.0)
+    (tmp_path / ".p.json.123.tmp").write_text('{"FW_R_LIM": 6')  # a crash mid-write
+    assert ParamStore(DECLS, path).get("FW_R_LIM") == 33.0
+    path.write_text('{"FW_R_LIM": 3')  # the file itself torn (not by us: we rename)
+    assert ParamStore(DECLS, path).get("FW_R_LIM") == 45.0
+
+
+def test_declarations_are_checked():
+    with pytest.raises(ParamError, match="declared twice"):
+        ParamStore((*DECLS, DECLS[0]))
+    with pytest.raises(ParamError, match="1-16 characters"):
+        ParamStore((ParamDecl("A_NAME_THAT_IS_TOO_LONG", 1.0),))
+    with pytest.raises(ParamError, match="default"):
+        ParamStore((ParamDecl("X", 5.0, 0.0, 1.0),))
+
+
+def test_qgc_params_file_round_trip_and_bad_lines(tmp_path):
+    store = ParamStore(DECLS)
+    store.set("FW_R_LIM", 55.5)
+    path = tmp_path / "v.params"
+    save_params(store, path)
+    assert "1\t1\tFW_R_LIM\t55.5\t9" in path.read_text()
+    other = ParamStore(DECLS)
+    assert load_params(other, path) == 2 and other.get("FW_R_LIM") == 55.5
+    path.write_text("# x\n1\t1\tFW_R_LIM\t60\t9\n1\t1\tFW_AIRSPD_TRIM\tfast\t9\n")
+    with pytest.raises(ParamError, match=r"v.params:3: FW_AIRSPD_TRIM: 'fast' is not a number"):
+        load_params(other, path)
+    assert other.get("FW_R_LIM") == 55.5, "nothing applied from a file with a bad line"
+    path.write_text("1\t1\tFW_R_LIM\t95\t9\n")
+    with pytest.raises(ParamError, match="v.params:1: FW_R_LIM: 95 outside"):
+        load_params(other, path)
