@@ -66,5 +66,5 @@ def test_qgc_params_file_round_trip_and_bad_lines(tmp_path):
         load_params(other, path)
     assert other.get("FW_R_LIM") == 55.5, "nothing applied from a file with a bad line"
     path.write_text("1\t1\tFW_R_LIM\t95\t9\n")
-    with pytest.raises(ParamError, match="v.params:1: FW_R_LIM: 95 outside"):
+    with pytest.raises(ParamError, match=r"v\.params:1: FW_R_LIM: 95 outside"):
         load_params(other, path)
