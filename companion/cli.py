@@ -118,7 +118,7 @@ params_app = typer.Typer(help="Parameters in QGroundControl .params files (vehic
 app.add_typer(params_app, name="params")
 
 
-def _param_store(config: Path, namespace: str | None):  # noqa: ANN202 - internal helper
+def _param_store(config: Path, namespace: str | None):
     from companion.params import ParamStore
 
     cfg = _load_checked(config, namespace)
@@ -152,7 +152,7 @@ def params_load(
     try:
         count = load_params(store, file)
     except (ParamError, OSError) as exc:
-        err.print(f"[red]params error:[/red] {exc}", highlight=False)
+        err.print(f"[red]params error:[/red] {exc}", highlight=False, soft_wrap=True)
         raise typer.Exit(EXIT_CONFIG) from None
     out.print(f"{count} parameters loaded from {file} into {store.path}")
 
