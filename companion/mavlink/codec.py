@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from pymavlink.dialects.v20 import common as dialect
+from mavlink_dialect import companion as dialect
 
 __all__ = ["dialect", "new_encoder", "new_parser"]
 

@@ -13,7 +13,6 @@ if TYPE_CHECKING:
     from companion.plugins.link.mavlink_link import MavlinkLink
 
 BUS_ACK_TIMEOUT_S = 3.0
-PROTOCOL_VERSION_ID = 300  # not in every dialect pymavlink ships; answered when it is
 
 
 def register_commands(link: MavlinkLink) -> None:
@@ -33,7 +32,7 @@ def register_commands(link: MavlinkLink) -> None:
         msg_id = round(args.params[0])
         if msg_id == d.MAVLINK_MSG_ID_AUTOPILOT_VERSION:
             return Outcome(extra=[link.identity.autopilot_version()])
-        if msg_id == PROTOCOL_VERSION_ID and hasattr(link.mav, "protocol_version_encode"):
+        if msg_id == d.MAVLINK_MSG_ID_PROTOCOL_VERSION:
             return Outcome(extra=[link.identity.protocol_version()])
         if msg_id in STREAMS:
             msg = STREAMS[msg_id].build(link.mav, link.snapshot)
