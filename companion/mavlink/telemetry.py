@@ -27,6 +27,8 @@ class Snapshot:
     health: SystemHealth | None = None
     servos: ServoOutput | None = None
     home_alt_m: float = math.nan
+    mission_seq: int = 0
+    mission_total: int = 0
 
 
 Builder = Callable[[Any, Snapshot], Any]
@@ -182,6 +184,11 @@ def _extended_sys_state(mav: Any, s: Snapshot) -> Any:
     return mav.extended_sys_state_encode(d.MAV_VTOL_STATE_UNDEFINED, landed)
 
 
+def _mission_current(mav: Any, s: Snapshot) -> Any:
+    state = d.MISSION_STATE_NO_MISSION if s.mission_total == 0 else d.MISSION_STATE_NOT_STARTED
+    return mav.mission_current_encode(s.mission_seq, s.mission_total, state)
+
+
 @dataclass(frozen=True)
 class Stream:
     name: str
@@ -205,6 +212,7 @@ STREAMS: dict[int, Stream] = {
         Stream("SERVO_OUTPUT_RAW", d.MAVLINK_MSG_ID_SERVO_OUTPUT_RAW, 2.0, _servo_output),
         Stream("SCALED_IMU", d.MAVLINK_MSG_ID_SCALED_IMU, 2.0, _scaled_imu),
         Stream("EXTENDED_SYS_STATE", d.MAVLINK_MSG_ID_EXTENDED_SYS_STATE, 1.0, _extended_sys_state),
+        Stream("MISSION_CURRENT", d.MAVLINK_MSG_ID_MISSION_CURRENT, 1.0, _mission_current),
     )
 }
 

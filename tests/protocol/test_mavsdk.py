@@ -7,8 +7,10 @@ import asyncio
 import pytest
 from mavsdk.asyncio import Configuration, Mavsdk
 from mavsdk.asyncio.plugins.action import ActionAsync
+from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
 from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
 from mavsdk.component_type import ComponentType
+from mavsdk.plugins.mission_raw import MissionItem
 
 from tests.protocol.mav_client import free_udp_port
 from tests.support.plugins import FakeNav
@@ -17,6 +19,7 @@ from tests.support.vehicle import wait_for
 VEHICLE = """
 [vehicle]
 name = "mavsdk"
+state_dir = "{state}"
 
 [[plugins]]
 name = "link"
@@ -58,9 +61,9 @@ async def _session(port: int, vehicle) -> dict:
 
 
 @pytest.mark.timeout(120)
-def test_mavsdk_sees_position_and_can_arm_and_disarm(vehicle_factory):
+def test_mavsdk_sees_position_and_can_arm_and_disarm(vehicle_factory, tmp_path):
     port = free_udp_port()
-    vehicle = vehicle_factory(VEHICLE.format(port=port))
+    vehicle = vehicle_factory(VEHICLE.format(port=port, state=tmp_path))
     vehicle.wait_running("link")
     result = asyncio.run(_session(port, vehicle))
     pos = result["position"]
@@ -70,3 +73,49 @@ def test_mavsdk_sees_position_and_can_arm_and_disarm(vehicle_factory):
     assert result["armed"] is True
     assert result["flight_pid"] > 0, "arming started the flight group"
     wait_for(lambda: vehicle.row("flight").pid == 0, 5, "disarm stopped the flight group")
+
+
+def _raw_items(count: int) -> list[MissionItem]:
+    items = []
+    for seq in range(count):
+        items.append(
+            MissionItem(
+                seq,
+                6,
+                16,
+                int(seq == 0),
+                1,
+                0.0,
+                10.0,
+                0.0,
+                float("nan"),
+                -379105000 + seq * 900,
+                1451340000 + (seq % 7) * 900,
+                100.0,
+                0,
+            )
+        )
+    return items
+
+
+async def _mission_session(port: int, items: list[MissionItem]) -> list:
+    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
+    async with Mavsdk(config) as mavsdk:
+        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
+        system = await mavsdk.first_autopilot(timeout_s=15.0)
+        mission = MissionRawAsync(system)
+        await mission.upload_mission(items)
+        return await mission.download_mission()
+
+
+@pytest.mark.timeout(120)
+def test_mavsdk_mission_raw_upload_and_download(vehicle_factory, tmp_path):
+    port = free_udp_port()
+    vehicle = vehicle_factory(VEHICLE.format(port=port, state=tmp_path))
+    vehicle.wait_running("link")
+    items = _raw_items(50)
+    got = asyncio.run(_mission_session(port, items))
+    assert [(i.seq, i.command, i.x, i.y) for i in got] == [
+        (i.seq, i.command, i.x, i.y) for i in items
+    ]
+    assert (tmp_path / "missions" / "mission.json").exists()

@@ -27,12 +27,14 @@ from companion.mavlink.endpoints import (
 )
 from companion.mavlink.identity import IdentityService
 from companion.mavlink.link_router import LinkRouter
+from companion.mavlink.mission_service import MissionService
 from companion.mavlink.params_service import ParamsService
 from companion.mavlink.service import Outgoing
 from companion.mavlink.signing import key_from
 from companion.mavlink.telemetry import Snapshot
 from companion.mavlink.timesync import TimesyncService
 from companion.messages import VehicleCommand
+from companion.mission.store import MissionStore
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 from companion.plugins.link.commands import register_commands
@@ -128,6 +130,9 @@ class MavlinkLink(Plugin):
         key = key_from(secret) if secret else None
         self.router = LinkRouter(self.mav, self.endpoints, services, key)
         self._serve_params(ctx, sysid)
+        store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
+        self.missions = MissionService(self.mav, store, sysid, ctx.settings["compid"])
+        self.router.add_service(self.missions)
         register_commands(self)
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         self._seq = 0
@@ -166,6 +171,8 @@ class MavlinkLink(Plugin):
                 pass
             if latest is not None:
                 setattr(s, key, latest)
+        s.mission_seq = self.missions.current
+        s.mission_total = len(self.missions.store.items[0])
         s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
         s.unix_us = time.time_ns() // 1000
         if s.health is not None:

@@ -1,0 +1,1 @@
+"""Missions: the item model, validation, atomic storage; pure and replayable."""

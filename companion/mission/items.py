@@ -1,0 +1,110 @@
+"""Mission items (MISSION_ITEM_INT fields) and what the vehicle can fly."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+from mavlink_dialect import companion as d
+
+MISSION_TYPES = (d.MAV_MISSION_TYPE_MISSION, d.MAV_MISSION_TYPE_FENCE, d.MAV_MISSION_TYPE_RALLY)
+
+NAV_COMMANDS = frozenset(
+    {
+        d.MAV_CMD_NAV_WAYPOINT,
+        d.MAV_CMD_NAV_LOITER_UNLIM,
+        d.MAV_CMD_NAV_LOITER_TURNS,
+        d.MAV_CMD_NAV_LOITER_TIME,
+        d.MAV_CMD_NAV_RETURN_TO_LAUNCH,
+        d.MAV_CMD_NAV_TAKEOFF,
+        d.MAV_CMD_NAV_LAND,
+    }
+)
+DO_COMMANDS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_JUMP})
+SUPPORTED = {
+    d.MAV_MISSION_TYPE_MISSION: NAV_COMMANDS | DO_COMMANDS,
+    d.MAV_MISSION_TYPE_FENCE: frozenset(
+        {
+            d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION,
+            d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_EXCLUSION,
+            d.MAV_CMD_NAV_FENCE_CIRCLE_INCLUSION,
+            d.MAV_CMD_NAV_FENCE_CIRCLE_EXCLUSION,
+            d.MAV_CMD_NAV_FENCE_RETURN_POINT,
+        }
+    ),
+    d.MAV_MISSION_TYPE_RALLY: frozenset({d.MAV_CMD_NAV_RALLY_POINT}),
+}
+GLOBAL_FRAMES = frozenset(
+    {
+        d.MAV_FRAME_GLOBAL,
+        d.MAV_FRAME_GLOBAL_INT,
+        d.MAV_FRAME_GLOBAL_RELATIVE_ALT,
+        d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+        d.MAV_FRAME_GLOBAL_TERRAIN_ALT,
+        d.MAV_FRAME_GLOBAL_TERRAIN_ALT_INT,
+    }
+)
+POSITIONLESS = frozenset(
+    {d.MAV_CMD_NAV_RETURN_TO_LAUNCH, d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_JUMP}
+)
+
+
+@dataclass(frozen=True)
+class MissionItem:
+    """One item, as MISSION_ITEM_INT carries it (x, y in degrees × 1e7)."""
+
+    seq: int
+    frame: int
+    command: int
+    current: int
+    autocontinue: int
+    param1: float
+    param2: float
+    param3: float
+    param4: float
+    x: int
+    y: int
+    z: float
+    mission_type: int = 0
+
+    @classmethod
+    def from_message(cls, msg: object) -> MissionItem:
+        """From MISSION_ITEM_INT, or legacy MISSION_ITEM (float degrees)."""
+        x, y = msg.x, msg.y  # type: ignore[attr-defined]
+        if msg.get_type() == "MISSION_ITEM":  # type: ignore[attr-defined]
+            x, y = round(x * 1e7), round(y * 1e7)
+        fields = {k: getattr(msg, k) for k in cls.__dataclass_fields__ if k not in ("x", "y")}
+        return cls(**{**fields, "x": int(x), "y": int(y)})
+
+    def as_dict(self) -> dict[str, float | int]:
+        return asdict(self)
+
+
+def check_item(item: MissionItem, count: int) -> int:
+    """MAV_MISSION_ACCEPTED, or the MAV_MISSION_RESULT that says why the item is refused."""
+    if item.command not in SUPPORTED.get(item.mission_type, frozenset()):
+        return d.MAV_MISSION_UNSUPPORTED
+    if item.command == d.MAV_CMD_DO_JUMP:
+        target = round(item.param1)
+        if not 0 <= target < count or target == item.seq:
+            return d.MAV_MISSION_INVALID_PARAM1
+        return d.MAV_MISSION_ACCEPTED
+    if item.command in POSITIONLESS:
+        return d.MAV_MISSION_ACCEPTED
+    if item.frame not in GLOBAL_FRAMES:
+        return d.MAV_MISSION_UNSUPPORTED_FRAME
+    if not -900_000_000 <= item.x <= 900_000_000:
+        return d.MAV_MISSION_INVALID_PARAM5_X
+    if not -1_800_000_000 <= item.y <= 1_800_000_000:
+        return d.MAV_MISSION_INVALID_PARAM6_Y
+    if item.x == 0 and item.y == 0 and item.command != d.MAV_CMD_NAV_TAKEOFF:
+        return d.MAV_MISSION_INVALID_PARAM5_X
+    return d.MAV_MISSION_ACCEPTED
+
+
+def check_mission(items: list[MissionItem]) -> int:
+    """The first refusal in a whole mission, or MAV_MISSION_ACCEPTED."""
+    for item in items:
+        result = check_item(item, len(items))
+        if result != d.MAV_MISSION_ACCEPTED:
+            return result
+    return d.MAV_MISSION_ACCEPTED

@@ -1,0 +1,123 @@
+"""The mission protocol state machine, driven by a pymavlink ground station in-process."""
+
+from __future__ import annotations
+
+import pytest
+
+from companion.mavlink.codec import new_encoder, new_parser
+from companion.mavlink.mission_service import MAX_RETRIES, MissionService
+from companion.mavlink.service import Peer
+from companion.mission.store import MissionStore
+from mavlink_dialect import companion as d
+
+GCS = Peer(255, 190, 0)
+OTHER = Peer(254, 190, 0)
+LAT, LON = -379105000, 1451340000
+
+
+class Bench:
+    def __init__(self, directory) -> None:
+        self.vehicle = new_encoder(1)
+        self.gcs = new_encoder(255, 190)
+        self.parser = new_parser()
+        self.directory = directory
+        self.service = MissionService(self.vehicle, MissionStore(directory), 1)
+
+    def send(self, msg, now=0.0, peer=GCS):
+        (decoded,) = self.parser.parse_buffer(msg.pack(self.gcs))
+        return [o.msg for o in self.service.handle(decoded, peer, now)]
+
+    def item(self, seq, command=d.MAV_CMD_NAV_WAYPOINT, x=LAT, y=LON, mission_type=0, p1=0.0):
+        frame = d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+        return self.gcs.mission_item_int_encode(
+            1, 1, seq, frame, command, 0, 1, p1, 0, 0, 0, x + seq * 1000, y, 100.0, mission_type
+        )
+
+    def upload(self, items, mission_type=0):
+        replies = self.send(self.gcs.mission_count_encode(1, 1, len(items), mission_type))
+        for item in items:
+            assert replies[-1].get_type() == "MISSION_REQUEST_INT"
+            assert replies[-1].seq == item.seq and replies[-1].mission_type == mission_type
+            replies = self.send(item)
+        return replies[-1]
+
+
+@pytest.fixture
+def bench(tmp_path):
+    return Bench(tmp_path)
+
+
+def test_upload_then_download_round_trip_and_it_survives_a_restart(bench):
+    items = [bench.item(i) for i in range(3)]
+    ack = bench.upload(items)
+    assert ack.get_type() == "MISSION_ACK" and ack.type == d.MAV_MISSION_ACCEPTED
+    restarted = Bench(bench.directory)
+    (count,) = restarted.send(restarted.gcs.mission_request_list_encode(1, 1, 0))
+    assert count.count == 3
+    (got,) = restarted.send(restarted.gcs.mission_request_int_encode(1, 1, 2, 0))
+    assert (got.x, got.y, got.z) == (LAT + 2000, LON, 100.0)
+    (legacy,) = restarted.send(restarted.gcs.mission_request_encode(1, 1, 1, 0))
+    assert legacy.get_type() == "MISSION_ITEM" and legacy.x == pytest.approx(-37.9104, abs=1e-6)
+
+
+def test_an_item_the_vehicle_cannot_fly_is_refused_and_the_old_mission_stays(bench):
+    bench.upload([bench.item(0)])
+    bad = [bench.item(0), bench.item(1, command=d.MAV_CMD_NAV_VTOL_TAKEOFF)]
+    assert bench.upload(bad).type == d.MAV_MISSION_UNSUPPORTED
+    jump = [bench.item(0), bench.item(1, command=d.MAV_CMD_DO_JUMP, p1=7)]
+    assert bench.upload(jump).type == d.MAV_MISSION_INVALID_PARAM1
+    nowhere = [bench.item(0, x=0, y=0)]
+    assert bench.upload(nowhere).type == d.MAV_MISSION_INVALID_PARAM5_X
+    assert len(bench.service.store.items[0]) == 1
+
+
+def test_fence_and_rally_are_separate_lists(bench):
+    fence = [
+        bench.item(i, d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION, mission_type=1)
+        for i in range(4)
+    ]
+    assert bench.upload(fence, 1).type == d.MAV_MISSION_ACCEPTED
+    rally = [bench.item(0, d.MAV_CMD_NAV_RALLY_POINT, mission_type=2)]
+    assert bench.upload(rally, 2).type == d.MAV_MISSION_ACCEPTED
+    assert bench.upload([bench.item(0, d.MAV_CMD_NAV_WAYPOINT, mission_type=2)], 2).type == (
+        d.MAV_MISSION_UNSUPPORTED
+    )
+    assert [len(bench.service.store.items[t]) for t in (0, 1, 2)] == [0, 4, 1]
+
+
+def test_interrupted_upload_retries_then_gives_up_keeping_the_old_mission(bench):
+    bench.upload([bench.item(0)])
+    bench.send(bench.gcs.mission_count_encode(1, 1, 3, 0), now=10.0)
+    bench.send(bench.item(0), now=10.1)
+    asks = []
+    for step in range(1, 20):
+        asks += [o.msg for o in bench.service.tick(10.1 + step * 0.6)]
+    requests = [m for m in asks if m.get_type() == "MISSION_REQUEST_INT"]
+    assert len(requests) == MAX_RETRIES and all(m.seq == 1 for m in requests)
+    assert asks[-1].get_type() == "MISSION_ACK"
+    assert asks[-1].type == d.MAV_MISSION_OPERATION_CANCELLED
+    assert len(bench.service.store.items[0]) == 1
+
+
+def test_huge_count_busy_transfer_and_clear(bench):
+    (ack,) = bench.send(bench.gcs.mission_count_encode(1, 1, 60000, 0))
+    assert ack.type == d.MAV_MISSION_NO_SPACE
+    bench.send(bench.gcs.mission_count_encode(1, 1, 2, 0))
+    (busy,) = bench.send(bench.gcs.mission_count_encode(1, 1, 2, 0), peer=OTHER)
+    assert busy.type == d.MAV_MISSION_DENIED
+    (restart,) = bench.send(bench.gcs.mission_count_encode(1, 1, 1, 0))
+    assert restart.get_type() == "MISSION_REQUEST_INT" and restart.seq == 0
+    bench.send(bench.item(0))
+    (cleared,) = bench.send(bench.gcs.mission_clear_all_encode(1, 1, 0))
+    assert cleared.type == d.MAV_MISSION_ACCEPTED and bench.service.store.items[0] == []
+
+
+def test_set_current_reports_mission_current(bench):
+    bench.upload([bench.item(i) for i in range(4)])
+    (current,) = bench.send(bench.gcs.mission_set_current_encode(1, 1, 2))
+    assert (current.seq, current.total) == (2, 4)
+
+
+def test_torn_mission_file_starts_empty(tmp_path):
+    (tmp_path / "mission.json").write_text('[{"seq": 0, "fra')
+    assert MissionStore(tmp_path).items[0] == []
