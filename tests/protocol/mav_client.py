@@ -11,6 +11,8 @@ os.environ.setdefault("MAVLINK20", "1")
 
 from pymavlink import mavutil
 
+from mavlink_dialect import companion as dialect
+
 
 def free_udp_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
@@ -51,6 +53,9 @@ class GroundStation:
         self.conn = mavutil.mavlink_connection(
             f"udpout:127.0.0.1:{port}", source_system=sysid, source_component=compid
         )
+        # Speak the vehicle's own dialect, so its messages (PROTOCOL_VERSION, ...) decode.
+        self.conn.mav = dialect.MAVLink(self.conn, srcSystem=sysid, srcComponent=compid)
+        self.conn.mav.robust_parsing = True
         self.mav = self.conn.mav
 
     def heartbeat(self) -> None:
