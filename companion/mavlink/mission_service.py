@@ -74,7 +74,8 @@ class MissionService:
         return Outgoing(msg, peer)
 
     def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
-        if msg.target_system != self.sysid or msg.target_component not in (0, self.compid):
+        # Broadcasts count too: MAVProxy addresses sysid 0 until it has heard a heartbeat.
+        if msg.target_system not in (0, self.sysid) or msg.target_component not in (0, self.compid):
             return []
         mission_type = getattr(msg, "mission_type", 0)
         if mission_type not in MISSION_TYPES:

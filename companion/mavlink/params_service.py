@@ -48,7 +48,8 @@ class ParamsService:
         self.refused = 0
 
     def _for_us(self, msg: Any) -> bool:
-        return msg.target_system == self.sysid and msg.target_component in (0, self.compid)
+        targets = (0, self.sysid)  # broadcasts included, as for missions
+        return msg.target_system in targets and msg.target_component in (0, self.compid)
 
     def value(self, index: int) -> Any:
         name = self.store.names[index]

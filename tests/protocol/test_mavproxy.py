@@ -1,0 +1,88 @@
+"""MAVProxy, run non-interactively, fetches parameters, loads waypoints and arms."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.protocol.mav_client import free_udp_port
+from tests.support.vehicle import wait_for
+
+VEHICLE = """
+[vehicle]
+name = "mavproxy"
+state_dir = "{state}"
+
+[[plugins]]
+name = "link"
+plugin = "link.mavlink"
+settings = {{ endpoints = ["udpin://127.0.0.1:{port}"] }}
+
+[[plugins]]
+name = "nav"
+plugin = "tests.support.plugins:FakeNav"
+
+[[plugins]]
+name = "flight"
+plugin = "tests.support.plugins:Waiting"
+group = "flight"
+"""
+WAYPOINTS = """QGC WPL 110
+0\t1\t0\t16\t0\t0\t0\t0\t-37.9105\t145.1340\t100\t1
+1\t0\t3\t16\t0\t0\t0\t0\t-37.9100\t145.1340\t100\t1
+2\t0\t3\t16\t0\t0\t0\t0\t-37.9100\t145.1350\t100\t1
+"""
+
+
+@pytest.mark.timeout(120)
+def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
+    mavproxy = Path(sys.executable).parent / "mavproxy.py"
+    assert mavproxy.exists() or shutil.which("mavproxy.py"), "MAVProxy is a dev dependency"
+    port = free_udp_port()
+    vehicle = vehicle_factory(VEHICLE.format(port=port, state=tmp_path / "state"))
+    vehicle.wait_running("link")
+    wp = tmp_path / "wp.txt"
+    wp.write_text(WAYPOINTS)
+    # MAVProxy's --cmd runs before it has heard the vehicle (and then resets its waypoint
+    # loader when the vehicle comes online), so commands are typed once it is connected.
+    proc = subprocess.Popen(
+        [sys.executable, str(mavproxy), f"--master=udpout:127.0.0.1:{port}"],
+        cwd=tmp_path,
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    mission = tmp_path / "state" / "missions" / "mission.json"
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)
+    reader.start()
+    try:
+        wait_for(lambda: vehicle.row("link").frames_ok > 20, 30, "MAVProxy connected")
+        time.sleep(2.0)
+        for line in ("param fetch", f"wp load {wp}", "arm throttle"):
+            proc.stdin.write(line + "\n")
+            proc.stdin.flush()
+        wait_for(lambda: vehicle.row("flight").pid, 30, "MAVProxy's arm to start the flight group")
+        wait_for(mission.exists, 20, "the uploaded mission stored")
+        # MAVProxy tries MAVLink FTP first (the vehicle does not offer it), then the protocol.
+        wait_for(lambda: any("Received 3 parameters" in x for x in lines), 30, "param fetch")
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            proc.kill()  # MAVProxy's own threads can ignore SIGTERM while stdin is open
+            proc.wait(timeout=5)
+        reader.join(timeout=5)
+    output = "".join(lines)
+    assert "Received 3 parameters" in output
+    assert "COMPONENT_ARM_DISARM: ACCEPTED" in output
+    assert len(json.loads(mission.read_text())) == 3
