@@ -157,6 +157,60 @@ def params_load(
     out.print(f"{count} parameters loaded from {file} into {store.path}")
 
 
+mission_app = typer.Typer(help="Missions in QGroundControl .plan files (vehicle stopped).")
+app.add_typer(mission_app, name="mission")
+
+
+def _mission_store(config: Path):
+    from companion.mission.store import MissionStore
+
+    cfg = _load_checked(config, None)
+    return MissionStore(Path(cfg.vehicle["state_dir"]) / "missions")
+
+
+@mission_app.command("load")
+def mission_load(
+    plan: Annotated[Path, typer.Argument(help=".plan file to store as the vehicle's mission")],
+    config: Annotated[Path, CONFIG_OPT],
+) -> None:
+    """Check a .plan (mission, fence, rally) and store it; all or nothing."""
+    from companion.mission.items import check_mission
+    from companion.mission.plan import PlanError, load_plan
+    from mavlink_dialect import companion as mav
+
+    store = _mission_store(config)
+    try:
+        lists = load_plan(plan)
+    except PlanError as exc:
+        err.print(f"[red]plan error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+    for mission_type, items in lists.items():
+        result = check_mission(items)
+        if result != mav.MAV_MISSION_ACCEPTED:
+            name = mav.enums["MAV_MISSION_RESULT"][result].name
+            err.print(f"{plan}: mission type {mission_type} refused: {name}", soft_wrap=True)
+            raise typer.Exit(EXIT_CONFIG)
+    for mission_type, items in lists.items():
+        store.replace(mission_type, items)
+    counts = ", ".join(
+        f"{len(v)} {k}" for k, v in zip(("mission", "fence", "rally"), lists.values(), strict=False)
+    )
+    out.print(f"stored {counts} items from {plan}")
+
+
+@mission_app.command("save")
+def mission_save(
+    plan: Annotated[Path, typer.Argument(help=".plan file to write")],
+    config: Annotated[Path, CONFIG_OPT],
+) -> None:
+    """Write the vehicle's stored mission and rally points as a .plan file."""
+    from companion.mission.plan import save_plan
+
+    store = _mission_store(config)
+    save_plan(plan, store.items)
+    out.print(f"{len(store.items[0])} mission items written to {plan}")
+
+
 def main() -> None:
     """Console-script entry point."""
     app()

@@ -119,3 +119,34 @@ def test_mavsdk_mission_raw_upload_and_download(vehicle_factory, tmp_path):
         (i.seq, i.command, i.x, i.y) for i in items
     ]
     assert (tmp_path / "missions" / "mission.json").exists()
+
+
+async def _import_and_upload(port: int, plan: str) -> tuple[int, int, int, int]:
+    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
+    async with Mavsdk(config) as mavsdk:
+        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
+        system = await mavsdk.first_autopilot(timeout_s=15.0)
+        mission = MissionRawAsync(system)
+        data = await mission.import_qgroundcontrol_mission(plan)
+        await mission.upload_mission(data.mission_items)
+        if data.geofence_items:
+            await mission.upload_geofence(data.geofence_items)
+        if data.rally_items:
+            await mission.upload_rally_points(data.rally_items)
+        back = await mission.download_mission()
+        return len(data.mission_items), len(back), len(data.geofence_items), len(data.rally_items)
+
+
+@pytest.mark.timeout(120)
+def test_mavsdk_imports_the_shipped_square_plan_and_uploads_it(vehicle_factory, tmp_path):
+    from tests.support.vehicle import REPO
+
+    port = free_udp_port()
+    vehicle = vehicle_factory(VEHICLE.format(port=port, state=tmp_path))
+    vehicle.wait_running("link")
+    plan = str(REPO / "qgc_plans" / "square.plan")
+    sent, back, fence, rally = asyncio.run(_import_and_upload(port, plan))
+    assert sent == back >= 6
+    assert (fence, rally) == (4, 1)
+    stored = tmp_path / "missions"
+    assert (stored / "fence.json").exists() and (stored / "rally.json").exists()
