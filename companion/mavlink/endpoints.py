@@ -244,6 +244,7 @@ def parse_serial_url(url: str) -> tuple[str, int]:
 
 
 DEFAULT_NETWORK_BYTES_S = 1_000_000.0
+SERIAL_SHARE = 0.8
 SCHEMES = frozenset({"udpout", "udpin", "tcpin", "serial"})
 
 
@@ -299,5 +300,7 @@ def default_budget(endpoint: Endpoint) -> float:
     if endpoint.options.budget_bytes_s is not None:
         return endpoint.options.budget_bytes_s
     if isinstance(endpoint, SerialEndpoint):
-        return endpoint.baud / 10.0  # 8N1: ten bits a byte
+        # 8N1 is ten bits a byte; keep a fifth of the wire free so the radio's buffer
+        # drains and acknowledgements never wait behind a backlog.
+        return endpoint.baud / 10.0 * SERIAL_SHARE
     return DEFAULT_NETWORK_BYTES_S

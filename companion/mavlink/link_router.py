@@ -8,6 +8,7 @@ forwarded and handled. Replies go to the endpoint of the peer that asked.
 from __future__ import annotations
 
 import logging
+import struct
 from dataclasses import dataclass
 from typing import Any
 
@@ -28,6 +29,7 @@ class LinkCounters:
     bad: int = 0  # CRC failures, truncated frames, garbage
     forwarded: int = 0
     foreign: int = 0  # addressed to another system
+    stream_errors: int = 0  # telemetry samples that could not be encoded
 
 
 class LinkRouter:
@@ -121,16 +123,17 @@ class LinkRouter:
                 endpoint.send(raw)
                 self.counters.forwarded += 1
 
-    def _emit(self, index: int, raw: bytes, priority: bool, now_s: float) -> None:
+    def _emit(self, index: int, raw: bytes, priority: bool, now_s: float) -> bool:
         budget = self.budgets[index]
         if priority:
             budget.take_priority(len(raw), now_s)
         elif not budget.take_telemetry(len(raw), now_s):
-            return
+            return False
         self.endpoints[index].send(raw)
         tlog = self.tlogs[index]
         if tlog is not None:
             tlog.write(raw)
+        return True
 
     def send(self, out: list[Outgoing], now_s: float) -> None:
         """Frame and send; telemetry only where the endpoint's budget allows."""
@@ -156,9 +159,23 @@ class LinkRouter:
             if not endpoint.has_remote():
                 continue
             for msg_id in self.schedules[index].due(now_s):
-                msg = STREAMS[msg_id].build(self.mav, snapshot)
-                if msg is not None:
-                    self.send([Outgoing(msg, Peer(0, 0, index), priority=False)], now_s)
+                try:
+                    msg = STREAMS[msg_id].build(self.mav, snapshot)
+                    if msg is not None:
+                        msg.pack(self.mav)  # values out of a field's range raise here
+                except (ValueError, OverflowError, struct.error) as exc:
+                    self.counters.stream_errors += 1
+                    log.debug("stream %s: %s", STREAMS[msg_id].name, exc)
+                    continue
+                if msg is not None and self._emit_telemetry(index, msg, now_s):
+                    self.schedules[index].mark_sent(msg_id, now_s)
+
+    def _emit_telemetry(self, index: int, msg: Any, now_s: float) -> bool:
+        packer = self.packers[index]
+        packer.seq = self.mav.seq
+        raw = msg.pack(packer)
+        self.mav.seq = (self.mav.seq + 1) % 256
+        return self._emit(index, raw, False, now_s)
 
     def next_due(self) -> float:
         times = [s.next_time() for s in self.schedules]

@@ -38,18 +38,32 @@ def _finite(x: float, fallback: float = 0.0) -> float:
     return x if math.isfinite(x) else fallback
 
 
+def _int16(x: float) -> int:
+    """Saturate to an int16 field (a sensor beyond its range must not break the link)."""
+    return max(-32768, min(32767, round(_finite(x))))
+
+
+def _int32(x: float) -> int:
+    return max(-(2**31), min(2**31 - 1, round(_finite(x))))
+
+
+def _f32(x: float) -> float:
+    """Keep a value inside float32 (NaN stays NaN: MAVLink's 'unknown')."""
+    return x if math.isnan(x) else max(-3.0e38, min(3.0e38, x))
+
+
 def _attitude(mav: Any, s: Snapshot) -> Any:
     n = s.nav
     if n is None or not n.flags & NavFlags.ATTITUDE_VALID:
         return None
     return mav.attitude_encode(
         s.time_boot_ms,
-        n.roll_rad,
-        n.pitch_rad,
-        n.yaw_rad,
-        _finite(n.roll_rate_rad_s),
-        _finite(n.pitch_rate_rad_s),
-        _finite(n.yaw_rate_rad_s),
+        _f32(n.roll_rad),
+        _f32(n.pitch_rad),
+        _f32(n.yaw_rad),
+        _f32(_finite(n.roll_rate_rad_s)),
+        _f32(_finite(n.pitch_rate_rad_s)),
+        _f32(_finite(n.yaw_rate_rad_s)),
     )
 
 
@@ -57,8 +71,10 @@ def _attitude_quaternion(mav: Any, s: Snapshot) -> Any:
     n = s.nav
     if n is None or not n.flags & NavFlags.ATTITUDE_VALID:
         return None
-    q = list(n.q)
-    rates = (_finite(n.roll_rate_rad_s), _finite(n.pitch_rate_rad_s), _finite(n.yaw_rate_rad_s))
+    q = [_f32(v) for v in n.q]
+    rates = tuple(
+        _f32(_finite(r)) for r in (n.roll_rate_rad_s, n.pitch_rate_rad_s, n.yaw_rate_rad_s)
+    )
     return mav.attitude_quaternion_encode(s.time_boot_ms, *q, *rates, [0.0] * 4)
 
 
@@ -67,16 +83,16 @@ def _global_position(mav: Any, s: Snapshot) -> Any:
     if n is None or not n.flags & NavFlags.POSITION_VALID:
         return None
     rel = n.alt_msl_m - s.home_alt_m if math.isfinite(s.home_alt_m) else 0.0
-    heading = math.degrees(n.yaw_rad) % 360.0
+    heading = math.degrees(_finite(n.yaw_rad)) % 360.0
     return mav.global_position_int_encode(
         s.time_boot_ms,
-        round(n.lat_deg * 1e7),
-        round(n.lon_deg * 1e7),
-        round(n.alt_msl_m * 1000),
-        round(rel * 1000),
-        round(_finite(n.vn_m_s) * 100),
-        round(_finite(n.ve_m_s) * 100),
-        round(_finite(n.vd_m_s) * 100),
+        _int32(n.lat_deg * 1e7),
+        _int32(n.lon_deg * 1e7),
+        _int32(n.alt_msl_m * 1000),
+        _int32(rel * 1000),
+        _int16(_finite(n.vn_m_s) * 100),
+        _int16(_finite(n.ve_m_s) * 100),
+        _int16(_finite(n.vd_m_s) * 100),
         round(heading * 100) % 36000,
     )
 
@@ -87,7 +103,10 @@ def _gps_raw(mav: Any, s: Snapshot) -> Any:
         return mav.gps_raw_int_encode(
             s.time_boot_ms * 1000, d.GPS_FIX_TYPE_NO_GPS, 0, 0, 0, 65535, 65535, 65535, 65535, 255
         )
-    dop = lambda v: 65535 if not math.isfinite(v) else min(65534, round(v * 100))  # noqa: E731
+
+    def u16(v: float, scale: float) -> int:
+        return 65535 if not math.isfinite(v) else max(0, min(65534, round(v * scale)))
+
     cog = (
         65535
         if not math.isfinite(g.course_rad)
@@ -96,12 +115,12 @@ def _gps_raw(mav: Any, s: Snapshot) -> Any:
     return mav.gps_raw_int_encode(
         g.t_us,
         g.fix_type,
-        round(g.lat_deg * 1e7),
-        round(g.lon_deg * 1e7),
-        round(_finite(g.alt_msl_m) * 1000),
-        dop(g.hdop),
-        dop(g.vdop),
-        65535 if not math.isfinite(g.ground_speed_m_s) else round(g.ground_speed_m_s * 100),
+        _int32(g.lat_deg * 1e7),
+        _int32(g.lon_deg * 1e7),
+        _int32(_finite(g.alt_msl_m) * 1000),
+        u16(g.hdop, 100),
+        u16(g.vdop, 100),
+        u16(g.ground_speed_m_s, 100),
         cog,
         g.satellites,
     )
@@ -111,12 +130,11 @@ def _vfr_hud(mav: Any, s: Snapshot) -> Any:
     n = s.nav
     if n is None:
         return None
-    ground = math.hypot(_finite(n.vn_m_s), _finite(n.ve_m_s))
-    heading = round(math.degrees(n.yaw_rad)) % 360
+    ground = _f32(math.hypot(_finite(n.vn_m_s), _finite(n.ve_m_s)))
+    heading = round(math.degrees(_finite(n.yaw_rad))) % 360
     throttle = 0
-    return mav.vfr_hud_encode(
-        ground, ground, heading, throttle, _finite(n.alt_msl_m), -_finite(n.vd_m_s)
-    )
+    alt, climb = _f32(_finite(n.alt_msl_m)), _f32(-_finite(n.vd_m_s))
+    return mav.vfr_hud_encode(ground, ground, heading, throttle, alt, climb)
 
 
 def _sys_status(mav: Any, s: Snapshot) -> Any:
@@ -160,8 +178,8 @@ def _scaled_imu(mav: Any, s: Snapshot) -> Any:
     i = s.imu
     if i is None:
         return None
-    mg = lambda a: round(a / 9.80665 * 1000)  # noqa: E731
-    mrad = lambda w: round(w * 1000)  # noqa: E731
+    mg = lambda a: _int16(a / 9.80665 * 1000)  # noqa: E731
+    mrad = lambda w: _int16(w * 1000)  # noqa: E731
     return mav.scaled_imu_encode(
         s.time_boot_ms,
         mg(i.ax_m_s2),
@@ -225,6 +243,7 @@ class StreamSchedule:
             mid: (1.0 / s.default_hz if s.default_hz > 0 else 0.0) for mid, s in STREAMS.items()
         }
         self.next_due = dict.fromkeys(STREAMS, 0.0)
+        self.last_sent = dict.fromkeys(STREAMS, 0.0)
 
     def set_interval(self, msg_id: int, interval_us: float) -> bool:
         """MAV_CMD_SET_MESSAGE_INTERVAL semantics: -1 off, 0 default, else µs."""
@@ -248,13 +267,20 @@ class StreamSchedule:
         return -1 if period <= 0 else round(period * 1e6)
 
     def due(self, now_s: float) -> list[int]:
-        """The streams to send now; schedules their next time."""
+        """The streams to send now, least recently sent first; schedules their next time.
+
+        When the link's budget cannot carry every stream, the ones it had to skip come
+        first next time, so a fast stream cannot starve the slow ones.
+        """
         out = []
         for mid, period in self.period_s.items():
             if period > 0 and now_s >= self.next_due[mid]:
                 out.append(mid)
                 self.next_due[mid] = max(self.next_due[mid] + period, now_s - period)
-        return out
+        return sorted(out, key=self.last_sent.__getitem__)
+
+    def mark_sent(self, msg_id: int, now_s: float) -> None:
+        self.last_sent[msg_id] = now_s
 
     def next_time(self) -> float:
         times = [self.next_due[m] for m, p in self.period_s.items() if p > 0]
