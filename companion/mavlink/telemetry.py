@@ -43,6 +43,11 @@ def _int16(x: float) -> int:
     return max(-32768, min(32767, round(_finite(x))))
 
 
+def _deg360(rad: float) -> float:
+    """An angle in degrees within [0, 360); 0 for values that are not finite."""
+    return _finite(math.degrees(_finite(rad)) % 360.0) % 360.0
+
+
 def _int32(x: float) -> int:
     return max(-(2**31), min(2**31 - 1, round(_finite(x))))
 
@@ -83,7 +88,7 @@ def _global_position(mav: Any, s: Snapshot) -> Any:
     if n is None or not n.flags & NavFlags.POSITION_VALID:
         return None
     rel = n.alt_msl_m - s.home_alt_m if math.isfinite(s.home_alt_m) else 0.0
-    heading = math.degrees(_finite(n.yaw_rad)) % 360.0
+    heading = _deg360(n.yaw_rad)
     return mav.global_position_int_encode(
         s.time_boot_ms,
         _int32(n.lat_deg * 1e7),
@@ -105,13 +110,10 @@ def _gps_raw(mav: Any, s: Snapshot) -> Any:
         )
 
     def u16(v: float, scale: float) -> int:
-        return 65535 if not math.isfinite(v) else max(0, min(65534, round(v * scale)))
+        x = v * scale
+        return 65535 if not math.isfinite(x) else max(0, min(65534, round(x)))
 
-    cog = (
-        65535
-        if not math.isfinite(g.course_rad)
-        else round(math.degrees(g.course_rad) * 100) % 36000
-    )
+    cog = 65535 if not math.isfinite(g.course_rad) else round(_deg360(g.course_rad) * 100) % 36000
     return mav.gps_raw_int_encode(
         g.t_us,
         g.fix_type,
@@ -131,7 +133,7 @@ def _vfr_hud(mav: Any, s: Snapshot) -> Any:
     if n is None:
         return None
     ground = _f32(math.hypot(_finite(n.vn_m_s), _finite(n.ve_m_s)))
-    heading = round(math.degrees(_finite(n.yaw_rad))) % 360
+    heading = round(_deg360(n.yaw_rad)) % 360
     throttle = 0
     alt, climb = _f32(_finite(n.alt_msl_m)), _f32(-_finite(n.vd_m_s))
     return mav.vfr_hud_encode(ground, ground, heading, throttle, alt, climb)
