@@ -167,8 +167,13 @@ class LinkRouter:
                     self.counters.stream_errors += 1
                     log.debug("stream %s: %s", STREAMS[msg_id].name, exc)
                     continue
-                if msg is not None and self._emit_telemetry(index, msg, now_s):
-                    self.schedules[index].mark_sent(msg_id, now_s)
+                if msg is None:
+                    continue
+                if not self._emit_telemetry(index, msg, now_s):
+                    # Out of budget: stop here rather than let smaller, younger streams slip
+                    # past, or a large frame would never find enough budget left for it.
+                    break
+                self.schedules[index].mark_sent(msg_id, now_s)
 
     def _emit_telemetry(self, index: int, msg: Any, now_s: float) -> bool:
         packer = self.packers[index]
