@@ -46,6 +46,32 @@ group = "flight"
 """
 
 
+CLIENT_VEHICLE = """
+[vehicle]
+name = "client"
+state_dir = "{state}"
+
+[[plugins]]
+name = "link"
+plugin = "link.mavlink"
+settings = {{ endpoints = ["{endpoint}"] }}
+
+[[plugins]]
+name = "nav"
+plugin = "tests.support.plugins:FakeNav"
+
+[[plugins]]
+name = "flight"
+plugin = "tests.support.plugins:Waiting"
+group = "flight"
+"""
+
+
+def client_vehicle(endpoint: str, state: object) -> str:
+    """A vehicle with the link on ``endpoint``, a known navigation solution, a flight group."""
+    return CLIENT_VEHICLE.format(endpoint=endpoint, state=state)
+
+
 class GroundStation:
     """QGroundControl's identity (sysid 255, compid 190) speaking to the vehicle's udpin."""
 

@@ -12,28 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from tests.protocol.mav_client import free_udp_port
+from tests.protocol.mav_client import client_vehicle, free_udp_port
 from tests.support.vehicle import wait_for
 
-VEHICLE = """
-[vehicle]
-name = "mavproxy"
-state_dir = "{state}"
-
-[[plugins]]
-name = "link"
-plugin = "link.mavlink"
-settings = {{ endpoints = ["udpin://127.0.0.1:{port}"] }}
-
-[[plugins]]
-name = "nav"
-plugin = "tests.support.plugins:FakeNav"
-
-[[plugins]]
-name = "flight"
-plugin = "tests.support.plugins:Waiting"
-group = "flight"
-"""
 WAYPOINTS = """QGC WPL 110
 0\t1\t0\t16\t0\t0\t0\t0\t-37.9105\t145.1340\t100\t1
 1\t0\t3\t16\t0\t0\t0\t0\t-37.9100\t145.1340\t100\t1
@@ -46,7 +27,7 @@ def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
     mavproxy = Path(sys.executable).parent / "mavproxy.py"
     assert mavproxy.exists() or shutil.which("mavproxy.py"), "MAVProxy is a dev dependency"
     port = free_udp_port()
-    vehicle = vehicle_factory(VEHICLE.format(port=port, state=tmp_path / "state"))
+    vehicle = vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path / "state"))
     vehicle.wait_running("link")
     wp = tmp_path / "wp.txt"
     wp.write_text(WAYPOINTS)

@@ -12,29 +12,9 @@ from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
 from mavsdk.component_type import ComponentType
 from mavsdk.plugins.mission_raw import MissionItem
 
-from tests.protocol.mav_client import free_udp_port
+from tests.protocol.mav_client import client_vehicle, free_udp_port
 from tests.support.plugins import FakeNav
 from tests.support.vehicle import wait_for
-
-VEHICLE = """
-[vehicle]
-name = "mavsdk"
-state_dir = "{state}"
-
-[[plugins]]
-name = "link"
-plugin = "link.mavlink"
-settings = {{ endpoints = ["udpout://127.0.0.1:{port}"] }}
-
-[[plugins]]
-name = "nav"
-plugin = "tests.support.plugins:FakeNav"
-
-[[plugins]]
-name = "flight"
-plugin = "tests.support.plugins:Waiting"
-group = "flight"
-"""
 
 
 async def _first(gen, predicate=lambda _v: True):
@@ -63,7 +43,7 @@ async def _session(port: int, vehicle) -> dict:
 @pytest.mark.timeout(120)
 def test_mavsdk_sees_position_and_can_arm_and_disarm(vehicle_factory, tmp_path):
     port = free_udp_port()
-    vehicle = vehicle_factory(VEHICLE.format(port=port, state=tmp_path))
+    vehicle = vehicle_factory(client_vehicle(f"udpout://127.0.0.1:{port}", tmp_path))
     vehicle.wait_running("link")
     result = asyncio.run(_session(port, vehicle))
     pos = result["position"]
@@ -111,7 +91,7 @@ async def _mission_session(port: int, items: list[MissionItem]) -> list:
 @pytest.mark.timeout(120)
 def test_mavsdk_mission_raw_upload_and_download(vehicle_factory, tmp_path):
     port = free_udp_port()
-    vehicle = vehicle_factory(VEHICLE.format(port=port, state=tmp_path))
+    vehicle = vehicle_factory(client_vehicle(f"udpout://127.0.0.1:{port}", tmp_path))
     vehicle.wait_running("link")
     items = _raw_items(50)
     got = asyncio.run(_mission_session(port, items))
@@ -142,7 +122,7 @@ def test_mavsdk_imports_the_shipped_square_plan_and_uploads_it(vehicle_factory, 
     from tests.support.vehicle import REPO
 
     port = free_udp_port()
-    vehicle = vehicle_factory(VEHICLE.format(port=port, state=tmp_path))
+    vehicle = vehicle_factory(client_vehicle(f"udpout://127.0.0.1:{port}", tmp_path))
     vehicle.wait_running("link")
     plan = str(REPO / "qgc_plans" / "square.plan")
     sent, back, fence, rally = asyncio.run(_import_and_upload(port, plan))
