@@ -29,6 +29,8 @@ class Snapshot:
     home_alt_m: float = math.nan
     mission_seq: int = 0
     mission_total: int = 0
+    home: tuple[float, float, float] | None = None  # lat_deg, lon_deg, alt_msl_m
+    health_cursor: int = 0  # PLUGIN_HEALTH sends one row at a time, round the table
 
 
 Builder = Callable[[Any, Snapshot], Any]
@@ -209,6 +211,63 @@ def _mission_current(mav: Any, s: Snapshot) -> Any:
     return mav.mission_current_encode(s.mission_seq, s.mission_total, state)
 
 
+def _home_position(mav: Any, s: Snapshot) -> Any:
+    if s.home is None:
+        return None
+    lat, lon, alt = s.home
+    q = [1.0, 0.0, 0.0, 0.0]
+    return mav.home_position_encode(
+        _int32(lat * 1e7), _int32(lon * 1e7), _int32(alt * 1000), 0, 0, 0, q, 0, 0, 0
+    )
+
+
+def _u32(x: int) -> int:
+    return max(0, min(2**32 - 1, int(x)))
+
+
+def _plugin_health(mav: Any, s: Snapshot) -> Any:
+    rows = s.health.rows() if s.health is not None else []
+    if not rows:
+        return None
+    index = s.health_cursor % len(rows)
+    s.health_cursor = index + 1
+    r = rows[index]
+    return mav.plugin_health_encode(
+        s.time_boot_ms,
+        _u32(r.pid),
+        _u32(r.restarts),
+        _u32(r.frames_ok),
+        _u32(r.frames_bad),
+        _u32(r.dropped),
+        _f32(_finite(r.cpu_pct)),
+        _f32(_finite(r.step_p99_us)),
+        index,
+        len(rows),
+        r.state,
+        r.name[:24],
+    )
+
+
+def _navigator_name(s: Snapshot) -> bytes:
+    for row in s.health.rows() if s.health is not None else []:
+        if row.kind.startswith(b"nav."):
+            return row.kind[4:20]
+    return b""
+
+
+def _nav_status(mav: Any, s: Snapshot) -> Any:
+    n = s.nav
+    if n is None:
+        return None
+    std = [
+        [_f32(_finite(v, math.nan)) for v in arr]
+        for arr in (n.pos_std_m, n.vel_std_m_s, n.att_std_rad)
+    ]
+    return mav.nav_status_encode(
+        s.time_boot_ms, n.flags, n.gps_rejected, n.heading_rejected, *std, 0.0, _navigator_name(s)
+    )
+
+
 @dataclass(frozen=True)
 class Stream:
     name: str
@@ -233,6 +292,9 @@ STREAMS: dict[int, Stream] = {
         Stream("SCALED_IMU", d.MAVLINK_MSG_ID_SCALED_IMU, 2.0, _scaled_imu),
         Stream("EXTENDED_SYS_STATE", d.MAVLINK_MSG_ID_EXTENDED_SYS_STATE, 1.0, _extended_sys_state),
         Stream("MISSION_CURRENT", d.MAVLINK_MSG_ID_MISSION_CURRENT, 1.0, _mission_current),
+        Stream("HOME_POSITION", d.MAVLINK_MSG_ID_HOME_POSITION, 0.2, _home_position),
+        Stream("PLUGIN_HEALTH", d.MAVLINK_MSG_ID_PLUGIN_HEALTH, 2.0, _plugin_health),
+        Stream("NAV_STATUS", d.MAVLINK_MSG_ID_NAV_STATUS, 1.0, _nav_status),
     )
 }
 

@@ -115,3 +115,21 @@ def test_garbage_and_bad_crc_are_counted_and_the_link_survives(link):
     gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AUTOPILOT_VERSION)
     assert gcs.ack(m.MAV_CMD_REQUEST_MESSAGE).result == m.MAV_RESULT_ACCEPTED
     assert gcs.recv("AUTOPILOT_VERSION").capabilities != 0
+
+
+def test_home_position_plugin_health_and_nav_status(link):
+    vehicle, gcs, _ = link
+    gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_HOME_POSITION)
+    assert gcs.ack(m.MAV_CMD_REQUEST_MESSAGE).result == m.MAV_RESULT_ACCEPTED
+    home = gcs.recv("HOME_POSITION")
+    assert (home.latitude, home.longitude) == (round(FakeNav.LAT * 1e7), round(FakeNav.LON * 1e7))
+    names = set()
+    deadline = time.monotonic() + 6
+    while len(names) < 4 and time.monotonic() < deadline:
+        row = gcs.conn.recv_match(type="PLUGIN_HEALTH", blocking=True, timeout=0.5)
+        if row is not None:
+            names.add(row.name)
+            assert row.count == 4
+    assert names == {"link", "nav", "imu", "relay_in_flight"}
+    nav = gcs.recv("NAV_STATUS")
+    assert nav.flags & 8  # POSITION_VALID, from the bus

@@ -33,7 +33,7 @@ from companion.mavlink.service import Outgoing
 from companion.mavlink.signing import key_from
 from companion.mavlink.telemetry import Snapshot
 from companion.mavlink.timesync import TimesyncService
-from companion.messages import VehicleCommand
+from companion.messages import NavFlags, VehicleCommand
 from companion.mission.store import MissionStore
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
@@ -173,6 +173,11 @@ class MavlinkLink(Plugin):
                 pass
             if latest is not None:
                 setattr(s, key, latest)
+        if s.home is None and s.nav is not None and s.nav.flags & NavFlags.POSITION_VALID:
+            # Home is where the first valid position was (ArduPilot and PX4 do the same
+            # at the first fix when disarmed).
+            s.home = (s.nav.lat_deg, s.nav.lon_deg, s.nav.alt_msl_m)
+            s.home_alt_m = s.nav.alt_msl_m
         s.mission_seq = self.missions.current
         s.mission_total = len(self.missions.store.items[0])
         s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
