@@ -118,7 +118,7 @@ def test_garbage_and_bad_crc_are_counted_and_the_link_survives(link):
 
 
 def test_home_position_plugin_health_and_nav_status(link):
-    vehicle, gcs, _ = link
+    _, gcs, _ = link
     gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_HOME_POSITION)
     assert gcs.ack(m.MAV_CMD_REQUEST_MESSAGE).result == m.MAV_RESULT_ACCEPTED
     home = gcs.recv("HOME_POSITION")
