@@ -1,0 +1,1 @@
+"""Device plug-ins that publish raw sensor readings."""

@@ -1,0 +1,73 @@
+"""``sensors.replay``: play a recorded sensor log onto the sensor channels.
+
+Each sample keeps the log's time stamp (``t_us``), so the navigators downstream run as
+they would have in the air. ``speed`` 1 plays in real time, N plays N times faster, 0 as
+fast as the process can publish. The wait between samples stands in for a device read.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+from companion.messages import Message
+from companion.plugin import Plugin, PluginContext, Setting
+from companion.sensorlog import CHANNEL_OF, LogStats, read_sensor_log
+
+
+class ReplaySensors(Plugin):
+    """Publishes a sensor log's samples on sensors/imu, gps, mag, baro and compass."""
+
+    settings = {
+        "file": Setting(str, doc="sensor log CSV (the design's format)"),
+        "speed": Setting(float, 1.0, "1 real time, N faster, 0 as fast as possible", min=0.0),
+        "loop": Setting(bool, False, "start again at the end"),
+    }
+    outputs = tuple(CHANNEL_OF.values())
+
+    @classmethod
+    def validate(cls, settings: dict) -> list[str]:  # type: ignore[override]
+        path = Path(settings["file"]).expanduser()
+        return [] if path.is_file() else [f"sensor log {path} does not exist"]
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.path = Path(ctx.settings["file"]).expanduser()
+        self.writers = {kind: ctx.bus.writer(name) for kind, name in CHANNEL_OF.items()}
+        self._pace = threading.Event()
+        self._restart()
+
+    def _restart(self) -> None:
+        self.stats = LogStats()
+        self.samples: Iterator[Message] = read_sensor_log(self.path, self.stats)
+        self.t0_log: int | None = None
+        self.t0_wall = time.monotonic()
+
+    def step(self) -> None:
+        msg = next(self.samples, None)
+        if msg is None:
+            self.ctx.health.frames_bad = self.stats.bad
+            if self.ctx.settings["loop"]:
+                self._restart()
+            else:
+                with self.ctx.bus.idle:  # the log is over: wait quietly until stopped
+                    self._pace.wait(0.5)
+            return
+        self._wait_until(msg.t_us)
+        self.writers[type(msg)].publish(msg)
+        self.ctx.health.ok()
+        self.ctx.health.frames_bad = self.stats.bad
+
+    def _wait_until(self, t_us: int) -> None:
+        speed = self.ctx.settings["speed"]
+        if self.t0_log is None:
+            self.t0_log = t_us
+        if speed <= 0:
+            return
+        due = self.t0_wall + (t_us - self.t0_log) / 1e6 / speed
+        delay = due - time.monotonic()
+        if delay > 0:
+            with self.ctx.bus.idle:
+                self._pace.wait(delay)
