@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import math
+
+import pytest
+
 from companion.messages import CommandId, VehicleCommand
 from tests.support.vehicle import wait_for
 
@@ -53,3 +57,41 @@ def test_replay_publishes_every_sample_in_order_with_log_times(vehicle_factory, 
     assert len(got_gps) == ROWS // 10 and got_gps[1].lon_deg == 145.1341
     assert imu.lost == 0
     wait_for(lambda: vehicle.row("replay").frames_bad == 1, 5, "the bogus row counted")
+
+
+def test_replayed_gps_and_compass_reach_nav_state_through_gps_compass(vehicle_factory, tmp_path):
+    log = tmp_path / "flight.csv"
+    header = "t,kind,ax,ay,az,gx,gy,gz,lat,lon,alt_m,vn,ve,vd,fix,hdop,mx,my,mz,baro_alt_m,"
+    lines = [header + "heading_deg,pitch_deg,roll_deg"]
+    for i in range(100):
+        t = i * 0.05
+        if i % 4 == 0:
+            lat = -37.91 + 20.0 * t / 111_320.0
+            lines.append(f"{t:.2f},gps,,,,,,,{lat:.8f},145.134,100,20,0,,3,0.8,,,,,,,")
+        lines.append(f"{t:.2f},compass,,,,,,,,,,,,,,,,,,,5.0,1.0,-2.0")
+    log.write_text("\n".join(lines) + "\n")
+    vehicle = vehicle_factory(
+        f"""
+        [vehicle]
+        name = "navchain"
+        [[plugins]]
+        name = "nav"
+        plugin = "nav.gps_compass"
+        [[plugins]]
+        name = "replay"
+        plugin = "sensors.replay"
+        group = "flight"
+        settings = {{ file = "{log}", speed = 2.0 }}
+        """
+    )
+    nav = vehicle.bus.latest_reader("nav/state")
+    vehicle.wait_running("nav")
+    vehicle.bus.writer("link/commands").publish(
+        VehicleCommand(t_us=0, seq=1, command=int(CommandId.START))
+    )
+    state = wait_for(
+        lambda: (s := nav.wait(0.2)) is not None and s.t_us >= 4_800_000 and s, 15, "the end"
+    )
+    assert state.lat_deg == pytest.approx(-37.91 + 20.0 * 4.8 / 111_320.0, abs=2e-5)
+    assert state.vn_m_s == pytest.approx(20.0, abs=0.5)
+    assert state.yaw_rad == pytest.approx(math.radians(5.0))

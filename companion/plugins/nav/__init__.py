@@ -1,0 +1,1 @@
+"""Estimator plug-ins that turn sensor channels into nav/state."""
