@@ -1,0 +1,1 @@
+"""Pure codecs for the wire protocols the vehicle speaks, and a reopening serial port."""
