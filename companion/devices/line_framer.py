@@ -1,65 +1,97 @@
-"""Cut a byte stream into ``$...`` sentences; count what is not a sentence and move on."""
+"""Cut a byte stream into ``$...`` text sentences; count what is not a sentence and move on.
+
+For the ASCII line protocols of the vehicle's devices (NMEA 0183, the OS-3000 ``$C``
+sentence, VectorNav ASCII): a sentence starts with ``$`` and ends at CR or LF. Chunks may
+split a sentence anywhere; it comes out whole once its line ending arrives. A ``$`` inside
+a sentence means the sentence was cut short (none of these protocols allows ``$`` in a
+field), so framing restarts there. Pure: no port, no clock.
+"""
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
+
+_STOP = re.compile(rb"[\r\n$]")  # what ends the sentence in progress
+_EOL = re.compile(rb"[\r\n]")
+DEFAULT_MAX_LEN = 200
 
 
 @dataclass
 class FramerCounters:
-    frames: int = 0
-    garbage_bytes: int = 0
-    garbage_runs: int = 0  # stretches of bytes outside any sentence
-    overlong: int = 0
+    """What the framer has seen since it was made."""
+
+    frames: int = 0  # sentences handed out
+    garbage_bytes: int = 0  # bytes outside any sentence (line endings excepted)
+    garbage_runs: int = 0  # unbroken stretches of such bytes
+    overlong: int = 0  # lines dropped for exceeding max_len
 
 
 class LineFramer:
-    """Feed arbitrary chunks; get back whole sentences (without the line ending)."""
+    """Feed arbitrary chunks; get back whole sentences, ``$`` first, line ending removed."""
 
-    def __init__(self, max_len: int = 200) -> None:
-        self.max_len = max_len
-        self.buf = bytearray()
+    def __init__(self, max_len: int = DEFAULT_MAX_LEN) -> None:
+        self.max_len = max_len  # longest sentence kept, counting the '$', not the CR/LF
         self.counters = FramerCounters()
+        self._line: bytearray | None = None  # the sentence in progress, None between them
+        self._discarding = False  # inside the tail of an over-long line
+        self._in_run = False  # the last bytes outside a sentence were garbage
 
     def feed(self, data: bytes) -> list[bytes]:
-        self.buf += data
+        """The sentences completed by this chunk, in order."""
         out: list[bytes] = []
-        while True:
-            start = self.buf.find(b"$")
-            if start < 0:
-                self._garbage(len(self.buf))
-                self.buf.clear()
-                return out
-            if start:
-                self._garbage(start)
-                del self.buf[:start]
-            end = self._line_end()
-            if end < 0:
-                if len(self.buf) > self.max_len:  # no end in sight: resynchronise
-                    self.counters.overlong += 1
-                    del self.buf[:1]
-                    continue
-                return out
-            line = bytes(self.buf[:end])
-            del self.buf[: end + 1]
-            if len(line) > self.max_len:
-                self.counters.overlong += 1
+        pos, end = 0, len(data)
+        while pos < end:
+            if self._line is None:
+                start = data.find(b"$", pos)
+                self._outside(data[pos : end if start < 0 else start])
+                if start < 0:
+                    break
+                self._begin()
+                pos = start + 1
                 continue
-            nested = line.rfind(b"$")
-            if nested > 0:  # a sentence cut short by the next one
-                self.counters.garbage_bytes += nested
-                line = line[nested:]
-            self.counters.frames += 1
-            out.append(line)
+            stop = _STOP.search(data, pos)
+            cut = end if stop is None else stop.start()
+            self._line += data[pos:cut]
+            if len(self._line) > self.max_len:
+                self._overlong(ended=stop is not None)
+            elif stop is None:
+                break
+            elif data[cut] == 0x24:  # '$': the sentence in progress was cut short
+                self._garbage(len(self._line))
+                self._line = None
+            else:
+                out.append(bytes(self._line))
+                self.counters.frames += 1
+                self._line = None
+            pos = end if stop is None else (cut if data[cut] == 0x24 else cut + 1)
+        return out
+
+    def _begin(self) -> None:
+        self._line = bytearray(b"$")
+        self._discarding = False
+        self._in_run = False
+
+    def _overlong(self, ended: bool) -> None:
+        self.counters.overlong += 1
+        self._line = None
+        # Without its line ending yet, the rest of the line is still to come: skip it
+        # quietly rather than count it as garbage a second time.
+        self._discarding = not ended
+
+    def _outside(self, chunk: bytes) -> None:
+        if self._discarding:
+            eol = _EOL.search(chunk)
+            if eol is None:
+                return
+            self._discarding = False
+            chunk = chunk[eol.end() :]
+        # Line endings between sentences are normal, not garbage.
+        self._garbage(len(chunk.translate(None, b"\r\n")))
 
     def _garbage(self, count: int) -> None:
-        # Line endings between sentences are not garbage.
-        if count and any(b not in (0x0A, 0x0D) for b in self.buf[:count]):
-            self.counters.garbage_runs += 1
-        self.counters.garbage_bytes += count
-
-    def _line_end(self) -> int:
-        for i, byte in enumerate(self.buf):
-            if byte in (0x0A, 0x0D):
-                return i
-        return -1
+        if count:
+            self.counters.garbage_bytes += count
+            if not self._in_run:
+                self.counters.garbage_runs += 1
+                self._in_run = True

@@ -3,33 +3,13 @@ device is reopened when it comes back."""
 
 from __future__ import annotations
 
-import os
-
 import pytest
 
 from tests.support.nmea import gga, rmc
+from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
 
 LAT, LON = -37.9105, 145.134
-
-
-class Pty:
-    """A pty whose slave is reached through a stable symlink, like /dev/ttyUSB0."""
-
-    def __init__(self, link) -> None:
-        self.link = link
-        self.master, self.slave = os.openpty()
-        if link.is_symlink():
-            link.unlink()
-        link.symlink_to(os.ttyname(self.slave))
-
-    def write(self, text: str) -> None:
-        os.write(self.master, text.encode())
-
-    def vanish(self) -> None:
-        os.close(self.master)
-        os.close(self.slave)
-        self.link.unlink()
 
 
 @pytest.mark.timeout(90)
