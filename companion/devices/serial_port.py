@@ -1,99 +1,155 @@
 """A serial device that comes back: read and write never raise, a vanished device is reopened.
 
-Accepts ``serial:///dev/ttyUSB0:4800`` (our form, baud in the URL), a plain device or pty
-path, and any pyserial URL (``socket://host:port``, ``loop://``).
+Device URLs:
+- ``serial://PATH[:BAUD]``: our form, the one MAVLink endpoints use too
+  (``serial:///dev/ttyUSB0:57600``). The baud rate is the last ``:digits`` suffix; without
+  it the ``baud`` argument is used. Give it explicitly when PATH itself ends in ``:digits``.
+- a plain path: a device (``/dev/ttyUSB0``), a symlink to one, or a pseudo-terminal.
+- any pyserial URL: ``socket://host:port``, ``loop://``, ``rfc2217://…``.
+
+Reads block at most ``read_timeout_s`` on pyserial's own timeout. When the device goes
+(unplugged USB adapter, a pty whose master closed, a socket whose peer left), the port is
+closed, ``reopens`` counts it, and opening is retried with back-off (0.1 s doubling to
+2 s). While waiting, ``read`` sleeps at most ``read_timeout_s`` per call, so the caller's
+``step()`` still returns regularly.
 """
 
 from __future__ import annotations
 
 import logging
 import threading
+import time
 
 import serial
 
 log = logging.getLogger(__name__)
 FIRST_RETRY_S = 0.1
 MAX_RETRY_S = 2.0
+SCHEME = "serial://"
+# What pyserial raises when a device is gone or cannot be opened (SerialException is an
+# OSError; ValueError for a malformed URL; TypeError when a port closes under a read).
+_PORT_ERRORS = (serial.SerialException, OSError, ValueError, TypeError)
 
 
 def split_device(url: str, baud: int) -> tuple[str, int]:
-    """The pyserial URL or path, and the baud rate (from ``serial://...:BAUD`` if given)."""
-    if url.startswith("serial://"):
-        path, sep, rate = url.removeprefix("serial://").rpartition(":")
-        if sep and rate.isdigit() and path:
-            return path, int(rate)
-        return url.removeprefix("serial://"), baud
-    return url, baud
+    """The path or pyserial URL to open, and the baud rate (``serial://PATH:BAUD`` wins)."""
+    if not url.startswith(SCHEME):
+        return url, baud
+    path = url.removeprefix(SCHEME)
+    head, sep, rate = path.rpartition(":")
+    if sep and head and rate.isdigit() and int(rate) > 0:
+        return head, int(rate)
+    return path, baud
 
 
 class ReopeningSerial:
-    """Reads block at most ``read_timeout_s``; failures close the port and retry later."""
+    """A port that is opened on first use and reopened, with back-off, whenever it fails."""
 
     def __init__(self, url: str, baud: int = 9600, read_timeout_s: float = 0.2) -> None:
-        self.url, self.baud = split_device(url, baud)
+        self.url = url
+        self.path, self.baud = split_device(url, baud)
         self.read_timeout_s = read_timeout_s
-        self.port: serial.SerialBase | None = None
-        self.reopens = 0
-        self.open_failures = 0
+        self.reopens = 0  # times the device was lost and reopening began
+        self.open_failures = 0  # failed attempts to open
+        self.opens = 0  # successful opens, the first included
         self.bytes_in = 0
         self.bytes_out = 0
+        self._port: serial.SerialBase | None = None
         self._retry_s = FIRST_RETRY_S
-        self._wait = threading.Event()
+        self._next_try = 0.0  # time.monotonic() of the next open attempt
+        self._closed = threading.Event()  # set by close(): ends any back-off wait at once
 
-    def _open(self) -> bool:
-        if self.port is not None:
-            return True
-        try:
-            self.port = serial.serial_for_url(
-                self.url, baudrate=self.baud, timeout=self.read_timeout_s, write_timeout=0
-            )
-        except (serial.SerialException, OSError, ValueError) as exc:
-            self.open_failures += 1
-            log.debug("cannot open %s: %s", self.url, exc)
-            # Bounded by the read timeout so the caller's step() still returns regularly.
-            self._wait.wait(min(self._retry_s, self.read_timeout_s))
-            self._retry_s = min(self._retry_s * 2, MAX_RETRY_S)
-            return False
-        self._retry_s = FIRST_RETRY_S
-        return True
+    @property
+    def is_open(self) -> bool:
+        """Whether the device is open now."""
+        return self._port is not None
 
-    def _lost(self, exc: Exception) -> None:
-        log.warning("%s vanished (%s): reopening", self.url, exc)
-        self.reopens += 1
-        if self.port is not None:
-            try:
-                self.port.close()
-            except (serial.SerialException, OSError):
-                pass
-        self.port = None
-
-    def read(self, size: int = 512) -> bytes:
-        """Up to ``size`` bytes, waiting at most the read timeout; b"" when nothing came."""
-        if not self._open():
+    def read(self, size: int = 4096) -> bytes:
+        """What has arrived, up to ``size`` bytes; waits at most the read timeout for the
+        first byte and returns b"" when none came."""
+        port = self._ensure_open(wait=True)
+        if port is None or size <= 0:
             return b""
         try:
-            data = self.port.read(size)  # type: ignore[union-attr]
-        except (serial.SerialException, OSError, TypeError) as exc:
+            # pyserial's read(size) waits until size bytes or the timeout: at 4800 baud that
+            # would hold every sentence back by the whole timeout and blur its time stamp.
+            # So wait for one byte, then take only what is already there.
+            data = port.read(1)
+            while data and len(data) < size and (waiting := port.in_waiting):
+                data += port.read(min(waiting, size - len(data)))
+        except _PORT_ERRORS as exc:
             self._lost(exc)
             return b""
         self.bytes_in += len(data)
         return data
 
     def write(self, data: bytes) -> int:
-        """Bytes written (0 when the device is gone: it is reopened on the next call)."""
-        if not self._open():
+        """Bytes written; 0 when the device is gone (it is reopened later) or too slow.
+
+        Blocks at most the read timeout. After a write timeout some bytes may have gone
+        out: pyserial does not say how many.
+        """
+        port = self._ensure_open(wait=False)
+        if port is None:
             return 0
         try:
-            written = self.port.write(data) or 0  # type: ignore[union-attr]
+            written = port.write(data) or 0
         except serial.SerialTimeoutException:
+            log.debug("%s: write timed out", self.url)
             return 0
-        except (serial.SerialException, OSError) as exc:
+        except _PORT_ERRORS as exc:
             self._lost(exc)
             return 0
         self.bytes_out += written
         return written
 
     def close(self) -> None:
-        if self.port is not None:
-            self.port.close()
-            self.port = None
+        """Close the device; a later read or write opens it again."""
+        self._closed.set()
+        self._drop_port()
+
+    def _ensure_open(self, wait: bool) -> serial.SerialBase | None:
+        if self._port is not None:
+            return self._port
+        self._closed.clear()
+        delay = self._next_try - time.monotonic()
+        if delay > 0:
+            if wait:  # back-off, bounded so the caller gets control back regularly
+                self._closed.wait(min(delay, self.read_timeout_s))
+            return None
+        try:
+            # A bounded write timeout, not 0: pyserial's non-blocking write retries EAGAIN in
+            # a busy loop while the device's buffer is full.
+            port = serial.serial_for_url(
+                self.path,
+                baudrate=self.baud,
+                timeout=self.read_timeout_s,
+                write_timeout=self.read_timeout_s,
+            )
+        except _PORT_ERRORS as exc:
+            self.open_failures += 1
+            # Warn once per outage; the retries after it would only repeat the news.
+            level = logging.WARNING if self._retry_s == FIRST_RETRY_S else logging.DEBUG
+            log.log(level, "cannot open %s: %s (retrying)", self.url, exc)
+            self._next_try = time.monotonic() + self._retry_s
+            self._retry_s = min(2 * self._retry_s, MAX_RETRY_S)
+            return None
+        log.info("opened %s at %d baud", self.url, self.baud)
+        self.opens += 1
+        self._retry_s = FIRST_RETRY_S
+        self._port = port
+        return port
+
+    def _lost(self, exc: BaseException) -> None:
+        log.warning("%s vanished (%s): reopening", self.url, exc)
+        self.reopens += 1
+        self._drop_port()
+        self._next_try = time.monotonic() + self._retry_s
+
+    def _drop_port(self) -> None:
+        port, self._port = self._port, None
+        if port is not None:
+            try:
+                port.close()
+            except _PORT_ERRORS:
+                pass  # already gone; nothing more to release

@@ -1,84 +1,179 @@
-"""NMEA GPS decoding: values to the last digit, epochs in either order, counted rejects."""
+"""NMEA GPS epochs from several receivers: one fix per epoch, values to the last digit."""
 
 from __future__ import annotations
 
 import math
 
+import pynmea2
 import pytest
-from hypothesis import given
-from hypothesis import strategies as st
 
-from companion.devices.line_framer import LineFramer
-from companion.devices.nmea_gps import KNOT_M_S, NmeaGpsDecoder
+from companion.devices.nmea_gps import NmeaGpsDecoder
 from companion.messages import GpsFixType
-from tests.support.nmea import gga, rmc
+from tests.unit.devices.nmea_text import (
+    GSV,
+    KNOT,
+    LAT,
+    LAT_TEXT,
+    LON,
+    LON_TEXT,
+    decode_all,
+    gga,
+    gsa,
+    nmea,
+    rmc,
+    utc_us,
+    vtg,
+)
 
-LAT, LON = -37.9105123, 145.1340456
+
+def ublox_epoch(second: int, alt: float, talker: str = "GN") -> list[tuple[int, str]]:
+    """u-blox order: RMC, VTG, GGA, GSA per constellation, GSV, GLL; 50 ms apart."""
+    time, t0 = f"1200{second:02d}.00", second * 1_000_000
+    sentences = [
+        rmc(time, talker=talker),
+        vtg(talker=talker),
+        gga(time, alt, talker=talker),
+        gsa(3, "0.9", "1.4", talker),
+        gsa(3, "0.9", "1.4", talker),
+        GSV,
+        nmea(f"{talker}GLL,{LAT_TEXT},S,{LON_TEXT},E,{time},A,A"),
+    ]
+    return [(t0 + 50_000 * (i + 1), s) for i, s in enumerate(sentences)]
+
+
+def sirf_epoch(second: int, alt: float) -> list[tuple[int, str]]:
+    """SiRF order: GGA, GSA, GSV, RMC, VTG; rendered by pynmea2 this time."""
+    time, t0 = f"1200{second:02d}.000", second * 1_000_000
+    fields = (time, LAT_TEXT, "S", LON_TEXT, "E", "1", "07", "1.1", f"{alt}", "M", "", "M", "", "")
+    sentences = [
+        str(pynmea2.GGA("GP", "GGA", fields)),
+        gsa(3, "1.1", "2.0"),
+        GSV,
+        str(
+            pynmea2.RMC(
+                "GP",
+                "RMC",
+                (time, "A", LAT_TEXT, "S", LON_TEXT, "E", "10.0", "0.0", "231126", "", ""),
+            )
+        ),
+        vtg("0.0", "10.0", "18.52"),
+    ]
+    return [(t0 + 50_000 * (i + 1), s) for i, s in enumerate(sentences)]
 
 
 @pytest.mark.parametrize("talker", ["GP", "GN"])
-def test_gga_after_rmc_gives_a_full_fix(talker):
+def test_rmc_first_receiver_gets_a_fix_on_each_gga(talker):
     dec = NmeaGpsDecoder()
-    assert dec.decode(rmc("120000.00", "231126", LAT, LON, 40.0, 90.0, talker), 1_000) is None
-    fix = dec.decode(gga("120000.00", LAT, LON, 123.4, talker=talker), 2_000)
-    assert fix.lat_deg == pytest.approx(LAT, abs=1e-9) and fix.lon_deg == pytest.approx(
-        LON, abs=1e-9
-    )
-    assert fix.alt_msl_m == 123.4 and fix.fix_type == GpsFixType.FIX_3D and fix.satellites == 9
-    assert fix.ground_speed_m_s == pytest.approx(40 * KNOT_M_S)
-    assert fix.ve_m_s == pytest.approx(40 * KNOT_M_S) and abs(fix.vn_m_s) < 1e-9
-    assert fix.utc_us == 1795435200 * 1_000_000 and fix.t_us == 2_000
-    assert math.isnan(fix.vd_m_s)
+    assert decode_all(dec, ublox_epoch(0, 100.0, talker)) == [], "it teaches the order"
+    assert len(decode_all(dec, ublox_epoch(1, 100.5, talker))) == 1
+    fixes = decode_all(dec, ublox_epoch(2, 101.5, talker))
+    assert len(fixes) == 1
+    fix = fixes[0]
+    assert fix.t_us == 2_050_000, "stamped with the epoch's first sentence (its RMC)"
+    assert fix.lat_deg == pytest.approx(LAT, abs=1e-9)
+    assert fix.lon_deg == pytest.approx(LON, abs=1e-9)
+    assert fix.alt_msl_m == 101.5 and fix.fix_type == GpsFixType.FIX_3D
+    assert fix.satellites == 9 and fix.hdop == 0.9 and fix.vdop == 1.4
+    assert fix.eph_m == pytest.approx(2.25) and fix.epv_m == pytest.approx(3.5)
+    assert fix.ground_speed_m_s == pytest.approx(40 * KNOT, abs=1e-9)
+    assert fix.course_rad == pytest.approx(math.pi / 2)
+    assert fix.ve_m_s == pytest.approx(40 * KNOT, abs=1e-9) and abs(fix.vn_m_s) < 1e-9
+    assert fix.vd_m_s == pytest.approx(-1.0)
+    assert fix.utc_us == utc_us(2026, 11, 23, 12, 0, 2)
+    assert dec.counters.ok == 3 * 5 and dec.counters.ignored == 3 * 2
+    assert dec.counters.fixes == 2 and dec.counters.dropped_epochs == 0
 
 
-def test_vertical_speed_uses_the_real_interval_and_midnight():
+def test_gga_first_receiver_gets_its_fix_once_the_velocity_arrived():
     dec = NmeaGpsDecoder()
-    dec.decode(gga("235959.80", LAT, LON, 100.0), 0)
-    fix = dec.decode(gga("000000.00", LAT, LON, 101.0), 200_000)  # 0.2 s later, next day
-    assert fix.vd_m_s == pytest.approx(-5.0)
-    fix = dec.decode(gga("000001.00", LAT, LON, 100.0), 1_200_000)
-    assert fix.vd_m_s == pytest.approx(1.0)
-    fix = dec.decode(gga("000010.00", LAT, LON, 100.0), 10_000_000)  # a 9 s gap: unknown
-    assert math.isnan(fix.vd_m_s)
+    decode_all(dec, sirf_epoch(0, 50.0))
+    timed = sirf_epoch(1, 48.0)
+    fixes = [dec.decode(s, t) for t, s in timed]
+    assert fixes[:-1] == [None] * 4 and fixes[-1] is not None, "emitted on the epoch's VTG"
+    fix = fixes[-1]
+    assert fix.t_us == 1_050_000, "stamped with the epoch's first sentence (its GGA)"
+    assert fix.lat_deg == pytest.approx(LAT, abs=1e-9)
+    assert fix.lon_deg == pytest.approx(LON, abs=1e-9)
+    assert fix.vn_m_s == pytest.approx(10 * KNOT, abs=1e-9) and fix.ve_m_s == 0.0
+    assert fix.vd_m_s == pytest.approx(2.0) and fix.vdop == 2.0 and fix.satellites == 7
+    assert fix.utc_us == utc_us(2026, 11, 23, 12, 0, 1)
 
 
-def test_rmc_only_receivers_get_2d_fixes_and_quality_codes_map():
+def test_gga_and_vtg_only_receiver_takes_velocity_from_vtg_in_kmh():
     dec = NmeaGpsDecoder()
-    assert dec.decode(rmc("115959.00", "231126", LAT, LON, 10.0, 0.0), 0) is None
-    fix = dec.decode(rmc("120000.00", "231126", LAT, LON, 10.0, 0.0), 0)
-    assert fix.fix_type == GpsFixType.FIX_2D and fix.vn_m_s == pytest.approx(10 * KNOT_M_S)
-    for quality, kind in ((0, GpsFixType.NO_FIX), (2, GpsFixType.DGPS), (4, GpsFixType.RTK_FIXED)):
-        assert dec.decode(gga("120001.00", LAT, LON, 5.0, quality), 1).fix_type == kind
+    timed = []
+    for second in range(3):  # VTG first, knots field left empty
+        timed += [(second, vtg("180.0", "", "36.0")), (second, gga(f"0000{second:02d}.00"))]
+    fixes = decode_all(dec, timed)
+    assert len(fixes) == 2
+    assert fixes[-1].vn_m_s == pytest.approx(-10.0) and abs(fixes[-1].ve_m_s) < 1e-9
+    assert fixes[-1].course_rad == pytest.approx(math.pi)
+    assert fixes[-1].utc_us == 0, "no RMC, no date"
+    assert fixes[-1].fix_type == GpsFixType.FIX_3D, "GGA-only receivers: 3-D"
 
 
-def test_bad_checksums_truncation_and_garbage_are_counted():
+def test_rmc_only_receiver_gets_2d_fixes_without_altitude():
     dec = NmeaGpsDecoder()
-    good = gga("120000.00", LAT, LON, 10.0)
-    broken = good[:-2] + ("00" if good[-2:] != "00" else "11")
-    assert dec.decode(broken, 0) is None
-    assert dec.decode(good[:20], 0) is None
-    assert dec.decode(b"\xff\xfe$GPXYZ,1,2*00", 0) is None
-    assert (
-        dec.decode("$GPGSV,3,1,11,03,03,111,00,04,15,270,00,06,01,010,00,13,06,292,00*74", 0)
-        is None
-    )
-    c = dec.counters
-    assert (c.bad_checksum, c.ignored, c.garbage, c.ok) == (1, 1, 2, 0)
+    fixes = decode_all(dec, [(i, rmc(f"1200{i:02d}.00", knots="0.0", course="")) for i in range(3)])
+    assert len(fixes) == 2
+    fix = fixes[-1]
+    assert fix.fix_type == GpsFixType.FIX_2D and math.isnan(fix.alt_msl_m)
+    assert fix.lat_deg == pytest.approx(LAT, abs=1e-9)
+    assert fix.vn_m_s == 0.0 and fix.ve_m_s == 0.0 and math.isnan(fix.course_rad)
+    assert fix.satellites == 255 and math.isnan(fix.hdop)
 
 
-def test_framer_finds_sentences_in_junk_and_split_reads():
-    framer = LineFramer()
-    s1, s2 = gga("120000.00", LAT, LON, 1.0), gga("120001.00", LAT, LON, 2.0)
-    stream = b"junk\x00" + s1.encode() + b"\r\n$GPG" + b"\r\n" + s2.encode() + b"\r\n"
-    out = []
-    for i in range(0, len(stream), 7):
-        out += framer.feed(stream[i : i + 7])
-    assert out[0] == s1.encode() and out[-1] == s2.encode()
-    assert framer.counters.garbage_bytes >= 5
+@pytest.mark.parametrize(
+    ("quality", "mode", "expected"),
+    [
+        (0, 1, GpsFixType.NO_FIX),
+        (1, 2, GpsFixType.FIX_2D),
+        (1, 3, GpsFixType.FIX_3D),
+        (2, 3, GpsFixType.DGPS),
+        (4, 3, GpsFixType.RTK_FIXED),
+        (5, 3, GpsFixType.RTK_FLOAT),
+        (6, 3, GpsFixType.NO_FIX),
+        (1, 1, GpsFixType.NO_FIX),
+    ],
+)
+def test_fix_type_comes_from_gga_quality_and_gsa_mode(quality, mode, expected):
+    dec = NmeaGpsDecoder()
+    timed = [(0, gga("120000.00")), (1, gsa(mode)), (2, gga("120001.00", quality=quality))]
+    (fix,) = decode_all(dec, timed)
+    assert fix.fix_type == expected
 
 
-@given(st.binary(max_size=400))
-def test_any_bytes_never_raise(data):
-    framer, dec = LineFramer(), NmeaGpsDecoder()
-    for line in framer.feed(data):
-        dec.decode(line, 0)
+def test_no_fix_gga_without_position_gives_a_no_fix_message():
+    dec = NmeaGpsDecoder()
+    empty = nmea("GPGGA,120001.00,,,,,0,00,99.99,,,,,,")
+    (fix,) = decode_all(dec, [(0, gga("120000.00")), (1, empty)])
+    assert fix.fix_type == GpsFixType.NO_FIX and math.isnan(fix.lat_deg)
+    assert fix.satellites == 0 and fix.hdop == 99.99
+
+
+def test_an_epoch_missing_its_rmc_comes_one_epoch_late_and_one_missing_gga_is_dropped():
+    dec = NmeaGpsDecoder()
+    decode_all(dec, ublox_epoch(0, 100.0) + ublox_epoch(1, 100.0))
+    no_rmc = ublox_epoch(2, 100.0)[1:]  # its RMC lost to a bad checksum
+    assert decode_all(dec, no_rmc) == []
+    late, on_time = decode_all(dec, ublox_epoch(3, 100.0))
+    assert late.t_us == 2_100_000 and late.utc_us == utc_us(2026, 11, 23, 12, 0, 2)
+    assert late.ve_m_s == pytest.approx(40 * KNOT, abs=1e-9), "velocity from the VTG"
+    assert on_time.t_us == 3_050_000
+    no_gga = [pair for pair in ublox_epoch(4, 100.0) if "GGA" not in pair[1]]
+    assert decode_all(dec, no_gga + ublox_epoch(5, 100.0)[:1]) == []
+    assert dec.counters.dropped_epochs == 1
+
+
+def test_a_receiver_that_stops_sending_rmc_is_followed_after_three_epochs():
+    dec = NmeaGpsDecoder()
+    timed = []
+    for second in range(3):
+        timed += [(second, rmc(f"1200{second:02d}.00")), (second, gga(f"1200{second:02d}.00"))]
+    for second in range(3, 9):  # from here on, GGA only
+        timed.append((second, gga(f"1200{second:02d}.00")))
+    fixes = decode_all(dec, timed)
+    # Epochs 3-5 wait for an RMC and come late; at 6 RMC is forgotten: epoch 5's late fix
+    # and epoch 6's on-time fix fall due together, and only the newer one is kept.
+    assert [f.t_us for f in fixes] == [1, 2, 3, 4, 6, 7, 8]
+    assert dec.counters.fixes == len(fixes) and dec.counters.dropped_epochs == 1

@@ -1,55 +1,151 @@
-"""OS-3000 `$C` sentences: values, optional fields, checksums, truncation, fuzz."""
+"""The OS-3000/OS-5000 ``$C`` sentence: values, optional fields, units, axes, rejects."""
 
 from __future__ import annotations
 
 import math
+from functools import reduce
 
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from companion.devices.os3000 import G, Os3000Decoder
+from companion.devices.os3000 import Os3000Decoder
+
+G = 9.80665
+# The two examples printed in the OS5000 Compass Manual, checksums as printed there.
+MANUAL_SHORT = "$C320.5P0.2R-18.3T19.0*3C"
+MANUAL_FULL = "$C212.4P2.5R-14.0T28.4Mx107977.90My-79422.00Mz173.27Ax0.045Ay-0.245Az0.977*3A"
 
 
-def sentence(body: str) -> str:
-    """An independent writer: XOR of the characters between '$' and '*'."""
-    checksum = 0
-    for char in body:
-        checksum ^= ord(char)
-    return f"${body}*{checksum:02X}"
+def sentence(text: str) -> str:
+    """``$<text>*hh`` with the XOR checksum, computed here (an independent writer)."""
+    return f"${text}*{reduce(lambda acc, ch: acc ^ ord(ch), text, 0):02X}"
 
 
-def test_heading_pitch_roll_temperature():
+def os3000(body: str) -> str:
+    """A ``$C`` sentence around ``body`` (heading onwards)."""
+    return sentence("C" + body)
+
+
+def counts(dec: Os3000Decoder) -> tuple[int, int, int]:
+    return dec.counters.ok, dec.counters.bad_checksum, dec.counters.garbage
+
+
+def test_the_factory_format_gives_the_compass_message():
     dec = Os3000Decoder()
-    reading = dec.decode(sentence("C271.5P-3.2R12.8T24.5"), 42)
+    reading = dec.decode(MANUAL_SHORT + "\r\n", 1234)
     c = reading.compass
-    assert c.t_us == 42 and c.heading_rad == pytest.approx(math.radians(271.5))
-    assert c.pitch_rad == pytest.approx(math.radians(-3.2))
-    assert c.roll_rad == pytest.approx(math.radians(12.8)) and c.temp_c == 24.5
-    assert reading.mag is None and reading.accel is None and dec.counters.ok == 1
+    assert c.t_us == 1234 and c.temp_c == 19.0
+    assert c.heading_rad == pytest.approx(math.radians(320.5), abs=1e-12)
+    assert c.pitch_rad == pytest.approx(math.radians(0.2), abs=1e-12)
+    assert c.roll_rad == pytest.approx(math.radians(-18.3), abs=1e-12)
+    assert reading.mag is None and reading.accel_m_s2 is None
+    assert counts(dec) == (1, 0, 0)
 
 
-def test_optional_magnetometer_and_accelerometer_fields():
-    reading = Os3000Decoder().decode(
-        sentence("C10.0P0.0R0.0T20.0Mx210.5My-50.0Mz-480.0Ax0.010Ay-0.020Az1.000"), 7
-    )
-    assert reading.mag.mx_gauss == pytest.approx(0.2105) and reading.mag.mz_gauss == -0.48
-    assert reading.accel.az_m_s2 == pytest.approx(-G)  # level: specific force -g, body FRD
-    assert reading.accel.ax_m_s2 == pytest.approx(-0.01 * G)
-    assert math.isnan(reading.accel.gx_rad_s)
+def test_magnetometer_in_gauss_and_accel_as_frd_specific_force():
+    reading = Os3000Decoder().decode(MANUAL_FULL.encode(), 7)
+    mag = reading.mag
+    assert mag.t_us == 7
+    assert (mag.mx_gauss, mag.my_gauss, mag.mz_gauss) == pytest.approx((107.9779, 79.422, -0.17327))
+    # Pitched up 2.5°, rolled left 14°: specific force forward +, right +, down -.
+    assert reading.accel_m_s2 == pytest.approx((0.045 * G, 0.245 * G, -0.977 * G))
 
 
-def test_bad_checksum_truncation_and_unknown_fields_are_counted():
+def test_level_and_still_reads_minus_g_on_z_like_the_imu():
+    reading = Os3000Decoder().decode(os3000("90.0P0.0R0.0T20.0Ax0.000Ay0.000Az1.000"), 0)
+    assert reading.accel_m_s2 == pytest.approx((0.0, 0.0, -G))
+
+
+@pytest.mark.parametrize(
+    ("fields", "has_mag", "has_accel"),
+    [
+        ("Mx100.0My-200.0Mz300.0", True, False),
+        ("Ax0.1Ay0.2Az0.9", False, True),
+        ("D21.01M512.3A1.001", False, False),  # depth and the scalar magnitudes only
+        ("Mx100.0My-200.0", False, False),  # an incomplete vector is no vector
+        ("D3.5Mx1My2Mz3A1.0Ax0Ay0Az1", True, True),
+    ],
+)
+def test_optional_fields_in_any_subset(fields, has_mag, has_accel):
+    reading = Os3000Decoder().decode(os3000("10.0P1.0R2.0T20.0" + fields), 0)
+    assert (reading.mag is not None, reading.accel_m_s2 is not None) == (has_mag, has_accel)
+
+
+def test_temperature_is_optional_and_heading_360_is_north():
+    reading = Os3000Decoder().decode(os3000("360.0P-90R180"), 0)
+    assert reading.compass.heading_rad == 0.0 and math.isnan(reading.compass.temp_c)
+    assert reading.compass.roll_rad == pytest.approx(math.pi)
+
+
+def test_the_magnetometer_unit_and_axes_are_settings():
+    dec = Os3000Decoder(mag_gauss_per_unit=1.0, axis_signs=(1.0, 1.0, 1.0))
+    mag = dec.decode(os3000("0P0R0Mx0.2My-0.1Mz0.4"), 0).mag
+    assert (mag.mx_gauss, mag.my_gauss, mag.mz_gauss) == (0.2, -0.1, 0.4)
+
+
+def test_lower_case_checksum_digits_are_accepted():
+    sentence = os3000("12.5P1R2T3")
+    assert Os3000Decoder().decode(sentence[:-2] + sentence[-2:].lower(), 0) is not None
+
+
+def test_wrong_checksums_are_counted():
     dec = Os3000Decoder()
-    good = sentence("C100.0P1.0R2.0T20.0")
-    assert dec.decode(good[:-2] + ("00" if good[-2:] != "00" else "01"), 0) is None
-    assert dec.decode(good[:12], 0) is None
-    assert dec.decode(sentence("C100.0P1.0R2.0X9"), 0) is None
-    assert dec.decode(sentence("C400.0P1.0R2.0"), 0) is None  # heading out of range
-    c = dec.counters
-    assert (c.ok, c.bad_checksum, c.garbage) == (0, 1, 3)
+    assert dec.decode(MANUAL_SHORT[:-2] + "3D", 0) is None
+    assert dec.decode(MANUAL_SHORT.replace("320.5", "321.5"), 0) is None
+    assert counts(dec) == (0, 2, 0)
 
 
-@given(st.text(max_size=80))
-def test_any_text_never_raises(text):
-    Os3000Decoder().decode("$" + text, 0)
+def test_every_truncation_is_garbage():
+    dec = Os3000Decoder()
+    for cut in range(len(MANUAL_FULL)):
+        assert dec.decode(MANUAL_FULL[:cut], 0) is None
+    assert counts(dec) == (0, 0, len(MANUAL_FULL))
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        "P1.0R2.0T3.0",  # no heading
+        "10.0R2.0T3.0",  # no pitch
+        "10.0P1.0",  # no roll
+        "10.0R2.0P1.0",  # out of order
+        "10.0P1.0R2.0T3.0T4.0",  # twice
+        "10.0P1.0R2.0Q5",  # unknown field
+        "10.0P91.0R2.0",
+        "361.0P1.0R2.0",
+        "10.0P1.0R2.0T" + "9" * 400,  # overflows to infinity
+        "10.0P1.0R2.0T1.2.3",
+        "10.0 P1.0R2.0",
+    ],
+)
+def test_malformed_bodies_are_garbage(body):
+    dec = Os3000Decoder()
+    assert dec.decode(os3000(body), 0) is None
+    assert counts(dec) == (0, 0, 1)
+
+
+@pytest.mark.parametrize(
+    "junk", [b"", b"\xff$C1P2R3*00", "$GPGGA,1*00", "C10P1R2*00", "$C1P2R3*G0"]
+)
+def test_junk_is_garbage(junk):
+    dec = Os3000Decoder()
+    assert dec.decode(junk, 0) is None
+    assert counts(dec) == (0, 0, 1)
+
+
+@given(st.lists(st.one_of(st.text(max_size=80), st.binary(max_size=80)), max_size=20))
+def test_any_input_never_raises(inputs):
+    dec = Os3000Decoder()
+    for item in inputs:
+        dec.decode(item, 0)
+    assert sum(counts(dec)) == len(inputs)
+
+
+@given(st.text(alphabet="0123456789.-+PRTDMAxyzQ", max_size=60))
+def test_checksummed_random_bodies_never_raise(body):
+    dec = Os3000Decoder()
+    reading = dec.decode(os3000(body), 0)
+    assert sum(counts(dec)) == 1
+    if reading is not None:
+        assert 0.0 <= reading.compass.heading_rad < 2 * math.pi
