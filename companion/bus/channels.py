@@ -212,7 +212,3 @@ class LatestReader(Reader[M]):
         if fresh is not None:
             self._latest = fresh
         return fresh
-
-
-LatestWriter = Writer
-QueueWriter = Writer

@@ -21,8 +21,8 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
-from functools import reduce
 
+from companion.devices.ascii_sentence import sentence_text, xor8
 from companion.messages import Compass, Magnetometer
 
 STANDARD_GRAVITY_M_S2 = 9.80665
@@ -86,16 +86,12 @@ class Os3000Decoder:
 
     def _checked_body(self, sentence: bytes | str) -> str | None:
         """The text after ``$C`` when the sentence is whole and its checksum right."""
-        try:
-            text = sentence.decode("ascii") if isinstance(sentence, bytes) else sentence
-        except UnicodeDecodeError:
-            text = ""
-        text = text.strip("\r\n")
+        text = sentence_text(sentence)
         body, star, checksum = text[1:].rpartition("*")
         if not text.startswith("$C") or not star or not _is_hex2(checksum):
             self.counters.garbage += 1
             return None
-        if reduce(lambda acc, ch: acc ^ ord(ch), body, 0) != int(checksum, 16):
+        if xor8(body) != int(checksum, 16):
             self.counters.bad_checksum += 1
             return None
         return body[1:]

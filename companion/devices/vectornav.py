@@ -27,8 +27,8 @@ import binascii
 import math
 import re
 from dataclasses import dataclass
-from functools import reduce
 
+from companion.devices.ascii_sentence import sentence_text, xor8
 from companion.messages import Imu, Magnetometer
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
@@ -68,11 +68,6 @@ class VectorNavReading:
     pressure_pa: float  # $VNIMU only, NaN otherwise
 
 
-def checksum8(payload: str) -> int:
-    """VectorNav's (and NMEA's) 8-bit XOR of the characters between ``$`` and ``*``."""
-    return reduce(lambda acc, ch: acc ^ ord(ch), payload, 0)
-
-
 def crc16(payload: str) -> int:
     """VectorNav's 16-bit CRC (CCITT polynomial 0x1021, initial value 0)."""
     return binascii.crc_hqx(payload.encode("ascii"), 0)
@@ -103,11 +98,7 @@ class VectorNavDecoder:
 
     def _checked_fields(self, sentence: bytes | str) -> list[str] | None:
         """The comma-separated fields of a whole VectorNav sentence whose checksum is right."""
-        try:
-            text = sentence.decode("ascii") if isinstance(sentence, bytes) else sentence
-        except UnicodeDecodeError:
-            text = ""
-        text = text.strip("\r\n")
+        text = sentence_text(sentence)
         payload, star, given = text[1:].rpartition("*")
         header = payload.split(",", 1)[0]
         if not (text.startswith("$") and text.isascii() and star and _HEADER.fullmatch(header)):
@@ -119,7 +110,7 @@ class VectorNavDecoder:
         if len(given) not in (2, 4) or not _HEX.issuperset(given):
             self.counters.garbage += 1
             return None
-        expected = checksum8(payload) if len(given) == 2 else crc16(payload)
+        expected = xor8(payload) if len(given) == 2 else crc16(payload)
         if int(given, 16) != expected:
             self.counters.bad_checksum += 1
             return None

@@ -14,7 +14,7 @@ import time
 from dataclasses import asdict
 
 from companion.bus import BusNode, MonotonicClock, Reader, cleanup_namespace
-from companion.exec_control.child import Child
+from companion.exec_control.child import FIRST_BACKOFF_S, Child
 from companion.exec_control.config import VehicleConfig
 from companion.messages import (
     NAME_LEN,
@@ -62,7 +62,7 @@ class Supervisor:
         for child in self.group(name):
             if not child.wanted:
                 child.wanted = True
-                child.backoff_s = 0.1
+                child.backoff_s = FIRST_BACKOFF_S
                 if child.proc is None:
                     child.start()
 

@@ -143,8 +143,7 @@ class LinkRouter:
             for index in targets:
                 packer = self.packers[index]
                 if id(packer) not in frames:
-                    packer.seq = self.mav.seq  # one sequence for the vehicle, signed or not
-                    frames[id(packer)] = item.msg.pack(packer)
+                    frames[id(packer)] = self._pack(packer, item.msg)
                 self._emit(index, frames[id(packer)], item.priority, now_s)
             self.mav.seq = (self.mav.seq + 1) % 256
 
@@ -161,26 +160,25 @@ class LinkRouter:
             for msg_id in self.schedules[index].due(now_s):
                 try:
                     msg = STREAMS[msg_id].build(self.mav, snapshot)
-                    if msg is not None:
-                        msg.pack(self.mav)  # values out of a field's range raise here
+                    # Framed once, for this endpoint; values out of a field's range raise here.
+                    raw = None if msg is None else self._pack(self.packers[index], msg)
                 except (ValueError, OverflowError, struct.error) as exc:
                     self.counters.stream_errors += 1
                     log.debug("stream %s: %s", STREAMS[msg_id].name, exc)
                     continue
-                if msg is None:
+                if raw is None:
                     continue
-                if not self._emit_telemetry(index, msg, now_s):
+                self.mav.seq = (self.mav.seq + 1) % 256
+                if not self._emit(index, raw, False, now_s):
                     # Out of budget: stop here rather than let smaller, younger streams slip
                     # past, or a large frame would never find enough budget left for it.
                     break
                 self.schedules[index].mark_sent(msg_id, now_s)
 
-    def _emit_telemetry(self, index: int, msg: Any, now_s: float) -> bool:
-        packer = self.packers[index]
+    def _pack(self, packer: Any, msg: Any) -> bytes:
+        """Frame a message with the vehicle's current sequence number (signed or not)."""
         packer.seq = self.mav.seq
-        raw = msg.pack(packer)
-        self.mav.seq = (self.mav.seq + 1) % 256
-        return self._emit(index, raw, False, now_s)
+        return msg.pack(packer)
 
     def next_due(self) -> float:
         times = [s.next_time() for s in self.schedules]

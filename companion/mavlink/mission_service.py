@@ -25,6 +25,12 @@ MAX_RETRIES = 5
 MAX_ITEMS = 1000
 
 
+def mission_current_message(mav: Any, seq: int, total: int) -> Any:
+    """MISSION_CURRENT for the stored mission (the executor will add the running states)."""
+    state = d.MISSION_STATE_NO_MISSION if total == 0 else d.MISSION_STATE_NOT_STARTED
+    return mav.mission_current_encode(seq, total, state)
+
+
 @dataclass
 class _Upload:
     peer: Peer
@@ -177,9 +183,7 @@ class MissionService:
         return [Outgoing(self.mission_current(), None)]
 
     def mission_current(self) -> Any:
-        total = len(self.store.items[0])
-        state = d.MISSION_STATE_NO_MISSION if total == 0 else d.MISSION_STATE_NOT_STARTED
-        return self.mav.mission_current_encode(self.current, total, state)
+        return mission_current_message(self.mav, self.current, len(self.store.items[0]))
 
     def tick(self, now_s: float) -> list[Outgoing]:
         out: list[Outgoing] = []

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from companion.mavlink.codec import dialect as d
+from companion.mavlink.mission_service import mission_current_message
 from companion.messages import GpsFix, Imu, NavFlags, NavState, ServoOutput, SystemHealth
 
 
@@ -207,8 +208,7 @@ def _extended_sys_state(mav: Any, s: Snapshot) -> Any:
 
 
 def _mission_current(mav: Any, s: Snapshot) -> Any:
-    state = d.MISSION_STATE_NO_MISSION if s.mission_total == 0 else d.MISSION_STATE_NOT_STARTED
-    return mav.mission_current_encode(s.mission_seq, s.mission_total, state)
+    return mission_current_message(mav, s.mission_seq, s.mission_total)
 
 
 def _home_position(mav: Any, s: Snapshot) -> Any:
@@ -299,13 +299,17 @@ STREAMS: dict[int, Stream] = {
 }
 
 
+def _default_period(msg_id: int) -> float:
+    """Seconds between samples at the stream's default rate; 0 when off by default."""
+    hz = STREAMS[msg_id].default_hz
+    return 1.0 / hz if hz > 0 else 0.0
+
+
 class StreamSchedule:
     """Per-endpoint rates and due times of every stream."""
 
     def __init__(self) -> None:
-        self.period_s = {
-            mid: (1.0 / s.default_hz if s.default_hz > 0 else 0.0) for mid, s in STREAMS.items()
-        }
+        self.period_s = {mid: _default_period(mid) for mid in STREAMS}
         self.next_due = dict.fromkeys(STREAMS, 0.0)
         self.last_sent = dict.fromkeys(STREAMS, 0.0)
 
@@ -316,8 +320,7 @@ class StreamSchedule:
         if interval_us < 0:
             self.period_s[msg_id] = 0.0
         elif interval_us == 0:
-            hz = STREAMS[msg_id].default_hz
-            self.period_s[msg_id] = 1.0 / hz if hz > 0 else 0.0
+            self.period_s[msg_id] = _default_period(msg_id)
         else:
             self.period_s[msg_id] = interval_us / 1e6
         self.next_due[msg_id] = 0.0
