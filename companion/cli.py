@@ -59,22 +59,91 @@ def run(
 CONFIGS = Path(__file__).resolve().parent / "configs"
 
 
+def _speed(text: str) -> float | None:
+    if text == "max":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = 0.0
+    if value <= 0:
+        raise typer.BadParameter("1 (real time), a factor such as 4, or max (lockstep)")
+    return value
+
+
+def _triple(text: str) -> tuple[float, float, float]:
+    try:
+        n, e, d = (float(v) for v in text.split(","))
+    except ValueError:
+        raise typer.BadParameter("expected N,E,D in m/s, e.g. 5,0,0") from None
+    return n, e, d
+
+
+def _outage(text: str):
+    from bridges.jsbsim.device_streams import Outage
+
+    try:
+        start, seconds = (float(v) for v in text.split(":"))
+    except ValueError:
+        raise typer.BadParameter("expected START:SECONDS, e.g. 60:30") from None
+    return Outage(start, seconds)
+
+
 @app.command()
 def sim(
+    aircraft: Annotated[str, typer.Option(help="airframe: c172p, J3Cub, or a TOML path")] = "c172p",
+    plan: Annotated[Path | None, typer.Option(help="QGroundControl .plan to preload")] = None,
+    speed: Annotated[str, typer.Option(help="1 = real time, N = N times, max = lockstep")] = "1",
+    link: Annotated[
+        list[str] | None,
+        typer.Option(help="MAVLink endpoint URL, repeatable (default udpout 14550 and 14540)"),
+    ] = None,
+    airborne: Annotated[bool, typer.Option(help="start in the air at cruise speed")] = False,
+    wind: Annotated[str, typer.Option(help="steady wind N,E,D m/s (blowing towards)")] = "0,0,0",
+    turbulence: Annotated[str, typer.Option(help="none, light, moderate, severe")] = "none",
+    gps_outage: Annotated[
+        list[str] | None, typer.Option(help="START:SECONDS of no GPS fix, repeatable")
+    ] = None,
+    duration: Annotated[float | None, typer.Option(help="simulated seconds, then stop")] = None,
+    seed: Annotated[int, typer.Option(help="sensor noise seed")] = 1,
+    noise: Annotated[float, typer.Option(help="sensor noise scale (0: perfect)")] = 1.0,
+    truth: Annotated[Path | None, typer.Option(help="write the true state CSV here")] = None,
     config: Annotated[Path, CONFIG_OPT] = CONFIGS / "sim.toml",
     namespace: Annotated[str | None, NS_OPT] = None,
-    duration: Annotated[
-        float | None, typer.Option(help="stop after this many seconds (default: run until Ctrl-C)")
-    ] = None,
+    state_dir: Annotated[str | None, typer.Option(help="parameters and missions dir")] = None,
     log_level: Annotated[str, typer.Option(help="DEBUG, INFO, WARNING")] = "INFO",
 ) -> None:
-    """Run the whole vehicle in simulation (today: the shipped sim config; see README)."""
-    from companion.exec_control.supervisor import Supervisor
+    """Fly the whole vehicle in JSBSim: devices on ptys, servos read back, MAVLink out."""
+    from bridges.jsbsim.options import BridgeOptions
+    from companion.bus.namespace import default_namespace
+    from companion.exec_control.config import ConfigError
+    from companion.sim_session import SimRequest, run_sim
 
     _setup_logging(log_level)
-    cfg = _load_checked(config, namespace)
-    err.print(f"vehicle {cfg.name!r}: {len(cfg.plugins)} plug-ins on bus {cfg.namespace!r}")
-    raise typer.Exit(Supervisor(cfg, log_level).run(duration_s=duration))
+    lists = _checked_plan(plan) if plan is not None else None
+    try:
+        opts = BridgeOptions(
+            airframe=aircraft,
+            airborne=airborne,
+            speed=_speed(speed),
+            wind_ned=_triple(wind),
+            turbulence=turbulence,
+            outages=[_outage(o) for o in gps_outage or []],
+            noise_scale=noise,
+            seed=seed,
+            duration_s=duration,
+            truth_path=str(truth) if truth else None,
+            namespace=namespace or default_namespace(),
+        )
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc)) from None
+    req = SimRequest(config, list(link or []), state_dir, lists)
+    try:
+        code = run_sim(req, opts, log_level)
+    except ConfigError as exc:
+        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+    raise typer.Exit(code)
 
 
 @app.command()
@@ -168,28 +237,24 @@ def _mission_store(config: Path):
     return MissionStore(Path(cfg.vehicle["state_dir"]) / "missions")
 
 
+def _checked_plan(plan: Path):
+    from companion.mission.plan import PlanError, checked_plan
+
+    try:
+        return checked_plan(plan)
+    except PlanError as exc:
+        err.print(f"[red]plan error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+
+
 @mission_app.command("load")
 def mission_load(
     plan: Annotated[Path, typer.Argument(help=".plan file to store as the vehicle's mission")],
     config: Annotated[Path, CONFIG_OPT],
 ) -> None:
     """Check a .plan (mission, fence, rally) and store it; all or nothing."""
-    from companion.mission.items import check_mission
-    from companion.mission.plan import PlanError, load_plan
-    from mavlink_dialect import companion as mav
-
     store = _mission_store(config)
-    try:
-        lists = load_plan(plan)
-    except PlanError as exc:
-        err.print(f"[red]plan error:[/red] {exc}", highlight=False, soft_wrap=True)
-        raise typer.Exit(EXIT_CONFIG) from None
-    for mission_type, items in lists.items():
-        result = check_mission(items)
-        if result != mav.MAV_MISSION_ACCEPTED:
-            name = mav.enums["MAV_MISSION_RESULT"][result].name
-            err.print(f"{plan}: mission type {mission_type} refused: {name}", soft_wrap=True)
-            raise typer.Exit(EXIT_CONFIG)
+    lists = _checked_plan(plan)
     for mission_type, items in lists.items():
         store.replace(mission_type, items)
     counts = ", ".join(

@@ -183,6 +183,8 @@ class NavState(Message):
 class ActuatorCommand(Message):
     """Normalised surface commands from control: surfaces in [-1, 1], throttle in [0, 1].
 
+    Signs follow the stick: aileron + rolls right, elevator + pitches the nose up, rudder +
+    yaws right. ``aux`` carries extra surfaces (flaps first) in [-1, 1]; NaN = not driven.
     Producers: control. Consumers: actuators.minissc.
     """
 
@@ -328,6 +330,28 @@ class SystemHealth(Message):
         return [self.plugins[i] for i in range(self.count)]
 
 
+class SimTruth(Message):
+    """The simulator's true state, for scoring and the live status line.
+
+    Producer: the simulator bridge. Consumers: tools and tests, never the flight code.
+    """
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("roll_rad", ctypes.c_double),
+        ("pitch_rad", ctypes.c_double),
+        ("yaw_rad", ctypes.c_double),  # [-π, π] from true north
+        ("lat_deg", ctypes.c_double),
+        ("lon_deg", ctypes.c_double),
+        ("alt_msl_m", ctypes.c_double),
+        ("alt_agl_m", ctypes.c_double),
+        ("vn_m_s", ctypes.c_double),
+        ("ve_m_s", ctypes.c_double),
+        ("vd_m_s", ctypes.c_double),
+        ("airspeed_m_s", ctypes.c_double),
+    ]
+
+
 class SimClock(Message):
     """Simulation time. Producer: the simulator bridge. Consumers: every vehicle clock."""
 
@@ -360,7 +384,7 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("sensors/compass", Compass, "queue", 32, "digital compass attitude"),
     Channel("sensors/baro", Baro, "queue", 32, "barometric altitude"),
     Channel("nav/state", NavState, "latest", doc="navigation solution"),
-    Channel("sim/truth", NavState, "latest", doc="simulator's true state"),
+    Channel("sim/truth", SimTruth, "latest", doc="simulator's true state"),
     Channel("sim/clock", SimClock, "latest", doc="simulation time"),
     Channel("control/actuators", ActuatorCommand, "queue", 8, "normalised surfaces"),
     Channel("actuators/servos", ServoOutput, "latest", doc="servo outputs written"),

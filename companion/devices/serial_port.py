@@ -103,6 +103,16 @@ class ReopeningSerial:
         self.bytes_out += written
         return written
 
+    def out_waiting(self) -> int:
+        """Bytes written but not yet gone out on the wire (0 when closed or unknown)."""
+        port = self._port
+        if port is None:
+            return 0
+        try:
+            return int(port.out_waiting)
+        except (*_PORT_ERRORS, AttributeError, NotImplementedError):
+            return 0
+
     def close(self) -> None:
         """Close the device; a later read or write opens it again."""
         self._closed.set()

@@ -7,6 +7,7 @@ match when a name looks misspelt. The CLI turns it into exit status 2.
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from difflib import get_close_matches
 from pathlib import Path
@@ -19,6 +20,7 @@ from companion.plugin import Plugin, Ports, Setting
 
 GROUPS = ("core", "flight")
 CLOCKS = ("monotonic", "sim")
+SIM_REF = "sim://"
 
 
 class ConfigError(Exception):
@@ -74,6 +76,7 @@ class _Checker:
     def __init__(self, path: Path, text: str) -> None:
         self.path = path
         self.lines = locate(text)
+        self.sim_refs: Mapping[str, str] | None = None
 
     def error(self, key_path: KeyPath, message: str) -> ConfigError:
         key = ".".join(str(p) if isinstance(p, str) else f"[{p}]" for p in key_path)
@@ -119,8 +122,14 @@ class _Checker:
         return value
 
 
-def load_config(path: str | Path, namespace: str | None = None) -> VehicleConfig:
-    """Read, parse and check the config; raise ConfigError on the first problem."""
+def load_config(
+    path: str | Path, namespace: str | None = None, sim_refs: Mapping[str, str] | None = None
+) -> VehicleConfig:
+    """Read, parse and check the config; raise ConfigError on the first problem.
+
+    A setting written ``"sim://NAME"`` takes the value ``sim_refs[NAME]``: the simulator's
+    device paths and the airframe, known only once ``companion sim`` has started it.
+    """
     path = Path(path)
     try:
         text = path.read_text()
@@ -134,6 +143,7 @@ def load_config(path: str | Path, namespace: str | None = None) -> VehicleConfig
         line = getattr(exc, "lineno", None)
         raise ConfigError(path, line, "", f"not valid TOML: {exc}") from None
     check = _Checker(path, text)
+    check.sim_refs = sim_refs
     check.unknown_keys(data, ["vehicle", "plugins"], ())
     vehicle = data.get("vehicle", {})
     if not isinstance(vehicle, dict):
@@ -157,6 +167,17 @@ def load_config(path: str | Path, namespace: str | None = None) -> VehicleConfig
         plugins=specs,
         vehicle=vehicle,
     )
+
+
+def _sim_ref(check: _Checker, value: Any, where: KeyPath) -> Any:
+    if not isinstance(value, str) or not value.startswith(SIM_REF):
+        return value
+    name = value[len(SIM_REF) :]
+    if check.sim_refs is None:
+        raise check.error(where, f"{value!r} names a simulated device: use `companion sim`")
+    if name not in check.sim_refs:
+        raise check.error(where, f"the simulator has no {name!r} (it has {sorted(check.sim_refs)})")
+    return check.sim_refs[name]
 
 
 def _plugin_specs(check: _Checker, entries: Any) -> list[PluginSpec]:
@@ -195,6 +216,10 @@ def _plugin_spec(check: _Checker, entry: Any, where: KeyPath) -> PluginSpec:
     raw_settings = entry.get("settings", {})
     if not isinstance(raw_settings, dict):
         raise check.error((*where, "settings"), "must be a table")
+    raw_settings = {
+        key: _sim_ref(check, value, (*where, "settings", key))
+        for key, value in raw_settings.items()
+    }
     settings = check.values(raw_settings, cls.settings, (*where, "settings"))
     for problem in cls.validate(settings):
         raise check.error((*where, "settings"), problem)

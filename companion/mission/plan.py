@@ -14,7 +14,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from companion.mission.items import MissionItem
+from companion.mission.items import MissionItem, check_mission
 from mavlink_dialect import companion as d
 
 
@@ -186,3 +186,14 @@ def _export_params(it: MissionItem) -> list[float | None]:
 def save_plan(path: str | Path, items: dict[int, list[MissionItem]]) -> None:
     """Write a .plan file (fence items are not exported yet: only mission and rally)."""
     Path(path).write_text(json.dumps(plan_json(items), indent=2))
+
+
+def checked_plan(path: str | Path) -> dict[int, list[MissionItem]]:
+    """``load_plan``, then every list checked as an upload would be; PlanError on refusal."""
+    lists = load_plan(path)
+    for mission_type, items in lists.items():
+        result = check_mission(items)
+        if result != d.MAV_MISSION_ACCEPTED:
+            name = d.enums["MAV_MISSION_RESULT"][result].name
+            raise PlanError(f"{path}: mission type {mission_type} refused: {name}")
+    return lists

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from companion.devices.line_framer import LineFramer
 from companion.devices.os3000 import Os3000Decoder
 from companion.devices.serial_port import ReopeningSerial
@@ -15,6 +17,13 @@ class Os3000Compass(Plugin):
         "device": Setting(str, doc="serial:///dev/ttyS0:19200, a pty path or a pyserial URL"),
         "baud": Setting(int, 19200, "baud rate when the URL does not give one", min=300),
         "mag_unit_gauss": Setting(float, 1e-3, "gauss per unit of the Mx/My/Mz fields", min=0.0),
+        "declination_deg": Setting(
+            float,
+            0.0,
+            "magnetic declination, east positive: added to make heading true",
+            min=-180.0,
+            max=180.0,
+        ),
     }
     outputs = ("sensors/compass", "sensors/mag")
 
@@ -25,6 +34,7 @@ class Os3000Compass(Plugin):
         self.decoder = Os3000Decoder(ctx.settings["mag_unit_gauss"])
         self.compass = ctx.bus.writer("sensors/compass")
         self.mag = ctx.bus.writer("sensors/mag")
+        self.declination_rad = math.radians(ctx.settings["declination_deg"])
 
     def step(self) -> None:
         with self.ctx.bus.idle:
@@ -34,6 +44,8 @@ class Os3000Compass(Plugin):
             reading = self.decoder.decode(sentence, t_us)
             if reading is None:
                 continue
+            heading = reading.compass.heading_rad + self.declination_rad
+            reading.compass.heading_rad = heading % math.tau
             self.compass.publish(reading.compass)
             if reading.mag is not None:
                 self.mag.publish(reading.mag)

@@ -1,0 +1,1 @@
+"""Servo output libraries: the airframe's channel map and the Mini SSC II wire format."""

@@ -1,0 +1,1 @@
+"""Actuator plug-ins: the servo card."""

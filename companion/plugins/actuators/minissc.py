@@ -1,0 +1,126 @@
+"""``actuators.minissc``: surface commands to a Mini SSC II servo card on a serial port.
+
+Group ``flight``: it runs while the vehicle is started (armed). On STOP (its process is
+stopped), when its command input goes stale, or when a command says disarmed, every
+channel goes to its safe position: throttle off, surfaces at trim.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from typing import Any
+
+from companion.actuators import minissc
+from companion.actuators.airframe import Airframe, AirframeError, load_airframe
+from companion.devices.serial_port import ReopeningSerial
+from companion.messages import ActuatorCommand, ServoOutput
+from companion.plugin import Plugin, PluginContext, Setting
+
+WAIT_S = 0.1  # also the refresh cadence when no command arrives
+CYCLE_MIN_S, CYCLE_MAX_S = 0.01, 0.1
+FRAME_BYTES = 3
+
+
+def surface_value(cmd: ActuatorCommand, surface: str) -> float:
+    """The command for a surface by name; ``flaps`` is aux[0]; other extras are not driven."""
+    if surface in ("aileron", "elevator", "rudder", "throttle"):
+        return float(getattr(cmd, surface))
+    if surface == "flaps":
+        return float(cmd.aux[0])
+    return float("nan")
+
+
+class MiniSscOutput(Plugin):
+    """Writes changed channels first, never more than one cycle of frames ahead of the wire."""
+
+    settings = {
+        "device": Setting(str, doc="serial:///dev/ttyS1:9600, a pty path or a pyserial URL"),
+        "baud": Setting(int, 9600, "the card's jumper setting", choices=(2400, 9600)),
+        "airframe": Setting(str, "c172p", "airframe name (companion/airframes) or TOML path"),
+        "stale_s": Setting(float, 0.5, "no command for this long: safe positions", min=0.05),
+    }
+    optional_inputs = ("control/actuators",)
+    outputs = ("actuators/servos",)
+
+    @classmethod
+    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
+        """The airframe file must load."""
+        try:
+            load_airframe(settings["airframe"])
+        except AirframeError as exc:
+            return [f"airframe: {exc}"]
+        return []
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.airframe: Airframe = load_airframe(ctx.settings["airframe"])
+        self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"])
+        self.per_second = minissc.frames_per_second(ctx.settings["baud"])
+        self.commands = ctx.bus.queue_reader("control/actuators")
+        self.waiter = ctx.bus.waiter([self.commands])
+        self.out = ctx.bus.writer("actuators/servos")
+        self.safe = {c.servo: c.safe for c in self.airframe.channels}
+        self.wanted = dict(self.safe)
+        self.sent: dict[int, int] = {}
+        self.refresh_order = [c.servo for c in self.airframe.channels]
+        self.last_command_at = time.monotonic()
+        self.cycle_s = CYCLE_MAX_S
+        self.stale = True
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:
+            self.waiter.wait(WAIT_S)
+        received = self.commands.drain()
+        now = time.monotonic()
+        if received:
+            gap = now - self.last_command_at
+            self.cycle_s = min(CYCLE_MAX_S, max(CYCLE_MIN_S, gap))
+            self.last_command_at = now
+            self.wanted = self._positions(received[-1])
+            self.stale = False
+        elif not self.stale and now - self.last_command_at > self.ctx.settings["stale_s"]:
+            self.ctx.log.warning(
+                "no command for %.2f s: safe positions", now - self.last_command_at
+            )
+            self.wanted, self.stale = dict(self.safe), True
+        self._send(self._room())
+
+    def close(self) -> None:
+        self.wanted = dict(self.safe)
+        self.sent = {}  # everything counts as changed: all channels go out
+        self._send(len(self.safe))
+        self.waiter.close()
+        self.port.close()
+
+    def _positions(self, cmd: ActuatorCommand) -> dict[int, int]:
+        if not cmd.armed:
+            return dict(self.safe)
+        return {c.servo: c.position(surface_value(cmd, c.surface)) for c in self.airframe.channels}
+
+    def _room(self) -> int:
+        """Frames that fit in one cycle, less what is still queued for the wire."""
+        cycle_frames = max(1, int(self.per_second * self.cycle_s))
+        return cycle_frames - self.port.out_waiting() // FRAME_BYTES
+
+    def _send(self, room: int) -> None:
+        plan = minissc.plan_cycle(self.wanted, self.sent, self.refresh_order, room)
+        if not plan:
+            return
+        data = b"".join(minissc.frame(s, p) for s, p in plan)
+        if self.port.write(data) != len(data):
+            self.ctx.health.bad()
+            return
+        self.ctx.health.ok(len(plan))
+        for servo, position in plan:
+            self.sent[servo] = position
+            self.refresh_order.remove(servo)
+            self.refresh_order.append(servo)
+        self._publish()
+
+    def _publish(self) -> None:
+        msg = ServoOutput(t_us=self.ctx.clock.now_us())
+        for servo, position in self.sent.items():
+            msg.position[servo] = position
+            msg.pulse_us[servo] = minissc.pulse_us(position)
+        self.out.publish(msg)
