@@ -71,7 +71,7 @@ class MiniSscOutput(Plugin):
     def step(self) -> None:
         with self.ctx.bus.idle:
             self.waiter.wait(WAIT_S)
-        received = self.commands.drain()
+        received = list(self.commands.drain())
         now = time.monotonic()
         if received:
             gap = now - self.last_command_at

@@ -1,0 +1,127 @@
+"""actuators.minissc on a real pty: frames, channel map, reversal, limits, safe positions."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from companion.actuators.airframe import load_airframe
+from companion.actuators.minissc import FrameDecoder, pulse_us
+from companion.messages import ActuatorCommand, CommandId, VehicleCommand
+from tests.support.pty import Pty
+from tests.support.vehicle import wait_for
+
+
+class CardEnd:
+    """The servo card's side of the line: decodes what the plug-in writes."""
+
+    def __init__(self, pty: Pty) -> None:
+        self.pty = pty
+        os.set_blocking(pty.master, False)
+        self.decoder = FrameDecoder()
+        self.positions: dict[int, int] = {}
+        self.frames = 0
+
+    def poll(self) -> dict[int, int]:
+        try:
+            data = os.read(self.pty.master, 4096)
+        except BlockingIOError:
+            data = b""
+        for servo, position in self.decoder.feed(data):
+            self.positions[servo] = position
+            self.frames += 1
+        return self.positions
+
+
+def command(**surfaces: float) -> ActuatorCommand:
+    msg = ActuatorCommand(t_us=0, armed=1)
+    for name, value in surfaces.items():
+        setattr(msg, name, value)
+    return msg
+
+
+def start_servos(vehicle_factory, tmp_path, airframe: str):
+    pty = Pty(tmp_path / "ttyServo")
+    vehicle = vehicle_factory(
+        f"""
+        [vehicle]
+        name = "servos"
+        [[plugins]]
+        name = "servos"
+        plugin = "actuators.minissc"
+        group = "flight"
+        settings = {{ device = "{pty.link}", airframe = "{airframe}", stale_s = 0.3 }}
+        """
+    )
+    card = CardEnd(pty)
+    commands = vehicle.bus.writer("link/commands")
+    wait_for(vehicle.health, 10, "the execution control's health table")
+
+    def started() -> bool:  # repeated: START sent before the supervisor listens is lost
+        commands.publish(VehicleCommand(t_us=0, seq=1, command=int(CommandId.START)))
+        return bool((row := vehicle.row("servos")) and row.pid)
+
+    wait_for(started, 10, "servo output started", period_s=0.5)
+    return vehicle, card, commands
+
+
+@pytest.mark.timeout(90)
+def test_commands_reach_the_card_through_the_channel_map(vehicle_factory, tmp_path):
+    vehicle, card, commands = start_servos(vehicle_factory, tmp_path, "J3Cub")
+    cub = load_airframe("J3Cub")
+    safe = {c.servo: c.safe for c in cub.channels}
+    wait_for(lambda: card.poll() == safe, 10, "safe positions at start")
+
+    actuators = vehicle.bus.writer("control/actuators")
+    servos = vehicle.bus.latest_reader("actuators/servos")
+    ail, elev, thr = cub.channel("aileron"), cub.channel("elevator"), cub.channel("throttle")
+    want = {ail.servo: ail.max, elev.servo: elev.max, thr.servo: thr.min + (thr.max - thr.min) // 2}
+
+    def commanded() -> bool:
+        # Nose down is elevator -1: the Cub's elevator servo is reversed, so that is its max;
+        # an aileron command of 5 is clamped to full travel.
+        actuators.publish(command(aileron=5.0, elevator=-1.0, throttle=0.5))
+        positions = card.poll()
+        return all(positions.get(s) in (p, p + 1) for s, p in want.items())
+
+    wait_for(commanded, 10, "the commanded positions on the wire")
+    assert vehicle.row("servos").restarts == 0
+    written = servos.get()
+    assert written.pulse_us[ail.servo] == pulse_us(ail.max)
+    assert written.position[elev.servo] == elev.max
+
+    # Input goes stale: every channel back to safe, throttle off.
+    wait_for(lambda: card.poll() == safe, 5, "safe positions once commands stop")
+
+    wait_for(
+        lambda: actuators.publish(command(throttle=1.0)) or card.poll()[thr.servo] == thr.max,
+        5,
+        "full throttle",
+    )
+    commands.publish(VehicleCommand(t_us=0, seq=2, command=int(CommandId.STOP)))
+    wait_for(lambda: vehicle.row("servos").pid == 0, 10, "servo output stopped")
+    wait_for(lambda: card.poll() == safe, 5, "safe positions written on STOP")
+
+
+@pytest.mark.timeout(90)
+def test_a_disarmed_command_means_safe_positions(vehicle_factory, tmp_path):
+    vehicle, card, _ = start_servos(vehicle_factory, tmp_path, "c172p")
+    c172 = load_airframe("c172p")
+    actuators = vehicle.bus.writer("control/actuators")
+    aileron = c172.channel("aileron")
+
+    def deflected() -> bool:
+        actuators.publish(command(aileron=-1.0, throttle=0.8))
+        return card.poll().get(aileron.servo) == aileron.min
+
+    wait_for(deflected, 10, "aileron full left")
+    safe = {c.servo: c.safe for c in c172.channels}
+
+    def disarmed() -> bool:
+        msg = command(aileron=-1.0, throttle=0.8)
+        msg.armed = 0
+        actuators.publish(msg)
+        return card.poll() == safe
+
+    wait_for(disarmed, 5, "safe positions on a disarmed command")
