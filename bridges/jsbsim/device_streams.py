@@ -17,6 +17,7 @@ from bridges.jsbsim.sensor_models import ImuSample, SensorErrors
 from companion.devices.ascii_sentence import xor8
 
 KNOT_M_S = 0.514444
+_VNIMU_FORMAT = "VNIMU," + ",".join(["%+.4f"] * 9) + ",%+.1f,%+.3f"
 UTC_EPOCH = dt.datetime(2026, 1, 1, tzinfo=dt.UTC)  # simulation time 0
 
 
@@ -92,9 +93,8 @@ def os3000_sentence(heading: float, pitch: float, roll: float, temp_c: float) ->
 
 def vnimu_sentence(s: ImuSample) -> bytes:
     """``$VNIMU``: mag (gauss), accel (m/s²), gyro (rad/s), temperature, pressure (kPa)."""
-    values = [*s.mag, *s.accel, *s.gyro]
-    text = ",".join(f"{v:+.4f}" for v in values)
-    return checked(f"VNIMU,{text},{s.temp_c:+.1f},{s.pressure_kpa:+.3f}")
+    text = _VNIMU_FORMAT % (*s.mag, *s.accel, *s.gyro, s.temp_c, s.pressure_kpa)
+    return checked(text)
 
 
 @dataclass

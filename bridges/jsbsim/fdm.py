@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass
 
 import jsbsim
+
+log = logging.getLogger(__name__)
 
 FT = 0.3048  # metres per foot
 
@@ -64,9 +67,11 @@ class Flight:
             raise ValueError(f"JSBSim has no aircraft {model!r}")
         self.fdm.set_dt(1.0 / rate_hz)
         self.home = home
-        self._initial_conditions(airborne_agl_m, speed_m_s)
+        self._initial_conditions(model, airborne_agl_m, speed_m_s)
 
-    def _initial_conditions(self, airborne_agl_m: float | None, speed_m_s: float) -> None:
+    def _initial_conditions(
+        self, model: str, airborne_agl_m: float | None, speed_m_s: float
+    ) -> None:
         f, h = self.fdm, self.home
         f["ic/lat-geod-deg"] = h.lat_deg
         f["ic/long-gc-deg"] = h.lon_deg
@@ -79,7 +84,10 @@ class Flight:
         f["propulsion/set-running"] = -1  # engines running, as if started on the ground
         f["fcs/mixture-cmd-norm"] = 1.0
         if airborne_agl_m:
-            f["simulation/do_simple_trim"] = 1  # steady level flight at the given speed
+            try:
+                f["simulation/do_simple_trim"] = 1  # steady level flight at the given speed
+            except jsbsim.TrimFailureError:
+                log.warning("%s cannot trim at %.1f m/s: starting untrimmed", model, speed_m_s)
         else:
             f["fcs/throttle-cmd-norm"] = 0.0
 

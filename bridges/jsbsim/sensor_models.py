@@ -97,16 +97,16 @@ class SensorErrors:
 
     def imu(self, s: TrueState, dt: float, pressure_kpa: float) -> ImuSample:
         """One IMU sample; the biases walk by ``dt`` seconds first."""
-        m, k, rng = self.m, self.m.scale, self.rng
+        m = self.m
         root = math.sqrt(max(dt, 0.0))
-        self.accel_bias += rng.normal(0.0, m.accel_walk_m_s2_rt_s * k * root, 3)
-        self.gyro_bias += rng.normal(0.0, m.gyro_walk_rad_s_rt_s * k * root, 3)
-        accel = np.array(s.f_body) + self.accel_bias + rng.normal(0.0, m.accel_noise_m_s2 * k, 3)
-        gyro = (
-            np.array([s.p, s.q, s.r]) + self.gyro_bias + rng.normal(0.0, m.gyro_noise_rad_s * k, 3)
-        )
+        # One draw for all fifteen: the IMU runs at 100 Hz and more.
+        z = self.rng.standard_normal(15) * m.scale
+        self.accel_bias += z[0:3] * (m.accel_walk_m_s2_rt_s * root)
+        self.gyro_bias += z[3:6] * (m.gyro_walk_rad_s_rt_s * root)
+        accel = np.array(s.f_body) + self.accel_bias + z[6:9] * m.accel_noise_m_s2
+        gyro = np.array((s.p, s.q, s.r)) + self.gyro_bias + z[9:12] * m.gyro_noise_rad_s
         mag = body_from_ned(s.roll, s.pitch, s.yaw) @ self.field_ned
-        mag = mag + rng.normal(0.0, m.mag_noise_gauss * k, 3)
+        mag = mag + z[12:15] * m.mag_noise_gauss
         return ImuSample(accel, gyro, mag, 25.0, pressure_kpa)
 
     def compass(self, s: TrueState) -> tuple[float, float, float]:

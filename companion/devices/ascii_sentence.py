@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import operator
 from functools import reduce
 
 
@@ -16,4 +17,5 @@ def sentence_text(sentence: bytes | str) -> str:
 
 def xor8(payload: str) -> int:
     """The 8-bit XOR of the characters between ``$`` and ``*`` (NMEA, OS-3000, VectorNav)."""
-    return reduce(lambda acc, ch: acc ^ ord(ch), payload, 0)
+    # On the bytes, so the loop stays in C: the IMU's sentences arrive at 100-400 Hz.
+    return reduce(operator.xor, payload.encode("latin-1", "replace"), 0)

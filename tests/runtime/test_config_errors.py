@@ -138,3 +138,36 @@ def test_registered_short_names_resolve_and_misspellings_get_a_suggestion(tmp_pa
     assert load("link.mavlink").__name__ == "MavlinkLink"
     err = refuse(tmp_path, GOOD.replace("tests.support.plugins:Relay", "link.mavlnk"))
     assert "did you mean 'link.mavlink'" in str(err)
+
+
+SIM_DEVICE = """\
+[vehicle]
+name = "v"
+
+[[plugins]]
+name = "gps"
+plugin = "sensors.nmea_gps"
+settings = { device = "sim://gps" }
+"""
+
+
+def test_simulated_devices_outside_the_simulator_are_refused(tmp_path):
+    err = refuse(tmp_path, SIM_DEVICE)
+    assert err.key == "plugins[0].settings.device" and err.line == 7
+    assert "companion sim" in str(err)
+
+
+def test_an_unknown_simulated_device_is_named(tmp_path):
+    path = write(tmp_path, SIM_DEVICE.replace("sim://gps", "sim://gsp"))
+    with pytest.raises(ConfigError, match=r"no 'gsp'.*\['gps', 'imu'\]"):
+        load_config(path, sim_refs={"gps": "/dev/pts/9", "imu": "/dev/pts/8"})
+    cfg = load_config(write(tmp_path, SIM_DEVICE), sim_refs={"gps": "/dev/pts/9"})
+    assert cfg.plugins[0].settings["device"] == "/dev/pts/9"
+
+
+def test_the_shipped_sim_config_loads_with_the_bridge_devices():
+    refs = {n: f"/dev/pts/{i}" for i, n in enumerate(("gps", "compass", "imu", "servos"))}
+    cfg = load_config(REPO / "companion/configs/sim.toml", sim_refs={**refs, "airframe": "J3Cub"})
+    check_topology(cfg)
+    servos = next(p for p in cfg.plugins if p.kind == "actuators.minissc")
+    assert servos.group == "flight" and servos.settings["airframe"] == "J3Cub"

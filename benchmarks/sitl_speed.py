@@ -1,0 +1,100 @@
+"""Lockstep simulation speed with the whole vehicle running.
+
+Usage: uv run python benchmarks/sitl_speed.py [--aircraft c172p] [--seconds 300]
+
+Runs ``companion sim --speed max --airborne`` for the given simulated time and prints the
+speed factor (simulated seconds per wall second, target ≥ 20×) from the bridge's own
+count, the CPU each process used, and the speed of JSBSim alone for comparison.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import psutil
+
+REPO = Path(__file__).resolve().parents[1]
+RESULT = re.compile(r"simulated ([\d.]+) s in ([\d.]+) s wall \(([\d.]+)x\); lockstep stalls (\d+)")
+
+
+def jsbsim_alone(aircraft: str, seconds: float) -> float:
+    """Speed factor of the flight dynamics with nothing else (the ceiling)."""
+    from bridges.jsbsim.fdm import Flight, Home
+    from companion.actuators.airframe import load_airframe
+
+    frame = load_airframe(aircraft)
+    saved = os.dup(1)  # JSBSim prints a banner on stdout
+    os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
+    try:
+        flight = Flight(frame.jsbsim_model, 100.0, Home(), 300.0, frame.cruise_speed_m_s)
+    finally:
+        os.dup2(saved, 1)
+    started = time.perf_counter()
+    while flight.t_s < seconds:
+        flight.step()
+        flight.state()
+    return seconds / (time.perf_counter() - started)
+
+
+def process_name(cmdline: list[str]) -> str:
+    """The plug-in's instance name for a plug-in host, else the module it runs."""
+    if "companion.exec_control.plugin_host" in cmdline:
+        return f"plug-in {json.loads(cmdline[-1])['name']}"
+    module = cmdline[cmdline.index("-m") + 1] if "-m" in cmdline else " ".join(cmdline[:3])
+    return module
+
+
+def cpu_of_tree(proc: psutil.Process, seen: dict[int, tuple[str, float]]) -> None:
+    """Remember each process's name and CPU seconds so far (they vanish at the end)."""
+    for p in [proc, *proc.children(recursive=True)]:
+        try:
+            t = p.cpu_times()
+            name = process_name(p.cmdline())
+            seen[p.pid] = (name, t.user + t.system)
+        except psutil.Error:
+            pass
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--aircraft", default="c172p")
+    parser.add_argument("--seconds", type=float, default=300.0)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        env = dict(os.environ, COMPANION_BUS=f"sitlbench{os.getpid()}")
+        cmd = [
+            sys.executable, "-m", "companion", "sim", "--speed", "max", "--airborne",
+            "--aircraft", args.aircraft, "--duration", str(args.seconds),
+            "--state-dir", tmp, "--link", "udpout://127.0.0.1:9",
+        ]  # fmt: skip
+        proc = subprocess.Popen(cmd, cwd=REPO, env=env, text=True, stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT)  # fmt: skip
+        root, cpu = psutil.Process(proc.pid), {}
+        while proc.poll() is None:
+            cpu_of_tree(root, cpu)
+            time.sleep(0.2)
+        out = proc.stdout.read() if proc.stdout else ""
+    match = RESULT.search(out)
+    if proc.returncode != 0 or match is None:
+        sys.stderr.write(out)
+        raise SystemExit("the simulation did not finish")
+    sim_s, wall_s, factor, stalls = match.groups()
+    print(f"aircraft {args.aircraft}: {sim_s} s simulated in {wall_s} s wall")
+    print(f"lockstep speed factor, whole vehicle: {factor}x   (target >= 20x; stalls {stalls})")
+    print(f"JSBSim alone: {jsbsim_alone(args.aircraft, 60.0):.0f}x")
+    print("CPU seconds per process over the run (start-up imports included):")
+    for name, seconds in sorted(cpu.values(), key=lambda v: -v[1]):
+        if name:
+            print(f"  {seconds:6.2f}  {name}")
+
+
+if __name__ == "__main__":
+    main()
