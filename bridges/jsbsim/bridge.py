@@ -8,16 +8,17 @@ import time
 from collections.abc import Callable
 
 from bridges.jsbsim.device_streams import EmulatedDevices
-from bridges.jsbsim.fdm import Flight, TrueState
+from bridges.jsbsim.fdm import Flight
 from bridges.jsbsim.lockstep import Lockstep, RealTime
 from bridges.jsbsim.options import BridgeOptions
 from bridges.jsbsim.ptys import PtyPort
-from bridges.jsbsim.sensor_models import MagneticField, NoiseModel, SensorErrors
 from bridges.jsbsim.truth_log import TruthLog
 from companion.actuators.airframe import load_airframe
 from companion.actuators.minissc import FrameDecoder
 from companion.bus.node import BusNode
 from companion.messages import SimClock, SimTruth
+from companion.simulation.sensor_errors import MagneticField, NoiseModel, SensorErrors
+from companion.simulation.true_state import TrueState
 
 log = logging.getLogger(__name__)
 
@@ -109,7 +110,7 @@ class SimBridge:
 
     def _publish_truth(self, s: TrueState, t_us: int) -> None:
         if self.truth is not None:
-            self.truth.add(s)
+            self.truth.add_state(s)
         self.truth_out.publish(
             SimTruth(
                 t_us,

@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import pynmea2
 
-from bridges.jsbsim.fdm import TrueState
-from bridges.jsbsim.sensor_models import ImuSample, SensorErrors
 from companion.devices.ascii_sentence import xor8
+from companion.simulation.sensor_errors import ImuSample, SensorErrors
+from companion.simulation.true_state import TrueState
 
 KNOT_M_S = 0.514444
 _VNIMU_FORMAT = "VNIMU," + ",".join(["%+.4f"] * 9) + ",%+.1f,%+.3f"

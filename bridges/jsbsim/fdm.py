@@ -8,6 +8,8 @@ from dataclasses import dataclass
 
 import jsbsim
 
+from companion.simulation.true_state import TrueState
+
 log = logging.getLogger(__name__)
 
 FT = 0.3048  # metres per foot
@@ -26,28 +28,6 @@ class Home:
     lon_deg: float = 145.1340
     ground_msl_m: float = 80.0
     heading_deg: float = 90.0
-
-
-@dataclass
-class TrueState:
-    """What the aircraft is really doing (SI units, body FRD, NED)."""
-
-    t_s: float
-    lat_deg: float
-    lon_deg: float
-    alt_msl_m: float
-    alt_agl_m: float
-    roll: float
-    pitch: float
-    yaw: float  # [-π, π] from true north
-    vn: float
-    ve: float
-    vd: float
-    p: float  # body rates, rad/s
-    q: float
-    r: float
-    f_body: tuple[float, float, float]  # specific force, m/s², body FRD
-    airspeed_m_s: float
 
 
 class Flight:

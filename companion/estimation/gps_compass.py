@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
+from companion.estimation.rotations import euler_to_quaternion
 from companion.messages import Compass, GpsFix, NavFlags, NavState
 
 EARTH_RADIUS_M = 6_378_137.0
@@ -28,19 +29,6 @@ class GpsCompassConfig:
     vel_std_m_s: float = 0.3
     gps_timeout_s: float = 2.0
     compass_timeout_s: float = 1.0
-
-
-def euler_to_quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, ...]:
-    """ZYX Euler angles to a body→NED quaternion (w, x, y, z)."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (
-        cr * cp * cy + sr * sp * sy,
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-    )
 
 
 class GpsCompassNavigator:

@@ -10,7 +10,7 @@ import pytest
 
 from companion.bus import BusNode, cleanup_namespace
 from companion.messages import Imu, NavState
-from tests.support.vehicle import REPO, assert_clean, unique_namespace
+from tests.support.vehicle import REPO, assert_clean, unique_namespace, wait_for
 
 WRITER = textwrap.dedent(
     """
@@ -58,7 +58,10 @@ def test_queue_delivers_every_sample_in_order_and_latest_the_newest(namespace):
                 received += queue.take(timeout_s=0.05)
                 if len(received) >= 50:
                     break
-            newest = latest.get()
+            # nav/state's last sample is written just after the last IMU one: wait for it.
+            newest = wait_for(
+                lambda: (n := latest.get()) is not None and n.t_us == 49 and n, 5, "nav 49"
+            )
         finally:
             go.publish(SimClock(t_us=2))
             writer.wait(timeout=10)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 import subprocess
 import sys
 from pathlib import Path
@@ -38,10 +37,3 @@ def finish(proc: subprocess.Popen[str], namespace: str, timeout_s: float) -> str
     assert proc.returncode == 0, out
     assert leftover_files(namespace) == [], "shared memory left behind"
     return out
-
-
-def read_truth(path: Path) -> dict[str, list[float]]:
-    """The truth CSV as columns."""
-    with path.open() as f:
-        rows = list(csv.DictReader(f))
-    return {key: [float(r[key]) for r in rows] for key in rows[0]}

@@ -7,14 +7,25 @@ import math
 import numpy as np
 import pytest
 
-from bridges.jsbsim.device_streams import DeviceRates, EmulatedDevices, Outage, nmea_epoch
-from bridges.jsbsim.fdm import TrueState
-from bridges.jsbsim.sensor_models import MagneticField, NoiseModel, SensorErrors
+from bridges.jsbsim.device_streams import (
+    DeviceRates,
+    EmulatedDevices,
+    Outage,
+    nmea_epoch,
+    os3000_sentence,
+)
 from companion.devices.line_framer import LineFramer
 from companion.devices.nmea_gps import NmeaGpsDecoder
 from companion.devices.os3000 import Os3000Decoder
 from companion.devices.vectornav import VectorNavDecoder
 from companion.messages import GpsFixType
+from companion.simulation.sensor_errors import (
+    MagneticField,
+    NoiseModel,
+    SensorErrors,
+    body_from_ned,
+)
+from companion.simulation.true_state import TrueState
 
 FIELD = MagneticField()
 
@@ -56,14 +67,28 @@ def test_imu_lines_decode_to_the_true_specific_force_rates_and_field():
 
 
 def test_compass_reports_magnetic_heading_to_a_tenth_of_a_degree():
-    devices = perfect_devices()
-    (line,) = lines(devices, 0.0, "compass")
-    reading = Os3000Decoder().decode(line, 7)
+    still = state(0.0)
+    gravity = body_from_ned(still.roll, still.pitch, still.yaw) @ np.array([0.0, 0.0, -9.8])
+    still.f_body = tuple(gravity)  # held still: the compass levels itself correctly
+    errors = SensorErrors(NoiseModel(scale=0.0), FIELD, seed=3)
+    reading = Os3000Decoder().decode(
+        LineFramer().feed(os3000_sentence(*errors.compass(still), 25.0))[0], 7
+    )
     assert reading is not None
     magnetic = (30.0 - FIELD.declination_deg) % 360
     assert math.degrees(reading.compass.heading_rad) == pytest.approx(magnetic, abs=0.051)
     assert math.degrees(reading.compass.roll_rad) == pytest.approx(10.0, abs=0.051)
     assert math.degrees(reading.compass.pitch_rad) == pytest.approx(-3.0, abs=0.051)
+
+
+def test_in_a_coordinated_turn_the_compass_reads_wings_level_and_a_wrong_heading():
+    turning = state(0.0)  # banked 10°, but the specific force stays in the plane of symmetry
+    turning.f_body = (0.0, 0.0, -9.95)
+    errors = SensorErrors(NoiseModel(scale=0.0), FIELD, seed=3)
+    heading, _, roll = errors.compass(turning)
+    assert roll == pytest.approx(0.0, abs=1e-9)
+    error = math.remainder(heading - (30.0 - FIELD.declination_deg), 360.0)
+    assert abs(error) > 5.0  # the thesis's trouble: a tilt error is a bigger heading error
 
 
 def test_gps_epochs_decode_to_the_true_position_and_velocity():

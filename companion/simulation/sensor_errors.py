@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bridges.jsbsim.fdm import TrueState
+from companion.estimation.rotations import tilt_compensated_heading
+from companion.simulation.true_state import TrueState
 
 EARTH_RADIUS_M = 6378137.0
 
@@ -110,13 +111,21 @@ class SensorErrors:
         return ImuSample(accel, gyro, mag, 25.0, pressure_kpa)
 
     def compass(self, s: TrueState) -> tuple[float, float, float]:
-        """(magnetic heading [0, 360), pitch, roll) in degrees, as the compass reports them."""
+        """(magnetic heading [0, 360), pitch, roll) in degrees, as an OS-3000 reports them.
+
+        Like the real part, it levels itself with its accelerometer: in a turn or while
+        accelerating the specific force is not vertical, so pitch and roll are wrong
+        (a coordinated turn reads wings level) and the tilt-compensated heading with them.
+        """
         k, rng = self.m.scale, self.rng
-        heading = math.degrees(s.yaw) - self.field.declination_deg
+        fx, fy, fz = s.f_body
+        roll = math.atan2(-fy, -fz) + math.radians(rng.normal(0.0, self.m.compass_tilt_deg * k))
+        pitch = math.atan2(fx, math.hypot(fy, fz))
+        pitch += math.radians(rng.normal(0.0, self.m.compass_tilt_deg * k))
+        mag = body_from_ned(s.roll, s.pitch, s.yaw) @ self.field_ned
+        heading = math.degrees(tilt_compensated_heading(mag, roll, pitch))
         heading += rng.normal(0.0, self.m.compass_heading_deg * k)
-        pitch = math.degrees(s.pitch) + rng.normal(0.0, self.m.compass_tilt_deg * k)
-        roll = math.degrees(s.roll) + rng.normal(0.0, self.m.compass_tilt_deg * k)
-        return heading % 360.0, pitch, roll
+        return heading % 360.0, math.degrees(pitch), math.degrees(roll)
 
     def gps(self, s: TrueState, dt: float) -> tuple[float, float, float, np.ndarray]:
         """(lat, lon, alt MSL, NED velocity) with the receiver's error; error evolves by dt."""
