@@ -187,6 +187,64 @@ params_app = typer.Typer(help="Parameters in QGroundControl .params files (vehic
 app.add_typer(params_app, name="params")
 
 
+@app.command()
+def replay(
+    log: Annotated[Path, typer.Argument(help="sensor log CSV (the design's format)")],
+    out_path: Annotated[Path, typer.Option("--out", "-o", help="estimate CSV to write")],
+    navigator: Annotated[str, typer.Option(help="ins_ekf or gps_compass")] = "ins_ekf",
+    plot: Annotated[Path | None, typer.Option(help="also draw the flight into this PNG")] = None,
+    truth: Annotated[Path | None, typer.Option(help="truth CSV to draw beside it")] = None,
+    rate: Annotated[float, typer.Option(help="estimate rows per second of log time")] = 50.0,
+    declination: Annotated[
+        float, typer.Option(help="magnetic declination, degrees east (compass, magnetometer)")
+    ] = 0.0,
+) -> None:
+    """Run a navigator over a recorded sensor log, offline, as fast as it goes."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from companion.estimation.offline import NAVIGATORS
+    from companion.replay import count_rows, replay_log
+
+    if navigator not in NAVIGATORS:
+        raise typer.BadParameter(f"navigator must be one of {', '.join(NAVIGATORS)}")
+    if not log.is_file():
+        raise typer.BadParameter(f"{log}: no such file")
+    _setup_logging("WARNING")
+    fixes: list = []
+    percent = TextColumn("{task.percentage:>3.0f}%")
+    columns = (TextColumn("{task.description}"), BarColumn(), percent, TimeRemainingColumn())
+    with Progress(*columns, console=err, transient=True) as bar:
+        task = bar.add_task(f"{navigator} over {log.name}", total=count_rows(log))
+        try:
+            summary, states = replay_log(
+                log, navigator, out_path, rate, declination,
+                lambda n: bar.advance(task, n), fixes if plot else None,
+            )  # fmt: skip
+        except ValueError as exc:
+            err.print(f"[red]{exc}[/red]", highlight=False, soft_wrap=True)
+            raise typer.Exit(EXIT_CONFIG) from None
+    _print_replay_summary(summary)
+    if plot is not None:
+        from companion.estimation.estimate_csv import read_estimate
+        from companion.replay_plot import plot_replay
+
+        plot_replay(states, plot, f"{log.name}: {navigator}", fixes,
+                    read_estimate(truth) if truth else None)  # fmt: skip
+        err.print(f"plot written to {plot}")
+
+
+def _print_replay_summary(s) -> None:
+    out.print(
+        f"{s.log}: {s.rows} rows ({s.bad_rows} bad), {s.log_seconds:.1f} s of log in "
+        f"{s.wall_seconds:.1f} s ({s.speed:.0f}x) -> {s.estimates} estimates"
+    )
+    out.print(
+        f"innovation rejections: GPS {s.gps_rejected}, heading {s.heading_rejected}; "
+        f"longest GPS gap {s.longest_outage_s:.1f} s; final horizontal 1-sigma "
+        f"{s.final_pos_std_m:.1f} m; samples flagged {s.flagged}"
+    )
+
+
 def _param_store(config: Path, namespace: str | None):
     from companion.params import ParamStore
 

@@ -35,11 +35,24 @@ def _f(row: dict[str, str], key: str) -> float:
     return float(text) if text else math.nan
 
 
+def _required(row: dict[str, str], keys: tuple[str, ...], kind: str) -> list[float]:
+    """The row's values for ``keys``, all present and finite (the common, fast case)."""
+    try:
+        values = [float(row[k]) for k in keys]
+    except (KeyError, TypeError, ValueError):
+        values = [math.nan]
+    if not math.isfinite(sum(values)):
+        raise ValueError(f"{kind} row needs {', '.join(keys)}")
+    return values
+
+
+_IMU_KEYS = ("ax", "ay", "az", "gx", "gy", "gz")
+_MAG_KEYS = ("mx", "my", "mz")
+_COMPASS_KEYS = ("heading_deg", "pitch_deg", "roll_deg")
+
+
 def _imu(row: dict[str, str], t_us: int) -> Imu:
-    values = [_f(row, k) for k in ("ax", "ay", "az", "gx", "gy", "gz")]
-    if any(math.isnan(v) for v in values):
-        raise ValueError("imu row needs ax, ay, az, gx, gy, gz")
-    return Imu(t_us, *values, math.nan)
+    return Imu(t_us, *_required(row, _IMU_KEYS, "imu"), math.nan)
 
 
 def _gps(row: dict[str, str], t_us: int) -> GpsFix:
@@ -61,10 +74,7 @@ def _gps(row: dict[str, str], t_us: int) -> GpsFix:
 
 
 def _mag(row: dict[str, str], t_us: int) -> Magnetometer:
-    values = [_f(row, k) for k in ("mx", "my", "mz")]
-    if any(math.isnan(v) for v in values):
-        raise ValueError("mag row needs mx, my, mz")
-    return Magnetometer(t_us, *values)
+    return Magnetometer(t_us, *_required(row, _MAG_KEYS, "mag"))
 
 
 def _baro(row: dict[str, str], t_us: int) -> Baro:
@@ -75,9 +85,7 @@ def _baro(row: dict[str, str], t_us: int) -> Baro:
 
 
 def _compass(row: dict[str, str], t_us: int) -> Compass:
-    values = [_f(row, k) for k in ("heading_deg", "pitch_deg", "roll_deg")]
-    if any(math.isnan(v) for v in values):
-        raise ValueError("compass row needs heading_deg, pitch_deg, roll_deg")
+    values = _required(row, _COMPASS_KEYS, "compass")
     heading, pitch, roll = (math.radians(v) for v in values)
     return Compass(t_us, heading % (2 * math.pi), pitch, roll, math.nan)
 

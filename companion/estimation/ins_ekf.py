@@ -35,14 +35,25 @@ HISTORY_S = 1.0
 COMPASS_TILT_TO_HEADING = 3.0
 JACOBIAN_STEP = 1e-4
 P, V, TH, BA, BG = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12), slice(12, 15)
+_I15, _I3 = np.eye(15), np.eye(3)
+_DIAG = np.diag_indices(15)
+_SOLUTION_VALID = int(
+    NavFlags.ATTITUDE_VALID | NavFlags.HEADING_VALID | NavFlags.VELOCITY_VALID
+    | NavFlags.POSITION_VALID | NavFlags.ALTITUDE_VALID
+)  # fmt: skip
+_DEAD_RECKONING = int(NavFlags.DEAD_RECKONING)
+_GPS_REJECTED = int(NavFlags.GPS_REJECTED)
+_HEADING_REJECTED = int(NavFlags.HEADING_REJECTED)
 
 
 @dataclass(frozen=True)
 class InsEkfConfig:
     """Noise densities, initial uncertainties, gates. Defaults: a MEMS IMU (VN-100 class)."""
 
-    accel_noise: float = 0.05  # m/s² / √Hz (velocity random walk)
-    gyro_noise: float = 0.003  # rad/s / √Hz (angle random walk)
+    # Noise densities a little above a VN-100's datasheet (0.14 mg/√Hz, 0.0035 °/s/√Hz):
+    # much larger values let a heading update drag the tilt about during GPS outages.
+    accel_noise: float = 0.01  # m/s² / √Hz (velocity random walk)
+    gyro_noise: float = 5e-4  # rad/s / √Hz (angle random walk)
     accel_bias_walk: float = 1e-3  # m/s² / √s
     gyro_bias_walk: float = 5e-5  # rad/s / √s
     accel_bias_std: float = 0.1  # initial 1-σ
@@ -56,6 +67,8 @@ class InsEkfConfig:
     gps_timeout_s: float = 2.0
     heading_timeout_s: float = 1.0  # magnetometer silent this long: use the compass
     reset_after: int = 10
+    heading_interval_s: float = 0.1  # magnetometer heading updates at most this often
+    covariance_interval_s: float = 0.04
     align_window_s: float = 0.5
 
 
@@ -67,13 +80,15 @@ class InsEkf:
         self.frame: LocalFrame | None = None
         self.aligner = Aligner(self.cfg.align_window_s, 9.80665)
         self.aligned = False
-        self.p, self.v = np.zeros(3), np.zeros(3)
+        # Lists of floats, not arrays: they change on every IMU sample.
+        self.p: list[float] = [0.0, 0.0, 0.0]
+        self.v: list[float] = [0.0, 0.0, 0.0]
         self.q: rot.Quat = (1.0, 0.0, 0.0, 0.0)
         self.ba, self.bg = np.zeros(3), np.zeros(3)
         self.P = np.zeros((15, 15))
         self.g = np.array([0.0, 0.0, 9.80665])
         self.t_us: int | None = None
-        self.rate = np.zeros(3)
+        self.rate: tuple[float, ...] = (0.0, 0.0, 0.0)
         self.history: deque[tuple[int, np.ndarray, np.ndarray]] = deque()
         self.last_gps_us: int | None = None
         self.last_compass: Compass | None = None
@@ -83,25 +98,38 @@ class InsEkf:
         self.gps_rejected = self.heading_rejected = self.gps_reject_run = 0
         self.last_gps_ok = self.last_heading_ok = True
         self.resets = 0
+        self.next_heading_us = 0
+        self.cov_dt = 0.0
+        self.cov_f: tuple[float, ...] = (0.0, 0.0, 0.0)
+        self.cov_w: tuple[float, ...] = (0.0, 0.0, 0.0)
+        self.cov_r: list[list[float]] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+        c = self.cfg
+        self.q_density = np.repeat(
+            np.square([0.0, c.accel_noise, c.gyro_noise, c.accel_bias_walk, c.gyro_bias_walk]), 3
+        )
 
     # -- inputs ---------------------------------------------------------------------
     def on_imu(self, imu: Imu) -> None:
         """Propagate to the sample's time (or collect it for the alignment)."""
-        accel = np.array((imu.ax_m_s2, imu.ay_m_s2, imu.az_m_s2))
-        gyro = np.array((imu.gx_rad_s, imu.gy_rad_s, imu.gz_rad_s))
-        if not (np.all(np.isfinite(accel)) and np.all(np.isfinite(gyro))):
+        values = (imu.ax_m_s2, imu.ay_m_s2, imu.az_m_s2, imu.gx_rad_s, imu.gy_rad_s, imu.gz_rad_s)
+        if not math.isfinite(sum(values)):
             return
         if not self.aligned:
-            self._collect(imu.t_us, accel, gyro)
+            self._collect(imu.t_us, np.array(values[:3]), np.array(values[3:]))
             return
         dt = (imu.t_us - self.t_us) / 1e6 if self.t_us is not None else 0.0
         self.t_us = imu.t_us
         if dt <= 0.0:
             return
         if dt > MAX_IMU_GAP_S:  # a hole in the data: time passes, nothing is integrated
-            self._propagate_covariance(dt, np.zeros(3), np.zeros(3))
+            self._flush_covariance()
+            self.cov_dt = dt
+            self._flush_covariance()
             return
-        self._integrate(dt, accel - self.ba, gyro - self.bg)
+        ba, bg = self.ba, self.bg
+        f = (values[0] - ba[0], values[1] - ba[1], values[2] - ba[2])
+        w = (values[3] - bg[0], values[4] - bg[1], values[5] - bg[2])
+        self._integrate(dt, f, w)
 
     def on_gps(self, fix: GpsFix) -> None:
         """Position and velocity update (or the first fix, which anchors the frame)."""
@@ -134,12 +162,14 @@ class InsEkf:
 
     def on_mag(self, reading: Magnetometer) -> None:
         """Heading update from the magnetometer, levelled with our own attitude."""
-        mag = np.array((reading.mx_gauss, reading.my_gauss, reading.mz_gauss))
-        if not np.all(np.isfinite(mag)):
+        values = (reading.mx_gauss, reading.my_gauss, reading.mz_gauss)
+        if not math.isfinite(sum(values)):
             return
+        mag = np.array(values)
         self.last_mag, self.last_mag_us = mag, reading.t_us
-        if not self.aligned:
+        if not self.aligned or reading.t_us < self.next_heading_us:
             return
+        self.next_heading_us = reading.t_us + round(self.cfg.heading_interval_s * 1e6)
         decl = math.radians(self.cfg.declination_deg)
         g0 = _mag_residual(self.q, mag, decl)
         # The heading is levelled with our own tilt, so it depends on roll and pitch too:
@@ -178,8 +208,8 @@ class InsEkf:
 
     def _start(self, a: Alignment, fix: GpsFix, vel: np.ndarray) -> None:
         assert self.frame is not None
-        self.p = self._fix_position(fix)
-        self.v = np.nan_to_num(vel)
+        self.p = self._fix_position(fix).tolist()
+        self.v = np.nan_to_num(vel).tolist()
         self.q = rot.euler_to_quaternion(a.roll, a.pitch, a.yaw)
         pos_std = fix.eph_m if math.isfinite(fix.eph_m) else self.cfg.gps_pos_std
         c = self.cfg
@@ -191,50 +221,59 @@ class InsEkf:
         self.last_gps_us = fix.t_us
 
     # -- propagation ----------------------------------------------------------------
-    def _integrate(self, dt: float, f: np.ndarray, w: np.ndarray) -> None:
-        r = rot.rotation_matrix(self.q)
-        a = r @ f + self.g
-        self.p = self.p + self.v * dt + 0.5 * a * dt * dt
-        self.v = self.v + a * dt
+    def _integrate(self, dt: float, f: tuple[float, ...], w: tuple[float, ...]) -> None:
+        # Plain floats: at 100-400 Hz numpy's per-call cost would dominate 3-vector sums.
+        r = rot.rotation_matrix_rows(self.q)
+        f0, f1, f2 = f
+        p, v = self.p, self.v
+        a = [row[0] * f0 + row[1] * f1 + row[2] * f2 for row in r]
+        a[2] += self.g[2]
+        half = 0.5 * dt * dt
+        self.p = [p[i] + v[i] * dt + a[i] * half for i in range(3)]
+        self.v = [v[i] + a[i] * dt for i in range(3)]
         dq = rot.rotation_vector_quaternion(w[0] * dt, w[1] * dt, w[2] * dt)
         self.q = rot.normalized(rot.multiply(self.q, dq))
         self.rate = w
-        self._propagate_covariance(dt, f, w, r)
+        self.cov_dt += dt
+        self.cov_f, self.cov_w, self.cov_r = f, w, r
+        if self.cov_dt >= self.cfg.covariance_interval_s:
+            self._flush_covariance()
         self.history.append((self.t_us, self.p, self.v))
-        while self.history and self.history[0][0] < self.t_us - HISTORY_S * 1e6:
+        if self.history[0][0] < self.t_us - HISTORY_S * 1e6:
             self.history.popleft()
 
-    def _propagate_covariance(
-        self, dt: float, f: np.ndarray, w: np.ndarray, r: np.ndarray | None = None
-    ) -> None:
-        r = rot.rotation_matrix(self.q) if r is None else r
-        phi = np.eye(15)
-        phi[P, V] = np.eye(3) * dt
+    def _flush_covariance(self) -> None:
+        """Bring P up to the nominal state's time (done in steps of a few IMU samples:
+        at 100-400 Hz, propagating P on every sample costs more than it gains)."""
+        dt = self.cov_dt
+        if dt <= 0.0:
+            return
+        r, f, w = np.array(self.cov_r), np.array(self.cov_f), np.array(self.cov_w)
+        phi = _I15.copy()
+        phi[P, V] = _I3 * dt
         phi[V, TH] = -(r @ rot.skew(f)) * dt
         phi[V, BA] = -r * dt
-        phi[TH, TH] = np.eye(3) - rot.skew(w) * dt
-        phi[TH, BG] = -np.eye(3) * dt
-        c = self.cfg
-        q_diag = np.repeat(
-            np.square([0.0, c.accel_noise, c.gyro_noise, c.accel_bias_walk, c.gyro_bias_walk]) * dt,
-            3,
-        )
-        self.P = phi @ self.P @ phi.T + np.diag(q_diag)
+        phi[TH, TH] = _I3 - rot.skew(w) * dt
+        phi[TH, BG] = -_I3 * dt
+        self.P = phi @ self.P @ phi.T
+        self.P[_DIAG] += self.q_density * dt
+        self.cov_dt = 0.0
 
     # -- updates --------------------------------------------------------------------
     def _update(self, y: np.ndarray, h: np.ndarray, r: np.ndarray) -> bool:
         """Gate, then correct; False when the innovation was rejected."""
+        self._flush_covariance()
         ph = self.P @ h.T
         s = h @ ph + r
         s_inv = np.linalg.inv(s)
         if float(y @ s_inv @ y) > CHI2_9999[len(y)]:
             return False
         k = ph @ s_inv
-        ikh = np.eye(15) - k @ h
+        ikh = _I15 - k @ h
         self.P = ikh @ self.P @ ikh.T + k @ r @ k.T  # Joseph form: stays symmetric, positive
         dx = k @ y
-        self.p = self.p + dx[P]
-        self.v = self.v + dx[V]
+        self.p = (dx[P] + self.p).tolist()
+        self.v = (dx[V] + self.v).tolist()
         self.q = rot.normalized(rot.multiply(self.q, rot.rotation_vector_quaternion(*dx[TH])))
         self.ba = self.ba + dx[BA]
         self.bg = self.bg + dx[BG]
@@ -249,8 +288,8 @@ class InsEkf:
         """Nominal position and velocity at an earlier time (for lagging fixes)."""
         for t, p, v in reversed(self.history):
             if t <= t_us:
-                return p, v
-        return self.p, self.v
+                return np.array(p), np.array(v)
+        return np.array(self.p), np.array(self.v)
 
     def _gps_update(self, fix: GpsFix) -> None:
         z_p = self._fix_position(fix)
@@ -262,7 +301,7 @@ class InsEkf:
         rows += [3 + i for i in range(3) if math.isfinite(z_v[i])]
         y_all = np.concatenate([z_p - p_then, z_v - v_then])
         sig = np.array([std, std, vstd] + [self.cfg.gps_vel_std] * 3)
-        h = np.eye(15)[rows]
+        h = _I15[rows]
         ok = self._update(y_all[rows], h, np.diag(np.square(sig[rows])))
         self.last_gps_ok = ok
         if ok:
@@ -276,8 +315,8 @@ class InsEkf:
 
     def _reset_to_gps(self, z_p: np.ndarray, z_v: np.ndarray, std: float) -> None:
         """The INS has disagreed with GPS for too long: believe GPS, and say so."""
-        self.p = z_p
-        self.v = np.where(np.isfinite(z_v), z_v, self.v)
+        self.p = z_p.tolist()
+        self.v = np.where(np.isfinite(z_v), z_v, self.v).tolist()
         self.P[:6, :] = 0.0
         self.P[:, :6] = 0.0
         self.P[:6, :6] = np.diag(np.square([std] * 3 + [self.cfg.gps_vel_std * 2] * 3))
@@ -314,30 +353,27 @@ class InsEkf:
             return msg
         msg.q[:] = self.q
         msg.roll_rad, msg.pitch_rad, msg.yaw_rad = rot.quaternion_to_euler(self.q)
-        msg.roll_rate_rad_s, msg.pitch_rate_rad_s, msg.yaw_rate_rad_s = self.rate.tolist()
-        msg.lat_deg, msg.lon_deg, msg.alt_msl_m = self.frame.geodetic(self.p)
-        msg.vn_m_s, msg.ve_m_s, msg.vd_m_s = self.v.tolist()
+        msg.roll_rate_rad_s, msg.pitch_rate_rad_s, msg.yaw_rate_rad_s = self.rate
+        msg.lat_deg, msg.lon_deg, msg.alt_msl_m = self.frame.geodetic(np.array(self.p))
+        msg.vn_m_s, msg.ve_m_s, msg.vd_m_s = self.v
         std = np.sqrt(np.diag(self.P))
         msg.pos_std_m[:] = std[P].tolist()
         msg.vel_std_m_s[:] = std[V].tolist()
         msg.att_std_rad[:] = std[TH].tolist()
         msg.accel_bias_m_s2[:] = self.ba.tolist()
         msg.gyro_bias_rad_s[:] = self.bg.tolist()
-        msg.flags = int(self._flags())
+        msg.flags = self._flags()
         return msg
 
-    def _flags(self) -> NavFlags:
-        flags = (
-            NavFlags.ATTITUDE_VALID | NavFlags.HEADING_VALID | NavFlags.VELOCITY_VALID
-            | NavFlags.POSITION_VALID | NavFlags.ALTITUDE_VALID
-        )  # fmt: skip
+    def _flags(self) -> int:
+        flags = _SOLUTION_VALID
         t = self.t_us or 0
         if self.last_gps_us is None or (t - self.last_gps_us) / 1e6 > self.cfg.gps_timeout_s:
-            flags |= NavFlags.DEAD_RECKONING
+            flags |= _DEAD_RECKONING
         if not self.last_gps_ok:
-            flags |= NavFlags.GPS_REJECTED
+            flags |= _GPS_REJECTED
         if not self.last_heading_ok:
-            flags |= NavFlags.HEADING_REJECTED
+            flags |= _HEADING_REJECTED
         return flags
 
 

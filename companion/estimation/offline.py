@@ -26,8 +26,8 @@ class Navigator(Protocol):
 class InsEkfRunner:
     """``nav.ins_ekf``'s navigator."""
 
-    def __init__(self, declination_deg: float = 0.0) -> None:
-        self.nav = InsEkf(InsEkfConfig(declination_deg=declination_deg))
+    def __init__(self, declination_deg: float = 0.0, config: InsEkfConfig | None = None) -> None:
+        self.nav = InsEkf(config or InsEkfConfig(declination_deg=declination_deg))
         self._feed: dict[type, Callable[[Message], None]] = {
             Imu: self.nav.on_imu,  # type: ignore[dict-item]
             GpsFix: self.nav.on_gps,  # type: ignore[dict-item]

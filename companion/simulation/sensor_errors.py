@@ -31,8 +31,8 @@ class NoiseModel:
     mag_noise_gauss: float = 0.002
     compass_heading_deg: float = 0.5
     compass_tilt_deg: float = 0.2
-    gps_horizontal_m: float = 1.5  # slowly wandering error (Gauss-Markov)
-    gps_vertical_m: float = 3.0
+    gps_horizontal_m: float = 1.0  # slowly wandering error (Gauss-Markov), per axis
+    gps_vertical_m: float = 2.0
     gps_correlation_s: float = 60.0
     gps_white_m: float = 0.3
     gps_velocity_m_s: float = 0.1

@@ -1,0 +1,77 @@
+"""``nav.ins_ekf``: the strapdown INS with its error-state EKF as a plug-in.
+
+Reads the IMU, GPS and whichever heading sources exist (magnetometer, compass), feeds
+them in time order to ``companion.estimation.ins_ekf.InsEkf`` (the navigator
+``companion replay --navigator ins_ekf`` runs), and publishes ``nav/state`` at
+``publish_hz`` of vehicle time.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+from companion.estimation.ins_ekf import InsEkfConfig
+from companion.estimation.offline import InsEkfRunner
+from companion.plugin import Plugin, PluginContext, Setting
+
+WAIT_S = 0.5
+_DEFAULTS = InsEkfConfig()
+
+
+class InsEkfPlugin(Plugin):
+    """IMU-driven navigation aided by GPS and a heading."""
+
+    settings = {
+        "publish_hz": Setting(float, 50.0, "nav/state rate, in vehicle time", min=1.0, max=400),
+        "declination_deg": Setting(
+            float, 0.0, "magnetic declination (east +) for magnetometer headings", -180, 180
+        ),
+        "gps_delay_s": Setting(float, 0.0, "how much the GPS's fixes lag the IMU", 0.0, 1.0),
+        "accel_noise": Setting(
+            float, _DEFAULTS.accel_noise, "accelerometer noise density, m/s²/√Hz", min=1e-5
+        ),
+        "gyro_noise": Setting(float, _DEFAULTS.gyro_noise, "gyro noise density, rad/s/√Hz", 1e-6),
+    }
+    inputs = ("sensors/imu", "sensors/gps")
+    optional_inputs = ("sensors/mag", "sensors/compass")
+    outputs = ("nav/state",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        s = ctx.settings
+        config = dataclasses.replace(
+            _DEFAULTS,
+            declination_deg=s["declination_deg"],
+            gps_delay_s=s["gps_delay_s"],
+            accel_noise=s["accel_noise"],
+            gyro_noise=s["gyro_noise"],
+        )
+        self.runner = InsEkfRunner(config=config)
+        self.readers = [ctx.bus.queue_reader(c) for c in (*self.inputs, *self.optional_inputs)]
+        self.waiter = ctx.bus.waiter(self.readers)
+        self.out = ctx.bus.writer("nav/state")
+        self.period_us = round(1e6 / s["publish_hz"])
+        self.next_us: int | None = None
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:
+            self.waiter.wait(WAIT_S)
+        samples: list[Any] = [m for r in self.readers for m in r.drain()]
+        if not samples:
+            return
+        samples.sort(key=lambda m: m.t_us)
+        for sample in samples:
+            self.runner.feed(sample)
+        self.ctx.health.ok(len(samples))
+        nav = self.runner.nav
+        self.ctx.health.frames_bad = nav.gps_rejected + nav.heading_rejected
+        t = nav.t_us
+        if t is None:
+            return
+        if self.next_us is None or t >= self.next_us:
+            self.out.publish(nav.state())
+            self.next_us = t + self.period_us
+
+    def close(self) -> None:
+        self.waiter.close()
