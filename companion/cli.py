@@ -208,7 +208,8 @@ def replay(
     if navigator not in NAVIGATORS:
         raise typer.BadParameter(f"navigator must be one of {', '.join(NAVIGATORS)}")
     if not log.is_file():
-        raise typer.BadParameter(f"{log}: no such file")
+        err.print(f"[red]{log}: no such file[/red]", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG)
     _setup_logging("WARNING")
     fixes: list = []
     percent = TextColumn("{task.percentage:>3.0f}%")

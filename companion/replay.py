@@ -19,6 +19,7 @@ from companion.messages import GpsFix, Message, NavFlags, NavState
 from companion.sensorlog import LogStats, read_sensor_log
 
 PROGRESS_ROWS = 2000
+_POSITION_VALID = int(NavFlags.POSITION_VALID)
 
 
 @dataclass
@@ -93,7 +94,7 @@ def replay_log(
     try:
         for state in run_navigator(nav, samples, rate_hz):
             states.append(state)
-            if state.flags & NavFlags.POSITION_VALID:
+            if state.flags & _POSITION_VALID:
                 writer.add(state.t_us / 1e6, state.roll_rad, state.pitch_rad, state.yaw_rad,
                            state.lat_deg, state.lon_deg, state.alt_msl_m,
                            state.vn_m_s, state.ve_m_s, state.vd_m_s)  # fmt: skip
@@ -120,4 +121,5 @@ def _summarise(summary: ReplaySummary, stats: LogStats, rows: int, states: list[
     summary.gps_rejected, summary.heading_rejected = end.gps_rejected, end.heading_rejected
     summary.final_pos_std_m = math.hypot(end.pos_std_m[0], end.pos_std_m[1])
     for flag in (NavFlags.DEAD_RECKONING, NavFlags.GPS_REJECTED, NavFlags.ALIGNING):
-        summary.flagged[flag.name] = sum(1 for s in states if s.flags & flag)
+        bit = int(flag)
+        summary.flagged[str(flag.name)] = sum(1 for s in states if s.flags & bit)

@@ -67,7 +67,7 @@ class InsEkfConfig:
     gps_timeout_s: float = 2.0
     heading_timeout_s: float = 1.0  # magnetometer silent this long: use the compass
     reset_after: int = 10
-    heading_interval_s: float = 0.1  # magnetometer heading updates at most this often
+    heading_interval_s: float = 0.2  # magnetometer heading updates at most this often
     covariance_interval_s: float = 0.04
     align_window_s: float = 0.5
 

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from companion.messages import CommandId, VehicleCommand
+from companion.messages import CommandId, NavFlags, VehicleCommand
 from tests.support.vehicle import wait_for
 
 ROWS = 100
@@ -98,3 +98,42 @@ def test_replayed_gps_and_compass_reach_nav_state_through_gps_compass(vehicle_fa
     assert state.lat_deg == pytest.approx(-37.91 + 20.0 * t / 111_320.0, abs=2e-5)
     assert state.vn_m_s == pytest.approx(20.0, abs=0.5)
     assert state.yaw_rad == pytest.approx(math.radians(5.0))
+
+
+def test_replayed_imu_gps_and_magnetometer_reach_nav_state_through_ins_ekf(
+    vehicle_factory, tmp_path
+):
+    from companion.simulation.synthetic_flight import FlightSpec, Leg
+    from companion.simulation.synthetic_log import synthesize
+
+    log = tmp_path / "flight.csv"
+    synthetic = synthesize(FlightSpec(legs=(Leg(12),), heading_deg=90.0, seed=2))
+    synthetic.write(log)
+    vehicle = vehicle_factory(
+        f"""
+        [vehicle]
+        name = "inschain"
+        [[plugins]]
+        name = "nav"
+        plugin = "nav.ins_ekf"
+        settings = {{ declination_deg = 11.7 }}
+        [[plugins]]
+        name = "replay"
+        plugin = "sensors.replay"
+        group = "flight"
+        settings = {{ file = "{log}", speed = 2.0 }}
+        """
+    )
+    nav = vehicle.bus.latest_reader("nav/state")
+    wait_for(lambda: (r := vehicle.row("nav")) is not None and r.step_p50_us > 0, 30, "nav up")
+    vehicle.bus.writer("link/commands").publish(
+        VehicleCommand(t_us=0, seq=1, command=int(CommandId.START))
+    )
+    state = wait_for(
+        lambda: (s := nav.wait(0.2)) is not None and s.t_us >= 11_000_000 and s, 30, "the end"
+    )
+    true = min(synthetic.truth, key=lambda s: abs(s.t_s - state.t_us / 1e6))
+    assert state.flags & NavFlags.POSITION_VALID and state.flags & NavFlags.ATTITUDE_VALID
+    assert math.degrees(state.yaw_rad) == pytest.approx(90.0, abs=2.0)
+    assert state.lon_deg == pytest.approx(true.lon_deg, abs=5e-5)
+    assert vehicle.row("nav").dropped == 0

@@ -25,13 +25,15 @@ class InsEkfPlugin(Plugin):
     settings = {
         "publish_hz": Setting(float, 50.0, "nav/state rate, in vehicle time", min=1.0, max=400),
         "declination_deg": Setting(
-            float, 0.0, "magnetic declination (east +) for magnetometer headings", -180, 180
+            float, 0.0, "magnetic declination (east +) for magnetometer headings", min=-180, max=180
         ),
-        "gps_delay_s": Setting(float, 0.0, "how much the GPS's fixes lag the IMU", 0.0, 1.0),
+        "gps_delay_s": Setting(float, 0.0, "how much the GPS's fixes lag the IMU", min=0, max=1),
         "accel_noise": Setting(
             float, _DEFAULTS.accel_noise, "accelerometer noise density, m/s²/√Hz", min=1e-5
         ),
-        "gyro_noise": Setting(float, _DEFAULTS.gyro_noise, "gyro noise density, rad/s/√Hz", 1e-6),
+        "gyro_noise": Setting(
+            float, _DEFAULTS.gyro_noise, "gyro noise density, rad/s/√Hz", min=1e-6
+        ),
     }
     inputs = ("sensors/imu", "sensors/gps")
     optional_inputs = ("sensors/mag", "sensors/compass")
@@ -55,8 +57,7 @@ class InsEkfPlugin(Plugin):
         self.next_us: int | None = None
 
     def step(self) -> None:
-        with self.ctx.bus.idle:
-            self.waiter.wait(WAIT_S)
+        self.waiter.wait(WAIT_S)  # the waiter counts its own idle time
         samples: list[Any] = [m for r in self.readers for m in r.drain()]
         if not samples:
             return

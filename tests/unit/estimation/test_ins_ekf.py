@@ -1,0 +1,96 @@
+"""nav.ins_ekf's navigator on synthetic flights with realistic noise, biases and an outage."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+
+from companion.estimation.ins_ekf import InsEkfConfig
+from companion.estimation.offline import InsEkfRunner
+from companion.messages import GpsFix, Imu, NavFlags
+from tests.unit.estimation.flights import DECLINATION, OUTAGE, flight, fly
+
+
+def test_meets_the_accuracy_targets_and_bridges_a_30_s_outage():
+    errors, states = fly("ins_ekf", flight())
+    assert errors.tilt_rms_deg <= 0.5
+    assert errors.yaw_rms_deg <= 2.0
+    assert errors.pos_rms_m <= 2.0
+    assert errors.vel_rms_m_s <= 0.3
+    assert errors.outage_end_m <= 30.0
+    # The outage is visible in the solution: flagged, and its uncertainty grows, then shrinks.
+    start, length = (t * 1e6 for t in OUTAGE)
+    inside = [s for s in states if start + 3e6 < s.t_us < start + length]
+    after = [s for s in states if s.t_us > start + length + 10e6]
+    assert inside and all(s.flags & NavFlags.DEAD_RECKONING for s in inside)
+    assert inside[-1].pos_std_m[0] > 3 * inside[0].pos_std_m[0]
+    assert not after[-1].flags & NavFlags.DEAD_RECKONING
+    assert after[-1].pos_std_m[0] < 2.0
+
+
+def test_beats_the_thesis_navigator_whose_compass_tilts_in_turns():
+    ins, _ = fly("ins_ekf", flight())
+    thesis, _ = fly("gps_compass", flight())
+    assert thesis.tilt_rms_deg > 3 * ins.tilt_rms_deg
+    assert thesis.outage_end_m > ins.outage_end_m
+
+
+def test_a_slow_imu_and_a_lagging_gps_with_its_delay_configured():
+    lagging = flight(imu_hz=20.0, latency=0.2)
+    runner = InsEkfRunner(config=InsEkfConfig(declination_deg=DECLINATION, gps_delay_s=0.2))
+    errors, _ = fly(runner, lagging)
+    assert errors.tilt_rms_deg <= 0.8
+    assert errors.pos_rms_m <= 2.5
+    assert errors.outage_end_m <= 40.0
+
+
+def test_compass_alone_gives_a_usable_heading():
+    errors, _ = fly("ins_ekf", flight(), drop={"mag"})
+    assert errors.yaw_rms_deg <= 3.0
+    assert errors.tilt_rms_deg <= 0.8
+
+
+def test_no_heading_sensor_at_all_aligns_from_the_gps_course_in_flight():
+    errors, states = fly("ins_ekf", flight(), drop={"mag", "compass"})
+    aligned = [s for s in states if not s.flags & NavFlags.ALIGNING]
+    assert aligned and aligned[0].t_us < 2e6  # started in the air, aligned at once
+    assert errors.yaw_rms_deg <= 3.0  # the turns make heading observable through GPS
+
+
+def test_gps_outliers_are_rejected_counted_and_do_not_move_the_solution():
+    clean, _ = fly("ins_ekf", flight())
+    runner = InsEkfRunner(DECLINATION)
+    bad = 0
+    original = runner.feed
+
+    def feed(sample):
+        nonlocal bad
+        if isinstance(sample, GpsFix) and 60e6 < sample.t_us < 62e6:
+            sample = GpsFix.from_buffer_copy(sample)
+            sample.lat_deg += 0.002  # 220 m north: a multipath jump
+            bad += 1
+        original(sample)
+
+    runner.feed = feed  # type: ignore[method-assign]
+    errors, states = fly(runner, flight())
+    assert bad >= 5 and states[-1].gps_rejected >= bad
+    assert errors.pos_p95_m <= clean.pos_p95_m + 1.0
+
+
+def test_a_hole_in_the_imu_data_is_survived():
+    runner = InsEkfRunner(DECLINATION)
+    errors, _ = fly(runner, flight(), drop=set())
+    nav = runner.nav
+    t = nav.t_us
+    nav.on_imu(Imu(t + 2_000_000, 0.0, 0.0, -9.8, 0.0, 0.0, 0.0, math.nan))  # 2 s later
+    nav.on_imu(Imu(t + 2_010_000, 0.0, 0.0, -9.8, 0.0, 0.0, 0.0, math.nan))
+    assert nav.state().t_us == t + 2_010_000
+    assert math.isfinite(nav.state().lat_deg)
+    assert errors.pos_rms_m <= 2.0
+
+
+def test_the_config_is_a_plain_record():
+    config = dataclasses.replace(InsEkfConfig(), gyro_noise=1e-3)
+    assert config.gyro_noise == 1e-3 and InsEkfConfig().gyro_noise == pytest.approx(5e-4)
