@@ -12,6 +12,7 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
+from companion.estimation.offline import true_headings
 from companion.messages import Message
 from companion.plugin import Plugin, PluginContext, Setting
 from companion.sensorlog import CHANNEL_OF, LogStats, read_sensor_log
@@ -24,6 +25,9 @@ class ReplaySensors(Plugin):
         "file": Setting(str, doc="sensor log CSV (the design's format)"),
         "speed": Setting(float, 1.0, "1 real time, N faster, 0 as fast as possible", min=0.0),
         "loop": Setting(bool, False, "start again at the end"),
+        "declination_deg": Setting(
+            float, 0.0, "added to the log's (magnetic) compass headings", min=-180, max=180
+        ),
     }
     outputs = tuple(CHANNEL_OF.values())
 
@@ -41,7 +45,9 @@ class ReplaySensors(Plugin):
 
     def _restart(self) -> None:
         self.stats = LogStats()
-        self.samples: Iterator[Message] = read_sensor_log(self.path, self.stats)
+        self.samples: Iterator[Message] = true_headings(
+            read_sensor_log(self.path, self.stats), self.ctx.settings["declination_deg"]
+        )
         self.t0_log: int | None = None
         self.t0_wall = time.monotonic()
 

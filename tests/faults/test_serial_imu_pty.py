@@ -1,0 +1,77 @@
+"""sensors.serial_imu on a real pseudo-terminal: exact values, bad frames counted, reopen."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.support.pty import Pty
+from tests.support.vehicle import wait_for
+from tests.unit.devices.test_vectornav import IMU, crc16, xor8
+
+GOOD = f"$VNIMU,{IMU}*{xor8('VNIMU,' + IMU)}\r\n"
+GOOD_CRC = f"$VNIMU,{IMU}*{crc16('VNIMU,' + IMU)}\r\n"
+CORRUPT = GOOD.replace("+00.381", "+00.391")  # one digit changed, checksum kept
+TRUNCATED = GOOD[:30] + "\r\n"
+
+
+def imu_vehicle(vehicle_factory, pty: Pty):
+    return vehicle_factory(
+        f"""
+        [vehicle]
+        name = "imu"
+        [[plugins]]
+        name = "imu"
+        plugin = "sensors.serial_imu"
+        settings = {{ device = "{pty.link}" }}
+        """
+    )
+
+
+@pytest.mark.timeout(60)
+def test_samples_are_exact_and_bad_frames_are_counted(vehicle_factory, tmp_path):
+    pty = Pty(tmp_path / "ttyImu")
+    vehicle = imu_vehicle(vehicle_factory, pty)
+    imu = vehicle.bus.queue_reader("sensors/imu")
+    mag = vehicle.bus.queue_reader("sensors/mag")
+    vehicle.wait_running("imu")
+    got, fields = [], []
+
+    def stream() -> bool:  # the port flushes its input when opened: repeat until heard
+        pty.write(GOOD + CORRUPT + TRUNCATED + "garbage\r\n" + GOOD_CRC)
+        got.extend(imu.take(0.3))
+        fields.extend(mag.take(0.1))
+        return len(got) >= 2 and len(fields) >= 2
+
+    wait_for(stream, 15, "IMU samples")
+    sample = got[0]
+    assert (sample.ax_m_s2, sample.ay_m_s2, sample.az_m_s2) == (0.381, -0.154, -9.657)
+    assert (sample.gx_rad_s, sample.gy_rad_s, sample.gz_rad_s) == (-0.005683, 0.002143, -0.001459)
+    assert sample.temp_c == 21.6
+    assert (fields[0].mx_gauss, fields[0].my_gauss, fields[0].mz_gauss) == (-2.0841, 0.6045, 2.8911)
+    # Each burst holds two good frames and three bad ones (checksum, truncated, garbage).
+    row = wait_for(
+        lambda: (
+            (r := vehicle.row("imu"))
+            and r.frames_ok >= 2
+            and 2 * r.frames_bad == 3 * r.frames_ok
+            and r
+        ),
+        5,
+        "every frame counted",
+    )
+    assert row.restarts == 0
+
+
+@pytest.mark.timeout(60)
+def test_the_imu_is_reopened_after_it_vanishes(vehicle_factory, tmp_path):
+    link = tmp_path / "ttyImu"
+    pty = Pty(link)
+    vehicle = imu_vehicle(vehicle_factory, pty)
+    imu = vehicle.bus.queue_reader("sensors/imu")
+    vehicle.wait_running("imu")
+    wait_for(lambda: pty.write(GOOD) or imu.take(0.2), 15, "first samples")
+    pty.vanish()
+    pty = Pty(link)  # the USB adapter comes back (a new pty behind the same name)
+    wait_for(lambda: pty.write(GOOD) or imu.take(0.2), 20, "samples after the reopen")
+    assert vehicle.row("imu").restarts == 0
+    pty.vanish()
