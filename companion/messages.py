@@ -218,12 +218,13 @@ class CommandId(enum.IntEnum):
 
     START = 1  # start the flight group (arm)
     STOP = 2  # stop the flight group, servos safe (disarm)
-    SET_MODE = 3  # param1 = mode number
+    SET_MODE = 3  # param1 = FlightMode
     MISSION_START = 4  # param1 = first item, param2 = last item
     RETURN_TO_LAUNCH = 5
     REPOSITION = 6  # param1 = lat_deg, param2 = lon_deg, param3 = alt_msl_m
     RESTART_PLUGINS = 7  # restart every plug-in (MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN)
-    LOITER = 8
+    LOITER = 8  # param1..3 = lat_deg, lon_deg, alt_msl_m (NaN: where it is)
+    SET_HOME = 9  # param1 = 1: here; else param5..7 = lat_deg, lon_deg, alt_msl_m
 
 
 class CommandResult(enum.IntEnum):
@@ -259,6 +260,7 @@ class CommandAck(Message):
         ("command", ctypes.c_uint16),
         ("result", ctypes.c_uint8),  # CommandResult
         ("source", ctypes.c_char * NAME_LEN),  # who answered
+        ("reason", ctypes.c_char * 48),  # why it was refused (told to the ground station)
     ]
 
 
@@ -330,6 +332,37 @@ class SystemHealth(Message):
         return [self.plugins[i] for i in range(self.count)]
 
 
+class FlightMode(enum.IntEnum):
+    """The vehicle's flight modes (``companion.modes`` maps them to MAVLink's encodings)."""
+
+    MANUAL = 1  # surfaces follow the pilot (no RC here: held neutral)
+    STABILIZED = 2  # wings level, height held
+    MISSION = 3  # fly the stored mission
+    LOITER = 4  # circle where it is
+    RTL = 5  # fly home and circle there
+    GUIDED = 6  # fly to a commanded point and circle there
+    TAKEOFF = 7
+
+
+class VehicleStatus(Message):
+    """Mode, home and the guided target. Producer: vehicle.commander. Consumers: link, control."""
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("mode", ctypes.c_uint8),  # FlightMode
+        ("armed", ctypes.c_uint8),
+        ("home_valid", ctypes.c_uint8),
+        ("home_lat_deg", ctypes.c_double),
+        ("home_lon_deg", ctypes.c_double),
+        ("home_alt_msl_m", ctypes.c_double),
+        ("target_lat_deg", ctypes.c_double),  # GUIDED: where to go (NaN otherwise)
+        ("target_lon_deg", ctypes.c_double),
+        ("target_alt_msl_m", ctypes.c_double),
+        ("mission_first", ctypes.c_int32),  # MISSION: the item to start from
+        ("changes", ctypes.c_uint32),  # mode changes since start
+    ]
+
+
 class SimTruth(Message):
     """The simulator's true state, for scoring and the live status line.
 
@@ -386,6 +419,7 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("nav/state", NavState, "latest", doc="navigation solution"),
     Channel("sim/truth", SimTruth, "latest", doc="simulator's true state"),
     Channel("sim/clock", SimClock, "latest", doc="simulation time"),
+    Channel("vehicle/status", VehicleStatus, "latest", doc="mode, home, guided target"),
     Channel("control/actuators", ActuatorCommand, "queue", 8, "normalised surfaces"),
     Channel("actuators/servos", ServoOutput, "latest", doc="servo outputs written"),
     Channel("link/commands", VehicleCommand, "queue", 16, "commands for the vehicle", True),

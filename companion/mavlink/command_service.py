@@ -19,6 +19,7 @@ from companion.mavlink.service import Outgoing, Peer
 log = logging.getLogger(__name__)
 
 RETRY_MEMORY_S = 10.0  # how long a finished command's result is kept for retransmissions
+SET_MODE_MESSAGE = 11  # the SET_MODE message's id, used as its command number
 
 
 @dataclass(frozen=True)
@@ -30,6 +31,7 @@ class CommandArgs:
     confirmation: int
     peer: Peer
     is_int: bool = False
+    frame: int = 0  # COMMAND_INT's frame (MAV_FRAME_GLOBAL for COMMAND_LONG)
 
 
 @dataclass
@@ -54,7 +56,7 @@ class _Pending:
 class CommandService:
     """Dispatches commands to handlers and answers each one exactly once."""
 
-    handles = frozenset({"COMMAND_LONG", "COMMAND_INT"})
+    handles = frozenset({"COMMAND_LONG", "COMMAND_INT", "SET_MODE"})
 
     def __init__(self, mav: Any, sysid: int, compid: int = 1) -> None:
         self.mav = mav
@@ -79,7 +81,7 @@ class CommandService:
                 msg.y / 1e7,
                 msg.z,
             )
-            return CommandArgs(msg.command, params, 0, peer, True)
+            return CommandArgs(msg.command, params, 0, peer, True, msg.frame)
         params = (
             msg.param1,
             msg.param2,
@@ -98,10 +100,22 @@ class CommandService:
         return Outgoing(msg, args.peer)
 
     def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
+        if msg.get_type() == "SET_MODE":
+            # The old SET_MODE message: answered, as ArduPilot does, by a COMMAND_ACK whose
+            # command is the message id (11).
+            if msg.target_system not in (0, self.sysid):
+                self.rejected_target += 1
+                return []
+            params = (float(msg.base_mode), float(msg.custom_mode), 0.0, 0.0, 0.0, 0.0, 0.0)
+            return self.dispatch(CommandArgs(SET_MODE_MESSAGE, params, 0, peer), now_s)
         if msg.target_system not in (0, self.sysid) or msg.target_component not in (0, self.compid):
             self.rejected_target += 1
             return []
-        args = self._args(msg, peer)
+        return self.dispatch(self._args(msg, peer), now_s)
+
+    def dispatch(self, args: CommandArgs, now_s: float) -> list[Outgoing]:
+        """Run a decoded command through its handler; exactly one ack, retries remembered."""
+        peer = args.peer
         key = (peer.sysid, peer.compid, args.command)
         previous = self._done.get(key)
         if args.confirmation > 0 and previous and now_s - previous[0] < RETRY_MEMORY_S:

@@ -31,6 +31,7 @@ class VehicleState:
 
     armed: bool = False
     custom_mode: int = 0
+    mode_flags: int = 0  # MAV_MODE_FLAG bits of the mode (auto, guided, stabilize, manual)
     system_status: int = mav_dialect.MAV_STATE_STANDBY
 
 
@@ -52,7 +53,7 @@ class IdentityService:
 
     def heartbeat(self) -> Any:
         d = mav_dialect
-        base = d.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+        base = d.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | self.state.mode_flags
         if self.state.armed:
             base |= d.MAV_MODE_FLAG_SAFETY_ARMED
         return self.mav.heartbeat_encode(

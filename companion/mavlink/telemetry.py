@@ -13,7 +13,16 @@ from typing import Any
 
 from companion.mavlink.codec import dialect as d
 from companion.mavlink.mission_service import mission_current_message
-from companion.messages import GpsFix, Imu, NavFlags, NavState, ServoOutput, SystemHealth
+from companion.mavlink.mode_messages import available_modes_monitor, current_mode
+from companion.messages import (
+    GpsFix,
+    Imu,
+    NavFlags,
+    NavState,
+    ServoOutput,
+    SystemHealth,
+    VehicleStatus,
+)
 
 
 @dataclass
@@ -27,6 +36,7 @@ class Snapshot:
     imu: Imu | None = None
     health: SystemHealth | None = None
     servos: ServoOutput | None = None
+    status: VehicleStatus | None = None
     home_alt_m: float = math.nan
     mission_seq: int = 0
     mission_total: int = 0
@@ -295,6 +305,18 @@ STREAMS: dict[int, Stream] = {
         Stream("HOME_POSITION", d.MAVLINK_MSG_ID_HOME_POSITION, 0.2, _home_position),
         Stream("PLUGIN_HEALTH", d.MAVLINK_MSG_ID_PLUGIN_HEALTH, 2.0, _plugin_health),
         Stream("NAV_STATUS", d.MAVLINK_MSG_ID_NAV_STATUS, 1.0, _nav_status),
+        Stream(
+            "CURRENT_MODE",
+            d.MAVLINK_MSG_ID_CURRENT_MODE,
+            0.5,
+            lambda m, s: current_mode(m, s.status),
+        ),
+        Stream(
+            "AVAILABLE_MODES_MONITOR",
+            d.MAVLINK_MSG_ID_AVAILABLE_MODES_MONITOR,
+            0.2,
+            lambda m, s: available_modes_monitor(m),
+        ),
     )
 }
 

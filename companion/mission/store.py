@@ -19,9 +19,14 @@ class MissionStore:
     def __init__(self, directory: Path | None) -> None:
         self.directory = directory
         self.items: dict[int, list[MissionItem]] = {t: [] for t in MISSION_TYPES}
-        if directory is not None:
+        self.reload()
+
+    def reload(self) -> MissionStore:
+        """Read the files again (another process may have stored a new mission)."""
+        if self.directory is not None:
             for mission_type in MISSION_TYPES:
-                self.items[mission_type] = self._load(directory / FILES[mission_type])
+                self.items[mission_type] = self._load(self.directory / FILES[mission_type])
+        return self
 
     def _load(self, path: Path) -> list[MissionItem]:
         try:

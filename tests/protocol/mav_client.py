@@ -61,6 +61,10 @@ name = "nav"
 plugin = "tests.support.plugins:FakeNav"
 
 [[plugins]]
+name = "commander"
+plugin = "vehicle.commander"
+
+[[plugins]]
 name = "flight"
 plugin = "tests.support.plugins:Waiting"
 group = "flight"

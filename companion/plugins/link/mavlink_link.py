@@ -28,6 +28,7 @@ from companion.mavlink.endpoints import (
 from companion.mavlink.identity import IdentityService
 from companion.mavlink.link_router import LinkRouter
 from companion.mavlink.mission_service import MissionService
+from companion.mavlink.mode_messages import current_mode, heartbeat_mode
 from companion.mavlink.params_service import ParamsService
 from companion.mavlink.service import Outgoing
 from companion.mavlink.signing import key_from
@@ -82,6 +83,7 @@ class MavlinkLink(Plugin):
         "sensors/gps",
         "sensors/imu",
         "actuators/servos",
+        "vehicle/status",
         "system/health",
         "link/command_acks",
     )
@@ -121,6 +123,7 @@ class MavlinkLink(Plugin):
             "nav": bus.latest_reader("nav/state"),
             "health": bus.latest_reader("system/health"),
             "servos": bus.latest_reader("actuators/servos"),
+            "status": bus.latest_reader("vehicle/status"),
             "gps": bus.queue_reader("sensors/gps"),
             "imu": bus.queue_reader("sensors/imu"),
         }
@@ -167,13 +170,17 @@ class MavlinkLink(Plugin):
     def _refresh_snapshot(self) -> None:
         s, r = self.snapshot, self.readers
         s.nav, s.health, s.servos = r["nav"].get(), r["health"].get(), r["servos"].get()
+        s.status = r["status"].get()
         for key in ("gps", "imu"):
             latest = None
             for latest in r[key].drain():  # noqa: B007 - only the newest matters here
                 pass
             if latest is not None:
                 setattr(s, key, latest)
-        if s.home is None and s.nav is not None and s.nav.flags & NavFlags.POSITION_VALID:
+        if s.status is not None and s.status.home_valid:
+            s.home = (s.status.home_lat_deg, s.status.home_lon_deg, s.status.home_alt_msl_m)
+            s.home_alt_m = s.status.home_alt_msl_m
+        elif s.home is None and s.nav is not None and s.nav.flags & NavFlags.POSITION_VALID:
             # Home is where the first valid position was (ArduPilot and PX4 do the same
             # at the first fix when disarmed).
             s.home = (s.nav.lat_deg, s.nav.lon_deg, s.nav.alt_msl_m)
@@ -182,10 +189,21 @@ class MavlinkLink(Plugin):
         s.mission_total = len(self.missions.store.items[0])
         s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
         s.unix_us = time.time_ns() // 1000
+        self._mode_changes(s)
         if s.health is not None:
             self.identity.state.armed = bool(s.health.flight_running)
             active = d.MAV_STATE_ACTIVE if s.health.flight_running else d.MAV_STATE_STANDBY
             self.identity.state.system_status = active
+
+    def _mode_changes(self, s: Snapshot) -> None:
+        """The heartbeat shows the commander's mode; a change is announced at once."""
+        state = self.identity.state
+        custom, flags = heartbeat_mode(s.status)
+        if custom != state.custom_mode and s.status is not None:
+            msg = current_mode(self.mav, s.status)
+            if msg is not None:
+                self.router.send([Outgoing(msg, None)], time.monotonic())
+        state.custom_mode, state.mode_flags = custom, flags
 
     def _wait_input(self, now_s: float) -> None:
         timeout = max(0.0, min(MAX_WAIT_S, self.router.next_due() - now_s))
@@ -202,11 +220,16 @@ class MavlinkLink(Plugin):
         self._wait_input(time.monotonic())
         now_s = time.monotonic()
         out: list[Outgoing] = []
+        reasons = []
         for ack in self.acks.drain():
             out += self.commands.complete(ack.seq, ack.result, now_s)
+            if ack.reason:
+                reasons.append(ack.reason.decode(errors="replace"))
         self._refresh_snapshot()
         out += self.router.tick(now_s)
         self.router.send(out, now_s)
+        for reason in reasons:  # after the ack: a ground station waits for that first
+            self.statustext(reason)
         self.router.stream_telemetry(self.snapshot, now_s)
         counts = self.router.counters
         self.ctx.health.frames_ok, self.ctx.health.frames_bad = counts.ok, counts.bad

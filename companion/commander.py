@@ -1,0 +1,144 @@
+"""The vehicle's mode, home and guided target: who may fly what, and when.
+
+Pure: commands and navigation in, decisions and a ``VehicleStatus`` out. The
+``vehicle.commander`` plug-in wraps it; the link reports what it decides.
+Rules (as PX4 and ArduPilot have them): MISSION needs a stored mission; RTL needs a home;
+GUIDED and LOITER need a position (or a given point); home is the first valid position
+while disarmed, and is set again at arming.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from companion.messages import (
+    CommandId,
+    CommandResult,
+    FlightMode,
+    NavFlags,
+    NavState,
+    VehicleCommand,
+    VehicleStatus,
+)
+
+INITIAL_MODE = FlightMode.LOITER  # PX4's "Hold": a fixed wing without a pilot circles
+
+
+@dataclass(frozen=True)
+class Decision:
+    """A command's outcome, and why when it is refused."""
+
+    result: CommandResult
+    reason: str = ""
+
+
+ACCEPTED = Decision(CommandResult.ACCEPTED)
+MODE_COMMANDS = frozenset(
+    {
+        CommandId.SET_MODE,
+        CommandId.MISSION_START,
+        CommandId.RETURN_TO_LAUNCH,
+        CommandId.REPOSITION,
+        CommandId.LOITER,
+        CommandId.SET_HOME,
+    }
+)
+
+
+class Commander:
+    """Mode state machine; ``mission_count`` says how many mission items are stored."""
+
+    def __init__(self, mission_count: Callable[[], int]) -> None:
+        self.mission_count = mission_count
+        self.mode = INITIAL_MODE
+        self.armed = False
+        self.home: tuple[float, float, float] | None = None
+        self.target = (math.nan, math.nan, math.nan)
+        self.mission_first = 0
+        self.changes = 0
+        self.position: tuple[float, float, float] | None = None
+
+    def on_nav(self, nav: NavState) -> None:
+        """Track the position; set home from the first fix while disarmed."""
+        if not nav.flags & NavFlags.POSITION_VALID:
+            return
+        self.position = (nav.lat_deg, nav.lon_deg, nav.alt_msl_m)
+        if self.home is None and not self.armed:
+            self.home = self.position
+
+    def on_armed(self, armed: bool) -> None:
+        """Arming sets home where the aircraft is (the place it will return to)."""
+        if armed and not self.armed and self.position is not None:
+            self.home = self.position
+        self.armed = armed
+
+    def handle(self, cmd: VehicleCommand) -> Decision | None:
+        """Act on a mode command; None for commands that are not the commander's."""
+        kind = cmd.command
+        p = list(cmd.param)
+        if kind == CommandId.SET_MODE:
+            try:
+                mode = FlightMode(round(p[0]))
+            except ValueError:
+                return Decision(CommandResult.DENIED, f"unknown mode {p[0]:g}")
+            return self._enter(mode)
+        if kind == CommandId.MISSION_START:
+            decision = self._enter(FlightMode.MISSION)
+            if decision.result == CommandResult.ACCEPTED:
+                self.mission_first = max(0, round(p[0]))
+            return decision
+        if kind == CommandId.RETURN_TO_LAUNCH:
+            return self._enter(FlightMode.RTL)
+        if kind in (CommandId.REPOSITION, CommandId.LOITER):
+            mode = FlightMode.GUIDED if kind == CommandId.REPOSITION else FlightMode.LOITER
+            return self._enter(mode, (p[0], p[1], p[2]))
+        if kind == CommandId.SET_HOME:
+            return self._set_home(p)
+        return None
+
+    def _enter(self, mode: FlightMode, point: tuple[float, ...] | None = None) -> Decision:
+        if mode == FlightMode.MISSION and self.mission_count() == 0:
+            return Decision(CommandResult.DENIED, "Mission: no mission stored")
+        if mode == FlightMode.RTL and self.home is None:
+            return Decision(CommandResult.DENIED, "Return: no home position yet")
+        if mode in (FlightMode.GUIDED, FlightMode.LOITER):
+            target = self._target(point)
+            if target is None:
+                name = "Go to" if mode == FlightMode.GUIDED else "Loiter"
+                return Decision(CommandResult.DENIED, f"{name}: no position yet")
+            self.target = target
+        else:
+            self.target = (math.nan, math.nan, math.nan)
+        if mode != self.mode:
+            self.changes += 1
+        self.mode = mode
+        return ACCEPTED
+
+    def _target(self, point: tuple[float, ...] | None) -> tuple[float, float, float] | None:
+        here = self.position
+        if point is not None and math.isfinite(point[0]) and math.isfinite(point[1]):
+            alt = point[2] if math.isfinite(point[2]) else (here[2] if here else math.nan)
+            return (point[0], point[1], alt)
+        return here
+
+    def _set_home(self, p: list[float]) -> Decision:
+        if round(p[0]) == 1:
+            if self.position is None:
+                return Decision(CommandResult.DENIED, "Home: no position yet")
+            self.home = self.position
+        elif all(math.isfinite(v) for v in p[4:7]) and abs(p[4]) <= 90 and abs(p[5]) <= 180:
+            self.home = (p[4], p[5], p[6])
+        else:
+            return Decision(CommandResult.DENIED, "Home: bad position")
+        return ACCEPTED
+
+    def status(self, t_us: int) -> VehicleStatus:
+        """What the link and the controller are told."""
+        msg = VehicleStatus(t_us=t_us, mode=int(self.mode), armed=int(self.armed))
+        msg.home_valid = int(self.home is not None)
+        msg.home_lat_deg, msg.home_lon_deg, msg.home_alt_msl_m = self.home or (math.nan,) * 3
+        msg.target_lat_deg, msg.target_lon_deg, msg.target_alt_msl_m = self.target
+        msg.mission_first, msg.changes = self.mission_first, self.changes
+        return msg

@@ -1,0 +1,107 @@
+"""Flight modes as the ground tools name and number them.
+
+One table says, for each ``FlightMode``: its name (AVAILABLE_MODES), PX4's custom_mode
+(main mode in bits 16-23, sub mode in bits 24-31: what MAVSDK decodes for every autopilot
+but ArduPilot, and what QGroundControl's PX4 plug-in shows), ArduPlane's mode number (what
+pymavlink and MAVProxy send for a fixed-wing that is not PX4), and MAVLink's standard mode.
+
+``decode_set_mode`` reads DO_SET_MODE / SET_MODE in either encoding:
+1. a full 32-bit PX4 custom_mode (≥ 65536) → PX4;
+2. a sub mode (param3) → PX4 main/sub (MAVSDK, pymavlink for PX4);
+3. reporting PX4, a main mode alone → PX4;
+4. otherwise ArduPlane's numbers (MAVProxy's ``mode AUTO``: 10), except 1 and 7, which are
+   PX4's MANUAL and STABILIZED as MAVSDK sends them (ArduPlane's CIRCLE and CRUISE, which
+   we do not fly, lose out);
+5. without the custom-mode flag, base_mode's AUTO/GUIDED/STABILIZE/MANUAL bits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from companion.messages import FlightMode
+from mavlink_dialect import companion as d
+
+PX4_MAIN_MANUAL, PX4_MAIN_AUTO, PX4_MAIN_STABILIZED = 1, 4, 7
+PX4_SUB_TAKEOFF, PX4_SUB_LOITER, PX4_SUB_MISSION, PX4_SUB_RTL = 2, 3, 4, 5
+
+
+def px4_custom_mode(main: int, sub: int = 0) -> int:
+    """PX4's packing of main and sub mode into custom_mode."""
+    return (main << 16) | (sub << 24)
+
+
+@dataclass(frozen=True)
+class ModeInfo:
+    """One mode in every encoding."""
+
+    mode: FlightMode
+    name: str
+    px4: int  # custom_mode
+    arduplane: int
+    standard: int  # MAV_STANDARD_MODE
+    base_flags: int  # MAV_MODE_FLAG bits besides CUSTOM_MODE_ENABLED and SAFETY_ARMED
+    user_selectable: bool = True
+
+
+_AUTO = d.MAV_MODE_FLAG_AUTO_ENABLED | d.MAV_MODE_FLAG_GUIDED_ENABLED
+_STAB = d.MAV_MODE_FLAG_STABILIZE_ENABLED
+MODES: tuple[ModeInfo, ...] = (
+    ModeInfo(FlightMode.MANUAL, "Manual", px4_custom_mode(PX4_MAIN_MANUAL), 0,
+             d.MAV_STANDARD_MODE_NON_STANDARD, d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED),
+    ModeInfo(FlightMode.STABILIZED, "Stabilized", px4_custom_mode(PX4_MAIN_STABILIZED), 5,
+             d.MAV_STANDARD_MODE_NON_STANDARD, _STAB | d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED),
+    ModeInfo(FlightMode.MISSION, "Mission", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_MISSION), 10,
+             d.MAV_STANDARD_MODE_MISSION, _STAB | _AUTO),
+    ModeInfo(FlightMode.LOITER, "Loiter", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_LOITER), 12,
+             d.MAV_STANDARD_MODE_POSITION_HOLD, _STAB | _AUTO),
+    ModeInfo(FlightMode.RTL, "Return", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_RTL), 11,
+             d.MAV_STANDARD_MODE_SAFE_RECOVERY, _STAB | _AUTO),
+    # PX4 flies "go to" in Hold: MAVSDK and QGroundControl's PX4 plug-in show it as Hold.
+    ModeInfo(FlightMode.GUIDED, "Guided", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_LOITER), 15,
+             d.MAV_STANDARD_MODE_NON_STANDARD, _STAB | d.MAV_MODE_FLAG_GUIDED_ENABLED),
+    ModeInfo(FlightMode.TAKEOFF, "Takeoff", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_TAKEOFF), 13,
+             d.MAV_STANDARD_MODE_TAKEOFF, _STAB | _AUTO),
+)  # fmt: skip
+BY_MODE = {m.mode: m for m in MODES}
+_ARDUPLANE = {m.arduplane: m.mode for m in MODES} | {1: FlightMode.LOITER, 2: FlightMode.STABILIZED}
+_PX4 = {m.px4: m.mode for m in MODES if m.mode != FlightMode.GUIDED}
+_STANDARD = {m.standard: m.mode for m in MODES if m.standard != d.MAV_STANDARD_MODE_NON_STANDARD}
+_STANDARD[d.MAV_STANDARD_MODE_ORBIT] = FlightMode.LOITER
+
+
+def from_px4(main: int, sub: int) -> FlightMode | None:
+    """A PX4 main/sub mode pair (sub 0 for the non-auto modes)."""
+    if main != PX4_MAIN_AUTO:
+        sub = 0
+    return _PX4.get(px4_custom_mode(main, sub))
+
+
+def decode_set_mode(
+    base_mode: int, custom: int, sub: int = 0, reporting_px4: bool = False
+) -> FlightMode | None:
+    """The mode a DO_SET_MODE (param1..3) or SET_MODE asks for, or None if unknown."""
+    if not base_mode & d.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED:
+        return _from_base_flags(base_mode)
+    if custom >= 1 << 16:
+        return from_px4((custom >> 16) & 0xFF, (custom >> 24) & 0xFF)
+    if sub or reporting_px4 or custom in (PX4_MAIN_MANUAL, PX4_MAIN_STABILIZED):
+        return from_px4(custom, sub)
+    return _ARDUPLANE.get(custom)
+
+
+def from_standard(standard_mode: int) -> FlightMode | None:
+    """DO_SET_STANDARD_MODE's mode."""
+    return _STANDARD.get(standard_mode)
+
+
+def _from_base_flags(base_mode: int) -> FlightMode | None:
+    if base_mode & d.MAV_MODE_FLAG_AUTO_ENABLED:
+        return FlightMode.MISSION
+    if base_mode & d.MAV_MODE_FLAG_GUIDED_ENABLED:
+        return FlightMode.GUIDED
+    if base_mode & d.MAV_MODE_FLAG_STABILIZE_ENABLED:
+        return FlightMode.STABILIZED
+    if base_mode & d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED:
+        return FlightMode.MANUAL
+    return None

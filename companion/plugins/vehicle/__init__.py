@@ -1,0 +1,1 @@
+"""Vehicle-level plug-ins: the commander (modes, home, guided target)."""
