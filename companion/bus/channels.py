@@ -8,7 +8,8 @@ full buffer made it lose.
 - Queue: every sample in order to every reader; a reader that falls behind loses the
   oldest samples (iceoryx2 "safe overflow"), the writer never blocks, the loss is counted.
 - Latest: a buffer of one with history one, so a reader always sees the newest value,
-  including one published before it connected.
+  including one published before it connected (once the writer's process has called
+  ``BusNode.update_connections``, which the plug-in host and the supervisor do often).
 """
 
 from __future__ import annotations
@@ -79,6 +80,14 @@ class Writer(Generic[M]):
         sample.write_payload(msg).send()
         self._notifier.notify()
         self.sent += 1
+
+    def update_connections(self) -> None:
+        """Hand the history (the last sample) to readers that joined since the last send.
+
+        iceoryx2 delivers history only when the publisher next sends or is asked to update
+        its connections, so a Latest writer that publishes rarely must be asked.
+        """
+        self._publisher.update_connections()
 
     def close(self) -> None:
         """Release the iceoryx2 ports."""

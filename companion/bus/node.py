@@ -54,6 +54,7 @@ class BusNode:
             builder = builder.name(iox2.NodeName.new(f"{name}.{os.getpid()}"))
         self._node = builder.create(iox2.ServiceType.Ipc)
         self._ports: list[Writer[Any] | Reader[Any]] = []
+        self._latest_writers: list[Writer[Any]] = []
         self.idle = IdleTally()
 
     def _pubsub(self, chan: Channel) -> Any:
@@ -89,7 +90,14 @@ class BusNode:
         notifier = self._event(chan).notifier_builder().create()
         port: Writer[Any] = Writer(name, pub, notifier)
         self._ports.append(port)
+        if chan.pattern == "latest":
+            self._latest_writers.append(port)
         return port
+
+    def update_connections(self) -> None:
+        """Give late readers of this node's Latest channels the last value published."""
+        for port in self._latest_writers:
+            port.update_connections()
 
     def queue_reader(self, name: str) -> QueueReader[Any]:
         """A reader of the Queue channel ``name``."""
@@ -135,6 +143,7 @@ class BusNode:
             except Exception as exc:  # closing twice, or after iceoryx2 already did
                 log.debug("closing %s: %s", port.name, exc)
         self._ports.clear()
+        self._latest_writers.clear()
         del self._node
 
     def __enter__(self) -> BusNode:

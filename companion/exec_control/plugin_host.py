@@ -27,6 +27,8 @@ from companion.plugin import Plugin, PluginContext
 EXIT_INIT_FAILED = 3
 EXIT_STEP_FAILED = 4
 STATS_PERIOD_S = 1.0
+# How often late readers of this process's Latest channels are handed the last value.
+CONNECTIONS_PERIOD_S = 0.05
 _PR_SET_PDEATHSIG = 1
 
 log = logging.getLogger("companion.plugin_host")
@@ -106,7 +108,7 @@ class PluginHost:
             log.exception("%s: init failed", self.spec["name"])
             return EXIT_INIT_FAILED
         code = 0
-        next_stats = time.monotonic()
+        next_stats = next_connections = time.monotonic()
         try:
             while not self.stopping:
                 started, idle_before = time.perf_counter(), self.bus.idle.seconds
@@ -114,7 +116,10 @@ class PluginHost:
                 # Busy time only: the wait for input is not the plug-in's cost.
                 idle = self.bus.idle.seconds - idle_before
                 self.timer.add(time.perf_counter() - started - idle)
-                if time.monotonic() >= next_stats:
+                if (now := time.monotonic()) >= next_connections:
+                    self.bus.update_connections()
+                    next_connections = now + CONNECTIONS_PERIOD_S
+                if now >= next_stats:
                     self.publish_stats()
                     next_stats = time.monotonic() + STATS_PERIOD_S
         except Exception:

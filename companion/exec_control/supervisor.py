@@ -162,6 +162,7 @@ class Supervisor:
                     acks.publish(self._ack(cmd, result))
             self.absorb_stats(stats)
             self.restart_dead()
+            bus.update_connections()
             if time.monotonic() >= next_health:
                 self.publish_health(health)
                 next_health = time.monotonic() + HEALTH_PERIOD_S

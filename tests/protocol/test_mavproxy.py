@@ -67,3 +67,55 @@ def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
     assert "Received 3 parameters" in output
     assert "COMPONENT_ARM_DISARM: ACCEPTED" in output
     assert len(json.loads(mission.read_text())) == 3
+
+
+@pytest.mark.timeout(120)
+def test_mavproxy_switches_modes_auto_rtl_loiter(vehicle_factory, tmp_path):
+    from companion.messages import FlightMode
+
+    mavproxy = Path(sys.executable).parent / "mavproxy.py"
+    port = free_udp_port()
+    vehicle = vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path / "state"))
+    status = vehicle.bus.latest_reader("vehicle/status")
+    wait_for(status.get, 20, "the commander up")
+    wp = tmp_path / "wp.txt"
+    wp.write_text(WAYPOINTS)
+    proc = subprocess.Popen(
+        [sys.executable, str(mavproxy), f"--master=udpout:127.0.0.1:{port}"],
+        cwd=tmp_path,
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)
+    reader.start()
+
+    def type_line(line: str) -> None:
+        proc.stdin.write(line + "\n")
+        proc.stdin.flush()
+
+    seen = []
+    try:
+        wait_for(lambda: vehicle.row("link").frames_ok > 20, 30, "MAVProxy connected")
+        time.sleep(2.0)
+        type_line(f"wp load {wp}")
+        wait_for((tmp_path / "state" / "missions" / "mission.json").exists, 20, "mission stored")
+        for command, mode in (
+            ("mode AUTO", FlightMode.MISSION),
+            ("mode RTL", FlightMode.RTL),
+            ("mode LOITER", FlightMode.LOITER),
+        ):
+            type_line(command)
+            wait_for(lambda m=mode: status.get().mode == m, 10, command)
+            seen.append(FlightMode(status.get().mode))
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(timeout=5)
+        reader.join(timeout=5)
+    assert seen == [FlightMode.MISSION, FlightMode.RTL, FlightMode.LOITER]

@@ -130,3 +130,54 @@ def test_mavsdk_imports_the_shipped_square_plan_and_uploads_it(vehicle_factory, 
     assert (fence, rally) == (4, 1)
     stored = tmp_path / "missions"
     assert (stored / "fence.json").exists() and (stored / "rally.json").exists()
+
+
+async def _mode_session(port: int, vehicle) -> dict:
+    from mavsdk.plugins.telemetry import FlightMode
+
+    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
+    seen: dict = {}
+    async with Mavsdk(config) as mavsdk:
+        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
+        system = await mavsdk.first_autopilot(timeout_s=15.0)
+        telemetry, action = TelemetryAsync(system), ActionAsync(system)
+        mission = MissionRawAsync(system)
+
+        async def mode_becomes(mode):
+            return await asyncio.wait_for(_first(telemetry.subscribe_flight_mode(), mode.__eq__), 5)
+
+        known = FlightMode.UNKNOWN.__ne__  # until the link has heard the commander
+        seen["initial"] = await asyncio.wait_for(
+            _first(telemetry.subscribe_flight_mode(), known), 10
+        )
+        await mission.upload_mission(_raw_items(5))
+        await action.arm()
+        await mission.start_mission()
+        seen["mission"] = await mode_becomes(FlightMode.MISSION)
+        await action.return_to_launch()
+        seen["rtl"] = await mode_becomes(FlightMode.RETURN_TO_LAUNCH)
+        await action.goto_location(-37.9, 145.12, 150.0, float("nan"))
+        seen["goto"] = await mode_becomes(FlightMode.HOLD)
+        await action.disarm()
+    return seen
+
+
+@pytest.mark.timeout(120)
+def test_mavsdk_flight_modes_start_mission_return_and_go_to(vehicle_factory, tmp_path):
+    from mavsdk.plugins.telemetry import FlightMode
+
+    from companion.messages import FlightMode as Mode
+
+    port = free_udp_port()
+    vehicle = vehicle_factory(client_vehicle(f"udpout://127.0.0.1:{port}", tmp_path))
+    status = vehicle.bus.latest_reader("vehicle/status")
+    wait_for(status.get, 20, "the commander up")
+    seen = asyncio.run(_mode_session(port, vehicle))
+    seen["target"] = status.get()
+    assert seen["initial"] == FlightMode.HOLD  # a fixed wing without a pilot circles
+    assert seen["mission"] == FlightMode.MISSION
+    assert seen["rtl"] == FlightMode.RETURN_TO_LAUNCH
+    status = seen["target"]
+    assert status.mode == Mode.GUIDED  # PX4 flies "go to" in Hold; MAVSDK names it so
+    assert (status.target_lat_deg, status.target_lon_deg) == pytest.approx((-37.9, 145.12))
+    assert status.target_alt_msl_m == pytest.approx(150.0)

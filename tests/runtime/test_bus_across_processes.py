@@ -5,6 +5,7 @@ from __future__ import annotations
 import subprocess
 import sys
 import textwrap
+import time
 
 import pytest
 
@@ -95,3 +96,21 @@ def test_latest_reader_that_joins_late_still_gets_the_newest_value(namespace):
         writer.publish(NavState(t_us=99))
         value = late.wait(2.0)
     assert value is not None and value.t_us == 99
+
+
+def test_a_value_published_once_reaches_a_reader_that_connects_much_later(vehicle_factory):
+    vehicle = vehicle_factory(
+        """
+        [vehicle]
+        name = "once"
+
+        [[plugins]]
+        name = "once"
+        plugin = "tests.support.plugins:PublishOnce"
+        """
+    )
+    vehicle.wait_running("once")
+    time.sleep(0.5)  # long after the only publication
+    late = vehicle.bus.latest_reader("nav/state")
+    value = wait_for(late.get, 2.0, "the value published before the reader existed")
+    assert value.yaw_rad == pytest.approx(0.25)

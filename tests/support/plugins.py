@@ -106,3 +106,19 @@ class FakeNav(Plugin):
             | NavFlags.VELOCITY_VALID
         )
         self.nav.publish(msg)
+
+
+class PublishOnce(Plugin):
+    """Publishes one nav/state value at start and nothing after, as a rare event would."""
+
+    outputs = ("nav/state",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.nav = ctx.bus.writer("nav/state")
+        self.nav.publish(NavState(t_us=ctx.clock.now_us(), yaw_rad=0.25))
+        self._pace = threading.Event()
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:
+            self._pace.wait(0.1)

@@ -81,7 +81,7 @@ def register_mode_commands(link: MavlinkLink) -> None:
     px4 = link.identity.autopilot == d.MAV_AUTOPILOT_PX4
 
     def to_commander(command: CommandId, params: tuple[float, ...] = ()) -> Outcome:
-        if link.readers["status"].get() is None:  # no commander in this vehicle
+        if not link.has_commander():
             return Outcome(d.MAV_RESULT_UNSUPPORTED)
         return Outcome(defer_seq=link.publish_command(command, params), timeout_s=BUS_ACK_TIMEOUT_S)
 

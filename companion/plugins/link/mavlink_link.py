@@ -41,6 +41,7 @@ from companion.plugin import Plugin, PluginContext, Setting
 from companion.plugins.link.commands import register_commands
 
 MAX_WAIT_S = 0.02
+COMMANDER = "vehicle.commander"
 STREAM_PARAMS = {
     "SR_ATTITUDE": (d.MAVLINK_MSG_ID_ATTITUDE,),
     "SR_POSITION": (d.MAVLINK_MSG_ID_GLOBAL_POSITION_INT, d.MAVLINK_MSG_ID_VFR_HUD),
@@ -233,6 +234,14 @@ class MavlinkLink(Plugin):
         self.router.stream_telemetry(self.snapshot, now_s)
         counts = self.router.counters
         self.ctx.health.frames_ok, self.ctx.health.frames_bad = counts.ok, counts.bad
+
+    def has_commander(self) -> bool:
+        """Whether the vehicle runs a commander to answer mode commands."""
+        if self.readers["status"].get() is not None:
+            return True
+        health = self.readers["health"].get()
+        rows = health.rows() if health is not None else []
+        return any(row.kind.decode() == COMMANDER for row in rows)
 
     def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
         """Put a VehicleCommand on the bus; returns its sequence number for the ack."""

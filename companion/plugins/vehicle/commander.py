@@ -2,7 +2,7 @@
 
 Takes the mode commands off ``link/commands`` (SET_MODE, MISSION_START, RTL, REPOSITION,
 LOITER, SET_HOME), answers each on ``link/command_acks`` (with the reason when refused),
-and publishes ``vehicle/status`` on every change and once a second.
+and publishes ``vehicle/status`` on every change and four times a second.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from companion.mission.store import MissionStore
 from companion.plugin import Plugin, PluginContext
 
 WAIT_S = 0.5
-STATUS_PERIOD_US = 1_000_000
+STATUS_PERIOD_US = 250_000  # 4 Hz: the link and the controller follow it
 
 
 class CommanderPlugin(Plugin):
