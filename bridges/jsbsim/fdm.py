@@ -96,7 +96,7 @@ class Flight:
             elif surface == "elevator":
                 f["fcs/elevator-cmd-norm"] = -value  # JSBSim: + is stick forward, nose down
             elif surface == "rudder":
-                f["fcs/rudder-cmd-norm"] = value
+                f["fcs/rudder-cmd-norm"] = -value  # JSBSim: + yaws left
             elif surface == "throttle":
                 f["fcs/throttle-cmd-norm"] = value
             elif surface == "flaps":
@@ -108,7 +108,7 @@ class Flight:
         return {
             "aileron": f["fcs/aileron-cmd-norm"],
             "elevator": -f["fcs/elevator-cmd-norm"],
-            "rudder": f["fcs/rudder-cmd-norm"],
+            "rudder": -f["fcs/rudder-cmd-norm"],
             "throttle": f["fcs/throttle-cmd-norm"],
         }
 

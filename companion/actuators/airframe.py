@@ -24,7 +24,7 @@ Surfaces take commands in [-1, 1], trim at 0, the two halves of travel scaled se
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -91,6 +91,9 @@ class Airframe:
     cruise_speed_m_s: float
     channels: tuple[ServoChannel, ...]
     source: str = ""
+    # The [control] table: flight-controller parameter defaults for this airframe (checked
+    # by the controller, which knows the names).
+    control: dict[str, float] = field(default_factory=dict)
 
     def channel(self, surface: str) -> ServoChannel | None:
         """The channel driving that surface, if the airframe has one."""
@@ -135,9 +138,19 @@ def load_airframe(name_or_path: str) -> Airframe:
             cruise_speed_m_s=float(head["cruise_speed_m_s"]),
             channels=channels,
             source=str(path),
+            control=_control(path, data.get("control", {})),
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise AirframeError(f"{path}: [airframe]: missing or bad key {exc}") from None
+
+
+def _control(path: Path, table: dict[str, Any]) -> dict[str, float]:
+    out = {}
+    for key, value in table.items():
+        if not isinstance(value, int | float) or isinstance(value, bool):
+            raise AirframeError(f"{path}: [control]: {key} must be a number, not {value!r}")
+        out[key] = float(value)
+    return out
 
 
 def _channel(path: Path, surface: str, spec: dict[str, Any]) -> ServoChannel:

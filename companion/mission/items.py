@@ -1,4 +1,9 @@
-"""Mission items (MISSION_ITEM_INT fields) and what the vehicle can fly."""
+"""Mission items (MISSION_ITEM_INT fields) and what the vehicle can fly.
+
+Only what the executor flies is accepted: no landing (the aircraft has no landing
+controller yet) and no terrain frames (it has no terrain data), so such a plan is refused
+at upload with the matching MAV_MISSION_RESULT instead of being skipped in flight.
+"""
 
 from __future__ import annotations
 
@@ -16,7 +21,6 @@ NAV_COMMANDS = frozenset(
         d.MAV_CMD_NAV_LOITER_TIME,
         d.MAV_CMD_NAV_RETURN_TO_LAUNCH,
         d.MAV_CMD_NAV_TAKEOFF,
-        d.MAV_CMD_NAV_LAND,
     }
 )
 DO_COMMANDS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_JUMP})
@@ -39,8 +43,6 @@ GLOBAL_FRAMES = frozenset(
         d.MAV_FRAME_GLOBAL_INT,
         d.MAV_FRAME_GLOBAL_RELATIVE_ALT,
         d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
-        d.MAV_FRAME_GLOBAL_TERRAIN_ALT,
-        d.MAV_FRAME_GLOBAL_TERRAIN_ALT_INT,
     }
 )
 POSITIONLESS = frozenset(

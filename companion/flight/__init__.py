@@ -1,0 +1,1 @@
+"""The flight controller: modes, the mission executor and the control laws put together."""

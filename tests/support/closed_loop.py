@@ -1,0 +1,107 @@
+"""The flight controller flying JSBSim in one process, on the true state.
+
+No sensors, no bus: the control laws and the mission executor against the real flight
+model, at hundreds of times real time. Used by the control tests and for tuning; the
+whole vehicle (drivers, navigator, link, servo card) is flown by ``companion sim``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from bridges.jsbsim.fdm import Flight, Home
+from companion.actuators.airframe import load_airframe
+from companion.flight.controller import ControlOutput, FlightController
+from companion.flight.params import control_params, flight_config
+from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
+from companion.mission.items import MissionItem
+
+PHYSICS_HZ = 100
+CONTROL_EVERY = 2  # control at 50 Hz
+
+
+@dataclass
+class Sample:
+    """One control step: time, truth and what the controller said."""
+
+    t_s: float
+    lat: float
+    lon: float
+    alt_msl: float
+    alt_agl: float
+    airspeed: float
+    roll: float
+    out: ControlOutput
+
+
+@dataclass
+class ClosedLoop:
+    """One aircraft, its controller, and the record of the flight."""
+
+    airframe: str = "c172p"
+    items: list[MissionItem] = field(default_factory=list)
+    mode: FlightMode = FlightMode.MISSION
+    wind_ned: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    turbulence: str = "none"
+    airborne_agl_m: float | None = None
+    overrides: dict[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        frame = load_airframe(self.airframe)
+        speed = frame.control.get("AIRSPEED_CRUISE", frame.cruise_speed_m_s)
+        self.flight = Flight(frame.jsbsim_model, PHYSICS_HZ, Home(), self.airborne_agl_m, speed)
+        self.flight.set_wind(*self.wind_ned)
+        self.flight.set_turbulence(self.turbulence)
+        decls = control_params(frame.control)
+        values = {d.name: d.default for d in decls} | self.overrides
+        self.controller = FlightController(flight_config(values), self.items)
+        s = self.flight.state()
+        self.status = VehicleStatus(mode=int(self.mode), armed=1, home_valid=1)
+        self.status.home_lat_deg, self.status.home_lon_deg = s.lat_deg, s.lon_deg
+        self.status.home_alt_msl_m = s.alt_msl_m - s.alt_agl_m
+        self.status.target_lat_deg = self.status.target_lon_deg = math.nan
+        self.status.target_alt_msl_m = math.nan
+        self.samples: list[Sample] = []
+        self.reached: list[int] = []
+
+    def nav(self) -> NavState:
+        """The true state as a perfect navigator would publish it."""
+        s = self.flight.state()
+        nav = NavState(t_us=round(s.t_s * 1e6))
+        nav.roll_rad, nav.pitch_rad, nav.yaw_rad = s.roll, s.pitch, s.yaw
+        nav.roll_rate_rad_s, nav.pitch_rate_rad_s = s.p, s.q
+        # Body yaw rate to earth heading rate is close enough for the yaw damper.
+        nav.yaw_rate_rad_s = s.r
+        nav.lat_deg, nav.lon_deg, nav.alt_msl_m = s.lat_deg, s.lon_deg, s.alt_msl_m
+        nav.vn_m_s, nav.ve_m_s, nav.vd_m_s = s.vn, s.ve, s.vd
+        nav.flags = int(NavFlags.ATTITUDE_VALID | NavFlags.POSITION_VALID)
+        return nav
+
+    def set_mode(self, mode: FlightMode) -> None:
+        """Switch mode as the commander would (a new change count)."""
+        self.status.mode = int(mode)
+        self.status.changes += 1
+
+    def run(self, seconds: float) -> None:
+        """Fly on for ``seconds`` of simulation time."""
+        steps = round(seconds * PHYSICS_HZ)
+        for i in range(steps):
+            if i % CONTROL_EVERY == 0:
+                self._control()
+            self.flight.step()
+
+    def _control(self) -> None:
+        s = self.flight.state()
+        out = self.controller.step(self.nav(), self.status, s.t_s)
+        self.reached += out.reached
+        self.flight.set_controls(
+            {
+                "aileron": out.aileron,
+                "elevator": out.elevator,
+                "rudder": out.rudder,
+                "throttle": out.throttle,
+            }
+        )
+        truth = (s.lat_deg, s.lon_deg, s.alt_msl_m, s.alt_agl_m, s.airspeed_m_s, s.roll)
+        self.samples.append(Sample(s.t_s, *truth, out))
