@@ -3,8 +3,8 @@
 Pure: commands and navigation in, decisions and a ``VehicleStatus`` out. The
 ``vehicle.commander`` plug-in wraps it; the link reports what it decides.
 Rules (as PX4 and ArduPilot have them): MISSION needs a stored mission; RTL needs a home;
-GUIDED and LOITER need a position (or a given point); home is the first valid position
-while disarmed, and is set again at arming.
+GUIDED and LOITER need a position (or a given point); home is the first valid position,
+and is set again at arming.
 """
 
 from __future__ import annotations
@@ -65,7 +65,7 @@ class Commander:
         if not nav.flags & NavFlags.POSITION_VALID:
             return
         self.position = (nav.lat_deg, nav.lon_deg, nav.alt_msl_m)
-        if self.home is None and not self.armed:
+        if self.home is None:  # armed before the first fix: home is where that fix is
             self.home = self.position
 
     def on_armed(self, armed: bool) -> None:

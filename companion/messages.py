@@ -363,6 +363,51 @@ class VehicleStatus(Message):
     ]
 
 
+class MissionState(enum.IntEnum):
+    """How far the running mission is (MAVLink's MISSION_STATE numbering)."""
+
+    NOT_STARTED = 2
+    ACTIVE = 3
+    COMPLETE = 5
+
+
+class ControlStatus(Message):
+    """What the flight controller is doing. Producer: control.fixed_wing. Consumer: link.
+
+    Feeds NAV_CONTROLLER_OUTPUT, MISSION_CURRENT and MISSION_ITEM_REACHED (sent when
+    ``reached_count`` grows).
+    """
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("nav_roll_rad", ctypes.c_double),
+        ("nav_pitch_rad", ctypes.c_double),
+        ("target_bearing_rad", ctypes.c_double),
+        ("wp_dist_m", ctypes.c_double),
+        ("alt_error_m", ctypes.c_double),
+        ("aspd_error_m_s", ctypes.c_double),
+        ("xtrack_error_m", ctypes.c_double),
+        ("airspeed_m_s", ctypes.c_double),  # estimated (no airspeed sensor): GPS and wind
+        ("wind_n_m_s", ctypes.c_double),
+        ("wind_e_m_s", ctypes.c_double),
+        ("mission_seq", ctypes.c_int32),
+        ("mission_state", ctypes.c_uint8),  # MissionState
+        ("landed", ctypes.c_uint8),
+        ("reached_count", ctypes.c_uint32),
+        ("last_reached", ctypes.c_int32),
+    ]
+
+
+class ParamChange(Message):
+    """A parameter a ground station set. Producer: link. Consumers: the parameter's owner."""
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("value", ctypes.c_double),
+        ("name", ctypes.c_char * 17),
+    ]
+
+
 class SimTruth(Message):
     """The simulator's true state, for scoring and the live status line.
 
@@ -421,11 +466,13 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("sim/clock", SimClock, "latest", doc="simulation time"),
     Channel("vehicle/status", VehicleStatus, "latest", doc="mode, home, guided target"),
     Channel("control/actuators", ActuatorCommand, "queue", 8, "normalised surfaces"),
+    Channel("control/status", ControlStatus, "latest", doc="guidance and mission progress"),
     Channel("actuators/servos", ServoOutput, "latest", doc="servo outputs written"),
     Channel("link/commands", VehicleCommand, "queue", 16, "commands for the vehicle", True),
     Channel("link/command_acks", CommandAck, "queue", 16, "command outcomes"),
     Channel("system/plugin_stats", PluginStats, "queue", 64, "per-plug-in counters", True),
     Channel("system/health", SystemHealth, "latest", doc="the health table"),
+    Channel("params/changes", ParamChange, "queue", 32, "parameters set from the ground"),
 )
 
 

@@ -100,6 +100,11 @@ class Plugin(ABC):
         return Ports(cls.inputs, cls.optional_inputs, cls.outputs)
 
     @classmethod
+    def param_decls(cls, settings: Mapping[str, Any]) -> tuple[ParamDecl, ...]:
+        """The parameters this instance serves (``params``, unless they depend on settings)."""
+        return tuple(cls.params)
+
+    @classmethod
     def validate(cls, settings: Mapping[str, Any]) -> list[str]:
         """Problems with the settings taken together (checked before anything starts)."""
         return []

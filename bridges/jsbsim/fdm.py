@@ -18,6 +18,8 @@ FT = 0.3048  # metres per foot
 TURBULENCE = {"none": (0, 0.0), "light": (2, 15.0), "moderate": (3, 30.0), "severe": (5, 45.0)}
 KT = 0.514444
 MILSPEC = 3  # atmosphere/turb-type: FGWinds::ttMilspec
+DROP_HEIGHT_FT = 4.0  # above the resting height of the shipped airframes' gear
+SETTLE_S = 3.0
 
 
 @dataclass(frozen=True)
@@ -59,7 +61,9 @@ class Flight:
         f["ic/psi-true-deg"] = h.heading_deg
         f["ic/h-agl-ft"] = (airborne_agl_m or 0.0) / FT
         f["ic/vc-kts"] = speed_m_s / KT if airborne_agl_m else 0.0
-        if not f.run_ic():
+        if not airborne_agl_m:
+            self._rest_on_gear()
+        elif not f.run_ic():
             raise RuntimeError("JSBSim refused the initial conditions")
         f["propulsion/set-running"] = -1  # engines running, as if started on the ground
         f["fcs/mixture-cmd-norm"] = 1.0
@@ -70,6 +74,28 @@ class Flight:
                 log.warning("%s cannot trim at %.1f m/s: starting untrimmed", model, speed_m_s)
         else:
             f["fcs/throttle-cmd-norm"] = 0.0
+
+    def _rest_on_gear(self) -> None:
+        """Start at the height and pitch the aircraft rests at on its wheels.
+
+        Placed with its centre of gravity on the ground, JSBSim's gear springs throw the
+        aircraft up and it lands on its nose; dropped from a little height it settles. So
+        it is dropped once, and started again where it came to rest, at time zero.
+        """
+        f = self.fdm
+        f["ic/h-agl-ft"] = DROP_HEIGHT_FT
+        if not f.run_ic():
+            raise RuntimeError("JSBSim refused the initial conditions")
+        for _ in range(round(SETTLE_S / f.get_delta_t())):
+            f.run()
+        rest_agl_ft, rest_pitch_deg = f["position/h-agl-ft"], f["attitude/theta-deg"]
+        h = self.home
+        f["ic/lat-geod-deg"], f["ic/long-gc-deg"] = h.lat_deg, h.lon_deg
+        f["ic/psi-true-deg"] = h.heading_deg
+        f["ic/h-agl-ft"], f["ic/theta-deg"] = rest_agl_ft, rest_pitch_deg
+        if not f.run_ic():
+            raise RuntimeError("JSBSim refused the initial conditions")
+        f.set_sim_time(0.0)
 
     def set_wind(self, north: float, east: float, down: float) -> None:
         """Steady wind, m/s, the direction it blows towards."""

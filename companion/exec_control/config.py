@@ -230,5 +230,5 @@ def _plugin_spec(check: _Checker, entry: Any, where: KeyPath) -> PluginSpec:
         settings=settings,
         ports=cls.ports(settings),
         line=line_of(check.lines, where),
-        params=tuple(cls.params),
+        params=cls.param_decls(settings),
     )

@@ -105,6 +105,8 @@ class FlightController:
         """Surface commands for this navigation solution."""
         dt = 0.0 if self._last_t is None else max(0.0, min(t_s - self._last_t, 0.2))
         self._last_t = t_s
+        if not status.home_valid and (self.landed is None or self.landed):
+            return ControlOutput()  # no home yet: nothing to fly from or back to
         frame = self._ensure_frame(nav, status)
         pos = frame.ne(nav.lat_deg, nav.lon_deg)
         vel = (nav.vn_m_s, nav.ve_m_s)

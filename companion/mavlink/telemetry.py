@@ -12,9 +12,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from companion.mavlink.codec import dialect as d
-from companion.mavlink.mission_service import mission_current_message
+from companion.mavlink.flight_messages import landed_state, mission_current, nav_controller_output
 from companion.mavlink.mode_messages import available_modes_monitor, current_mode
 from companion.messages import (
+    ControlStatus,
     GpsFix,
     Imu,
     NavFlags,
@@ -37,6 +38,7 @@ class Snapshot:
     health: SystemHealth | None = None
     servos: ServoOutput | None = None
     status: VehicleStatus | None = None
+    control: ControlStatus | None = None  # None while the flight controller is not running
     home_alt_m: float = math.nan
     mission_seq: int = 0
     mission_total: int = 0
@@ -211,14 +213,16 @@ def _scaled_imu(mav: Any, s: Snapshot) -> Any:
 
 def _extended_sys_state(mav: Any, s: Snapshot) -> Any:
     landed = d.MAV_LANDED_STATE_UNDEFINED
-    if s.nav is not None and s.nav.flags & NavFlags.VELOCITY_VALID:
+    if (controlled := landed_state(s.control)) is not None:
+        landed = controlled
+    elif s.nav is not None and s.nav.flags & NavFlags.VELOCITY_VALID:
         moving = math.hypot(_finite(s.nav.vn_m_s), _finite(s.nav.ve_m_s)) > 5.0
         landed = d.MAV_LANDED_STATE_IN_AIR if moving else d.MAV_LANDED_STATE_ON_GROUND
     return mav.extended_sys_state_encode(d.MAV_VTOL_STATE_UNDEFINED, landed)
 
 
 def _mission_current(mav: Any, s: Snapshot) -> Any:
-    return mission_current_message(mav, s.mission_seq, s.mission_total)
+    return mission_current(mav, s.mission_seq, s.mission_total, s.control)
 
 
 def _home_position(mav: Any, s: Snapshot) -> Any:
@@ -302,6 +306,12 @@ STREAMS: dict[int, Stream] = {
         Stream("SCALED_IMU", d.MAVLINK_MSG_ID_SCALED_IMU, 2.0, _scaled_imu),
         Stream("EXTENDED_SYS_STATE", d.MAVLINK_MSG_ID_EXTENDED_SYS_STATE, 1.0, _extended_sys_state),
         Stream("MISSION_CURRENT", d.MAVLINK_MSG_ID_MISSION_CURRENT, 1.0, _mission_current),
+        Stream(
+            "NAV_CONTROLLER_OUTPUT",
+            d.MAVLINK_MSG_ID_NAV_CONTROLLER_OUTPUT,
+            2.0,
+            lambda m, s: nav_controller_output(m, s.control),
+        ),
         Stream("HOME_POSITION", d.MAVLINK_MSG_ID_HOME_POSITION, 0.2, _home_position),
         Stream("PLUGIN_HEALTH", d.MAVLINK_MSG_ID_PLUGIN_HEALTH, 2.0, _plugin_health),
         Stream("NAV_STATUS", d.MAVLINK_MSG_ID_NAV_STATUS, 1.0, _nav_status),

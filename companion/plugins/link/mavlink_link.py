@@ -34,13 +34,14 @@ from companion.mavlink.service import Outgoing
 from companion.mavlink.signing import key_from
 from companion.mavlink.telemetry import Snapshot
 from companion.mavlink.timesync import TimesyncService
-from companion.messages import NavFlags, VehicleCommand
+from companion.messages import ControlStatus, NavFlags, ParamChange, VehicleCommand
 from companion.mission.store import MissionStore
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 from companion.plugins.link.commands import register_commands
 
 MAX_WAIT_S = 0.02
+CONTROL_STALE_US = 2_000_000  # the flight controller stopped (disarmed) this long ago
 COMMANDER = "vehicle.commander"
 STREAM_PARAMS = {
     "SR_ATTITUDE": (d.MAVLINK_MSG_ID_ATTITUDE,),
@@ -87,8 +88,9 @@ class MavlinkLink(Plugin):
         "vehicle/status",
         "system/health",
         "link/command_acks",
+        "control/status",
     )
-    outputs = ("link/commands",)
+    outputs = ("link/commands", "params/changes")
 
     @classmethod
     def validate(cls, settings: Mapping[str, Any]) -> list[str]:
@@ -125,11 +127,14 @@ class MavlinkLink(Plugin):
             "health": bus.latest_reader("system/health"),
             "servos": bus.latest_reader("actuators/servos"),
             "status": bus.latest_reader("vehicle/status"),
+            "control": bus.latest_reader("control/status"),
             "gps": bus.queue_reader("sensors/gps"),
             "imu": bus.queue_reader("sensors/imu"),
         }
         self.acks = bus.queue_reader("link/command_acks")
         self.to_vehicle = bus.writer("link/commands")
+        self.param_changes = bus.writer("params/changes")
+        self.reached_count = 0
         timesync = TimesyncService(self.mav, lambda: ctx.clock.now_us() * 1000)
         services = [self.identity, self.commands, timesync]
         secret = ctx.settings["signing_key"]
@@ -148,10 +153,17 @@ class MavlinkLink(Plugin):
         self.store = ParamStore(ctx.param_decls or self.params, path)
         service = ParamsService(self.mav, self.store, sysid, ctx.settings["compid"])
         service.on_refusal = self.statustext
-        service.on_change = lambda name, value: self._apply_rates()
+        service.on_change = self._param_changed
         self.router.add_service(service)
         self._apply_rates()
         self._params_service = service
+
+    def _param_changed(self, name: str, value: float) -> None:
+        """Tell the parameter's owner (it follows params/changes) and apply our own."""
+        change = ParamChange(t_us=self.ctx.clock.now_us(), value=value)
+        change.name = name.encode()[:16]
+        self.param_changes.publish(change)
+        self._apply_rates()
 
     def _apply_rates(self) -> None:
         """The SR_* parameters set every endpoint's default stream rates."""
@@ -172,6 +184,7 @@ class MavlinkLink(Plugin):
         s, r = self.snapshot, self.readers
         s.nav, s.health, s.servos = r["nav"].get(), r["health"].get(), r["servos"].get()
         s.status = r["status"].get()
+        s.control = self._fresh_control()
         for key in ("gps", "imu"):
             latest = None
             for latest in r[key].drain():  # noqa: B007 - only the newest matters here
@@ -195,6 +208,17 @@ class MavlinkLink(Plugin):
             self.identity.state.armed = bool(s.health.flight_running)
             active = d.MAV_STATE_ACTIVE if s.health.flight_running else d.MAV_STATE_STANDBY
             self.identity.state.system_status = active
+
+    def _fresh_control(self) -> ControlStatus | None:
+        """The controller's status while it runs; MISSION_ITEM_REACHED when it grows."""
+        control = self.readers["control"].get()
+        if control is None or self.ctx.clock.now_us() - control.t_us > CONTROL_STALE_US:
+            return None
+        if control.reached_count != self.reached_count and control.last_reached >= 0:
+            msg = self.mav.mission_item_reached_encode(control.last_reached)
+            self.router.send([Outgoing(msg, None)], time.monotonic())
+        self.reached_count = control.reached_count
+        return control
 
     def _mode_changes(self, s: Snapshot) -> None:
         """The heartbeat shows the commander's mode; a change is announced at once."""

@@ -1,0 +1,1 @@
+"""Control plug-ins: the fixed-wing flight controller."""

@@ -1,0 +1,143 @@
+"""``control.fixed_wing``: flies the modes and the stored mission (group ``flight``).
+
+Runs on every navigation solution: the commander's mode and targets in, normalised
+surface commands out on ``control/actuators`` (the servo plug-in turns them into bytes),
+and guidance and mission progress on ``control/status`` for the link. Every gain, limit
+and speed is a parameter: the airframe file gives the defaults, the ground station may
+change them in flight (they arrive on ``params/changes``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from companion.actuators.airframe import AirframeError, load_airframe
+from companion.flight.controller import ControlOutput, FlightController
+from companion.flight.params import control_params, flight_config
+from companion.messages import (
+    ActuatorCommand,
+    ControlStatus,
+    FlightMode,
+    MissionState,
+    VehicleStatus,
+)
+from companion.mission.store import FILES, MissionStore
+from companion.params import ParamDecl, ParamStore
+from companion.plugin import Plugin, PluginContext, Setting
+
+WAIT_S = 0.5
+STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item is reached)
+MISSION_CHECK_US = 1_000_000
+
+
+class FixedWingPlugin(Plugin):
+    """Guidance, energy and attitude control for one airframe."""
+
+    settings = {
+        "airframe": Setting(str, "c172p", "airframe name (companion/airframes) or TOML path"),
+    }
+    inputs = ("nav/state",)
+    optional_inputs = ("vehicle/status", "params/changes")
+    outputs = ("control/actuators", "control/status")
+
+    @classmethod
+    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
+        try:
+            control_params(load_airframe(settings["airframe"]).control)
+        except (AirframeError, KeyError) as exc:
+            return [f"airframe: {exc}"]
+        return []
+
+    @classmethod
+    def param_decls(cls, settings: Mapping[str, Any]) -> tuple[ParamDecl, ...]:
+        return control_params(load_airframe(settings["airframe"]).control)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        decls = self.param_decls(ctx.settings)
+        state_dir = Path(ctx.vehicle.get("state_dir", "."))
+        # The link owns the stored values; read them once, then follow params/changes.
+        stored = ParamStore(decls, state_dir / "params.json")
+        self.values = {d.name: stored.get(d.name) for d in decls}
+        self.missions = MissionStore(state_dir / "missions")
+        self.mission_file = state_dir / "missions" / FILES[0]
+        self.mission_stamp = self._mission_stamp()
+        self.controller = FlightController(flight_config(self.values), self.missions.items[0])
+        bus = ctx.bus
+        self.nav = bus.latest_reader("nav/state")
+        self.status_in = bus.latest_reader("vehicle/status")
+        self.changes = bus.queue_reader("params/changes")
+        self.surfaces = bus.writer("control/actuators")
+        self.status_out = bus.writer("control/status")
+        self.reached_count = 0
+        self.last_reached = -1
+        self.next_status_us = 0
+        self.next_mission_check_us = 0
+        self.default_status = VehicleStatus(mode=int(FlightMode.LOITER), armed=1)
+
+    def _mission_stamp(self) -> float:
+        try:
+            return self.mission_file.stat().st_mtime_ns
+        except FileNotFoundError:
+            return 0.0
+
+    def _follow_changes(self, now_us: int) -> None:
+        changed = False
+        for change in self.changes.drain():
+            name = change.name.decode(errors="replace")
+            if name in self.values and math.isfinite(change.value):
+                self.values[name] = change.value
+                changed = True
+        if changed:
+            self.controller.set_config(flight_config(self.values))
+        if now_us >= self.next_mission_check_us:
+            self.next_mission_check_us = now_us + MISSION_CHECK_US
+            stamp = self._mission_stamp()
+            if stamp != self.mission_stamp:
+                self.mission_stamp = stamp
+                self.controller.set_mission(self.missions.reload().items[0])
+                self.ctx.log.info("new mission: %d items", len(self.missions.items[0]))
+
+    def step(self) -> None:
+        nav = self.nav.wait(WAIT_S)
+        if nav is None:
+            return  # no navigation: the servo plug-in goes safe when commands stop
+        now_us = self.ctx.clock.now_us()
+        self._follow_changes(now_us)
+        status = self.status_in.get() or self.default_status
+        out = self.controller.step(nav, status, nav.t_us / 1e6)
+        cmd = ActuatorCommand(t_us=nav.t_us, armed=1)
+        cmd.aileron, cmd.elevator, cmd.rudder = out.aileron, out.elevator, out.rudder
+        cmd.throttle = out.throttle
+        for i in range(len(cmd.aux)):
+            cmd.aux[i] = math.nan
+        self.surfaces.publish(cmd)
+        self.ctx.health.ok()
+        if out.reached:
+            self.reached_count += len(out.reached)
+            self.last_reached = out.reached[-1]
+        if out.reached or now_us >= self.next_status_us:
+            self.status_out.publish(self._status(now_us, out, status))
+            self.next_status_us = now_us + STATUS_PERIOD_US
+
+    def _status(self, now_us: int, out: ControlOutput, status: VehicleStatus) -> ControlStatus:
+        msg = ControlStatus(t_us=now_us)
+        msg.nav_roll_rad, msg.nav_pitch_rad = out.nav_roll, out.nav_pitch
+        msg.target_bearing_rad, msg.wp_dist_m = out.target_bearing, out.wp_dist
+        msg.alt_error_m, msg.aspd_error_m_s = out.alt_error, out.aspd_error
+        msg.xtrack_error_m, msg.airspeed_m_s = out.xtrack, out.airspeed
+        msg.wind_n_m_s, msg.wind_e_m_s = self.controller.wind.wind_ne
+        running = self.controller.executor is not None
+        msg.mission_seq = self.controller.executor.current if running else 0
+        if out.mission_finished:
+            msg.mission_state = MissionState.COMPLETE
+        elif running and status.mode == FlightMode.MISSION:
+            msg.mission_state = MissionState.ACTIVE
+        else:
+            msg.mission_state = MissionState.NOT_STARTED
+        msg.landed = int(out.landed)
+        msg.reached_count, msg.last_reached = self.reached_count, self.last_reached
+        return msg
