@@ -26,9 +26,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from companion.estimation.estimate_csv import read_estimate
 from companion.estimation.scoring import EARTH_RADIUS_M, Errors
 from companion.messages import GpsFix
+from companion.simulation.evaluation import fly, messages, truth_columns
 from companion.simulation.synthetic_flight import FlightSpec
 from companion.simulation.synthetic_log import synthesize
-from tests.unit.estimation.flights import fly, messages, truth_columns
 
 OUTAGE = (150.0, 30.0)
 DECLINATION = 11.7  # the synthetic field's

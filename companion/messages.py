@@ -97,6 +97,7 @@ class GpsFix(Message):
         ("vn_m_s", ctypes.c_double),
         ("ve_m_s", ctypes.c_double),
         ("vd_m_s", ctypes.c_double),  # NaN when no vertical velocity is known
+        ("vd_std_m_s", ctypes.c_double),  # 1-σ of vd when the source says; 0 or NaN: unknown
         ("ground_speed_m_s", ctypes.c_double),
         ("course_rad", ctypes.c_double),  # over ground, [0, 2π) from north; NaN unknown
         ("hdop", ctypes.c_double),
@@ -124,7 +125,10 @@ class Compass(Message):
 
 
 class Baro(Message):
-    """Barometric altitude relative to the first reading. Producers: sensors.replay."""
+    """Barometric altitude relative to the first reading.
+
+    Producers: sensors.serial_imu ($VNIMU pressure), sensors.replay. Consumers: nav.ins_ekf.
+    """
 
     _fields_ = [
         ("t_us", ctypes.c_int64),

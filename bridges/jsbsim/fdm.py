@@ -18,6 +18,7 @@ FT = 0.3048  # metres per foot
 TURBULENCE = {"none": (0, 0.0), "light": (2, 15.0), "moderate": (3, 30.0), "severe": (5, 45.0)}
 KT = 0.514444
 MILSPEC = 3  # atmosphere/turb-type: FGWinds::ttMilspec
+IDLE_THROTTLE = 0.05
 DROP_HEIGHT_FT = 4.0  # above the resting height of the shipped airframes' gear
 SETTLE_S = 3.0
 
@@ -73,7 +74,7 @@ class Flight:
             except jsbsim.TrimFailureError:
                 log.warning("%s cannot trim at %.1f m/s: starting untrimmed", model, speed_m_s)
         else:
-            f["fcs/throttle-cmd-norm"] = 0.0
+            self.set_controls({"throttle": 0.0})
 
     def _rest_on_gear(self) -> None:
         """Start at the height and pitch the aircraft rests at on its wheels.
@@ -125,6 +126,9 @@ class Flight:
                 f["fcs/rudder-cmd-norm"] = -value  # JSBSim: + yaws left
             elif surface == "throttle":
                 f["fcs/throttle-cmd-norm"] = value
+                # A pilot holds the brakes at idle; the servo card has no brake channel.
+                brake = 1.0 if value < IDLE_THROTTLE else 0.0
+                f["fcs/left-brake-cmd-norm"] = f["fcs/right-brake-cmd-norm"] = brake
             elif surface == "flaps":
                 f["fcs/flap-cmd-norm"] = max(0.0, value)
 

@@ -62,6 +62,9 @@ _EXTRACT: dict[str, Callable[[pynmea2.TalkerSentence], object]] = {
 _MALFORMED = (ValueError, IndexError, KeyError, TypeError, AttributeError)
 
 
+DERIVED_VD_STD_M_S = 1.5
+
+
 @dataclass
 class NmeaCounters:
     """What the decoder has seen since it was made."""
@@ -245,6 +248,9 @@ class NmeaGpsDecoder:
         fix.eph_m, fix.epv_m = self.uere_m * fix.hdop, self.uere_m * fix.vdop
         _set_velocity(fix, rmc, epoch.vtg)
         fix.vd_m_s = epoch.vd_m_s
+        # NMEA has no vertical speed: this one differences two altitudes, each with metres
+        # of noise, so say how rough it is.
+        fix.vd_std_m_s = DERIVED_VD_STD_M_S if math.isfinite(epoch.vd_m_s) else math.nan
         return fix
 
     def _utc_us(self, epoch: _Epoch) -> int:

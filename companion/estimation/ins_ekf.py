@@ -27,7 +27,7 @@ import numpy as np
 from companion.estimation import rotations as rot
 from companion.estimation.ins_align import Aligner, Alignment
 from companion.estimation.local_frame import LocalFrame, normal_gravity
-from companion.messages import Compass, GpsFix, Imu, Magnetometer, NavFlags, NavState
+from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer, NavFlags, NavState
 
 CHI2_9999 = {1: 15.14, 2: 18.42, 3: 21.11, 4: 23.51, 5: 25.74, 6: 27.86}
 MAX_IMU_GAP_S = 0.5
@@ -60,6 +60,11 @@ class InsEkfConfig:
     gyro_bias_std: float = math.radians(0.5)
     gps_pos_std: float = 3.0  # when the fix carries no accuracy
     gps_vel_std: float = 0.3
+    baro_std: float = 0.5  # m, barometric height over seconds
+    baro_interval_s: float = 0.1
+    baro_timeout_s: float = 1.0  # barometer silent this long: GPS height again
+    baro_offset_tau_s: float = 300.0  # how slowly GPS pulls the barometer's datum
+    gps_vert_with_baro_std: float = 10.0  # GPS height still anchors the datum, weakly
     compass_std: float = math.radians(2.0)
     mag_heading_std: float = math.radians(4.0)
     declination_deg: float = 0.0  # for magnetometer headings
@@ -99,6 +104,9 @@ class InsEkf:
         self.last_gps_ok = self.last_heading_ok = True
         self.resets = 0
         self.next_heading_us = 0
+        self.baro_offset: float | None = None  # baro height + offset = height in the frame
+        self.last_baro_us: int | None = None
+        self.next_baro_us = 0
         self.cov_dt = 0.0
         self.cov_f: tuple[float, ...] = (0.0, 0.0, 0.0)
         self.cov_w: tuple[float, ...] = (0.0, 0.0, 0.0)
@@ -143,6 +151,24 @@ class InsEkf:
             self.pending_fix = fix
             return
         self._gps_update(fix)
+
+    def on_baro(self, reading: Baro) -> None:
+        """Barometric height: the vertical channel follows it; GPS only moves its datum."""
+        h = reading.alt_rel_m
+        if not self.aligned or not math.isfinite(h) or reading.t_us < self.next_baro_us:
+            return
+        self.next_baro_us = reading.t_us + round(self.cfg.baro_interval_s * 1e6)
+        if self.baro_offset is None or not self._baro_fresh(reading.t_us):
+            self.baro_offset = -self.p[2] - h  # (re)join where the INS height is now
+        self.last_baro_us = reading.t_us
+        y = np.array([-(h + self.baro_offset) - self.p[2]])
+        self._update(y, _I15[[2]], np.array([[self.cfg.baro_std**2]]))
+
+    def _baro_fresh(self, now_us: int) -> bool:
+        return (
+            self.last_baro_us is not None
+            and (now_us - self.last_baro_us) / 1e6 < self.cfg.baro_timeout_s
+        )
 
     def on_compass(self, reading: Compass) -> None:
         """Heading update from a digital compass (heading already true), when no
@@ -297,10 +323,15 @@ class InsEkf:
         p_then, v_then = self._state_at(fix.t_us - round(self.cfg.gps_delay_s * 1e6))
         std = fix.eph_m if math.isfinite(fix.eph_m) and fix.eph_m > 0 else self.cfg.gps_pos_std
         vstd = fix.epv_m if math.isfinite(fix.epv_m) and fix.epv_m > 0 else 1.5 * std
+        if self._baro_fresh(fix.t_us):
+            self._pull_baro_datum(z_p[2], fix.t_us)
+            vstd = max(vstd, self.cfg.gps_vert_with_baro_std)
         rows = [0, 1] + ([2] if math.isfinite(fix.alt_msl_m) else [])
         rows += [3 + i for i in range(3) if math.isfinite(z_v[i])]
         y_all = np.concatenate([z_p - p_then, z_v - v_then])
-        sig = np.array([std, std, vstd] + [self.cfg.gps_vel_std] * 3)
+        c = self.cfg
+        vd_std = fix.vd_std_m_s if fix.vd_std_m_s > 0 else c.gps_vel_std  # NaN > 0 is False
+        sig = np.array([std, std, vstd, c.gps_vel_std, c.gps_vel_std, vd_std])
         h = _I15[rows]
         ok = self._update(y_all[rows], h, np.diag(np.square(sig[rows])))
         self.last_gps_ok = ok
@@ -312,6 +343,13 @@ class InsEkf:
         self.gps_reject_run += 1
         if self.gps_reject_run >= self.cfg.reset_after:
             self._reset_to_gps(z_p, z_v, std)
+
+    def _pull_baro_datum(self, gps_down: float, t_us: int) -> None:
+        """Let the barometer's datum follow GPS height slowly (weather, temperature)."""
+        if self.baro_offset is None or self.last_gps_us is None or not math.isfinite(gps_down):
+            return
+        dt = max(0.0, (t_us - self.last_gps_us) / 1e6)
+        self.baro_offset += (-gps_down + self.p[2]) * min(1.0, dt / self.cfg.baro_offset_tau_s)
 
     def _reset_to_gps(self, z_p: np.ndarray, z_v: np.ndarray, std: float) -> None:
         """The INS has disagreed with GPS for too long: believe GPS, and say so."""

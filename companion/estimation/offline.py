@@ -12,7 +12,7 @@ from typing import Protocol
 
 from companion.estimation.gps_compass import GpsCompassNavigator
 from companion.estimation.ins_ekf import InsEkf, InsEkfConfig
-from companion.messages import Compass, GpsFix, Imu, Magnetometer, Message, NavState
+from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer, Message, NavState
 
 
 class Navigator(Protocol):
@@ -33,10 +33,11 @@ class InsEkfRunner:
             GpsFix: self.nav.on_gps,  # type: ignore[dict-item]
             Compass: self.nav.on_compass,  # type: ignore[dict-item]
             Magnetometer: self.nav.on_mag,  # type: ignore[dict-item]
+            Baro: self.nav.on_baro,  # type: ignore[dict-item]
         }
 
     def feed(self, sample: Message) -> None:
-        """Route one sample to the filter (barometer samples are not used)."""
+        """Route one sample to the filter."""
         handler = self._feed.get(type(sample))
         if handler is not None:
             handler(sample)

@@ -293,8 +293,12 @@ class FlightController:
         return out
 
     def _turn_radius(self) -> float:
-        """The radius the aircraft turns at now, at most 80 % of the bank limit."""
-        v = max(self.wind.airspeed, self.config["AIRSPEED_MIN"])
+        """The radius of a turn at cruise speed and 80 % of the bank limit.
+
+        From the planned speed, not the measured one: a circle whose radius followed every
+        gust would never be flown round.
+        """
+        v = self.config["AIRSPEED_CRUISE"]
         return v * v / (G * math.tan(self.config.roll_limit * 0.8))
 
     def _lateral(

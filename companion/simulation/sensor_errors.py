@@ -29,6 +29,7 @@ class NoiseModel:
     gyro_bias_rad_s: float = 0.003
     gyro_walk_rad_s_rt_s: float = 2e-5
     mag_noise_gauss: float = 0.002
+    baro_noise_pa: float = 3.0  # about 0.25 m of height
     compass_heading_deg: float = 0.5
     compass_tilt_deg: float = 0.2
     gps_horizontal_m: float = 1.0  # slowly wandering error (Gauss-Markov), per axis
@@ -100,14 +101,15 @@ class SensorErrors:
         """One IMU sample; the biases walk by ``dt`` seconds first."""
         m = self.m
         root = math.sqrt(max(dt, 0.0))
-        # One draw for all fifteen: the IMU runs at 100 Hz and more.
-        z = self.rng.standard_normal(15) * m.scale
+        # One draw for all sixteen: the IMU runs at 100 Hz and more.
+        z = self.rng.standard_normal(16) * m.scale
         self.accel_bias += z[0:3] * (m.accel_walk_m_s2_rt_s * root)
         self.gyro_bias += z[3:6] * (m.gyro_walk_rad_s_rt_s * root)
         accel = np.array(s.f_body) + self.accel_bias + z[6:9] * m.accel_noise_m_s2
         gyro = np.array((s.p, s.q, s.r)) + self.gyro_bias + z[9:12] * m.gyro_noise_rad_s
         mag = body_from_ned(s.roll, s.pitch, s.yaw) @ self.field_ned
         mag = mag + z[12:15] * m.mag_noise_gauss
+        pressure_kpa += z[15] * m.baro_noise_pa / 1000.0
         return ImuSample(accel, gyro, mag, 25.0, pressure_kpa)
 
     def compass(self, s: TrueState) -> tuple[float, float, float]:

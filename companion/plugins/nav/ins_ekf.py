@@ -36,7 +36,7 @@ class InsEkfPlugin(Plugin):
         ),
     }
     inputs = ("sensors/imu", "sensors/gps")
-    optional_inputs = ("sensors/mag", "sensors/compass")
+    optional_inputs = ("sensors/mag", "sensors/compass", "sensors/baro")
     outputs = ("nav/state",)
 
     def init(self, ctx: PluginContext) -> None:
