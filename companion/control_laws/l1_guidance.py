@@ -17,6 +17,8 @@ from companion.geodesy import wrap_pi
 
 G = 9.80665
 MIN_SPEED = 1.0  # below this the ground course is meaningless
+XTRACK_I_CAPTURE_RAD = math.radians(5.0)
+XTRACK_I_MAX_RAD = 0.1
 
 
 @dataclass(frozen=True)
@@ -41,9 +43,17 @@ def _dot(a: tuple[float, float], b: tuple[float, float]) -> float:
 class L1Guidance:
     """Track a line A→B or a circle; ``period_s`` and ``damping`` as ArduPlane's NAVL1_*."""
 
-    def __init__(self, period_s: float = 17.0, damping: float = 0.75) -> None:
+    def __init__(
+        self, period_s: float = 17.0, damping: float = 0.75, xtrack_i: float = 0.02
+    ) -> None:
         self.period_s = period_s
         self.damping = damping
+        # A constant sideways push (a wind component, a slight sideslip the airframe flies
+        # straight with) leaves plain L1 a steady offset; ArduPlane's answer is a small
+        # integrator on the capture angle, bounded and restarted on every new line.
+        self.xtrack_i = xtrack_i
+        self.integ = 0.0
+        self._line: tuple[tuple[float, float], tuple[float, float]] | None = None
 
     def l1_distance(self, speed: float) -> float:
         """How far ahead the reference point is, m."""
@@ -55,8 +65,11 @@ class L1Guidance:
         vel: tuple[float, float],
         a: tuple[float, float],
         b: tuple[float, float],
+        dt: float = 0.0,
     ) -> LateralDemand:
         """Follow the line from ``a`` through ``b`` (north/east metres)."""
+        if self._line != (a, b):
+            self._line, self.integ = (a, b), 0.0
         speed = max(math.hypot(*vel), MIN_SPEED)
         vel = vel if math.hypot(*vel) >= MIN_SPEED else (speed, 0.0)
         l1 = self.l1_distance(speed)
@@ -75,7 +88,10 @@ class L1Guidance:
             return self._towards(vel, speed, l1, (-from_a[0], -from_a[1]), xtrack, bearing_b)
         eta_track = math.atan2(_cross(vel, u), _dot(vel, u))
         eta_capture = -math.asin(max(-1.0, min(1.0, xtrack / l1)))
-        eta = max(-math.pi / 2, min(math.pi / 2, eta_track + eta_capture))
+        if abs(eta_capture) < XTRACK_I_CAPTURE_RAD:  # only once the line is captured
+            self.integ += eta_capture * self.xtrack_i * dt
+            self.integ = max(-XTRACK_I_MAX_RAD, min(XTRACK_I_MAX_RAD, self.integ))
+        eta = max(-math.pi / 2, min(math.pi / 2, eta_track + eta_capture + self.integ))
         lat_acc = 4.0 * self.damping**2 * speed * speed / l1 * math.sin(eta)
         return LateralDemand(lat_acc, bearing_b, xtrack, math.hypot(*to_b))
 

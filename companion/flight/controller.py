@@ -80,7 +80,12 @@ class FlightController:
                 old_tecs.throttle_integ,
                 old_tecs.pitch_integ,
             )
-        self.l1 = L1Guidance(config["NAVL1_PERIOD"], config["NAVL1_DAMPING"])
+        old_l1 = getattr(self, "l1", None)
+        self.l1 = L1Guidance(
+            config["NAVL1_PERIOD"], config["NAVL1_DAMPING"], config["NAVL1_XTRACK_I"]
+        )
+        if old_l1 is not None:
+            self.l1.integ, self.l1._line = old_l1.integ, old_l1._line
         if self.executor is not None:
             self.executor.config = config.executor
 
@@ -271,7 +276,7 @@ class FlightController:
         cfg = self.config
         speed_dem = sp.speed if math.isfinite(sp.speed) else cfg["AIRSPEED_CRUISE"]
         speed_dem = max(cfg["AIRSPEED_MIN"], min(cfg["AIRSPEED_MAX"], speed_dem))
-        lateral = self._lateral(sp, pos, vel, airspeed)
+        lateral = self._lateral(sp, pos, vel, dt)
         roll_dem = bank_for(lateral.lat_acc, cfg.roll_limit)
         energy = self.tecs.step(nav.alt_msl_m, -nav.vd_m_s, airspeed, sp.alt_msl, speed_dem, dt)
         surfaces = self.attitude.step(
@@ -302,10 +307,10 @@ class FlightController:
         return v * v / (G * math.tan(self.config.roll_limit * 0.8))
 
     def _lateral(
-        self, sp: Setpoint, pos: tuple[float, float], vel: tuple[float, float], airspeed: float
+        self, sp: Setpoint, pos: tuple[float, float], vel: tuple[float, float], dt: float
     ) -> LateralDemand:
         if sp.kind == Kind.CIRCLE:
             # A circle tighter than the bank limit allows is flown at the tightest it can.
             radius = max(sp.radius, self._turn_radius())
             return self.l1.circle(pos, vel, sp.b, radius, sp.clockwise)
-        return self.l1.line(pos, vel, sp.a, sp.b)
+        return self.l1.line(pos, vel, sp.a, sp.b, dt)

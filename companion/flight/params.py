@@ -37,6 +37,7 @@ CONTROL_PARAMS = (
     _p("PTCH_LIM_MIN_DEG", -15.0, -45.0, 0.0, "deg", "largest nose-down pitch"),
     _p("NAVL1_PERIOD", 17.0, 5.0, 60.0, "s", "L1 guidance period: larger is gentler"),
     _p("NAVL1_DAMPING", 0.75, 0.5, 1.0, "", "L1 guidance damping"),
+    _p("NAVL1_XTRACK_I", 0.02, 0.0, 0.1, "1/s", "L1 cross-track integrator gain"),
     _p("TECS_TIME_CONST", 5.0, 2.0, 20.0, "s", "height error → climb rate time constant"),
     _p("TECS_SPD_TC", 3.0, 1.0, 20.0, "s", "speed error → acceleration time constant"),
     _p("TECS_CLMB_MAX", 3.0, 0.5, 15.0, "m/s", "climb rate at full throttle"),

@@ -16,6 +16,7 @@ if TYPE_CHECKING:
     from companion.plugins.link.mavlink_link import MavlinkLink
 
 BUS_ACK_TIMEOUT_S = 3.0
+FORCE_DISARM = 21196
 RELATIVE_FRAMES = frozenset(
     {
         d.MAV_FRAME_GLOBAL_RELATIVE_ALT,
@@ -30,6 +31,13 @@ def register_commands(link: MavlinkLink) -> None:
 
     def arm_disarm(args: CommandArgs) -> Outcome:
         command = CommandId.START if args.params[0] >= 0.5 else CommandId.STOP
+        control = link.snapshot.control
+        in_air = control is not None and not control.landed
+        if command == CommandId.STOP and in_air and round(args.params[1]) != FORCE_DISARM:
+            # As ArduPilot and PX4: stopping the flight plug-ins in the air drops the
+            # aircraft, so it takes the magic number to mean it.
+            link.statustext("Disarm refused: flying (param2 21196 forces it)")
+            return Outcome(d.MAV_RESULT_DENIED)
         return Outcome(defer_seq=link.publish_command(command), timeout_s=BUS_ACK_TIMEOUT_S)
 
     def reboot(args: CommandArgs) -> Outcome:
