@@ -98,6 +98,10 @@ class Commander:
             return self._set_home(p)
         return None
 
+    def failsafe(self, mode: FlightMode) -> Decision:
+        """A failsafe's mode change (Return, or Loiter where the aircraft is)."""
+        return self._enter(mode)
+
     def _enter(self, mode: FlightMode, point: tuple[float, ...] | None = None) -> Decision:
         if mode == FlightMode.MISSION and self.mission_count() == 0:
             return Decision(CommandResult.DENIED, "Mission: no mission stored")

@@ -412,6 +412,28 @@ class ParamChange(Message):
     ]
 
 
+class LinkStatus(Message):
+    """What the link hears from ground stations. Producer: link. Consumer: vehicle.commander."""
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        # Wall-clock seconds since the last ground-station heartbeat (NaN: none heard yet).
+        # Wall time, not vehicle time: in a lockstep simulation a person's ground station
+        # still beats once a real second.
+        ("gcs_silence_s", ctypes.c_double),
+    ]
+
+
+class StatusText(Message):
+    """A line for the ground station's message list (STATUSTEXT). Producers: any plug-in."""
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("severity", ctypes.c_uint8),  # MAV_SEVERITY
+        ("text", ctypes.c_char * 51),
+    ]
+
+
 class SimTruth(Message):
     """The simulator's true state, for scoring and the live status line.
 
@@ -477,6 +499,8 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("system/plugin_stats", PluginStats, "queue", 64, "per-plug-in counters", True),
     Channel("system/health", SystemHealth, "latest", doc="the health table"),
     Channel("params/changes", ParamChange, "queue", 32, "parameters set from the ground"),
+    Channel("link/status", LinkStatus, "latest", doc="ground-station heartbeats heard"),
+    Channel("vehicle/statustext", StatusText, "queue", 16, "messages for the operator", True),
 )
 
 

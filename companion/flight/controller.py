@@ -17,7 +17,7 @@ from companion.control_laws.wind import WindEstimator
 from companion.flight.params import FlightConfig
 from companion.flight.takeoff import Phase, RunwayTakeoff
 from companion.geodesy import LocalFrame
-from companion.messages import FlightMode, NavState, VehicleStatus
+from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 from companion.mission.executor import Kind, MissionExecutor, Setpoint
 from companion.mission.items import MissionItem
 
@@ -62,6 +62,7 @@ class FlightController:
         self._last_t: float | None = None
         self._mode_key: tuple[int, int] | None = None
         self._mode_setpoint: Setpoint | None = None
+        self._hold_course: Setpoint | None = None
         self.set_config(config)
 
     def set_config(self, config: FlightConfig) -> None:
@@ -123,7 +124,7 @@ class FlightController:
         if mode == FlightMode.MANUAL:
             out.throttle = self.config["TRIM_THROTTLE"] if not self.landed else 0.0
             return out
-        setpoint = self._setpoint(mode, status, pos, nav, t_s, out)
+        setpoint = self._dead_reckoning(self._setpoint(mode, status, pos, nav, t_s, out), pos, nav)
         if setpoint is None:
             self.attitude.reset()
             return out  # on the ground with nothing that flies from there: idle
@@ -131,6 +132,25 @@ class FlightController:
             return self._fly_takeoff(setpoint, pos, nav, airspeed, dt, out)
         self.takeoff = None
         return self._fly(setpoint, pos, vel, nav, airspeed, dt, out)
+
+    def _dead_reckoning(
+        self, setpoint: Setpoint | None, pos: tuple[float, float], nav: NavState
+    ) -> Setpoint | None:
+        """Without GPS, hold the course and height the aircraft had when it was lost.
+
+        Dead-reckoned positions drift, so following waypoints with them would steer by a
+        growing error; a straight course at a known height is the safe thing until GPS
+        returns (then the commander has the aircraft loiter).
+        """
+        if not nav.flags & NavFlags.DEAD_RECKONING or self.landed:
+            self._hold_course = None
+            return setpoint
+        if self._hold_course is None:
+            course = math.atan2(nav.ve_m_s, nav.vn_m_s)
+            ahead = (pos[0] + 1e5 * math.cos(course), pos[1] + 1e5 * math.sin(course))
+            alt = setpoint.alt_msl if setpoint is not None else nav.alt_msl_m
+            self._hold_course = Setpoint(Kind.LINE, pos, ahead, alt)
+        return self._hold_course
 
     def _update_landed(self, nav: NavState, airspeed: float) -> None:
         agl = nav.alt_msl_m - self.home_alt

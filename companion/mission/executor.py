@@ -22,7 +22,7 @@ from mavlink_dialect import companion as d
 RELATIVE_FRAMES = (d.MAV_FRAME_GLOBAL_RELATIVE_ALT, d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT)
 ON_CIRCLE = 0.25  # within this fraction of the radius the aircraft counts as circling
 TAKEOFF_MARGIN_M = 5.0
-MAX_JUMPS_PER_STEP = 32  # a loop of DO_JUMPs with no NAV item in between must not hang
+MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
 
 
 class Kind(enum.IntEnum):
@@ -116,9 +116,16 @@ class MissionExecutor:
         the next leg ends on that leg instead of overshooting it.
         """
         self._turn_radius = turn_radius
+        seen: set[tuple[int, tuple[tuple[int, int], ...]]] = set()
         for _ in range(MAX_JUMPS_PER_STEP):
             if self.current >= len(self.items):
                 return self._end(pos)
+            # Back at an item with every finite jump counter unchanged: an endless loop of
+            # DO items that never flies anywhere. End the mission rather than spin.
+            state = (self.current, tuple(sorted(self._jumps_done.items())))
+            if state in seen:
+                return self._end(pos)
+            seen.add(state)
             item = self.items[self.current]
             setpoint = self._item(item, pos, alt_msl, t_s)
             if setpoint is not None:
@@ -136,7 +143,12 @@ class MissionExecutor:
         if self._hold is None:
             self.finished = True
             self._hold = Setpoint(
-                Kind.CIRCLE, self._prev, self._prev, self._prev_alt, self.config.loiter_radius
+                Kind.CIRCLE,
+                self._prev,
+                self._prev,
+                self._prev_alt,
+                self.config.loiter_radius,
+                speed=self.speed,
             )
         return self._hold
 
@@ -163,7 +175,8 @@ class MissionExecutor:
         repeats = round(item.param2)
         done = self._jumps_done.get(item.seq, 0)
         if repeats < 0 or done < repeats:
-            self._jumps_done[item.seq] = done + 1
+            if repeats >= 0:  # an endless jump keeps no count (see the loop check in step)
+                self._jumps_done[item.seq] = done + 1
             self.current = max(0, min(round(item.param1), len(self.items)))
         else:
             self.current += 1

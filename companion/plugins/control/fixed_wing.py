@@ -25,7 +25,8 @@ from companion.messages import (
     VehicleStatus,
 )
 from companion.mission.store import FILES, MissionStore
-from companion.params import ParamDecl, ParamStore
+from companion.params import ParamDecl
+from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext, Setting
 
 WAIT_S = 0.5
@@ -59,17 +60,16 @@ class FixedWingPlugin(Plugin):
         super().init(ctx)
         decls = self.param_decls(ctx.settings)
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
-        # The link owns the stored values; read them once, then follow params/changes.
-        stored = ParamStore(decls, state_dir / "params.json")
-        self.values = {d.name: stored.get(d.name) for d in decls}
+        self.params = LiveParams(ctx.bus, decls, state_dir)
         self.missions = MissionStore(state_dir / "missions")
         self.mission_file = state_dir / "missions" / FILES[0]
         self.mission_stamp = self._mission_stamp()
-        self.controller = FlightController(flight_config(self.values), self.missions.items[0])
+        self.controller = FlightController(
+            flight_config(self.params.values), self.missions.items[0]
+        )
         bus = ctx.bus
         self.nav = bus.latest_reader("nav/state")
         self.status_in = bus.latest_reader("vehicle/status")
-        self.changes = bus.queue_reader("params/changes")
         self.surfaces = bus.writer("control/actuators")
         self.status_out = bus.writer("control/status")
         self.reached_count = 0
@@ -85,14 +85,8 @@ class FixedWingPlugin(Plugin):
             return 0.0
 
     def _follow_changes(self, now_us: int) -> None:
-        changed = False
-        for change in self.changes.drain():
-            name = change.name.decode(errors="replace")
-            if name in self.values and math.isfinite(change.value):
-                self.values[name] = change.value
-                changed = True
-        if changed:
-            self.controller.set_config(flight_config(self.values))
+        if self.params.poll():
+            self.controller.set_config(flight_config(self.params.values))
         if now_us >= self.next_mission_check_us:
             self.next_mission_check_us = now_us + MISSION_CHECK_US
             stamp = self._mission_stamp()

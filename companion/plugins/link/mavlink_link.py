@@ -25,6 +25,7 @@ from companion.mavlink.endpoints import (
     open_endpoint,
     split_options,
 )
+from companion.mavlink.gcs_watch import GcsWatch
 from companion.mavlink.identity import IdentityService
 from companion.mavlink.link_router import LinkRouter
 from companion.mavlink.mission_service import MissionService
@@ -34,14 +35,15 @@ from companion.mavlink.service import Outgoing
 from companion.mavlink.signing import key_from
 from companion.mavlink.telemetry import Snapshot
 from companion.mavlink.timesync import TimesyncService
-from companion.messages import ControlStatus, NavFlags, ParamChange, VehicleCommand
+from companion.messages import ControlStatus, LinkStatus, NavFlags, ParamChange, VehicleCommand
 from companion.mission.store import MissionStore
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 from companion.plugins.link.commands import register_commands
 
 MAX_WAIT_S = 0.02
-CONTROL_STALE_US = 2_000_000  # the flight controller stopped (disarmed) this long ago
+CONTROL_STALE_US = 2_000_000
+LINK_STATUS_PERIOD_S = 0.2  # the flight controller stopped (disarmed) this long ago
 COMMANDER = "vehicle.commander"
 STREAM_PARAMS = {
     "SR_ATTITUDE": (d.MAVLINK_MSG_ID_ATTITUDE,),
@@ -89,8 +91,9 @@ class MavlinkLink(Plugin):
         "system/health",
         "link/command_acks",
         "control/status",
+        "vehicle/statustext",
     )
-    outputs = ("link/commands", "params/changes")
+    outputs = ("link/commands", "params/changes", "link/status")
 
     @classmethod
     def validate(cls, settings: Mapping[str, Any]) -> list[str]:
@@ -134,12 +137,17 @@ class MavlinkLink(Plugin):
         self.acks = bus.queue_reader("link/command_acks")
         self.to_vehicle = bus.writer("link/commands")
         self.param_changes = bus.writer("params/changes")
+        self.link_status = bus.writer("link/status")
+        self.texts = bus.queue_reader("vehicle/statustext")
+        self.next_link_status_s = 0.0
         self.reached_count = 0
         timesync = TimesyncService(self.mav, lambda: ctx.clock.now_us() * 1000)
         services = [self.identity, self.commands, timesync]
         secret = ctx.settings["signing_key"]
         key = key_from(secret) if secret else None
         self.router = LinkRouter(self.mav, self.endpoints, services, key)
+        self.gcs = GcsWatch()
+        self.router.add_service(self.gcs)
         self._serve_params(ctx, sysid)
         store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
         self.missions = MissionService(self.mav, store, sysid, ctx.settings["compid"])
@@ -255,6 +263,13 @@ class MavlinkLink(Plugin):
         self.router.send(out, now_s)
         for reason in reasons:  # after the ack: a ground station waits for that first
             self.statustext(reason)
+        for text in self.texts.drain():  # failsafes and other plug-ins' announcements
+            self.statustext(text.text.decode(errors="replace"), text.severity)
+        if now_s >= self.next_link_status_s:
+            self.next_link_status_s = now_s + LINK_STATUS_PERIOD_S
+            status = LinkStatus(t_us=self.ctx.clock.now_us())
+            status.gcs_silence_s = self.gcs.silence_s(now_s)
+            self.link_status.publish(status)
         self.router.stream_telemetry(self.snapshot, now_s)
         counts = self.router.counters
         self.ctx.health.frames_ok, self.ctx.health.frames_bad = counts.ok, counts.bad

@@ -1,55 +1,87 @@
-"""``vehicle.commander``: the flight mode, home and guided target (group ``core``).
+"""``vehicle.commander``: the flight mode, home, guided target and failsafes (group ``core``).
 
 Takes the mode commands off ``link/commands`` (SET_MODE, MISSION_START, RTL, REPOSITION,
 LOITER, SET_HOME), answers each on ``link/command_acks`` (with the reason when refused),
-and publishes ``vehicle/status`` on every change and four times a second.
+applies the failsafes (ground-station link, GPS, geofence; ``companion.failsafe``) and
+publishes ``vehicle/status`` on every change and four times a second, and what the
+operator should read on ``vehicle/statustext``.
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+from typing import Any
 
 from companion.commander import MODE_COMMANDS, Commander
-from companion.messages import NAME_LEN, CommandAck
-from companion.mission.store import MissionStore
+from companion.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
+from companion.messages import NAME_LEN, CommandAck, FlightMode, NavFlags, StatusText
+from companion.mission.fence import Fence
+from companion.mission.store import FILES, MissionStore
+from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
 
 WAIT_S = 0.5
 STATUS_PERIOD_US = 250_000  # 4 Hz: the link and the controller follow it
+FENCE_CHECK_US = 1_000_000
+CONTROL_STALE_US = 2_000_000
 
 
 class CommanderPlugin(Plugin):
     """Mode state for the link and the flight controller."""
 
+    params = FAILSAFE_PARAMS
     inputs = ("link/commands",)
-    optional_inputs = ("nav/state", "system/health")
-    outputs = ("vehicle/status", "link/command_acks")
+    optional_inputs = ("nav/state", "system/health", "control/status", "link/status")
+    outputs = ("vehicle/status", "link/command_acks", "vehicle/statustext")
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
-        store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
+        state_dir = Path(ctx.vehicle.get("state_dir", "."))
+        self.store = MissionStore(state_dir / "missions")
+        self.fence_file = state_dir / "missions" / FILES[1]
+        self.fence_stamp: int | None = None
+        self.fence = Fence.from_items([])
         # The link writes missions in its own process: read the stored file each time.
-        self.commander = Commander(lambda: len(store.reload().items[0]))
-        self.commands = ctx.bus.queue_reader("link/commands")
-        self.nav = ctx.bus.latest_reader("nav/state")
-        self.health = ctx.bus.latest_reader("system/health")
-        self.waiter = ctx.bus.waiter([self.commands, self.nav])
-        self.acks = ctx.bus.writer("link/command_acks")
-        self.out = ctx.bus.writer("vehicle/status")
+        self.commander = Commander(lambda: len(self.store.reload().items[0]))
+        self.live = LiveParams(ctx.bus, self.params, state_dir)
+        self.failsafes = Failsafes(self.live.values)
+        bus = ctx.bus
+        self.commands = bus.queue_reader("link/commands")
+        self.nav = bus.latest_reader("nav/state")
+        self.health = bus.latest_reader("system/health")
+        self.control = bus.latest_reader("control/status")
+        self.link = bus.latest_reader("link/status")
+        self.waiter = bus.waiter([self.commands, self.nav])
+        self.acks = bus.writer("link/command_acks")
+        self.out = bus.writer("vehicle/status")
+        self.texts = bus.writer("vehicle/statustext")
         self.next_status_us = 0
+        self.next_fence_us = 0
 
     def step(self) -> None:
         self.waiter.wait(WAIT_S)
         c = self.commander
-        if (nav := self.nav.get()) is not None:
+        now = self.ctx.clock.now_us()
+        nav = self.nav.get()
+        if nav is not None:
             c.on_nav(nav)
         if (health := self.health.get()) is not None:
             c.on_armed(bool(health.flight_running))
+        self.live.poll()
+        changed = self._commands()
+        changed |= self._failsafes(now, nav)
+        if changed or now >= self.next_status_us:
+            self.out.publish(c.status(now))
+            self.next_status_us = now + STATUS_PERIOD_US
+            self.ctx.health.ok()
+
+    def _commands(self) -> bool:
         changed = False
         for cmd in self.commands.drain():
             if cmd.command not in MODE_COMMANDS:
                 continue  # START, STOP, restarts: the execution control's
-            decision = c.handle(cmd)
+            decision = self.commander.handle(cmd)
             if decision is None:
                 continue
             ack = CommandAck(t_us=self.ctx.clock.now_us(), seq=cmd.seq, command=cmd.command)
@@ -60,11 +92,48 @@ class CommanderPlugin(Plugin):
             if decision.reason:
                 self.ctx.log.info("refused: %s", decision.reason)
             changed = True
-        now = self.ctx.clock.now_us()
-        if changed or now >= self.next_status_us:
-            self.out.publish(c.status(now))
-            self.next_status_us = now + STATUS_PERIOD_US
-            self.ctx.health.ok()
+        return changed
+
+    def _failsafes(self, now: int, nav: Any) -> bool:
+        c = self.commander
+        control = self.control.get()
+        flying = (
+            c.armed
+            and control is not None
+            and now - control.t_us < CONTROL_STALE_US
+            and not control.landed
+        )
+        link = self.link.get()
+        valid = nav is not None and nav.flags & NavFlags.POSITION_VALID
+        situation = Situation(
+            now_us=now,
+            mode=c.mode,
+            flying=bool(flying),
+            gcs_silence_s=link.gcs_silence_s if link is not None else math.nan,
+            nav_flags=nav.flags if nav is not None else 0,
+            fence_breach=self._fence(now).breach(nav.lat_deg, nav.lon_deg) if valid else None,
+        )
+        changed = False
+        for action in self.failsafes.step(situation):
+            self.ctx.log.warning("%s", action.text)
+            msg = StatusText(t_us=now, severity=action.severity)
+            msg.text = action.text.encode()[:50]
+            self.texts.publish(msg)
+            if action.mode is not None and action.mode != c.mode:
+                changed |= c.failsafe(FlightMode(action.mode)).result == 0
+        return changed
+
+    def _fence(self, now: int) -> Fence:
+        if now >= self.next_fence_us or now < self.next_fence_us - FENCE_CHECK_US:
+            self.next_fence_us = now + FENCE_CHECK_US
+            try:
+                stamp = self.fence_file.stat().st_mtime_ns
+            except FileNotFoundError:
+                stamp = 0
+            if stamp != self.fence_stamp:
+                self.fence_stamp = stamp
+                self.fence = Fence.from_items(self.store.reload().items[1])
+        return self.fence
 
     def close(self) -> None:
         self.waiter.close()

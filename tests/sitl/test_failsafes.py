@@ -1,0 +1,154 @@
+"""Failsafes in lockstep flights: ground-station link lost, GPS lost, fence breached.
+
+A pymavlink ground station (QGroundControl's identity) arms and starts the square plan,
+then takes away what the failsafe watches, and checks the mode in the heartbeat and the
+STATUSTEXT the operator reads.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+
+import pytest
+
+os.environ.setdefault("MAVLINK20", "1")
+from pymavlink import mavutil
+
+from companion.messages import FlightMode
+from companion.modes import BY_MODE
+from mavlink_dialect import companion as d
+from tests.protocol.mav_client import free_udp_port
+from tests.sim.sim_run import finish, start_sim
+from tests.support.vehicle import REPO
+
+PLAN = str(REPO / "qgc_plans" / "square.plan")
+
+
+class Station:
+    """A ground station that beats only while asked to."""
+
+    def __init__(self, port: int) -> None:
+        self.conn = mavutil.mavlink_connection(f"udpin:127.0.0.1:{port}", source_system=255)
+        self.beating = True
+        self.texts: list[str] = []
+        self.mode = -1
+        self._next_beat = 0.0
+
+    def pump(self, seconds: float) -> None:
+        """Receive (and beat once a second if beating) for ``seconds`` of wall time."""
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            if self.beating and time.monotonic() >= self._next_beat:
+                self.conn.mav.heartbeat_send(d.MAV_TYPE_GCS, d.MAV_AUTOPILOT_INVALID, 0, 0, 0)
+                self._next_beat = time.monotonic() + 1.0
+            msg = self.conn.recv_match(type=["HEARTBEAT", "STATUSTEXT"], blocking=True, timeout=0.1)
+            if msg is None or msg.get_srcSystem() != 1:
+                continue
+            if msg.get_type() == "STATUSTEXT":
+                self.texts.append(msg.text)
+            else:
+                self.mode = msg.custom_mode
+
+    def until(self, predicate, seconds: float, what: str) -> None:
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            self.pump(0.2)
+            if predicate():
+                return
+        raise AssertionError(f"not {what} within {seconds} s; messages: {self.texts}")
+
+    def command(self, command: int, *params: float) -> None:
+        values = [*params, 0, 0, 0, 0, 0, 0, 0][:7]
+        self.conn.mav.command_long_send(1, 1, command, 0, *values)
+
+    def in_mode(self, mode: FlightMode) -> bool:
+        return self.mode == BY_MODE[mode].px4
+
+    def said(self, words: str) -> bool:
+        return any(words in t for t in self.texts)
+
+    def fly_mission(self) -> None:
+        self.until(lambda: self.mode >= 0, 60, "the vehicle heard")
+        home = self.conn.recv_match(type="HOME_POSITION", blocking=True, timeout=60)
+        assert home is not None, "no home position"
+        self.command(d.MAV_CMD_COMPONENT_ARM_DISARM, 1)
+        self.pump(1.0)
+        self.command(d.MAV_CMD_MISSION_START, 0, 0)
+        self.until(lambda: self.in_mode(FlightMode.MISSION), 20, "in Mission")
+
+
+def _sim(tmp_path, *args: str):
+    port = free_udp_port()
+    station = Station(port)
+    proc, namespace, _truth = start_sim(
+        tmp_path, f"udpout://127.0.0.1:{port}", "--plan", PLAN, *args
+    )
+    return station, proc, namespace
+
+
+@pytest.mark.timeout(240)
+def test_ground_station_lost_returns_home_then_resumes_the_mission(tmp_path):
+    station, proc, namespace = _sim(tmp_path, "--duration", "1500")
+    try:
+        station.fly_mission()
+        station.pump(3.0)  # airborne (about 75 s of flight at lockstep speed)
+        station.beating = False
+        station.until(lambda: station.in_mode(FlightMode.RTL), 30, "returning")
+        assert station.said("ground station lost")
+        station.beating = True
+        station.until(lambda: station.in_mode(FlightMode.MISSION), 30, "back in the mission")
+        assert station.said("resuming the mission")
+    finally:
+        proc.terminate()
+        finish(proc, namespace, 60)
+        station.conn.close()
+
+
+@pytest.mark.timeout(240)
+def test_gps_lost_holds_heading_and_loiters_when_it_returns(tmp_path):
+    # The outage starts once the aircraft is well on its way (take-off takes about 70 s).
+    station, proc, namespace = _sim(tmp_path, "--duration", "1500", "--gps-outage", "150:20")
+    try:
+        station.fly_mission()
+        station.until(lambda: station.said("GPS lost"), 60, "told of the GPS loss")
+        assert station.in_mode(FlightMode.MISSION)  # the course is held, the mode kept
+        station.until(lambda: station.in_mode(FlightMode.LOITER), 60, "loitering")
+        assert station.said("GPS back")
+    finally:
+        proc.terminate()
+        finish(proc, namespace, 60)
+        station.conn.close()
+
+
+@pytest.mark.timeout(240)
+def test_fence_breach_returns_home(tmp_path):
+    station, proc, namespace = _sim(tmp_path, "--duration", "1500")
+    try:
+        # A 1 km circle round home: the first leg (to 1.8 km east) leaves it.
+        lat, lon = -37.9105, 145.1340
+        station.fly_mission()
+        station.command(d.MAV_CMD_DO_SET_MODE, 1, 4, 3)  # loiter while the fence goes up
+        _upload_circle_fence(station, lat, lon, 1000.0)
+        station.command(d.MAV_CMD_MISSION_START, 0, 0)
+        station.until(lambda: station.said("Fence breached"), 90, "told of the breach")
+        station.until(lambda: station.in_mode(FlightMode.RTL), 10, "returning")
+    finally:
+        proc.terminate()
+        finish(proc, namespace, 60)
+        station.conn.close()
+
+
+def _upload_circle_fence(station: Station, lat: float, lon: float, radius: float) -> None:
+    mav, fence = station.conn.mav, d.MAV_MISSION_TYPE_FENCE
+    mav.mission_count_send(1, 1, 1, fence)
+    req = station.conn.recv_match(
+        type=["MISSION_REQUEST_INT", "MISSION_REQUEST"], blocking=True, timeout=10
+    )
+    assert req is not None
+    mav.mission_item_int_send(
+        1, 1, 0, d.MAV_FRAME_GLOBAL, d.MAV_CMD_NAV_FENCE_CIRCLE_INCLUSION, 0, 1,
+        radius, 0, 0, 0, round(lat * 1e7), round(lon * 1e7), 0, fence,
+    )  # fmt: skip
+    ack = station.conn.recv_match(type="MISSION_ACK", blocking=True, timeout=10)
+    assert ack is not None and ack.type == d.MAV_MISSION_ACCEPTED

@@ -1,0 +1,464 @@
+"""The mission executor: which item is current, what setpoint it gives, and when items end.
+
+No dynamics: the aircraft is teleported along the path (or round a circle) and the
+executor is stepped at each position, so what is tested is only the executor's logic —
+take-off, waypoint acceptance (radius, the square line, the turn lead), DO_CHANGE_SPEED,
+DO_JUMP, the loiters, RTL and what happens after the last item.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from companion.geodesy import LocalFrame
+from companion.mission.executor import (
+    ExecutorConfig,
+    Kind,
+    MissionExecutor,
+    Setpoint,
+)
+from companion.mission.items import MissionItem, check_mission
+from mavlink_dialect import companion as d
+
+HOME = LocalFrame(-37.9105, 145.1340)
+HOME_ALT = 80.0
+REL = d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+
+
+def item(
+    seq: int,
+    command: int,
+    ne: tuple[float, float] | None = None,
+    z: float = 0.0,
+    p1: float = 0.0,
+    p2: float = 0.0,
+    p3: float = 0.0,
+) -> MissionItem:
+    """A MISSION_ITEM_INT at ``ne`` metres from home (None: no position)."""
+    x = y = 0
+    if ne is not None:
+        lat, lon = HOME.latlon(*ne)
+        x, y = round(lat * 1e7), round(lon * 1e7)
+    return MissionItem(seq, REL, command, 0, 1, p1, p2, p3, 0.0, x, y, z)
+
+
+def wp(seq: int, ne: tuple[float, float], z: float = 100.0, radius: float = 0.0) -> MissionItem:
+    return item(seq, d.MAV_CMD_NAV_WAYPOINT, ne, z, p2=radius)
+
+
+def jump(seq: int, target: int, repeats: int) -> MissionItem:
+    return item(seq, d.MAV_CMD_DO_JUMP, p1=target, p2=repeats)
+
+
+def speed(seq: int, m_s: float) -> MissionItem:
+    return item(seq, d.MAV_CMD_DO_CHANGE_SPEED, p1=0, p2=m_s, p3=-1)
+
+
+def executor(
+    items: list[MissionItem],
+    pos: tuple[float, float] = (0.0, 0.0),
+    alt: float = HOME_ALT + 100.0,
+    config: ExecutorConfig | None = None,
+) -> MissionExecutor:
+    assert check_mission(items) == d.MAV_MISSION_ACCEPTED  # only plans the vehicle takes
+    ex = MissionExecutor(items, HOME, HOME_ALT, config or ExecutorConfig())
+    ex.start(0, pos, alt)
+    return ex
+
+
+def dist(a: tuple[float, float], b: tuple[float, float]) -> float:
+    return math.hypot(b[0] - a[0], b[1] - a[1])
+
+
+def towards(pos: tuple[float, float], to: tuple[float, float], step: float) -> tuple[float, float]:
+    gap = dist(pos, to)
+    if gap <= step:
+        return to
+    return pos[0] + (to[0] - pos[0]) * step / gap, pos[1] + (to[1] - pos[1]) * step / gap
+
+
+def on_circle(centre: tuple[float, float], radius: float, deg: float) -> tuple[float, float]:
+    a = math.radians(deg)
+    return centre[0] + radius * math.cos(a), centre[1] + radius * math.sin(a)
+
+
+def fly_lines(
+    ex: MissionExecutor,
+    pos: tuple[float, float] = (0.0, 0.0),
+    step_m: float = 5.0,
+    turn_radius: float = 0.0,
+    max_steps: int = 20_000,
+) -> tuple[list[int], list[Setpoint], tuple[float, float]]:
+    """Teleport towards each LINE's end until the executor finishes or gives a circle.
+
+    Returns the items reached (in order, from every drain), the setpoints and where the
+    aircraft ended.
+    """
+    reached: list[int] = []
+    setpoints: list[Setpoint] = []
+    for t in range(max_steps):
+        sp = ex.step(pos, sp_alt(setpoints), float(t), turn_radius)
+        setpoints.append(sp)
+        reached += ex.drain_reached()
+        if ex.finished or sp.kind != Kind.LINE:
+            return reached, setpoints, pos
+        pos = towards(pos, sp.b, step_m)
+    raise AssertionError("the mission never finished")
+
+
+def sp_alt(setpoints: list[Setpoint]) -> float:
+    """The altitude the aircraft is at: the last one it was asked for."""
+    return setpoints[-1].alt_msl if setpoints else HOME_ALT + 100.0
+
+
+# --- take-off ------------------------------------------------------------------------------
+
+
+def test_takeoff_climbs_until_within_5_m_then_flies_on():
+    items = [item(0, d.MAV_CMD_NAV_TAKEOFF, None, z=50.0), wp(1, (1_000.0, 0.0))]
+    ex = executor(items, alt=HOME_ALT)
+    for k, alt in enumerate([80.0, 100.0, 120.0, 124.9]):
+        pos = (k * 20.0, 0.0)
+        sp = ex.step(pos, alt, float(k))
+        assert sp.kind == Kind.TAKEOFF
+        assert sp.alt_msl == pytest.approx(HOME_ALT + 50.0)  # relative to home
+        assert ex.current == 0 and not ex.finished
+        assert ex.drain_reached() == []
+    pos = (100.0, 0.0)
+    sp = ex.step(pos, 125.1, 5.0)
+    assert ex.drain_reached() == [0]
+    assert sp.kind == Kind.LINE
+    assert sp.a == pos  # the leg starts where the climb ended
+    assert sp.b == pytest.approx((1_000.0, 0.0), abs=0.05)
+    assert sp.alt_msl == pytest.approx(HOME_ALT + 100.0)
+
+
+# --- waypoints -----------------------------------------------------------------------------
+
+
+def test_waypoints_are_reached_in_order_and_reported_once():
+    points = [(0.0, 800.0), (800.0, 800.0), (800.0, 0.0), (400.0, -300.0)]
+    items = [wp(i, p, z=100.0 + 10 * i) for i, p in enumerate(points)]
+    ex = executor(items)
+    reached, setpoints, _ = fly_lines(ex)
+    assert reached == [0, 1, 2, 3]
+    assert ex.finished
+    # Each leg went to its own waypoint, from the previous one, at that waypoint's height.
+    legs = [sp for sp in setpoints if sp.kind == Kind.LINE]
+    targets: list[tuple[float, float]] = []
+    for sp in legs:
+        if not targets or sp.b != targets[-1]:
+            targets.append(sp.b)
+    assert [pytest.approx(p, abs=0.05) for p in points] == targets
+    starts = [(0.0, 0.0), *points[:-1]]  # the first leg from where the mission started
+    for sp in legs:
+        k = targets.index(sp.b)
+        assert sp.alt_msl == pytest.approx(HOME_ALT + 100.0 + 10 * k)
+        assert sp.a == pytest.approx(starts[k], abs=0.05)
+    assert ex.drain_reached() == []  # already drained
+
+
+def test_waypoint_acceptance_radius_from_the_item_or_the_default():
+    ex = executor([wp(0, (1_000.0, 0.0), radius=100.0), wp(1, (1_000.0, 1_000.0))])
+    assert ex.step((895.0, 0.0), 180.0, 0.0).b == pytest.approx((1_000.0, 0.0), abs=0.05)
+    ex.step((905.0, 0.0), 180.0, 1.0)
+    assert ex.drain_reached() == [0]
+    # The next one takes the configured default (30 m).
+    ex.step((1_000.0, 965.0), 180.0, 2.0)
+    assert ex.drain_reached() == []
+    ex.step((1_000.0, 975.0), 180.0, 3.0)
+    assert ex.drain_reached() == [1]
+
+
+def test_passing_the_square_line_reaches_a_waypoint_far_off_to_the_side():
+    ex = executor([wp(0, (1_000.0, 0.0)), wp(1, (1_000.0, 1_000.0))])
+    # 400 m to the side, just short of the line square to the leg: not yet.
+    sp = ex.step((999.0, 400.0), 180.0, 0.0)
+    assert ex.drain_reached() == [] and sp.b == pytest.approx((1_000.0, 0.0), abs=0.05)
+    # Just past it: reached, though never inside its radius.
+    sp = ex.step((1_001.0, 400.0), 180.0, 1.0)
+    assert ex.drain_reached() == [0]
+    assert sp.kind == Kind.LINE
+    assert sp.a == pytest.approx((1_000.0, 0.0), abs=0.05)  # the next leg starts at it
+    assert sp.b == pytest.approx((1_000.0, 1_000.0), abs=0.05)
+
+
+def test_square_line_follows_the_leg_direction():
+    # A leg flown south-west: "past" means further along the leg, not just further south.
+    ex = executor([wp(0, (-1_000.0, -1_000.0)), wp(1, (-2_000.0, 0.0))])
+    ex.step((-800.0, -1_100.0), 180.0, 0.0)  # beside it, still short
+    ex.step((-1_150.0, -800.0), 180.0, 0.5)  # south of it, but still short along the leg
+    assert ex.drain_reached() == []
+    ex.step((-1_150.0, -1_000.0), 180.0, 1.0)  # past it, 150 m away
+    assert ex.drain_reached() == [0]
+
+
+def switch_distance(turn_radius: float, second: tuple[float, float] | None) -> float:
+    """Fly north along the first leg in 1 m steps; how far from the corner it was reached."""
+    corner = (1_000.0, 0.0)
+    items = [wp(0, corner)] + ([wp(1, second)] if second else [])
+    ex = executor(items)
+    for k in range(1_001):
+        pos = (float(k), 0.0)
+        ex.step(pos, 180.0, float(k), turn_radius)
+        if ex.drain_reached():
+            return dist(pos, corner)
+    raise AssertionError("the corner was never reached")
+
+
+def test_turn_lead_switches_a_90_degree_corner_early():
+    plain = switch_distance(0.0, (1_000.0, 1_000.0))
+    lead = switch_distance(150.0, (1_000.0, 1_000.0))
+    assert plain == pytest.approx(30.0, abs=1.0)  # the acceptance radius
+    assert lead == pytest.approx(150.0, abs=1.0)  # R·tan(90°/2)
+
+
+def test_turn_lead_is_smaller_for_a_gentle_turn_and_capped_by_the_legs():
+    gentle = switch_distance(150.0, (2_000.0, 600.0))  # about 31° of turn
+    turn = math.atan2(600.0, 1_000.0)
+    assert gentle == pytest.approx(max(30.0, 150.0 * math.tan(turn / 2)), abs=1.0)
+    # A huge turn radius cannot start the turn before half the leg.
+    assert switch_distance(5_000.0, (1_000.0, 1_000.0)) == pytest.approx(500.0, abs=1.0)
+
+
+def test_no_turn_lead_on_the_last_waypoint():
+    assert switch_distance(150.0, None) == pytest.approx(30.0, abs=1.0)
+
+
+# --- DO commands ---------------------------------------------------------------------------
+
+
+def test_do_change_speed_sets_the_setpoint_speed():
+    items = [
+        wp(0, (500.0, 0.0)),
+        speed(1, 22.0),
+        wp(2, (1_000.0, 0.0)),
+        speed(3, -1.0),  # back to cruise
+        wp(4, (1_500.0, 0.0)),
+    ]
+    ex = executor(items)
+    reached, setpoints, _ = fly_lines(ex)
+    assert reached == [0, 2, 4]  # DO items are not reported as reached
+    by_target: dict[int, set[float | str]] = {0: set(), 2: set(), 4: set()}
+    for sp in setpoints:
+        if sp.kind == Kind.LINE:
+            k = round(sp.b[0] / 500.0) * 2 - 2
+            by_target[k].add("nan" if math.isnan(sp.speed) else sp.speed)
+    assert by_target == {0: {"nan"}, 2: {22.0}, 4: {"nan"}}
+
+
+def test_changed_speed_carries_into_a_loiter():
+    items = [
+        speed(0, 19.0),
+        item(1, d.MAV_CMD_NAV_LOITER_UNLIM, (500.0, 0.0), z=100.0, p3=100.0),
+    ]
+    ex = executor(items)
+    sp = ex.step((0.0, 0.0), 180.0, 0.0)
+    assert sp.kind == Kind.CIRCLE and sp.speed == 19.0
+
+
+def test_do_jump_repeats_the_loop_twice_more_then_continues():
+    a, b, c = (500.0, 0.0), (500.0, 500.0), (0.0, 500.0)
+    items = [wp(0, a), wp(1, b), jump(2, 0, 2), wp(3, c)]
+    ex = executor(items)
+    reached, _, _ = fly_lines(ex)
+    assert reached == [0, 1, 0, 1, 0, 1, 3]
+    assert ex.finished
+
+
+def test_do_jump_forever_keeps_looping():
+    items = [wp(0, (500.0, 0.0)), wp(1, (500.0, 500.0)), jump(2, 0, -1), wp(3, (0.0, 500.0))]
+    ex = executor(items)
+    reached: list[int] = []
+    pos = (0.0, 0.0)
+    for t in range(3_000):  # long enough for several laps
+        sp = ex.step(pos, 180.0, float(t))
+        reached += ex.drain_reached()
+        pos = towards(pos, sp.b, 10.0)
+    assert not ex.finished
+    assert len(reached) > 10 and 3 not in reached
+    assert reached == [k % 2 for k in range(len(reached))]  # 0, 1, 0, 1, ...
+
+
+@pytest.mark.timeout(10)
+@pytest.mark.parametrize("turn_radius", [0.0, 150.0])
+def test_do_jump_loop_without_nav_items_does_not_hang(turn_radius: float):
+    items = [wp(0, (500.0, 0.0)), speed(1, 20.0), jump(2, 1, -1)]
+    ex = executor(items)
+    first = ex.step((0.0, 0.0), 180.0, 0.0, turn_radius)
+    assert first.kind == Kind.LINE
+    sp = ex.step((490.0, 0.0), 180.0, 1.0, turn_radius)  # reaches the waypoint, then spins
+    assert ex.drain_reached() == [0]
+    assert sp.kind == Kind.CIRCLE  # it stopped in a holding circle ...
+    assert sp.b == pytest.approx((500.0, 0.0), abs=0.05)  # ... where it was going
+    again = ex.step((480.0, 50.0), 180.0, 2.0, turn_radius)
+    assert again == sp
+
+
+@pytest.mark.timeout(10)
+def test_do_jumps_to_each_other_do_not_hang_at_the_start():
+    ex = executor([jump(0, 1, -1), jump(1, 0, -1)], pos=(30.0, 40.0))
+    sp = ex.step((30.0, 40.0), 150.0, 0.0, 150.0)
+    assert sp.kind == Kind.CIRCLE and sp.b == (30.0, 40.0)
+    assert ex.finished
+
+
+def test_a_long_finite_jump_loop_without_nav_items_is_consistent():
+    repeats = 40  # two items per lap, 80 DO items to run through in one step
+    items = [wp(0, (500.0, 0.0)), speed(1, 20.0), jump(2, 1, repeats), wp(3, (500.0, 800.0))]
+    ex = executor(items)
+    ex.step((0.0, 0.0), 180.0, 0.0)
+    sp = ex.step((490.0, 0.0), 180.0, 1.0)
+    assert ex.drain_reached() == [0]
+    # Either it runs the finite loop out and flies on to the next waypoint ...
+    if not ex.finished:
+        assert sp.kind == Kind.LINE and sp.b == pytest.approx((500.0, 800.0), abs=0.05)
+        reached, setpoints, _ = fly_lines(ex, pos=(490.0, 0.0))
+        assert reached == [3] and setpoints[-1].b == pytest.approx((500.0, 800.0), abs=0.05)
+        return
+    # ... or, having said the mission is finished, it stays finished on its hold circle.
+    for t in range(2, 10):
+        again = ex.step((490.0, 10.0), 180.0, float(t))
+        assert ex.finished and again == sp
+
+
+# --- loiters -------------------------------------------------------------------------------
+
+
+def test_loiter_time_counts_from_reaching_the_circle():
+    centre, radius = (1_000.0, 0.0), 100.0
+    items = [item(0, d.MAV_CMD_NAV_LOITER_TIME, centre, z=100.0, p1=30.0, p3=radius)]
+    ex = executor(items)
+    for t in range(0, 100, 5):  # a long way off: time does not count
+        sp = ex.step((0.0, 0.0), 180.0, float(t))
+        assert sp.kind == Kind.CIRCLE and not ex.finished
+    assert sp.b == pytest.approx(centre, abs=0.05) and sp.radius == radius and sp.clockwise
+    assert sp.alt_msl == pytest.approx(HOME_ALT + 100.0)
+    # On the circle from t = 100: done at t = 130, not before.
+    t = 100.0
+    while t < 129.9:
+        ex.step(on_circle(centre, radius, 6.0 * (t - 100.0)), 180.0, t)
+        assert ex.drain_reached() == [] and not ex.finished, t
+        t += 0.5
+    sp = ex.step(on_circle(centre, radius, 180.0), 180.0, 130.0)
+    assert ex.drain_reached() == [0]
+    assert ex.finished and sp.kind == Kind.CIRCLE  # the last item: circles its point
+    assert sp.b == pytest.approx(centre, abs=0.05)
+
+
+def test_loiter_time_starts_counting_within_a_quarter_radius_of_the_circle():
+    centre, radius = (1_000.0, 0.0), 100.0
+    items = [item(0, d.MAV_CMD_NAV_LOITER_TIME, centre, z=100.0, p1=10.0, p3=radius)]
+    ex = executor(items)
+    ex.step((870.0, 0.0), 180.0, 0.0)  # 130 m from the centre: not yet on the circle
+    ex.step((880.0, 0.0), 180.0, 5.0)  # 120 m: on it
+    ex.step((880.0, 0.0), 180.0, 14.9)
+    assert not ex.finished
+    ex.step((880.0, 0.0), 180.0, 15.0)
+    assert ex.finished and ex.drain_reached() == [0]
+
+
+@pytest.mark.parametrize("direction", [+1, -1])
+def test_loiter_turns_completes_after_720_degrees(direction: int):
+    centre, radius = (1_000.0, 0.0), 100.0
+    items = [
+        item(0, d.MAV_CMD_NAV_LOITER_TURNS, centre, z=100.0, p1=2.0, p3=radius),
+        wp(1, (2_000.0, 0.0)),
+    ]
+    ex = executor(items)
+    assert ex.step((0.0, 0.0), 180.0, 0.0).kind == Kind.CIRCLE
+    done_at = None
+    for k in range(800):  # one degree per step, from 180° round the circle
+        sp = ex.step(on_circle(centre, radius, 180.0 + direction * k), 180.0, 1.0 + k)
+        if ex.drain_reached() == [0]:
+            done_at = k
+            break
+        assert sp.kind == Kind.CIRCLE
+    assert done_at is not None
+    assert 700 <= done_at <= 722
+    assert sp.kind == Kind.LINE and sp.b == pytest.approx((2_000.0, 0.0), abs=0.05)
+    assert sp.a == pytest.approx(centre, abs=0.05)  # the next leg starts at its centre
+
+
+@pytest.mark.parametrize(
+    "command",
+    [d.MAV_CMD_NAV_LOITER_UNLIM, d.MAV_CMD_NAV_LOITER_TIME, d.MAV_CMD_NAV_LOITER_TURNS],
+)
+@pytest.mark.parametrize(
+    ("p3", "radius", "clockwise"), [(150.0, 150.0, True), (-150.0, 150.0, False), (0.0, 80.0, True)]
+)
+def test_loiter_radius_sign_gives_the_direction(
+    command: int, p3: float, radius: float, clockwise: bool
+):
+    ex = executor([item(0, command, (1_000.0, 0.0), z=100.0, p1=5.0, p3=p3)])
+    sp = ex.step((0.0, 0.0), 180.0, 0.0)
+    assert sp.kind == Kind.CIRCLE
+    assert sp.radius == radius  # 0: the configured default
+    assert sp.clockwise is clockwise
+
+
+def test_loiter_unlimited_never_ends():
+    centre = (1_000.0, 0.0)
+    ex = executor([item(0, d.MAV_CMD_NAV_LOITER_UNLIM, centre, z=100.0, p3=80.0)])
+    for k in range(2_000):
+        sp = ex.step(on_circle(centre, 80.0, 2.0 * k), 180.0, float(k))
+    assert sp.kind == Kind.CIRCLE and not ex.finished and ex.drain_reached() == []
+
+
+# --- RTL and the end of the mission ---------------------------------------------------------
+
+
+def test_rtl_flies_home_at_rtl_altitude_then_circles_home():
+    config = ExecutorConfig(rtl_alt_rel=60.0, loiter_radius=80.0)
+    items = [wp(0, (1_500.0, 0.0), z=120.0), item(1, d.MAV_CMD_NAV_RETURN_TO_LAUNCH)]
+    ex = executor(items, config=config)
+    reached, setpoints, pos = fly_lines(ex, step_m=10.0)
+    assert reached == [0, 1]
+    home_legs = [sp for sp in setpoints if sp.kind == Kind.LINE and sp.b == (0.0, 0.0)]
+    assert home_legs
+    for sp in home_legs:
+        assert sp.a == pytest.approx((1_500.0, 0.0), abs=0.05)  # from the last waypoint
+        assert sp.alt_msl == pytest.approx(HOME_ALT + 60.0)
+        assert not math.isfinite(sp.speed)
+    final = setpoints[-1]
+    assert ex.finished
+    assert final.kind == Kind.CIRCLE
+    assert final.b == (0.0, 0.0) and final.radius == 80.0
+    assert final.alt_msl == pytest.approx(HOME_ALT + 60.0)
+    assert dist(pos, (0.0, 0.0)) <= 120.0  # switched once within 1.5 loiter radii
+    assert dist(pos, (0.0, 0.0)) > 100.0  # ... and not before
+    # Circling home from now on, reported reached only once.
+    for t in range(50):
+        sp = ex.step(on_circle((0.0, 0.0), 80.0, 7.0 * t), 140.0, 1e4 + t)
+        assert sp.kind == Kind.CIRCLE and sp.b == (0.0, 0.0)
+        assert ex.drain_reached() == []
+
+
+def test_after_the_last_item_it_circles_the_last_point():
+    items = [wp(0, (500.0, 0.0), z=50.0), wp(1, (500.0, 500.0), z=70.0)]
+    ex = executor(items)
+    ex.step((0.0, 0.0), 180.0, 0.0)
+    ex.step((490.0, 0.0), 180.0, 1.0)
+    assert ex.drain_reached() == [0] and not ex.finished
+    sp = ex.step((500.0, 480.0), 150.0, 2.0)  # 20 m short: within the acceptance radius
+    assert ex.drain_reached() == [1]
+    assert ex.finished
+    assert sp.kind == Kind.CIRCLE
+    assert sp.b == pytest.approx((500.0, 500.0), abs=0.05)  # the waypoint, not the aircraft
+    assert sp.radius == ExecutorConfig().loiter_radius
+    assert sp.alt_msl == pytest.approx(HOME_ALT + 70.0)
+    # The aircraft moving about does not move the circle.
+    for t in range(3, 20):
+        again = ex.step((500.0 + 10 * t, 500.0), 150.0, float(t))
+        assert again == sp and ex.finished
+
+
+def test_start_part_way_through_skips_the_earlier_items():
+    items = [wp(0, (500.0, 0.0)), wp(1, (500.0, 500.0)), wp(2, (0.0, 500.0))]
+    ex = MissionExecutor(items, HOME, HOME_ALT)
+    ex.start(1, (100.0, 100.0), 180.0)
+    sp = ex.step((100.0, 100.0), 180.0, 0.0)
+    assert sp.a == (100.0, 100.0)  # from where the aircraft is
+    assert sp.b == pytest.approx((500.0, 500.0), abs=0.05)
