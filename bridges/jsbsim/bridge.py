@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import heapq
 import logging
+import math
 import time
 from collections.abc import Callable
 
@@ -93,6 +94,10 @@ class SimBridge:
         self.flight.step()
         self.frames += 1
         s = self.flight.state()
+        if not all(math.isfinite(v) for v in (s.lat_deg, s.lon_deg, s.alt_msl_m, s.vn, s.vd)):
+            log.error("JSBSim's flight model diverged at %.2f s: stopping the simulation", s.t_s)
+            self.stopping = True
+            return
         t_us = round(s.t_s * 1e6)
         self.clock.publish(SimClock(t_us=t_us, frame=self.frames))
         self._publish_truth(s, t_us)

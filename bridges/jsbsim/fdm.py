@@ -19,6 +19,7 @@ TURBULENCE = {"none": (0, 0.0), "light": (2, 15.0), "moderate": (3, 30.0), "seve
 KT = 0.514444
 MILSPEC = 3  # atmosphere/turb-type: FGWinds::ttMilspec
 IDLE_THROTTLE = 0.05
+TURBULENCE_MIN_AGL_M = 5.0
 DROP_HEIGHT_FT = 4.0  # above the resting height of the shipped airframes' gear
 SETTLE_S = 3.0
 
@@ -50,6 +51,7 @@ class Flight:
             raise ValueError(f"JSBSim has no aircraft {model!r}")
         self.fdm.set_dt(1.0 / rate_hz)
         self.home = home
+        self.turbulence = False
         self._initial_conditions(model, airborne_agl_m, speed_m_s)
 
     def _initial_conditions(
@@ -107,10 +109,11 @@ class Flight:
     def set_turbulence(self, level: str) -> None:
         """MIL-F-8785C turbulence: none, light, moderate or severe."""
         severity, wind_kt = TURBULENCE[level]
+        self.turbulence = severity > 0
         if severity == 0:
             self.fdm["atmosphere/turb-type"] = 0
             return
-        self.fdm["atmosphere/turb-type"] = MILSPEC
+        self.fdm["atmosphere/turb-type"] = MILSPEC if self._above_ground() else 0
         self.fdm["atmosphere/turbulence/milspec/severity"] = severity
         self.fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = wind_kt * KT / FT
 
@@ -142,8 +145,15 @@ class Flight:
             "throttle": f["fcs/throttle-cmd-norm"],
         }
 
+    def _above_ground(self) -> bool:
+        return float(self.fdm["position/h-agl-ft"]) * FT > TURBULENCE_MIN_AGL_M
+
     def step(self) -> None:
         """Advance one frame."""
+        if self.turbulence:
+            # JSBSim's MIL-F-8785C scale lengths shrink with height; on the runway they
+            # give gusts that throw a parked Cub into the air and the model into NaNs.
+            self.fdm["atmosphere/turb-type"] = MILSPEC if self._above_ground() else 0
         self.fdm.run()
 
     @property

@@ -18,7 +18,7 @@ from companion.flight.params import FlightConfig
 from companion.flight.takeoff import Phase, RunwayTakeoff
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
-from companion.mission.executor import Kind, MissionExecutor, Setpoint
+from companion.mission.executor import Kind, MissionExecutor, Setpoint, past_point
 from companion.mission.items import MissionItem
 
 AIRBORNE_AGL_M = 10.0
@@ -116,7 +116,10 @@ class FlightController:
         frame = self._ensure_frame(nav, status)
         pos = frame.ne(nav.lat_deg, nav.lon_deg)
         vel = (nav.vn_m_s, nav.ve_m_s)
-        self.wind.update(vel, nav.yaw_rad, dt)
+        if self.landed:
+            self.wind.on_ground(vel, nav.yaw_rad)
+        else:
+            self.wind.update(vel, nav.yaw_rad, dt)
         airspeed = self.wind.airspeed
         self._update_landed(nav, airspeed)
         out = ControlOutput(airspeed=airspeed, landed=bool(self.landed))
@@ -190,8 +193,11 @@ class FlightController:
     ) -> Setpoint:
         """Return and go-to circle their point on arrival; a take-off circles when high."""
         radius = self.config["WP_LOITER_RAD"]
-        near = math.hypot(sp.b[0] - pos[0], sp.b[1] - pos[1]) < radius * 1.5
-        if sp.kind == Kind.LINE and mode in (FlightMode.RTL, FlightMode.GUIDED) and near:
+        reach = max(radius, self._turn_radius()) * 1.5
+        near = math.hypot(sp.b[0] - pos[0], sp.b[1] - pos[1]) < reach
+        # Passing the point counts too: the line goes on past it for ever.
+        arrived = near or past_point(sp.a, sp.b, pos)
+        if sp.kind == Kind.LINE and mode in (FlightMode.RTL, FlightMode.GUIDED) and arrived:
             return Setpoint(Kind.CIRCLE, sp.b, sp.b, sp.alt_msl, radius)
         if sp.kind == Kind.TAKEOFF and alt >= sp.alt_msl - 5.0:
             return Setpoint(Kind.CIRCLE, pos, pos, sp.alt_msl, radius)
@@ -275,7 +281,7 @@ class FlightController:
         )
         self.tecs.reset(demand.pitch)
         out.aileron, out.elevator = surfaces.aileron, surfaces.elevator
-        out.rudder = demand.rudder if demand.rudder is not None else surfaces.rudder
+        out.rudder = demand.rudder
         out.throttle = demand.throttle
         out.nav_roll, out.nav_pitch = demand.roll, demand.pitch
         out.target_bearing = to.heading

@@ -35,7 +35,7 @@ class TakeoffDemand:
     roll: float
     pitch: float
     throttle: float
-    rudder: float | None  # None: the attitude controller's yaw damper decides
+    rudder: float
 
 
 class RunwayTakeoff:
@@ -75,10 +75,14 @@ class RunwayTakeoff:
         if self.phase == Phase.ROTATE and agl >= CLIMB_OUT_AGL_M:
             self.phase = Phase.CLIMB_OUT
         throttle = v["THR_MAX"]
+        # The rudder holds the runway heading until the aircraft is high enough for normal
+        # guidance: on the wheels it steers, just after rotation (slow, wings level) it
+        # keeps a gust or a tailwind from swinging the nose round.
+        heading_dem = self.heading - math.atan2(self.xtrack(pos), STEER_LOOKAHEAD_M)
+        rudder = v["TKOFF_STEER_P"] * wrap_pi(heading_dem - yaw) - 0.3 * yaw_rate
+        rudder = max(-1.0, min(1.0, rudder))
         if self.phase == Phase.GROUND_ROLL:
-            heading_dem = self.heading - math.atan2(self.xtrack(pos), STEER_LOOKAHEAD_M)
-            rudder = v["TKOFF_STEER_P"] * wrap_pi(heading_dem - yaw) - 0.3 * yaw_rate
             pitch = math.radians(v["TKOFF_GND_PITCH"])
-            return TakeoffDemand(self.phase, 0.0, pitch, throttle, max(-1.0, min(1.0, rudder)))
+            return TakeoffDemand(self.phase, 0.0, pitch, throttle, rudder)
         pitch = math.radians(v["TKOFF_PITCH_DEG"])
-        return TakeoffDemand(self.phase, 0.0, pitch, throttle, None)
+        return TakeoffDemand(self.phase, 0.0, pitch, throttle, rudder)

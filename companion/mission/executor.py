@@ -193,7 +193,7 @@ class MissionExecutor:
         b = self.point_of(item, pos)
         radius = item.param2 if item.param2 > 0 else self.config.wp_radius
         radius = max(radius, self._turn_lead(self._prev, b))
-        if _distance(pos, b) <= radius or _past(self._prev, b, pos):
+        if _distance(pos, b) <= radius or past_point(self._prev, b, pos):
             self._advance(True, b, self.alt_of(item))
             return None
         return Setpoint(Kind.LINE, self._prev, b, self.alt_of(item), speed=self.speed)
@@ -234,7 +234,9 @@ class MissionExecutor:
         home = (0.0, 0.0)
         rtl_alt = self.home_alt_msl + self.config.rtl_alt_rel
         radius = self.config.loiter_radius
-        if not self.finished and _distance(pos, home) <= radius * 1.5:
+        reach = max(radius, self._turn_radius) * 1.5
+        there = _distance(pos, home) <= reach or past_point(self._prev, home, pos)
+        if not self.finished and there:
             self.finished = True
             self.reached.append(item.seq)
         if self.finished:
@@ -275,7 +277,7 @@ def _distance(a: tuple[float, float], b: tuple[float, float]) -> float:
     return math.hypot(b[0] - a[0], b[1] - a[1])
 
 
-def _past(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> bool:
+def past_point(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> bool:
     """True once ``pos`` is beyond the line through ``b`` square to the leg a→b."""
     leg = (b[0] - a[0], b[1] - a[1])
     if math.hypot(*leg) < 1.0:

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import pytest
 
+from companion.failsafe import FAILSAFE_PARAMS
+from companion.plugins.link.mavlink_link import MavlinkLink
 from tests.protocol.mav_client import client_vehicle, free_udp_port
 from tests.support.vehicle import wait_for
 
@@ -54,7 +56,10 @@ def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
         wait_for(lambda: vehicle.row("flight").pid, 30, "MAVProxy's arm to start the flight group")
         wait_for(mission.exists, 20, "the uploaded mission stored")
         # MAVProxy tries MAVLink FTP first (the vehicle does not offer it), then the protocol.
-        wait_for(lambda: any("Received 3 parameters" in x for x in lines), 30, "param fetch")
+        # Every parameter the config's plug-ins declare: the link's rates, the failsafes.
+        count = len(MavlinkLink.params) + len(FAILSAFE_PARAMS)
+        said = f"Received {count} parameters"
+        wait_for(lambda: any(said in x for x in lines), 30, "param fetch")
     finally:
         proc.terminate()
         try:
@@ -64,7 +69,7 @@ def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
             proc.wait(timeout=5)
         reader.join(timeout=5)
     output = "".join(lines)
-    assert "Received 3 parameters" in output
+    assert f"Received {len(MavlinkLink.params) + len(FAILSAFE_PARAMS)} parameters" in output
     assert "COMPONENT_ARM_DISARM: ACCEPTED" in output
     assert len(json.loads(mission.read_text())) == 3
 

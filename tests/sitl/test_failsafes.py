@@ -33,6 +33,7 @@ class Station:
         self.beating = True
         self.texts: list[str] = []
         self.mode = -1
+        self.modes: list[int] = []  # every mode the heartbeat has shown, in order
         self._next_beat = 0.0
 
     def pump(self, seconds: float) -> None:
@@ -49,6 +50,8 @@ class Station:
                 self.texts.append(msg.text)
             else:
                 self.mode = msg.custom_mode
+                if not self.modes or self.modes[-1] != self.mode:
+                    self.modes.append(self.mode)
 
     def until(self, predicate, seconds: float, what: str) -> None:
         end = time.monotonic() + seconds
@@ -95,10 +98,10 @@ def test_ground_station_lost_returns_home_then_resumes_the_mission(tmp_path):
         station.pump(3.0)  # airborne (about 75 s of flight at lockstep speed)
         station.beating = False
         station.until(lambda: station.in_mode(FlightMode.RTL), 30, "returning")
-        assert station.said("ground station lost")
+        station.until(lambda: station.said("ground station lost"), 5, "told why")
         station.beating = True
         station.until(lambda: station.in_mode(FlightMode.MISSION), 30, "back in the mission")
-        assert station.said("resuming the mission")
+        station.until(lambda: station.said("resuming the mission"), 5, "told so")
     finally:
         proc.terminate()
         finish(proc, namespace, 60)
@@ -107,14 +110,16 @@ def test_ground_station_lost_returns_home_then_resumes_the_mission(tmp_path):
 
 @pytest.mark.timeout(240)
 def test_gps_lost_holds_heading_and_loiters_when_it_returns(tmp_path):
-    # The outage starts once the aircraft is well on its way (take-off takes about 70 s).
-    station, proc, namespace = _sim(tmp_path, "--duration", "1500", "--gps-outage", "150:20")
+    # The outage starts once the aircraft is on its first leg, well inside the fence
+    # (take-off takes about 70 s).
+    station, proc, namespace = _sim(tmp_path, "--duration", "1500", "--gps-outage", "110:10")
     try:
         station.fly_mission()
         station.until(lambda: station.said("GPS lost"), 60, "told of the GPS loss")
         assert station.in_mode(FlightMode.MISSION)  # the course is held, the mode kept
-        station.until(lambda: station.in_mode(FlightMode.LOITER), 60, "loitering")
-        assert station.said("GPS back")
+        loiter = BY_MODE[FlightMode.LOITER].px4
+        station.until(lambda: loiter in station.modes, 60, "loitering")
+        station.until(lambda: station.said("GPS back"), 5, "told GPS is back")
     finally:
         proc.terminate()
         finish(proc, namespace, 60)
