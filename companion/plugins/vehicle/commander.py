@@ -21,9 +21,10 @@ from companion.mission.store import FILES, MissionStore
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
 
-WAIT_S = 0.5
+WAIT_S = 0.05
 STATUS_PERIOD_US = 250_000  # 4 Hz: the link and the controller follow it
 FENCE_CHECK_US = 1_000_000
+FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) second
 CONTROL_STALE_US = 2_000_000
 
 
@@ -52,12 +53,16 @@ class CommanderPlugin(Plugin):
         self.health = bus.latest_reader("system/health")
         self.control = bus.latest_reader("control/status")
         self.link = bus.latest_reader("link/status")
-        self.waiter = bus.waiter([self.commands, self.nav])
+        # Commands wake it at once; the rest (navigation at 100 Hz and more) is read when
+        # it wakes on its own, 20 times a wall second: waking for every navigation sample
+        # cost a lockstep simulation a tenth of its speed.
+        self.waiter = bus.waiter([self.commands])
         self.acks = bus.writer("link/command_acks")
         self.out = bus.writer("vehicle/status")
         self.texts = bus.writer("vehicle/statustext")
         self.next_status_us = 0
         self.next_fence_us = 0
+        self.next_failsafe_us = 0
 
     def step(self) -> None:
         self.waiter.wait(WAIT_S)
@@ -70,7 +75,9 @@ class CommanderPlugin(Plugin):
             c.on_armed(bool(health.flight_running))
         self.live.poll()
         changed = self._commands()
-        changed |= self._failsafes(now, nav)
+        if now >= self.next_failsafe_us or now < self.next_failsafe_us - FAILSAFE_PERIOD_US:
+            self.next_failsafe_us = now + FAILSAFE_PERIOD_US
+            changed |= self._failsafes(now, nav)
         if changed or now >= self.next_status_us:
             self.out.publish(c.status(now))
             self.next_status_us = now + STATUS_PERIOD_US
