@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from companion.estimation import rotations as rot
+from companion.estimation.baro_datum import BaroDatum
 from companion.estimation.ins_align import Aligner, Alignment
 from companion.estimation.local_frame import LocalFrame, normal_gravity
 from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer, NavFlags, NavState
@@ -104,9 +105,8 @@ class InsEkf:
         self.last_gps_ok = self.last_heading_ok = True
         self.resets = 0
         self.next_heading_us = 0
-        self.baro_offset: float | None = None  # baro height + offset = height in the frame
-        self.last_baro_us: int | None = None
-        self.next_baro_us = 0
+        c0 = self.cfg
+        self.baro = BaroDatum(c0.baro_interval_s, c0.baro_timeout_s, c0.baro_offset_tau_s)
         self.cov_dt = 0.0
         self.cov_f: tuple[float, ...] = (0.0, 0.0, 0.0)
         self.cov_w: tuple[float, ...] = (0.0, 0.0, 0.0)
@@ -154,21 +154,12 @@ class InsEkf:
 
     def on_baro(self, reading: Baro) -> None:
         """Barometric height: the vertical channel follows it; GPS only moves its datum."""
-        h = reading.alt_rel_m
-        if not self.aligned or not math.isfinite(h) or reading.t_us < self.next_baro_us:
+        if not self.aligned:
             return
-        self.next_baro_us = reading.t_us + round(self.cfg.baro_interval_s * 1e6)
-        if self.baro_offset is None or not self._baro_fresh(reading.t_us):
-            self.baro_offset = -self.p[2] - h  # (re)join where the INS height is now
-        self.last_baro_us = reading.t_us
-        y = np.array([-(h + self.baro_offset) - self.p[2]])
-        self._update(y, _I15[[2]], np.array([[self.cfg.baro_std**2]]))
-
-    def _baro_fresh(self, now_us: int) -> bool:
-        return (
-            self.last_baro_us is not None
-            and (now_us - self.last_baro_us) / 1e6 < self.cfg.baro_timeout_s
-        )
+        up = self.baro.height(reading.alt_rel_m, reading.t_us, self.p[2])
+        if up is not None:
+            y = np.array([-up - self.p[2]])
+            self._update(y, _I15[[2]], np.array([[self.cfg.baro_std**2]]))
 
     def on_compass(self, reading: Compass) -> None:
         """Heading update from a digital compass (heading already true), when no
@@ -323,8 +314,9 @@ class InsEkf:
         p_then, v_then = self._state_at(fix.t_us - round(self.cfg.gps_delay_s * 1e6))
         std = fix.eph_m if math.isfinite(fix.eph_m) and fix.eph_m > 0 else self.cfg.gps_pos_std
         vstd = fix.epv_m if math.isfinite(fix.epv_m) and fix.epv_m > 0 else 1.5 * std
-        if self._baro_fresh(fix.t_us):
-            self._pull_baro_datum(z_p[2], fix.t_us)
+        if self.baro.fresh(fix.t_us):
+            since = (fix.t_us - self.last_gps_us) / 1e6 if self.last_gps_us is not None else 0.0
+            self.baro.follow_gps(z_p[2], self.p[2], since)
             vstd = max(vstd, self.cfg.gps_vert_with_baro_std)
         rows = [0, 1] + ([2] if math.isfinite(fix.alt_msl_m) else [])
         rows += [3 + i for i in range(3) if math.isfinite(z_v[i])]
@@ -343,13 +335,6 @@ class InsEkf:
         self.gps_reject_run += 1
         if self.gps_reject_run >= self.cfg.reset_after:
             self._reset_to_gps(z_p, z_v, std)
-
-    def _pull_baro_datum(self, gps_down: float, t_us: int) -> None:
-        """Let the barometer's datum follow GPS height slowly (weather, temperature)."""
-        if self.baro_offset is None or self.last_gps_us is None or not math.isfinite(gps_down):
-            return
-        dt = max(0.0, (t_us - self.last_gps_us) / 1e6)
-        self.baro_offset += (-gps_down + self.p[2]) * min(1.0, dt / self.cfg.baro_offset_tau_s)
 
     def _reset_to_gps(self, z_p: np.ndarray, z_v: np.ndarray, std: float) -> None:
         """The INS has disagreed with GPS for too long: believe GPS, and say so."""

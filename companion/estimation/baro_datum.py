@@ -1,0 +1,43 @@
+"""The barometer's datum for the INS: barometric height + offset = height in the frame.
+
+The barometer is smooth over seconds but its zero drifts with weather and temperature;
+GPS height is noisy but has no drift. So the INS's vertical channel follows the
+barometer, and GPS pulls the offset towards itself with a time constant of minutes.
+"""
+
+from __future__ import annotations
+
+import math
+
+
+class BaroDatum:
+    """Holds the offset and how fresh the barometer is."""
+
+    def __init__(self, interval_s: float, timeout_s: float, tau_s: float) -> None:
+        self.interval_us = round(interval_s * 1e6)
+        self.timeout_s = timeout_s
+        self.tau_s = tau_s
+        self.offset: float | None = None
+        self.last_us: int | None = None
+        self.next_us = 0
+
+    def fresh(self, now_us: int) -> bool:
+        """The barometer has spoken recently enough to be the height source."""
+        return self.last_us is not None and (now_us - self.last_us) / 1e6 < self.timeout_s
+
+    def height(self, baro_m: float, t_us: int, ins_down: float) -> float | None:
+        """The height measurement (metres up in the frame) for this reading, or None when
+        it is not used (rate-limited or not a number)."""
+        if not math.isfinite(baro_m) or t_us < self.next_us:
+            return None
+        self.next_us = t_us + self.interval_us
+        if self.offset is None or not self.fresh(t_us):
+            self.offset = -ins_down - baro_m  # (re)join where the INS height is now
+        self.last_us = t_us
+        return baro_m + self.offset
+
+    def follow_gps(self, gps_down: float, ins_down: float, dt_s: float) -> None:
+        """Move the datum a little towards what GPS says the height is."""
+        if self.offset is None or not math.isfinite(gps_down):
+            return
+        self.offset += (ins_down - gps_down) * min(1.0, max(dt_s, 0.0) / self.tau_s)

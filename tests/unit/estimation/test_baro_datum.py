@@ -1,0 +1,32 @@
+"""The barometer's datum: joins the INS height, is rate-limited, and follows GPS slowly."""
+
+from __future__ import annotations
+
+import pytest
+
+from companion.estimation.baro_datum import BaroDatum
+
+
+def test_the_first_reading_joins_the_ins_height_and_later_ones_move_with_the_barometer():
+    datum = BaroDatum(interval_s=0.1, timeout_s=1.0, tau_s=300.0)
+    assert datum.height(12.0, 0, ins_down=-50.0) == pytest.approx(50.0)
+    assert datum.height(13.0, 50_000, ins_down=-50.0) is None  # within the interval
+    assert datum.height(13.0, 100_000, ins_down=-50.0) == pytest.approx(51.0)
+    assert datum.fresh(500_000) and not datum.fresh(1_200_000)
+
+
+def test_after_a_silence_it_joins_again_where_the_ins_is():
+    datum = BaroDatum(interval_s=0.1, timeout_s=1.0, tau_s=300.0)
+    datum.height(0.0, 0, ins_down=-10.0)
+    assert datum.height(0.0, 5_000_000, ins_down=-30.0) == pytest.approx(30.0)
+
+
+def test_gps_pulls_the_datum_with_its_time_constant():
+    datum = BaroDatum(interval_s=0.1, timeout_s=1.0, tau_s=100.0)
+    datum.height(0.0, 0, ins_down=-100.0)  # the barometer says 100 m
+    for _ in range(100):  # GPS says 110 m for 100 s, a fix a second
+        datum.follow_gps(gps_down=-110.0, ins_down=-100.0, dt_s=1.0)
+    # One time constant against a fixed 10 m disagreement: 10 m, not more, not at once.
+    assert datum.offset == pytest.approx(100.0 + 10.0, abs=0.01)
+    datum.follow_gps(gps_down=float("nan"), ins_down=-100.0, dt_s=1.0)
+    assert datum.offset == pytest.approx(110.0, abs=0.01)
