@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 A = 6378137.0  # WGS-84 semi-major axis, m
+STANDARD_GRAVITY = 9.80665  # m/s², the conventional g the control laws use
 E2 = 6.69437999014e-3  # first eccentricity squared
 
 

@@ -401,6 +401,12 @@ class ControlStatus(Message):
         ("last_reached", ctypes.c_int32),
     ]
 
+    STALE_US = 2_000_000  # no newer status for this long: the controller has stopped
+
+    def fresh(self, now_us: int) -> bool:
+        """Whether the controller is still running (it publishes ten times a second)."""
+        return now_us - self.t_us < self.STALE_US
+
 
 class ParamChange(Message):
     """A parameter a ground station set. Producer: link. Consumers: the parameter's owner."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-G = 9.80665
+from companion.geodesy import STANDARD_GRAVITY as G
 
 
 @dataclass

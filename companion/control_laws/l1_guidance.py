@@ -13,9 +13,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import wrap_pi
 
-G = 9.80665
 MIN_SPEED = 1.0  # below this the ground course is meaningless
 XTRACK_I_CAPTURE_RAD = math.radians(5.0)
 XTRACK_I_MAX_RAD = 0.1

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-G = 9.80665
+from companion.geodesy import STANDARD_GRAVITY as G
 
 
 @dataclass

@@ -11,11 +11,12 @@ import math
 from dataclasses import dataclass, field
 
 from companion.control_laws.attitude import AttitudeController
-from companion.control_laws.l1_guidance import G, L1Guidance, LateralDemand, bank_for
+from companion.control_laws.l1_guidance import L1Guidance, LateralDemand, bank_for
 from companion.control_laws.tecs import Tecs
 from companion.control_laws.wind import WindEstimator
 from companion.flight.params import FlightConfig
 from companion.flight.takeoff import Phase, RunwayTakeoff
+from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 from companion.mission.executor import Kind, MissionExecutor, Setpoint, past_point
@@ -63,30 +64,19 @@ class FlightController:
         self._mode_key: tuple[int, int] | None = None
         self._mode_setpoint: Setpoint | None = None
         self._hold_course: Setpoint | None = None
-        self.set_config(config)
-
-    def set_config(self, config: FlightConfig) -> None:
-        """New parameter values; the integrators are kept."""
-        self.config = config
-        old_att = getattr(self, "attitude", None)
-        old_tecs = getattr(self, "tecs", None)
         self.attitude = AttitudeController(config.attitude)
         self.tecs = Tecs(config.tecs)
-        if old_att is not None and old_tecs is not None:
-            self.attitude.roll_integ, self.attitude.pitch_integ = (
-                old_att.roll_integ,
-                old_att.pitch_integ,
-            )
-            self.tecs.throttle_integ, self.tecs.pitch_integ = (
-                old_tecs.throttle_integ,
-                old_tecs.pitch_integ,
-            )
-        old_l1 = getattr(self, "l1", None)
         self.l1 = L1Guidance(
             config["NAVL1_PERIOD"], config["NAVL1_DAMPING"], config["NAVL1_XTRACK_I"]
         )
-        if old_l1 is not None:
-            self.l1.integ, self.l1._line = old_l1.integ, old_l1._line
+
+    def set_config(self, config: FlightConfig) -> None:
+        """New parameter values; the laws keep their integrators and memory."""
+        self.config = config
+        self.attitude.gains = config.attitude
+        self.tecs.gains = config.tecs
+        self.l1.period_s, self.l1.damping = config["NAVL1_PERIOD"], config["NAVL1_DAMPING"]
+        self.l1.xtrack_i = config["NAVL1_XTRACK_I"]
         if self.executor is not None:
             self.executor.config = config.executor
 

@@ -28,6 +28,15 @@ class MissionStore:
                 self.items[mission_type] = self._load(self.directory / FILES[mission_type])
         return self
 
+    def stamp(self, mission_type: int) -> int:
+        """The stored list's modification time (ns; 0 when none): a change means reload."""
+        if self.directory is None:
+            return 0
+        try:
+            return (self.directory / FILES[mission_type]).stat().st_mtime_ns
+        except FileNotFoundError:
+            return 0
+
     def _load(self, path: Path) -> list[MissionItem]:
         try:
             raw = json.loads(path.read_text())

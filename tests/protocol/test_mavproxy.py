@@ -24,52 +24,73 @@ WAYPOINTS = """QGC WPL 110
 """
 
 
+class MavProxy:
+    """MAVProxy run as a user runs it, its console typed into and read back."""
+
+    def __init__(self, port: int, cwd: Path) -> None:
+        mavproxy = Path(sys.executable).parent / "mavproxy.py"
+        assert mavproxy.exists() or shutil.which("mavproxy.py"), "MAVProxy is a dev dependency"
+        self.proc = subprocess.Popen(
+            [sys.executable, str(mavproxy), f"--master=udpout:127.0.0.1:{port}"],
+            cwd=cwd,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        self.lines: list[str] = []
+        self._reader = threading.Thread(
+            target=lambda: self.lines.extend(self.proc.stdout), daemon=True
+        )
+        self._reader.start()
+
+    def type(self, line: str) -> None:
+        self.proc.stdin.write(line + "\n")
+        self.proc.stdin.flush()
+
+    def connected(self, vehicle) -> None:
+        """Wait until MAVProxy talks to the link and has settled.
+
+        MAVProxy's --cmd runs before it has heard the vehicle (and then resets its waypoint
+        loader when the vehicle comes online), so commands are typed once it is connected.
+        """
+        wait_for(lambda: vehicle.row("link").frames_ok > 20, 30, "MAVProxy connected")
+        time.sleep(2.0)
+
+    def close(self) -> str:
+        """Stop MAVProxy; everything it printed."""
+        self.proc.terminate()
+        try:
+            self.proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()  # MAVProxy's own threads can ignore SIGTERM while stdin is open
+            self.proc.wait(timeout=5)
+        self._reader.join(timeout=5)
+        return "".join(self.lines)
+
+
 @pytest.mark.timeout(120)
 def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
-    mavproxy = Path(sys.executable).parent / "mavproxy.py"
-    assert mavproxy.exists() or shutil.which("mavproxy.py"), "MAVProxy is a dev dependency"
     port = free_udp_port()
     vehicle = vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path / "state"))
     vehicle.wait_running("link")
     wp = tmp_path / "wp.txt"
     wp.write_text(WAYPOINTS)
-    # MAVProxy's --cmd runs before it has heard the vehicle (and then resets its waypoint
-    # loader when the vehicle comes online), so commands are typed once it is connected.
-    proc = subprocess.Popen(
-        [sys.executable, str(mavproxy), f"--master=udpout:127.0.0.1:{port}"],
-        cwd=tmp_path,
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
     mission = tmp_path / "state" / "missions" / "mission.json"
-    lines: list[str] = []
-    reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)
-    reader.start()
+    # Every parameter the config's plug-ins declare: the link's rates, the failsafes.
+    said = f"Received {len(MavlinkLink.params) + len(FAILSAFE_PARAMS)} parameters"
+    mavproxy = MavProxy(port, tmp_path)
     try:
-        wait_for(lambda: vehicle.row("link").frames_ok > 20, 30, "MAVProxy connected")
-        time.sleep(2.0)
+        mavproxy.connected(vehicle)
         for line in ("param fetch", f"wp load {wp}", "arm throttle"):
-            proc.stdin.write(line + "\n")
-            proc.stdin.flush()
+            mavproxy.type(line)
         wait_for(lambda: vehicle.row("flight").pid, 30, "MAVProxy's arm to start the flight group")
         wait_for(mission.exists, 20, "the uploaded mission stored")
         # MAVProxy tries MAVLink FTP first (the vehicle does not offer it), then the protocol.
-        # Every parameter the config's plug-ins declare: the link's rates, the failsafes.
-        count = len(MavlinkLink.params) + len(FAILSAFE_PARAMS)
-        said = f"Received {count} parameters"
-        wait_for(lambda: any(said in x for x in lines), 30, "param fetch")
+        wait_for(lambda: any(said in x for x in mavproxy.lines), 30, "param fetch")
     finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            proc.kill()  # MAVProxy's own threads can ignore SIGTERM while stdin is open
-            proc.wait(timeout=5)
-        reader.join(timeout=5)
-    output = "".join(lines)
-    assert f"Received {len(MavlinkLink.params) + len(FAILSAFE_PARAMS)} parameters" in output
+        output = mavproxy.close()
+    assert said in output
     assert "COMPONENT_ARM_DISARM: ACCEPTED" in output
     assert len(json.loads(mission.read_text())) == 3
 
@@ -78,49 +99,26 @@ def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
 def test_mavproxy_switches_modes_auto_rtl_loiter(vehicle_factory, tmp_path):
     from companion.messages import FlightMode
 
-    mavproxy = Path(sys.executable).parent / "mavproxy.py"
     port = free_udp_port()
     vehicle = vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path / "state"))
     status = vehicle.bus.latest_reader("vehicle/status")
     wait_for(status.get, 20, "the commander up")
     wp = tmp_path / "wp.txt"
     wp.write_text(WAYPOINTS)
-    proc = subprocess.Popen(
-        [sys.executable, str(mavproxy), f"--master=udpout:127.0.0.1:{port}"],
-        cwd=tmp_path,
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
-    lines: list[str] = []
-    reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)
-    reader.start()
-
-    def type_line(line: str) -> None:
-        proc.stdin.write(line + "\n")
-        proc.stdin.flush()
-
     seen = []
+    mavproxy = MavProxy(port, tmp_path)
     try:
-        wait_for(lambda: vehicle.row("link").frames_ok > 20, 30, "MAVProxy connected")
-        time.sleep(2.0)
-        type_line(f"wp load {wp}")
+        mavproxy.connected(vehicle)
+        mavproxy.type(f"wp load {wp}")
         wait_for((tmp_path / "state" / "missions" / "mission.json").exists, 20, "mission stored")
         for command, mode in (
             ("mode AUTO", FlightMode.MISSION),
             ("mode RTL", FlightMode.RTL),
             ("mode LOITER", FlightMode.LOITER),
         ):
-            type_line(command)
+            mavproxy.type(command)
             wait_for(lambda m=mode: status.get().mode == m, 10, command)
             seen.append(FlightMode(status.get().mode))
     finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(timeout=5)
-        reader.join(timeout=5)
+        mavproxy.close()
     assert seen == [FlightMode.MISSION, FlightMode.RTL, FlightMode.LOITER]

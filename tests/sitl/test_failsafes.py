@@ -7,8 +7,10 @@ STATUSTEXT the operator reads.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
+from collections.abc import Iterator
 
 import pytest
 
@@ -81,19 +83,26 @@ class Station:
         self.until(lambda: self.in_mode(FlightMode.MISSION), 20, "in Mission")
 
 
-def _sim(tmp_path, *args: str):
+@contextlib.contextmanager
+def flying(tmp_path, *args: str) -> Iterator[Station]:
+    """``companion sim`` with the square plan (and ``args``), a station on its link; the
+    simulation is stopped and checked clean afterwards, whatever the test did."""
     port = free_udp_port()
     station = Station(port)
     proc, namespace, _truth = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--plan", PLAN, *args
+        tmp_path, f"udpout://127.0.0.1:{port}", "--plan", PLAN, "--duration", "1500", *args
     )
-    return station, proc, namespace
+    try:
+        yield station
+    finally:
+        proc.terminate()
+        finish(proc, namespace, 60)
+        station.conn.close()
 
 
 @pytest.mark.timeout(240)
 def test_ground_station_lost_returns_home_then_resumes_the_mission(tmp_path):
-    station, proc, namespace = _sim(tmp_path, "--duration", "1500")
-    try:
+    with flying(tmp_path) as station:
         station.fly_mission()
         station.pump(3.0)  # airborne (about 75 s of flight at lockstep speed)
         station.beating = False
@@ -102,34 +111,24 @@ def test_ground_station_lost_returns_home_then_resumes_the_mission(tmp_path):
         station.beating = True
         station.until(lambda: station.in_mode(FlightMode.MISSION), 30, "back in the mission")
         station.until(lambda: station.said("resuming the mission"), 5, "told so")
-    finally:
-        proc.terminate()
-        finish(proc, namespace, 60)
-        station.conn.close()
 
 
 @pytest.mark.timeout(240)
 def test_gps_lost_holds_heading_and_loiters_when_it_returns(tmp_path):
     # The outage starts once the aircraft is on its first leg, well inside the fence
     # (take-off takes about 70 s).
-    station, proc, namespace = _sim(tmp_path, "--duration", "1500", "--gps-outage", "110:10")
-    try:
+    with flying(tmp_path, "--gps-outage", "110:10") as station:
         station.fly_mission()
         station.until(lambda: station.said("GPS lost"), 60, "told of the GPS loss")
         assert station.in_mode(FlightMode.MISSION)  # the course is held, the mode kept
         loiter = BY_MODE[FlightMode.LOITER].px4
         station.until(lambda: loiter in station.modes, 60, "loitering")
         station.until(lambda: station.said("GPS back"), 5, "told GPS is back")
-    finally:
-        proc.terminate()
-        finish(proc, namespace, 60)
-        station.conn.close()
 
 
 @pytest.mark.timeout(240)
 def test_fence_breach_returns_home(tmp_path):
-    station, proc, namespace = _sim(tmp_path, "--duration", "1500")
-    try:
+    with flying(tmp_path) as station:
         # A 1 km circle round home: the first leg (to 1.8 km east) leaves it.
         lat, lon = -37.9105, 145.1340
         station.fly_mission()
@@ -138,10 +137,6 @@ def test_fence_breach_returns_home(tmp_path):
         station.command(d.MAV_CMD_MISSION_START, 0, 0)
         station.until(lambda: station.said("Fence breached"), 90, "told of the breach")
         station.until(lambda: station.in_mode(FlightMode.RTL), 10, "returning")
-    finally:
-        proc.terminate()
-        finish(proc, namespace, 60)
-        station.conn.close()
 
 
 def _upload_circle_fence(station: Station, lat: float, lon: float, radius: float) -> None:

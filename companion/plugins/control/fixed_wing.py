@@ -24,10 +24,11 @@ from companion.messages import (
     MissionState,
     VehicleStatus,
 )
-from companion.mission.store import FILES, MissionStore
+from companion.mission.store import MissionStore
 from companion.params import ParamDecl
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext, Setting
+from mavlink_dialect import companion as d
 
 WAIT_S = 0.5
 STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item is reached)
@@ -62,8 +63,7 @@ class FixedWingPlugin(Plugin):
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
         self.params = LiveParams(ctx.bus, decls, state_dir)
         self.missions = MissionStore(state_dir / "missions")
-        self.mission_file = state_dir / "missions" / FILES[0]
-        self.mission_stamp = self._mission_stamp()
+        self.mission_stamp = self.missions.stamp(d.MAV_MISSION_TYPE_MISSION)
         self.controller = FlightController(
             flight_config(self.params.values), self.missions.items[0]
         )
@@ -78,18 +78,12 @@ class FixedWingPlugin(Plugin):
         self.next_mission_check_us = 0
         self.default_status = VehicleStatus(mode=int(FlightMode.LOITER), armed=1)
 
-    def _mission_stamp(self) -> float:
-        try:
-            return self.mission_file.stat().st_mtime_ns
-        except FileNotFoundError:
-            return 0.0
-
     def _follow_changes(self, now_us: int) -> None:
         if self.params.poll():
             self.controller.set_config(flight_config(self.params.values))
         if now_us >= self.next_mission_check_us:
             self.next_mission_check_us = now_us + MISSION_CHECK_US
-            stamp = self._mission_stamp()
+            stamp = self.missions.stamp(d.MAV_MISSION_TYPE_MISSION)
             if stamp != self.mission_stamp:
                 self.mission_stamp = stamp
                 self.controller.set_mission(self.missions.reload().items[0])

@@ -42,8 +42,7 @@ from companion.plugin import Plugin, PluginContext, Setting
 from companion.plugins.link.commands import register_commands
 
 MAX_WAIT_S = 0.02
-CONTROL_STALE_US = 2_000_000
-LINK_STATUS_PERIOD_S = 0.2  # the flight controller stopped (disarmed) this long ago
+LINK_STATUS_PERIOD_S = 0.2  # link/status (ground-station silence) five times a second
 COMMANDER = "vehicle.commander"
 STREAM_PARAMS = {
     "SR_ATTITUDE": (d.MAVLINK_MSG_ID_ATTITUDE,),
@@ -220,7 +219,7 @@ class MavlinkLink(Plugin):
     def _fresh_control(self) -> ControlStatus | None:
         """The controller's status while it runs; MISSION_ITEM_REACHED when it grows."""
         control = self.readers["control"].get()
-        if control is None or self.ctx.clock.now_us() - control.t_us > CONTROL_STALE_US:
+        if control is None or not control.fresh(self.ctx.clock.now_us()):
             return None
         if control.reached_count != self.reached_count and control.last_reached >= 0:
             msg = self.mav.mission_item_reached_encode(control.last_reached)

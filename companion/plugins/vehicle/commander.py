@@ -17,15 +17,15 @@ from companion.commander import MODE_COMMANDS, Commander
 from companion.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.messages import NAME_LEN, CommandAck, FlightMode, NavFlags, StatusText
 from companion.mission.fence import Fence
-from companion.mission.store import FILES, MissionStore
+from companion.mission.store import MissionStore
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
+from mavlink_dialect import companion as d
 
 WAIT_S = 0.05
 STATUS_PERIOD_US = 250_000  # 4 Hz: the link and the controller follow it
 FENCE_CHECK_US = 1_000_000
 FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) second
-CONTROL_STALE_US = 2_000_000
 
 
 class CommanderPlugin(Plugin):
@@ -40,7 +40,6 @@ class CommanderPlugin(Plugin):
         super().init(ctx)
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
         self.store = MissionStore(state_dir / "missions")
-        self.fence_file = state_dir / "missions" / FILES[1]
         self.fence_stamp: int | None = None
         self.fence = Fence.from_items([])
         # The link writes missions in its own process: read the stored file each time.
@@ -104,12 +103,7 @@ class CommanderPlugin(Plugin):
     def _failsafes(self, now: int, nav: Any) -> bool:
         c = self.commander
         control = self.control.get()
-        flying = (
-            c.armed
-            and control is not None
-            and now - control.t_us < CONTROL_STALE_US
-            and not control.landed
-        )
+        flying = c.armed and control is not None and control.fresh(now) and not control.landed
         link = self.link.get()
         valid = nav is not None and nav.flags & NavFlags.POSITION_VALID
         situation = Situation(
@@ -133,10 +127,7 @@ class CommanderPlugin(Plugin):
     def _fence(self, now: int) -> Fence:
         if now >= self.next_fence_us or now < self.next_fence_us - FENCE_CHECK_US:
             self.next_fence_us = now + FENCE_CHECK_US
-            try:
-                stamp = self.fence_file.stat().st_mtime_ns
-            except FileNotFoundError:
-                stamp = 0
+            stamp = self.store.stamp(d.MAV_MISSION_TYPE_FENCE)
             if stamp != self.fence_stamp:
                 self.fence_stamp = stamp
                 self.fence = Fence.from_items(self.store.reload().items[1])
