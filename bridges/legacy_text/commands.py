@@ -19,6 +19,7 @@ from mavlink_dialect import companion as mavlink
 log = logging.getLogger(__name__)
 
 FORCE_DISARM = 21196.0
+IN_PROGRESS_WAIT_S = 10.0  # after IN_PROGRESS, how long the final answer may take
 RESULT_NAMES = {value: entry.name for value, entry in mavlink.enums["MAV_RESULT"].items()}
 
 
@@ -70,21 +71,25 @@ class CommandSender:
 
     def request(self, word: str, now_s: float) -> None:
         """The ground station sent ``word`` (START or STOP)."""
-        if self.pending is not None:
-            self._finish("SUPERSEDED")
         if word == "START":
-            self.pending = self._arm(word, 1.0, 0.0, "arm")
+            new = self._arm(word, 1.0, 0.0, "arm")
         elif word == "STOP":
             force = FORCE_DISARM if self.force_stop else 0.0
-            self.pending = self._arm(word, 0.0, force, "forced disarm" if force else "disarm")
+            new = self._arm(word, 0.0, force, "forced disarm" if force else "disarm")
         else:
             raise ValueError(f"not a command: {word!r}")
-        self.pending.next_send_s = now_s
+        if self.pending is not None:
+            self._finish("SUPERSEDED")
+        new.next_send_s = now_s
+        self.pending = new
 
     def tick(self, now_s: float) -> CommandLong | None:
         """The command to send now, if one is due."""
         p = self.pending
-        if p is None or p.in_progress or now_s < p.next_send_s:
+        if p is None or now_s < p.next_send_s:
+            return None
+        if p.in_progress:  # the vehicle is working on it: wait for the final answer, bounded
+            self._finish("NO_FINAL_ACK")
             return None
         if p.sends >= self.attempts:
             self._finish("NO_ACK")
@@ -100,6 +105,7 @@ class CommandSender:
             return
         if result == mavlink.MAV_RESULT_IN_PROGRESS:
             p.in_progress = True
+            p.next_send_s = now_s + IN_PROGRESS_WAIT_S
             return
         name = RESULT_NAMES.get(result, str(result))
         armed = p.label == "arm" and result == mavlink.MAV_RESULT_ACCEPTED

@@ -10,6 +10,7 @@ latest attitude, never a backlog.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from bridges.legacy_text.frames import FRAME_BYTES
@@ -27,8 +28,10 @@ def check_rates(rates_hz: dict[str, float], baud: int) -> None:
     if baud <= 0:
         raise ValueError(f"baud rate {baud} must be positive")
     for kind, rate in rates_hz.items():
-        if rate < 0:
-            raise ValueError(f"{kind} rate {rate:g} Hz must not be negative")
+        if not (math.isfinite(rate) and rate >= 0):
+            raise ValueError(
+                f"{kind} rate {rate:g} Hz must be a finite number of frames a second, not negative"
+            )
     total = sum(rates_hz.values())
     capacity = frames_per_second(baud)
     if total > capacity:
@@ -53,17 +56,23 @@ class DownlinkSchedule:
         self.frame_s = 1.0 / frames_per_second(self.baud)
 
     def due(self, now_s: float, ready: set[str]) -> str | None:
-        """The kind to send now, of those with fresh data in ``ready``; the most overdue first."""
-        if now_s < self.wire_free_s:
-            return None
+        """The kind to send now, of those with fresh data in ``ready``; the most overdue first.
+
+        A kind that is due without data waits a whole period: when its data comes back it
+        goes at its rate, not in a burst, and the caller's sleep is never zero.
+        """
         best: str | None = None
         for kind, rate in self.rates_hz.items():
-            if rate <= 0 or kind not in ready:
+            if rate <= 0:
                 continue
-            due = self.next_due_s.get(kind, now_s)
-            if due <= now_s and (best is None or due < self.next_due_s.get(best, now_s)):
+            due = self.next_due_s.setdefault(kind, now_s)
+            if due > now_s:
+                continue
+            if kind not in ready:
+                self.next_due_s[kind] = now_s + 1.0 / rate
+            elif best is None or due < self.next_due_s[best]:
                 best = kind
-        return best
+        return best if now_s >= self.wire_free_s else None
 
     def sent(self, kind: str, now_s: float) -> None:
         """A frame of ``kind`` went out at ``now_s``."""
@@ -75,5 +84,6 @@ class DownlinkSchedule:
 
     def wait_s(self, now_s: float) -> float:
         """Seconds until something could be due (for the caller's sleep)."""
-        soonest = max(self.wire_free_s, min(self.next_due_s.values(), default=now_s))
+        dues = [self.next_due_s.get(k, now_s) for k, r in self.rates_hz.items() if r > 0]
+        soonest = max(self.wire_free_s, min(dues, default=math.inf))
         return max(0.0, soonest - now_s)

@@ -77,10 +77,8 @@ class FrameReader:
     def feed(self, data: bytes, now_s: float) -> list[str]:
         """The commands completed by ``data``, in order."""
         last = self._last_byte_s
-        if data and self._text and last is not None and now_s - last > self.gap_s:
-            self.counts.partial += 1
-            log.debug("partial frame %r dropped after a pause", bytes(self._text))
-            self._text.clear()
+        if data and last is not None and now_s - last > self.gap_s:
+            self._pause()
         if data:
             self._last_byte_s = now_s
         found: list[str] = []
@@ -96,6 +94,14 @@ class FrameReader:
                 self._text.clear()
                 self._skipping = False
         return found
+
+    def _pause(self) -> None:
+        """A silent line ends whatever frame was under way: the next byte starts afresh."""
+        if self._text:
+            self.counts.partial += 1
+            log.debug("partial frame %r dropped after a pause", bytes(self._text))
+            self._text.clear()
+        self._skipping = False
 
     def _printable(self, byte: int) -> None:
         if self._skipping:
