@@ -1,0 +1,1 @@
+"""Flight campaigns: many lockstep simulated flights, scored from the truth, on Ray."""

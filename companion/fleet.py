@@ -1,0 +1,1 @@
+"""Several complete simulated vehicles at once (`companion sim --count N`)."""
