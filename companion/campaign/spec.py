@@ -227,11 +227,9 @@ def _outages(spec: _Spec, value: list) -> tuple[tuple[float, float], ...]:
     out = []
     for o in value:
         if not (isinstance(o, list) and len(o) == 2 and all(isinstance(v, int | float) for v in o)):
-            raise spec.error(
-                ("flights", "gps_outages"), f"an outage is [start_s, seconds], got {o!r}"
-            )
+            raise spec.error(where, f"an outage is [start_s, seconds], got {o!r}")
         if o[0] < 0 or o[1] <= 0:
-            raise spec.error(("flights", "gps_outages"), f"outage {o!r}: start >= 0, length > 0")
+            raise spec.error(where, f"outage {o!r}: start >= 0, length > 0")
         out.append((float(o[0]), float(o[1])))
     return tuple(out)
 
