@@ -25,8 +25,8 @@ NS_OPT = typer.Option("--namespace", "-n", help="bus namespace (default: config 
 EXIT_CONFIG = 2
 
 
-def _setup_logging(level: str) -> None:
-    logging.basicConfig(level=level, format="%(asctime)s exec_control %(levelname)s %(message)s")
+def _setup_logging(level: str, who: str = "exec_control") -> None:
+    logging.basicConfig(level=level, format=f"%(asctime)s {who} %(levelname)s %(message)s")
 
 
 def _load_checked(config: Path, namespace: str | None):
@@ -89,6 +89,53 @@ def _outage(text: str):
     return Outage(start, seconds)
 
 
+def _home(text: str | None):
+    from bridges.jsbsim.fdm import Home
+
+    if text is None:
+        return Home()
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if not 2 <= len(values) <= 4:
+        raise typer.BadParameter("expected LAT,LON[,GROUND_MSL_M[,HEADING_DEG]]")
+    names = ("lat_deg", "lon_deg", "ground_msl_m", "heading_deg")
+    return Home(**dict(zip(names, values, strict=False)))
+
+
+def _single_links(link: list[str] | None, api_port_base: int | None) -> list[str]:
+    """One vehicle: ``--link`` replaces the config's endpoints, as always; an explicit
+    ``--api-port-base`` adds the API port (and the default ground station if no ``--link``)."""
+    from companion.fleet import GCS_LINK
+
+    links = list(link or [])
+    if api_port_base is not None:
+        links = links or [GCS_LINK]
+        links += [f"udpout://127.0.0.1:{api_port_base}"] if api_port_base else []
+    return links
+
+
+def _fleet_settings(config: Path) -> tuple[dict, dict]:
+    from companion.exec_control.config import ConfigError, load_sections
+
+    try:
+        return load_sections(config)
+    except ConfigError as exc:
+        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+
+
+def _run_fleet(req) -> int:
+    from companion.fleet import Fleet
+
+    try:
+        fleet = Fleet(req)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc)) from None
+    return fleet.run()
+
+
 @app.command()
 def sim(
     aircraft: Annotated[str, typer.Option(help="airframe: c172p, J3Cub, or a TOML path")] = "c172p",
@@ -112,32 +159,59 @@ def sim(
     namespace: Annotated[str | None, NS_OPT] = None,
     state_dir: Annotated[str | None, typer.Option(help="parameters and missions dir")] = None,
     log_level: Annotated[str, typer.Option(help="DEBUG, INFO, WARNING")] = "INFO",
+    home: Annotated[
+        str | None, typer.Option(help="LAT,LON[,GROUND_MSL_M[,HEADING_DEG]] of the start")
+    ] = None,
+    sysid: Annotated[
+        int | None, typer.Option(min=1, max=255, help="MAVLink system id (default: config)")
+    ] = None,
+    count: Annotated[
+        int | None, typer.Option(min=1, max=254, help="vehicles to fly (default: [fleet] or 1)")
+    ] = None,
+    spacing: Annotated[
+        float | None, typer.Option(min=0, help="metres east between vehicles (default 50)")
+    ] = None,
+    api_port_base: Annotated[
+        int | None,
+        typer.Option(min=0, max=65535, help="vehicle i also sends to udpout 14540+i-1; 0: none"),
+    ] = None,
 ) -> None:
-    """Fly the whole vehicle in JSBSim: devices on ptys, servos read back, MAVLink out."""
+    """Fly the whole vehicle in JSBSim: devices on ptys, servos read back, MAVLink out.
+
+    With --count N, N vehicles: sysid i, bus NAMESPACE_v<i>, state STATE_DIR/v<i>, each
+    (i-1)*spacing m east of home, all on the --link endpoints, each on its own API port.
+    """
     from bridges.jsbsim.options import BridgeOptions
     from companion.bus.namespace import default_namespace
     from companion.exec_control.config import ConfigError
+    from companion.fleet import GCS_LINK, FleetRequest
     from companion.sim_session import SimRequest, run_sim
 
     _setup_logging(log_level)
     lists = _checked_plan(plan) if plan is not None else None
+    vehicle, fleet = _fleet_settings(config)
     try:
         opts = BridgeOptions(
-            airframe=aircraft,
-            airborne=airborne,
-            speed=_speed(speed),
-            wind_ned=_triple(wind),
-            turbulence=turbulence,
-            outages=[_outage(o) for o in gps_outage or []],
-            noise_scale=noise,
-            seed=seed,
-            duration_s=duration,
-            truth_path=str(truth) if truth else None,
+            airframe=aircraft, home=_home(home), airborne=airborne, speed=_speed(speed),
+            wind_ned=_triple(wind), turbulence=turbulence,
+            outages=[_outage(o) for o in gps_outage or []], noise_scale=noise, seed=seed,
+            duration_s=duration, truth_path=str(truth) if truth else None,
             namespace=namespace or default_namespace(),
-        )
+        )  # fmt: skip
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from None
-    req = SimRequest(config, list(link or []), state_dir, lists)
+    count = count if count is not None else fleet["count"]
+    if count > 1:
+        if sysid is not None:
+            raise typer.BadParameter("a fleet's vehicles are sysid 1..N; --sysid is for one")
+        raise typer.Exit(_run_fleet(FleetRequest(
+            count=count, opts=opts, config=config, links=list(link or [GCS_LINK]),
+            state_dir=Path(state_dir or vehicle["state_dir"]).expanduser(),
+            spacing_m=fleet["spacing_m"] if spacing is None else spacing,
+            api_port_base=fleet["api_port_base"] if api_port_base is None else api_port_base,
+            plan=plan, log_level=log_level,
+        )))  # fmt: skip
+    req = SimRequest(config, _single_links(link, api_port_base), state_dir, lists, sysid)
     try:
         code = run_sim(req, opts, log_level)
     except ConfigError as exc:
@@ -220,28 +294,60 @@ app.add_typer(params_app, name="params")
 
 @app.command()
 def replay(
-    log: Annotated[Path, typer.Argument(help="sensor log CSV (the design's format)")],
-    out_path: Annotated[Path, typer.Option("--out", "-o", help="estimate CSV to write")],
+    logs: Annotated[
+        list[str],
+        typer.Argument(
+            metavar="LOG...",
+            help="sensor log CSVs (the design's format), folders of them or quoted patterns",
+        ),
+    ],
+    out_path: Annotated[
+        Path, typer.Option("--out", "-o", help="estimate CSV to write (a directory for many logs)")
+    ],
     navigator: Annotated[str, typer.Option(help="ins_ekf or gps_compass")] = "ins_ekf",
-    plot: Annotated[Path | None, typer.Option(help="also draw the flight into this PNG")] = None,
+    plot: Annotated[
+        Path | None, typer.Option(help="also draw the flight into this PNG (many: a directory)")
+    ] = None,
     truth: Annotated[Path | None, typer.Option(help="truth CSV to draw beside it")] = None,
     rate: Annotated[float, typer.Option(help="estimate rows per second of log time")] = 50.0,
     declination: Annotated[
         float, typer.Option(help="magnetic declination, degrees east (compass, magnetometer)")
     ] = 0.0,
+    address: Annotated[
+        str | None, typer.Option(help="many logs: Ray cluster address (default: local)")
+    ] = None,
+    cpus: Annotated[int | None, typer.Option(help="many logs: CPUs of the local Ray")] = None,
 ) -> None:
-    """Run a navigator over a recorded sensor log, offline, as fast as it goes."""
-    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+    """Run a navigator over recorded sensor logs, offline, as fast as it goes.
 
+    One log runs here; several (or a folder, or a pattern) run on Ray, one task a log,
+    with an estimate each in the --out directory and a summary table of their health.
+    """
     from companion.estimation.offline import NAVIGATORS
-    from companion.replay import count_rows, replay_log
+    from companion.replay_batch import is_batch
 
     if navigator not in NAVIGATORS:
         raise typer.BadParameter(f"navigator must be one of {', '.join(NAVIGATORS)}")
+    _setup_logging("WARNING")
+    if is_batch(logs):
+        if truth is not None:
+            raise typer.BadParameter("--truth goes with a single log")
+        _replay_batch(logs, out_path, navigator, plot, rate, declination, address, cpus)
+    else:
+        _replay_one(Path(logs[0]), out_path, navigator, plot, truth, rate, declination)
+
+
+def _replay_one(
+    log: Path, out_path: Path, navigator: str, plot: Path | None, truth: Path | None,
+    rate: float, declination: float,
+) -> None:  # fmt: skip
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from companion.replay import count_rows, replay_log
+
     if not log.is_file():
         err.print(f"[red]{log}: no such file[/red]", highlight=False, soft_wrap=True)
         raise typer.Exit(EXIT_CONFIG)
-    _setup_logging("WARNING")
     fixes: list = []
     percent = TextColumn("{task.percentage:>3.0f}%")
     columns = (TextColumn("{task.description}"), BarColumn(), percent, TimeRemainingColumn())
@@ -263,6 +369,30 @@ def replay(
         plot_replay(states, plot, f"{log.name}: {navigator}", fixes,
                     read_estimate(truth) if truth else None)  # fmt: skip
         err.print(f"plot written to {plot}")
+
+
+def _replay_batch(
+    args: list[str], out_dir: Path, navigator: str, plot: Path | None, rate: float,
+    declination: float, address: str | None, cpus: int | None,
+) -> None:  # fmt: skip
+    from companion.replay_batch import (
+        SUMMARY_NAME,
+        LogsError,
+        find_logs,
+        replay_logs,
+        summary_table,
+    )  # fmt: skip
+
+    try:
+        logs = find_logs(args, out_dir)
+    except LogsError as exc:
+        err.print(f"[red]{exc}[/red]", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+    rows = replay_logs(logs, out_dir, navigator, rate, declination, plot, address, cpus, err)
+    out.print(summary_table(rows, f"{navigator} over {len(rows)} logs"))
+    failed = sum(1 for r in rows if r.error)
+    out.print(f"{len(rows) - failed} ok, {failed} failed; summary {out_dir / SUMMARY_NAME}")
+    raise typer.Exit(1 if failed else 0)
 
 
 def _print_replay_summary(s) -> None:
@@ -364,6 +494,37 @@ def mission_save(
     store = _mission_store(config)
     save_plan(plan, store.items)
     out.print(f"{len(store.items[0])} mission items written to {plan}")
+
+
+@app.command()
+def campaign(
+    spec_file: Annotated[Path, typer.Argument(metavar="SPEC.toml", help="the campaign spec")],
+    results: Annotated[
+        Path | None, typer.Option("--out", help="results dir (default SPEC_results/)")
+    ] = None,
+    address: Annotated[str | None, typer.Option(help="Ray cluster (default: a local one)")] = None,
+    cpus: Annotated[int | None, typer.Option(help="CPUs of the local Ray instance")] = None,
+    retry_failed: Annotated[bool, typer.Option(help="fly failed flights again")] = False,
+    log_level: Annotated[str, typer.Option(help="DEBUG, INFO, WARNING")] = "WARNING",
+) -> None:
+    """Fly every flight of a campaign in lockstep simulation on Ray; score, tabulate, report."""
+    from companion.campaign.runner import run_campaign
+    from companion.campaign.spec import load_spec
+    from companion.exec_control.config import ConfigError
+
+    _setup_logging(log_level, "campaign")
+    try:
+        spec = load_spec(spec_file)
+    except ConfigError as exc:
+        err.print(f"[red]campaign spec error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+    out_dir = results or Path(f"{spec_file.stem}_results")
+    outcome = run_campaign(spec, out_dir, address, cpus, retry_failed, console=err)
+    out.print(
+        f"{outcome.flown} flown ({outcome.failed} failed), {outcome.skipped} already done; "
+        f"results {outcome.results}" + (f", report {outcome.report}" if outcome.report else "")
+    )
+    raise typer.Exit(1 if outcome.failed else 0)
 
 
 def main() -> None:

@@ -34,7 +34,7 @@ from mavlink_dialect import companion as d
 
 log = logging.getLogger(__name__)
 GCS_SYSID, GCS_COMPID = 255, 190
-SILENT_S = 60.0  # no MAVLink from the vehicle this long (wall): it has stalled
+SILENT_S = 45.0  # no MAVLink from the vehicle this long (wall): it has stalled
 TAIL_S = 1.0  # keep flying this long (wall) after completion: the loiter at home is in the truth
 FAILSAFE_PREFIXES = ("Failsafe", "Fence breached")
 
@@ -89,6 +89,12 @@ def fly_flight(job: FlightJob) -> dict[str, Any]:
     return row
 
 
+def failed_row(job: FlightJob, error: str) -> dict[str, Any]:
+    """The row of a flight whose task itself failed (the worker died, it was cancelled)."""
+    folder = Path(job.out_dir) / job.flight.flight_id
+    return _row(job.flight, folder, Timeline(), error, math.nan)
+
+
 def _row(flight: Flight, folder: Path, tl: Timeline, error: str, wall_s: float) -> dict[str, Any]:
     score = TrackScore(math.nan, math.nan, math.nan, math.nan, 0)
     truth_path = folder / "truth.csv"
@@ -104,6 +110,7 @@ def _row(flight: Flight, folder: Path, tl: Timeline, error: str, wall_s: float) 
     return {
         "flight_id": flight.flight_id,
         "plan": Path(flight.plan).stem,
+        "plan_path": flight.plan,
         "airframe": flight.airframe,
         "condition": flight.condition,
         "wind_n": flight.wind_ned[0], "wind_e": flight.wind_ned[1], "wind_d": flight.wind_ned[2],

@@ -14,6 +14,7 @@ winds = [[0, 0, 0], [0, 5, 0]]                # N, E, D m/s (blowing towards)
 turbulence = ["none", "light"]
 gps_outages = [[], [[120, 30]]]               # each: a list of [start_s, seconds]
 seeds = [1, 2, 3]
+configs = ["", "gps_compass.toml"]            # vehicle configs ("": the shipped sim.toml)
 ```
 Errors name the file, the line and the key, as the vehicle config's do.
 """
@@ -48,7 +49,6 @@ _CAMPAIGN_KEYS: dict[str, Any] = {
     "max_sim_s": 900.0,
     "cpus_per_flight": 1.0,
     "airborne": False,
-    "config": "",
 }
 _FLIGHT_KEYS: dict[str, Any] = {
     "plans": None,  # required
@@ -57,6 +57,7 @@ _FLIGHT_KEYS: dict[str, Any] = {
     "turbulence": ["none"],
     "gps_outages": [[]],
     "seeds": [1],
+    "configs": [""],  # vehicle configs; "" is the shipped sim.toml
 }
 
 
@@ -197,13 +198,21 @@ def _grid(spec: _Spec, camp: dict, dims: dict) -> list[Flight]:
             raise spec.error(("flights", "turbulence"), f"{t!r} is not one of {list(TURBULENCE)}")
     outages = [_outages(spec, o) for o in _list(spec, dims, "gps_outages", list)]
     seeds = _list(spec, dims, "seeds", int)
-    config = str(_beside(spec.path, camp["config"])) if camp["config"] else str(SIM_CONFIG)
+    configs = [_config(spec, c) for c in _list(spec, dims, "configs", str)]
+    grid = itertools.product(plans, airframes, winds, turbulence, outages, seeds, configs)
     return [
-        Flight(str(p), a, w, t, o, s, config, camp["airborne"], float(camp["max_sim_s"]))
-        for p, a, w, t, o, s in itertools.product(
-            plans, airframes, winds, turbulence, outages, seeds
-        )
+        Flight(str(p), a, w, t, o, s, c, camp["airborne"], float(camp["max_sim_s"]))
+        for p, a, w, t, o, s, c in grid
     ]
+
+
+def _config(spec: _Spec, name: str) -> str:
+    if not name:
+        return str(SIM_CONFIG)
+    path = _beside(spec.path, name)
+    if not path.is_file():
+        raise spec.error(("flights", "configs"), f"{name!r}: no such vehicle config")
+    return str(path)
 
 
 def _list(spec: _Spec, dims: dict, key: str, kind: type) -> list:
