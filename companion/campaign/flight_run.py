@@ -34,7 +34,6 @@ from mavlink_dialect import companion as d
 
 log = logging.getLogger(__name__)
 GCS_SYSID, GCS_COMPID = 255, 190
-SILENT_S = 45.0  # no MAVLink from the vehicle this long (wall): it has stalled
 TAIL_S = 1.0  # keep flying this long (wall) after completion: the loiter at home is in the truth
 FAILSAFE_PREFIXES = ("Failsafe", "Fence breached")
 
@@ -70,6 +69,7 @@ class FlightJob:
     flight: Flight
     out_dir: str
     timeout_s: float
+    silent_s: float = 45.0  # no MAVLink from the vehicle this long (wall): it has stalled
 
 
 def fly_flight(job: FlightJob) -> dict[str, Any]:
@@ -81,7 +81,7 @@ def fly_flight(job: FlightJob) -> dict[str, Any]:
     timeline = Timeline()
     error = ""
     try:
-        _fly(flight, folder, job.timeout_s, timeline)
+        _fly(job, folder, timeline)
     except FlightError as exc:
         error = str(exc)
     (folder / "timeline.json").write_text(json.dumps(timeline.__dict__, indent=1))
@@ -130,7 +130,8 @@ def _row(flight: Flight, folder: Path, tl: Timeline, error: str, wall_s: float) 
     }  # fmt: skip
 
 
-def _fly(flight: Flight, folder: Path, timeout_s: float, tl: Timeline) -> None:
+def _fly(job: FlightJob, folder: Path, tl: Timeline) -> None:
+    flight = job.flight
     port = _free_udp_port()
     namespace = f"camp{os.getpid()}p{port}"
     gcs = mavutil.mavlink_connection(
@@ -143,7 +144,7 @@ def _fly(flight: Flight, folder: Path, timeout_s: float, tl: Timeline) -> None:
             stderr=subprocess.STDOUT, start_new_session=True,
         )  # fmt: skip
         try:
-            _Pilot(gcs, proc, time.monotonic() + timeout_s, tl).fly()
+            _Pilot(gcs, proc, time.monotonic() + job.timeout_s, tl, job.silent_s).fly()
         finally:
             _end(proc)
             gcs.close()
@@ -170,8 +171,11 @@ def _sim_command(flight: Flight, folder: Path, port: int, namespace: str) -> lis
 class _Pilot:
     """The ground station's side: heartbeats, arm, start, follow the mission."""
 
-    def __init__(self, gcs: Any, proc: subprocess.Popen, deadline: float, tl: Timeline) -> None:
+    def __init__(
+        self, gcs: Any, proc: subprocess.Popen, deadline: float, tl: Timeline, silent_s: float
+    ) -> None:
         self.gcs, self.proc, self.deadline, self.tl = gcs, proc, deadline, tl
+        self.silent_s = silent_s
         self.heard = time.monotonic()
         self.next_beat = 0.0
 
@@ -235,8 +239,8 @@ class _Pilot:
     def _check_alive(self, now: float) -> None:
         if self.proc.poll() is not None:
             raise FlightError(f"the simulation ended (exit {self.proc.returncode}) before the end")
-        if now - self.heard > SILENT_S:
-            raise FlightError(f"hung: the vehicle was silent for {SILENT_S:.0f} s")
+        if now - self.heard > self.silent_s:
+            raise FlightError(f"hung: the vehicle was silent for {self.silent_s:.0f} s")
 
     def _note(self, msg: Any) -> None:
         ms = getattr(msg, "time_boot_ms", None)

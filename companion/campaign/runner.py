@@ -48,7 +48,8 @@ def run_campaign(
     table = ResultsTable(out_dir / "results.csv")
     done = table.done_ids(retry_failed)
     todo = [f for f in spec.flights if f.flight_id not in done]
-    jobs = [FlightJob(f, str(out_dir / "flights"), spec.flight_timeout_s) for f in todo]
+    folder = str(out_dir / "flights")
+    jobs = [FlightJob(f, folder, spec.flight_timeout_s, spec.silent_s) for f in todo]
     skipped = len(spec.flights) - len(todo)
     if skipped:
         log.info("%d flights already done: skipped", skipped)

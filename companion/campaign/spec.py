@@ -5,6 +5,7 @@
 name = "airframes-in-wind"
 mode = "grid"             # or "random": `samples` flights drawn from the grid (sample_seed)
 flight_timeout_s = 600    # wall seconds; a flight still running then is hung: failed
+silent_s = 45             # wall seconds without MAVLink from the vehicle: hung, failed
 max_sim_s = 900           # simulated seconds to complete the mission in
 
 [flights]                 # every list is one dimension of the grid
@@ -49,6 +50,7 @@ _CAMPAIGN_KEYS: dict[str, Any] = {
     "max_sim_s": 900.0,
     "cpus_per_flight": 1.0,
     "airborne": False,
+    "silent_s": 45.0,
 }
 _FLIGHT_KEYS: dict[str, Any] = {
     "plans": None,  # required
@@ -111,6 +113,7 @@ class CampaignSpec:
     flights: list[Flight]
     flight_timeout_s: float
     cpus_per_flight: float
+    silent_s: float = 45.0
 
 
 class _Spec:
@@ -175,10 +178,11 @@ def load_spec(path: str | Path) -> CampaignSpec:
             raise spec.error(("campaign", "samples"), "random mode needs samples > 0")
         rng = random.Random(camp["sample_seed"])
         flights = rng.sample(flights, min(camp["samples"], len(flights)))
-    if camp["flight_timeout_s"] <= 0 or camp["cpus_per_flight"] <= 0:
-        raise spec.error(("campaign",), "flight_timeout_s and cpus_per_flight must be positive")
+    for key in ("flight_timeout_s", "cpus_per_flight", "silent_s"):
+        if camp[key] <= 0:
+            raise spec.error(("campaign", key), f"{key} must be positive")
     return CampaignSpec(path, camp["name"], flights, float(camp["flight_timeout_s"]),
-                        float(camp["cpus_per_flight"]))  # fmt: skip
+                        float(camp["cpus_per_flight"]), float(camp["silent_s"]))  # fmt: skip
 
 
 def _grid(spec: _Spec, camp: dict, dims: dict) -> list[Flight]:

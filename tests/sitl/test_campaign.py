@@ -1,0 +1,93 @@
+"""``companion campaign``: a handful of lockstep flights on a local Ray instance.
+
+Two flights fly qgc_plans/short_leg.plan (calm, and a 4 m/s crosswind); two more use a
+vehicle config without its MAVLink link, so the ground station never hears them: they
+hang, and must be recorded as failed with their logs while the campaign finishes. A
+rerun flies nothing.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import psutil
+
+from tests.support.vehicle import REPO, companion_env
+
+SPEC = """
+[campaign]
+name = "small"
+flight_timeout_s = 300
+silent_s = 25
+
+[flights]
+plans = ["short_leg.plan"]
+airframes = ["c172p"]
+winds = [[0, 0, 0], [0, 4, 0]]
+seeds = [3]
+configs = ["", "silent.toml"]
+"""
+
+
+def silent_config(path: Path) -> None:
+    """The shipped simulation config less its link plug-in: a vehicle nobody hears."""
+    text = (REPO / "companion" / "configs" / "sim.toml").read_text()
+    head, link, rest = text.partition('[[plugins]]\nname = "link"')
+    assert link, "sim.toml has a link plug-in"
+    path.write_text(head + rest[rest.index("[[plugins]]") :])
+
+
+def campaign(spec: Path, out: Path) -> subprocess.CompletedProcess:
+    args = [str(spec), "--out", str(out), "--cpus", "2"]
+    return subprocess.run(
+        [sys.executable, "-m", "companion", "campaign", *args],
+        env=companion_env("campaign_driver"),
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
+
+
+def rows(out: Path) -> list[dict[str, str]]:
+    with (out / "results.csv").open(newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_a_small_campaign_scores_each_flight_and_survives_hung_ones(tmp_path):
+    spec = tmp_path / "small.toml"
+    spec.write_text(SPEC)
+    silent_config(tmp_path / "silent.toml")
+    out = tmp_path / "results"
+    done = campaign(spec, out)
+    assert done.returncode == 1, done.stdout + done.stderr  # two flights failed
+    table = rows(out)
+    assert len(table) == 4 and len({r["flight_id"] for r in table}) == 4
+    flown = [r for r in table if r["config"] == "sim.toml"]
+    hung = [r for r in table if r["config"] == "silent.toml"]
+    assert {r["condition"] for r in flown} == {"calm none", "wind 0,4,0 none"}
+    for row in flown:
+        assert row["status"] == "ok" and row["completed"] == "True", row
+        assert float(row["xtrack_rms_m"]) < 10.0 and float(row["xtrack_p95_m"]) < 15.0
+        assert float(row["alt_rms_m"]) < 5.0 and int(row["samples"]) > 100
+        assert 60.0 < float(row["time_to_complete_s"]) < float(row["sim_s"])
+        assert row["failsafes"] == ""
+    for row in hung:
+        assert row["status"] == "failed" and "hung" in row["error"], row
+        assert math.isnan(float(row["xtrack_rms_m"]))
+        assert Path(row["log"]).is_file()
+    assert (out / "report.html").read_text().count("<tr>") == 5  # header and four flights
+    assert (out / "distributions.png").stat().st_size > 0
+    assert (out / "worst_tracks.png").stat().st_size > 0
+    procs = psutil.process_iter(["cmdline"])
+    left = [p for p in procs if str(out) in " ".join(p.info["cmdline"] or [])]
+    assert not left, "a flight's processes outlived the campaign"
+    assert not [p for p in Path("/dev/shm").iterdir() if p.name.startswith("cmp_camp")]
+
+    again = campaign(spec, out)
+    assert "0 flown (0 failed), 4 already done" in again.stdout
+    assert rows(out) == table
