@@ -56,6 +56,7 @@ class VehicleConfig:
     clock: str
     plugins: list[PluginSpec] = field(default_factory=list)
     vehicle: dict[str, Any] = field(default_factory=dict)
+    fleet: dict[str, Any] = field(default_factory=dict)  # only `companion sim` reads it
 
 
 _VEHICLE_KEYS: dict[str, Setting] = {
@@ -67,6 +68,15 @@ _VEHICLE_KEYS: dict[str, Setting] = {
         str, "", "where parameters and missions persist (default ~/.local/state/companion/NAME)"
     ),
 }
+# `companion sim` flies this many copies of the vehicle; `companion run` ignores the table.
+_FLEET_KEYS: dict[str, Setting] = {
+    "count": Setting(int, 1, "vehicles `companion sim` starts", min=1, max=254),
+    "spacing_m": Setting(float, 50.0, "vehicle i starts (i-1) * spacing_m east of home", min=0.0),
+    "api_port_base": Setting(
+        int, 14540, "vehicle i also sends to udpout 127.0.0.1:base+i-1 (0: none)", min=0, max=65535
+    ),
+}
+_TABLES = ["vehicle", "plugins", "fleet"]
 _PLUGIN_KEYS = ("name", "plugin", "group", "settings")
 
 
@@ -122,15 +132,7 @@ class _Checker:
         return value
 
 
-def load_config(
-    path: str | Path, namespace: str | None = None, sim_refs: Mapping[str, str] | None = None
-) -> VehicleConfig:
-    """Read, parse and check the config; raise ConfigError on the first problem.
-
-    A setting written ``"sim://NAME"`` takes the value ``sim_refs[NAME]``: the simulator's
-    device paths and the airframe, known only once ``companion sim`` has started it.
-    """
-    path = Path(path)
+def _parse(path: Path) -> tuple[_Checker, dict[str, Any]]:
     try:
         text = path.read_text()
     except FileNotFoundError:
@@ -143,14 +145,45 @@ def load_config(
         line = getattr(exc, "lineno", None)
         raise ConfigError(path, line, "", f"not valid TOML: {exc}") from None
     check = _Checker(path, text)
-    check.sim_refs = sim_refs
-    check.unknown_keys(data, ["vehicle", "plugins"], ())
-    vehicle = data.get("vehicle", {})
-    if not isinstance(vehicle, dict):
-        raise check.error(("vehicle",), "must be a table: [vehicle]")
-    vehicle = check.values(vehicle, _VEHICLE_KEYS, ("vehicle",))
+    check.unknown_keys(data, _TABLES, ())
+    return check, data
+
+
+def _table(check: _Checker, data: dict[str, Any], name: str, decl: dict[str, Setting]) -> dict:
+    table = data.get(name, {})
+    if not isinstance(table, dict):
+        raise check.error((name,), f"must be a table: [{name}]")
+    return check.values(table, decl, (name,))
+
+
+def _vehicle_and_fleet(check: _Checker, data: dict[str, Any]) -> tuple[dict, dict]:
+    vehicle = _table(check, data, "vehicle", _VEHICLE_KEYS)
     if not vehicle["state_dir"]:
         vehicle["state_dir"] = str(Path("~/.local/state/companion").expanduser() / vehicle["name"])
+    return vehicle, _table(check, data, "fleet", _FLEET_KEYS)
+
+
+def load_sections(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The checked ``[vehicle]`` and ``[fleet]`` tables, defaults filled in.
+
+    ``companion sim`` needs them before the simulator exists, when the plug-ins' ``sim://``
+    settings cannot be resolved yet; the rest of the file is checked when each vehicle starts.
+    """
+    return _vehicle_and_fleet(*_parse(Path(path)))
+
+
+def load_config(
+    path: str | Path, namespace: str | None = None, sim_refs: Mapping[str, str] | None = None
+) -> VehicleConfig:
+    """Read, parse and check the config; raise ConfigError on the first problem.
+
+    A setting written ``"sim://NAME"`` takes the value ``sim_refs[NAME]``: the simulator's
+    device paths and the airframe, known only once ``companion sim`` has started it.
+    """
+    path = Path(path)
+    check, data = _parse(path)
+    check.sim_refs = sim_refs
+    vehicle, fleet = _vehicle_and_fleet(check, data)
     ns = namespace or vehicle["namespace"] or None
     if ns is not None:
         try:
@@ -166,6 +199,7 @@ def load_config(
         clock=vehicle["clock"],
         plugins=specs,
         vehicle=vehicle,
+        fleet=fleet,
     )
 
 
