@@ -106,6 +106,7 @@ class SimRequest:
     links: list[str]
     state_dir: str | None = None
     plan: dict[int, list[MissionItem]] | None = None  # checked .plan lists to preload
+    sysid: int | None = None  # overrides the config's [vehicle] sysid (one of a fleet)
 
 
 def vehicle_config(req: SimRequest, opts: BridgeOptions, devices: dict[str, str]) -> VehicleConfig:
@@ -116,6 +117,9 @@ def vehicle_config(req: SimRequest, opts: BridgeOptions, devices: dict[str, str]
             spec.settings["endpoints"] = list(req.links)
     if req.state_dir:
         cfg.vehicle["state_dir"] = req.state_dir
+    if req.sysid is not None:
+        cfg.vehicle["sysid"] = req.sysid  # what the link plug-in reads
+        cfg = dataclasses.replace(cfg, sysid=req.sysid)
     if req.plan is not None:
         store = MissionStore(Path(cfg.vehicle["state_dir"]) / "missions")
         for mission_type, items in req.plan.items():
@@ -186,9 +190,14 @@ def _t_us(sample: object) -> int:
     return 0 if sample is None else int(sample.t_us)
 
 
-def status_line(t_us: int, factor: float, health: object, truth: object) -> str:
-    """``sim 12.3 s  x24.1  ARMED  alt 123 m  air 50.2 m/s  -37.91050 145.13400``."""
+def status_line(t_us: int, factor: float, health: object, truth: object, mode: str = "") -> str:
+    """``sim 12.3 s  x24.1  ARMED  alt 123 m  air 50.2 m/s  -37.91050 145.13400``.
+
+    A mode name, when given, follows the arm state (the fleet's lines carry it).
+    """
     armed = "ARMED" if health is not None and health.flight_running else "disarmed"
+    if mode:
+        armed = f"{armed:8s}  {mode:10s}"
     if truth is None:
         return f"sim {t_us / 1e6:7.1f} s  x{factor:5.1f}  {armed}"
     return (
