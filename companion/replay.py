@@ -19,6 +19,9 @@ from companion.messages import GpsFix, Message, NavFlags, NavState
 from companion.sensorlog import LogStats, read_sensor_log
 
 PROGRESS_ROWS = 2000
+# A gap between fixes counts as an outage beyond this: twice the period of the slowest
+# GPS receivers logged (1 Hz), so ordinary jitter is never one.
+OUTAGE_MIN_S = 2.0
 _POSITION_VALID = int(NavFlags.POSITION_VALID)
 
 
@@ -35,8 +38,14 @@ class ReplaySummary:
     wall_seconds: float = 0.0
     gps_rejected: int = 0
     heading_rejected: int = 0
-    longest_outage_s: float = 0.0
-    final_pos_std_m: float = math.nan
+    longest_outage_s: float = 0.0  # longest gap between fixes, outage or not
+    outages: int = 0  # gaps longer than OUTAGE_MIN_S
+    outage_total_s: float = 0.0
+    final_pos_std_m: float = math.nan  # horizontal 1-sigma
+    final_alt_std_m: float = math.nan
+    final_vel_std_m_s: float = math.nan
+    final_tilt_std_deg: float = math.nan  # the larger of roll and pitch
+    final_yaw_std_deg: float = math.nan
     flagged: dict[str, int] = field(default_factory=dict)
 
     @property
@@ -63,7 +72,11 @@ def _watch_gps(
             if fixes is not None:
                 fixes.append(sample)
             if last is not None:
-                summary.longest_outage_s = max(summary.longest_outage_s, (sample.t_us - last) / 1e6)
+                gap = (sample.t_us - last) / 1e6
+                summary.longest_outage_s = max(summary.longest_outage_s, gap)
+                if gap > OUTAGE_MIN_S:
+                    summary.outages += 1
+                    summary.outage_total_s += gap
             last = sample.t_us
         yield sample
 
@@ -120,6 +133,13 @@ def _summarise(summary: ReplaySummary, stats: LogStats, rows: int, states: list[
     summary.log_seconds = (end.t_us - states[0].t_us) / 1e6
     summary.gps_rejected, summary.heading_rejected = end.gps_rejected, end.heading_rejected
     summary.final_pos_std_m = math.hypot(end.pos_std_m[0], end.pos_std_m[1])
+    summary.final_alt_std_m = end.pos_std_m[2]
+    summary.final_vel_std_m_s = math.hypot(*end.vel_std_m_s)
+    # A navigator that does not estimate its attitude's uncertainty leaves it at zero,
+    # which no filter's sigma ever is: unknown, not perfect.
+    if any(end.att_std_rad):
+        summary.final_tilt_std_deg = math.degrees(max(end.att_std_rad[0], end.att_std_rad[1]))
+        summary.final_yaw_std_deg = math.degrees(end.att_std_rad[2])
     for flag in (NavFlags.DEAD_RECKONING, NavFlags.GPS_REJECTED, NavFlags.ALIGNING):
         bit = int(flag)
         summary.flagged[str(flag.name)] = sum(1 for s in states if s.flags & bit)
