@@ -297,7 +297,7 @@ def replay(
     logs: Annotated[
         list[str],
         typer.Argument(
-            metavar="LOG...",
+            metavar="LOG",
             help="sensor log CSVs (the design's format), folders of them or quoted patterns",
         ),
     ],
@@ -320,8 +320,7 @@ def replay(
 ) -> None:
     """Run a navigator over recorded sensor logs, offline, as fast as it goes.
 
-    One log runs here; several (or a folder, or a pattern) run on Ray, one task a log,
-    with an estimate each in the --out directory and a summary table of their health.
+    Several logs, a folder or a pattern run on Ray; --out is then a directory.
     """
     from companion.estimation.offline import NAVIGATORS
     from companion.replay_batch import is_batch
