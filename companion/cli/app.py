@@ -1,0 +1,50 @@
+"""The ``companion`` command's app, consoles and the helpers every command shares."""
+
+from __future__ import annotations
+
+import logging
+import sys
+from pathlib import Path
+
+import typer
+from rich.console import Console
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="On-board software of a MAVLink-speaking fixed-wing UAV companion computer.",
+)
+err = Console(stderr=True)
+# A pipe gets a wide console so the status table is not folded into unreadable columns.
+out = Console() if sys.stdout.isatty() else Console(width=200)
+
+CONFIG_OPT = typer.Option("--config", "-c", help="vehicle config (TOML)")
+NS_OPT = typer.Option("--namespace", "-n", help="bus namespace (default: config or $COMPANION_BUS)")
+EXIT_CONFIG = 2
+
+
+def setup_logging(level: str, who: str = "exec_control") -> None:
+    logging.basicConfig(level=level, format=f"%(asctime)s {who} %(levelname)s %(message)s")
+
+
+def load_checked(config: Path, namespace: str | None):
+    from companion.exec_control.config import ConfigError, load_config
+    from companion.exec_control.topology import check_topology
+
+    try:
+        cfg = load_config(config, namespace)
+        check_topology(cfg)
+    except ConfigError as exc:
+        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+    return cfg
+
+
+def plan_or_exit(plan: Path):
+    from companion.mission.plan import PlanError, checked_plan
+
+    try:
+        return checked_plan(plan)
+    except PlanError as exc:
+        err.print(f"[red]plan error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None

@@ -1,0 +1,156 @@
+"""``companion run``, ``status``, ``graph``, and the stopped vehicle's parameters and missions."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from companion.cli.app import (
+    CONFIG_OPT,
+    EXIT_CONFIG,
+    NS_OPT,
+    app,
+    err,
+    load_checked,
+    out,
+    plan_or_exit,
+    setup_logging,
+)
+
+
+@app.command()
+def run(
+    config: Annotated[Path, CONFIG_OPT],
+    namespace: Annotated[str | None, NS_OPT] = None,
+    log_level: Annotated[str, typer.Option(help="DEBUG, INFO, WARNING")] = "INFO",
+) -> None:
+    """Run the vehicle: every plug-in of the config in its own process, supervised."""
+    from companion.exec_control.supervisor import Supervisor
+
+    setup_logging(log_level)
+    cfg = load_checked(config, namespace)
+    raise typer.Exit(Supervisor(cfg, log_level).run())
+
+
+@app.command()
+def graph(
+    config: Annotated[Path, CONFIG_OPT],
+    namespace: Annotated[str | None, NS_OPT] = None,
+) -> None:
+    """Check a config and print its channel graph (who writes and reads each channel)."""
+    from companion.exec_control.topology import graph_lines
+
+    cfg = load_checked(config, namespace)
+    out.print(f"{cfg.path}: vehicle {cfg.name!r}, sysid {cfg.sysid}, bus {cfg.namespace!r}")
+    for spec in cfg.plugins:
+        out.print(f"  {spec.name:16} {spec.kind:28} {spec.group}")
+    for line in graph_lines(cfg):
+        out.print(line, highlight=False)
+
+
+@app.command()
+def status(
+    namespace: Annotated[str | None, NS_OPT] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="machine-readable output")] = False,
+    timeout: Annotated[float, typer.Option(help="seconds to wait for the table")] = 3.0,
+) -> None:
+    """Print the health table of a running vehicle (read from its bus)."""
+    from companion.bus import default_namespace
+    from companion.status_view import health_dict, health_table, read_health
+
+    ns = namespace or default_namespace()
+    msg = read_health(ns, timeout)
+    if msg is None:
+        err.print(f"no vehicle is publishing system/health on bus {ns!r}")
+        raise typer.Exit(1)
+    if as_json:
+        sys.stdout.write(json.dumps(health_dict(msg), indent=2) + "\n")
+    else:
+        out.print(health_table(msg))
+
+
+params_app = typer.Typer(help="Parameters in QGroundControl .params files (vehicle stopped).")
+app.add_typer(params_app, name="params")
+
+
+def _param_store(config: Path, namespace: str | None):
+    from companion.params import ParamStore
+
+    cfg = load_checked(config, namespace)
+    decls = [d for spec in cfg.plugins for d in spec.params]
+    return cfg, ParamStore(decls, Path(cfg.vehicle["state_dir"]) / "params.json")
+
+
+@params_app.command("save")
+def params_save(
+    file: Annotated[Path, typer.Argument(help=".params file to write")],
+    config: Annotated[Path, CONFIG_OPT],
+) -> None:
+    """Write the vehicle's stored parameters to a .params file."""
+    from companion.params.qgc_file import save_params
+
+    cfg, store = _param_store(config, None)
+    save_params(store, file, sysid=cfg.sysid)
+    out.print(f"{len(store)} parameters written to {file}")
+
+
+@params_app.command("load")
+def params_load(
+    file: Annotated[Path, typer.Argument(help=".params file to read")],
+    config: Annotated[Path, CONFIG_OPT],
+) -> None:
+    """Check a .params file against the config's declarations and store it (all or nothing)."""
+    from companion.params import ParamError
+    from companion.params.qgc_file import load_params
+
+    _, store = _param_store(config, None)
+    try:
+        count = load_params(store, file)
+    except (ParamError, OSError) as exc:
+        err.print(f"[red]params error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+    out.print(f"{count} parameters loaded from {file} into {store.path}")
+
+
+mission_app = typer.Typer(help="Missions in QGroundControl .plan files (vehicle stopped).")
+app.add_typer(mission_app, name="mission")
+
+
+def _mission_store(config: Path):
+    from companion.mission.store import MissionStore
+
+    cfg = load_checked(config, None)
+    return MissionStore(Path(cfg.vehicle["state_dir"]) / "missions")
+
+
+@mission_app.command("load")
+def mission_load(
+    plan: Annotated[Path, typer.Argument(help=".plan file to store as the vehicle's mission")],
+    config: Annotated[Path, CONFIG_OPT],
+) -> None:
+    """Check a .plan (mission, fence, rally) and store it; all or nothing."""
+    store = _mission_store(config)
+    lists = plan_or_exit(plan)
+    for mission_type, items in lists.items():
+        store.replace(mission_type, items)
+    counts = ", ".join(
+        f"{len(v)} {k}" for k, v in zip(("mission", "fence", "rally"), lists.values(), strict=False)
+    )
+    out.print(f"stored {counts} items from {plan}")
+
+
+@mission_app.command("save")
+def mission_save(
+    plan: Annotated[Path, typer.Argument(help=".plan file to write")],
+    config: Annotated[Path, CONFIG_OPT],
+) -> None:
+    """Write the vehicle's stored mission and rally points as a .plan file."""
+    from companion.mission.plan import save_plan
+
+    store = _mission_store(config)
+    save_plan(plan, store.items)
+    out.print(f"{len(store.items[0])} mission items written to {plan}")
