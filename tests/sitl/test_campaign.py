@@ -3,7 +3,7 @@
 Two flights fly qgc_plans/short_leg.plan (calm, and a 4 m/s crosswind); two more use a
 vehicle config without its MAVLink link, so the ground station never hears them: they
 hang, and must be recorded as failed with their logs while the campaign finishes. A
-rerun flies nothing.
+rerun flies nothing. A flight whose vehicle cannot start is failed with the reason.
 """
 
 from __future__ import annotations
@@ -16,6 +16,8 @@ from pathlib import Path
 
 import psutil
 
+from companion.campaign.flight_run import FlightJob, fly_flight
+from companion.campaign.spec import Flight
 from tests.support.vehicle import REPO, companion_env
 
 SPEC = """
@@ -91,3 +93,15 @@ def test_a_small_campaign_scores_each_flight_and_survives_hung_ones(tmp_path):
     again = campaign(spec, out)
     assert "0 flown (0 failed), 4 already done" in again.stdout
     assert rows(out) == table
+
+
+def test_a_flight_whose_vehicle_cannot_start_is_failed_with_its_log(tmp_path):
+    broken = tmp_path / "broken.toml"
+    broken.write_text('[vehicle]\nname = "sim"\nclokc = "sim"\n')  # a typo: the vehicle refuses
+    flight = Flight(str(REPO / "qgc_plans" / "short_leg.plan"), "c172p", (0.0, 0.0, 0.0), "none",
+                    (), 1, str(broken), False, 600.0)  # fmt: skip
+    row = fly_flight(FlightJob(flight, str(tmp_path / "flights"), timeout_s=120.0, silent_s=60.0))
+    assert row["status"] == "failed" and "the simulation ended (exit 2)" in row["error"], row
+    assert row["completed"] is False and math.isnan(row["xtrack_p95_m"])
+    log = Path(row["log"]).read_text()
+    assert "clokc" in log and "did you mean 'clock'" in log
