@@ -229,6 +229,7 @@ class CommandId(enum.IntEnum):
     RESTART_PLUGINS = 7  # restart every plug-in (MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN)
     LOITER = 8  # param1..3 = lat_deg, lon_deg, alt_msl_m (NaN: where it is)
     SET_HOME = 9  # param1 = 1: here; else param5..7 = lat_deg, lon_deg, alt_msl_m
+    INJECT_FAILURE = 10  # param1..3 = MAVLink FAILURE_UNIT, FAILURE_TYPE, instance (simulator)
 
 
 class CommandResult(enum.IntEnum):
@@ -256,7 +257,8 @@ class VehicleCommand(Message):
 
 
 class CommandAck(Message):
-    """Outcome of a VehicleCommand. Producers: exec_control, control. Consumers: link."""
+    """Outcome of a VehicleCommand. Producers: exec_control, commander, the simulator bridge.
+    Consumers: link."""
 
     _fields_ = [
         ("t_us", ctypes.c_int64),

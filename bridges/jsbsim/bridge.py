@@ -9,6 +9,7 @@ import time
 from collections.abc import Callable
 
 from bridges.jsbsim.device_streams import EmulatedDevices
+from bridges.jsbsim.failures import DeviceFailures
 from bridges.jsbsim.fdm import Flight
 from bridges.jsbsim.lockstep import Lockstep, RealTime
 from bridges.jsbsim.options import BridgeOptions
@@ -17,13 +18,14 @@ from bridges.jsbsim.truth_log import TruthLog
 from companion.actuators.airframe import load_airframe
 from companion.actuators.minissc import FrameDecoder
 from companion.bus.node import BusNode
-from companion.messages import SimClock, SimTruth
+from companion.messages import CommandAck, CommandId, SimClock, SimTruth
 from companion.simulation.sensor_errors import MagneticField, NoiseModel, SensorErrors
 from companion.simulation.true_state import TrueState
 
 log = logging.getLogger(__name__)
 
 SENSORS = ("gps", "compass", "imu")
+COMMAND_FRAMES = 8  # link/commands is looked at every this many physics frames
 STANDARD_PRESSURE_KPA = 101.325
 
 
@@ -49,6 +51,7 @@ class SimBridge:
         self.flight.set_turbulence(opts.turbulence)
         errors = SensorErrors(NoiseModel(scale=opts.noise_scale), MagneticField(), opts.seed)
         self.devices = EmulatedDevices(errors, opts.rates, opts.outages)
+        self.failures = DeviceFailures(opts.seed)
         self.ports = {name: PtyPort(name) for name in (*SENSORS, "servos")}
         self.pending: list[tuple[float, int, str, bytes]] = []  # (release, order, port, data)
         self.order = 0
@@ -60,6 +63,8 @@ class SimBridge:
         self.bus = BusNode(opts.namespace, "sim_bridge")
         self.clock = self.bus.writer("sim/clock")
         self.truth_out = self.bus.writer("sim/truth")
+        self.commands = self.bus.queue_reader("link/commands")
+        self.acks = self.bus.writer("link/command_acks")
         self.frames = 0
         self.stopping = False
         self.clock.publish(SimClock(t_us=0, frame=0))
@@ -101,7 +106,10 @@ class SimBridge:
         t_us = round(s.t_s * 1e6)
         self.clock.publish(SimClock(t_us=t_us, frame=self.frames))
         self._publish_truth(s, t_us)
-        for name, release, data in self.devices.due(s, pressure_kpa(s.alt_msl_m)):
+        for name, release, measured in self.devices.due(s, pressure_kpa(s.alt_msl_m)):
+            data = self.failures.filter(name, measured)
+            if data is None:
+                continue
             heapq.heappush(self.pending, (release, self.order, name, data))
             self.order += 1
         while self.pending and self.pending[0][0] <= s.t_s + 1e-9:
@@ -112,6 +120,19 @@ class SimBridge:
         else:
             self.lockstep.wait()
         self._apply_servos()
+        if self.frames % COMMAND_FRAMES == 0:
+            self._serve_commands(t_us)
+
+    def _serve_commands(self, t_us: int) -> None:
+        """Answer the commands meant for the simulator (failure injection)."""
+        for cmd in self.commands.drain():
+            if cmd.command != CommandId.INJECT_FAILURE:
+                continue  # the vehicle's plug-ins answer the rest
+            unit, failure_type, instance = (round(v) for v in cmd.param[:3])
+            ack = CommandAck(t_us=t_us, seq=cmd.seq, command=cmd.command)
+            ack.result = int(self.failures.inject(unit, failure_type, instance))
+            ack.source = b"sim_bridge"
+            self.acks.publish(ack)
 
     def _publish_truth(self, s: TrueState, t_us: int) -> None:
         if self.truth is not None:

@@ -7,9 +7,12 @@ import asyncio
 import pytest
 from mavsdk.asyncio import Configuration, Mavsdk
 from mavsdk.asyncio.plugins.action import ActionAsync
+from mavsdk.asyncio.plugins.failure import FailureAsync
 from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
+from mavsdk.asyncio.plugins.param import ParamAsync
 from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
 from mavsdk.component_type import ComponentType
+from mavsdk.plugins.failure import FailureError, FailureType, FailureUnit
 from mavsdk.plugins.mission_raw import MissionItem
 
 from tests.protocol.mav_client import client_vehicle, free_udp_port
@@ -181,3 +184,32 @@ def test_mavsdk_flight_modes_start_mission_return_and_go_to(vehicle_factory, tmp
     assert status.mode == Mode.GUIDED  # PX4 flies "go to" in Hold; MAVSDK names it so
     assert (status.target_lat_deg, status.target_lon_deg) == pytest.approx((-37.9, 145.12))
     assert status.target_alt_msl_m == pytest.approx(150.0)
+
+
+async def _failure_session(port: int) -> list[str]:
+    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
+    results = []
+    async with Mavsdk(config) as mavsdk:
+        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
+        system = await mavsdk.first_autopilot(timeout_s=15.0)
+        failure, param = FailureAsync(system), ParamAsync(system)
+        for enabled in (0.0, 1.0):
+            await param.set_param_float("SYS_FAILURE_EN", enabled)
+            try:
+                await failure.inject(FailureUnit.SENSOR_GPS, FailureType.OFF, 0)
+                results.append("SUCCESS")
+            except FailureError as exc:
+                results.append(exc.result.name)
+    return results
+
+
+@pytest.mark.timeout(120)
+def test_mavsdk_failure_injection_is_refused_off_and_outside_the_simulator(
+    vehicle_factory, tmp_path
+):
+    # This vehicle runs on the hardware clock: even with SYS_FAILURE_EN set there is no
+    # simulator to fail a device in (tests/sitl/test_failsafes.py injects in one).
+    port = free_udp_port()
+    vehicle = vehicle_factory(client_vehicle(f"udpout://127.0.0.1:{port}", tmp_path))
+    vehicle.wait_running("link")
+    assert asyncio.run(_failure_session(port)) == ["DENIED", "UNSUPPORTED"]

@@ -25,6 +25,7 @@ from tests.sim.sim_run import finish, start_sim
 from tests.support.vehicle import REPO
 
 PLAN = str(REPO / "qgc_plans" / "square.plan")
+WATCHED = ["HEARTBEAT", "STATUSTEXT", "MISSION_CURRENT", "COMMAND_ACK"]
 
 
 class Station:
@@ -36,6 +37,8 @@ class Station:
         self.texts: list[str] = []
         self.mode = -1
         self.modes: list[int] = []  # every mode the heartbeat has shown, in order
+        self.mission_seq = -1
+        self.acks: dict[int, int] = {}  # command → the result of its latest COMMAND_ACK
         self._next_beat = 0.0
 
     def pump(self, seconds: float) -> None:
@@ -45,11 +48,15 @@ class Station:
             if self.beating and time.monotonic() >= self._next_beat:
                 self.conn.mav.heartbeat_send(d.MAV_TYPE_GCS, d.MAV_AUTOPILOT_INVALID, 0, 0, 0)
                 self._next_beat = time.monotonic() + 1.0
-            msg = self.conn.recv_match(type=["HEARTBEAT", "STATUSTEXT"], blocking=True, timeout=0.1)
+            msg = self.conn.recv_match(type=WATCHED, blocking=True, timeout=0.1)
             if msg is None or msg.get_srcSystem() != 1:
                 continue
             if msg.get_type() == "STATUSTEXT":
                 self.texts.append(msg.text)
+            elif msg.get_type() == "MISSION_CURRENT":
+                self.mission_seq = msg.seq
+            elif msg.get_type() == "COMMAND_ACK":
+                self.acks[msg.command] = msg.result
             else:
                 self.mode = msg.custom_mode
                 if not self.modes or self.modes[-1] != self.mode:
@@ -66,6 +73,13 @@ class Station:
     def command(self, command: int, *params: float) -> None:
         values = [*params, 0, 0, 0, 0, 0, 0, 0][:7]
         self.conn.mav.command_long_send(1, 1, command, 0, *values)
+
+    def acked(self, command: int, *params: float) -> int:
+        """Send a command and return the result of its COMMAND_ACK."""
+        self.acks.pop(command, None)
+        self.command(command, *params)
+        self.until(lambda: command in self.acks, 10, f"command {command} acknowledged")
+        return self.acks[command]
 
     def in_mode(self, mode: FlightMode) -> bool:
         return self.mode == BY_MODE[mode].px4
@@ -115,12 +129,20 @@ def test_ground_station_lost_returns_home_then_resumes_the_mission(tmp_path):
 
 @pytest.mark.timeout(240)
 def test_gps_lost_holds_heading_and_loiters_when_it_returns(tmp_path):
-    # The outage starts once the aircraft is on its first leg, well inside the fence
-    # (take-off takes about 70 s).
-    with flying(tmp_path, "--gps-outage", "110:10") as station:
+    # The GPS is switched off as a PX4 user would, with MAV_CMD_INJECT_FAILURE (what
+    # MAVSDK's Failure.inject sends), once the aircraft is on its first leg.
+    gps, off, ok = d.FAILURE_UNIT_SENSOR_GPS, d.FAILURE_TYPE_OFF, d.FAILURE_TYPE_OK
+    with flying(tmp_path) as station:
         station.fly_mission()
-        station.until(lambda: station.said("GPS lost"), 60, "told of the GPS loss")
+        assert station.acked(d.MAV_CMD_INJECT_FAILURE, gps, off) == d.MAV_RESULT_DENIED
+        assert station.said("SYS_FAILURE_EN")  # refused until enabled, as PX4
+        station.conn.mav.param_set_send(1, 1, b"SYS_FAILURE_EN", 1, d.MAV_PARAM_TYPE_REAL32)
+        station.until(lambda: station.mission_seq >= 1, 60, "on the first leg")
+        assert station.acked(d.MAV_CMD_INJECT_FAILURE, gps, off) == d.MAV_RESULT_ACCEPTED
+        station.until(lambda: station.said("GPS lost"), 30, "told of the GPS loss")
         assert station.in_mode(FlightMode.MISSION)  # the course is held, the mode kept
+        station.pump(0.5)  # some seconds of dead reckoning at lockstep speed
+        assert station.acked(d.MAV_CMD_INJECT_FAILURE, gps, ok) == d.MAV_RESULT_ACCEPTED
         loiter = BY_MODE[FlightMode.LOITER].px4
         station.until(lambda: loiter in station.modes, 60, "loitering")
         station.until(lambda: station.said("GPS back"), 5, "told GPS is back")

@@ -75,12 +75,27 @@ def register_commands(link: MavlinkLink) -> None:
         return Outcome(extra=[link.mav.message_interval_encode(msg_id, interval)])
 
     register_mode_commands(link)
+    service.register(d.MAV_CMD_INJECT_FAILURE, lambda args: inject_failure(link, args))
     service.register(d.MAV_CMD_COMPONENT_ARM_DISARM, arm_disarm)
     service.register(d.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, reboot)
     service.register(d.MAV_CMD_REQUEST_MESSAGE, request_message)
     service.register(d.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES, capabilities)
     service.register(d.MAV_CMD_SET_MESSAGE_INTERVAL, set_interval)
     service.register(d.MAV_CMD_GET_MESSAGE_INTERVAL, get_interval)
+
+
+def inject_failure(link: MavlinkLink, args: CommandArgs) -> Outcome:
+    """MAV_CMD_INJECT_FAILURE, as PX4: off unless SYS_FAILURE_EN is 1; the simulator
+    bridge applies it to its emulated devices and answers (UNSUPPORTED for what it cannot)."""
+    if link.store.get("SYS_FAILURE_EN") < 0.5:
+        link.statustext("Failure injection is off (set SYS_FAILURE_EN to 1)")
+        return Outcome(d.MAV_RESULT_DENIED)
+    if link.ctx.vehicle.get("clock") != "sim":
+        link.statustext("Failure injection needs the simulator")
+        return Outcome(d.MAV_RESULT_UNSUPPORTED)
+    params = tuple(float(round(v)) for v in args.params[:3])
+    seq = link.publish_command(CommandId.INJECT_FAILURE, params)
+    return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)
 
 
 def register_mode_commands(link: MavlinkLink) -> None:
