@@ -10,7 +10,6 @@ import math
 from collections.abc import Callable, Iterable, Iterator
 from typing import Protocol
 
-from companion.estimation.gps_compass import GpsCompassNavigator
 from companion.estimation.ins_ekf import InsEkf, InsEkfConfig
 from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer, Message, NavState
 
@@ -51,6 +50,10 @@ class GpsCompassRunner:
     """``nav.gps_compass``'s navigator."""
 
     def __init__(self, declination_deg: float = 0.0) -> None:
+        # Imported here: filterpy brings scipy.stats (~2.5 s of CPU), which the ins_ekf
+        # plug-in, importing this module for its own runner, must not pay at every start.
+        from companion.estimation.gps_compass import GpsCompassNavigator
+
         self.nav = GpsCompassNavigator()
 
     def feed(self, sample: Message) -> None:
