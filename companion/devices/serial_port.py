@@ -19,6 +19,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from collections.abc import Callable
 
 import serial
 
@@ -67,21 +68,32 @@ class ReopeningSerial:
     def read(self, size: int = 4096) -> bytes:
         """What has arrived, up to ``size`` bytes; waits at most the read timeout for the
         first byte and returns b"" when none came."""
+        return self.read_stamped(lambda: 0, size)[0]
+
+    def read_stamped(self, now_us: Callable[[], int], size: int = 4096) -> tuple[bytes, int]:
+        """As ``read``, with ``now_us()`` taken when the first byte arrived.
+
+        The time is taken before the rest is read: in a lockstep simulation the bytes still
+        unread hold the simulator at the frame that sent them, so the stamp is that frame's
+        time however late the reader runs after it (and on hardware, the first byte is
+        the closest to when the sentence was sent).
+        """
         port = self._ensure_open(wait=True)
         if port is None or size <= 0:
-            return b""
+            return b"", now_us()
         try:
             # pyserial's read(size) waits until size bytes or the timeout: at 4800 baud that
             # would hold every sentence back by the whole timeout and blur its time stamp.
             # So wait for one byte, then take only what is already there.
             data = port.read(1)
+            t_us = now_us()
             while data and len(data) < size and (waiting := port.in_waiting):
                 data += port.read(min(waiting, size - len(data)))
         except _PORT_ERRORS as exc:
             self._lost(exc)
-            return b""
+            return b"", now_us()
         self.bytes_in += len(data)
-        return data
+        return data, t_us
 
     def write(self, data: bytes) -> int:
         """Bytes written; 0 when the device is gone (it is reopened later) or too slow.

@@ -26,8 +26,7 @@ class NmeaGps(Plugin):
 
     def step(self) -> None:
         with self.ctx.bus.idle:  # waiting for the device is not busy time
-            data = self.port.read()
-        t_us = self.ctx.clock.now_us()  # stamped at reception, in the vehicle time base
+            data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
         for sentence in self.framer.feed(data):
             fix = self.decoder.decode(sentence, t_us)
             if fix is not None:

@@ -50,8 +50,7 @@ class SerialImu(Plugin):
 
     def step(self) -> None:
         with self.ctx.bus.idle:
-            data = self.port.read()
-        t_us = self.ctx.clock.now_us()
+            data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
         for sentence in self.framer.feed(data):
             reading = self.decoder.decode(sentence, t_us)
             if reading is None:

@@ -60,6 +60,29 @@ def test_reads_what_the_pty_master_writes(tmp_path):
     pty.vanish()
 
 
+def test_a_stamped_read_takes_the_time_while_the_rest_is_still_unread(tmp_path):
+    # What lockstep simulation relies on: the simulator cannot move its clock on while
+    # bytes it sent are unread, so a stamp taken before the rest is read is that frame's.
+    pty = Pty(tmp_path / "ttyIMU")
+    port = ReopeningSerial(f"serial://{pty.link}:115200", 115200, TIMEOUT_S)
+    port.read()  # opened
+    sentence = b"$VNIMU,1,2,3*00\r\n"
+    os.write(pty.master, sentence)
+    time.sleep(0.05)
+    unread_at_stamp = []
+
+    def now_us() -> int:
+        unread_at_stamp.append(port._port.in_waiting)
+        return 42
+
+    data, t_us = port.read_stamped(now_us)
+    assert (data, t_us) == (sentence, 42)
+    assert unread_at_stamp == [len(sentence) - 1]
+    assert port.read_stamped(now_us, size=0) == (b"", 42)
+    port.close()
+    pty.vanish()
+
+
 def test_a_read_returns_what_has_arrived_without_waiting_out_the_timeout(tmp_path):
     pty = Pty(tmp_path / "ttyIMU")
     port = ReopeningSerial(str(pty.link), 115200, read_timeout_s=5.0)
