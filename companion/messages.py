@@ -210,6 +210,9 @@ class ServoOutput(Message):
         ("t_us", ctypes.c_int64),
         ("pulse_us", ctypes.c_uint16 * 8),  # equivalent PWM pulse width, 0 = channel unused
         ("position", ctypes.c_uint8 * 8),  # Mini SSC position 0-254
+        # The t_us of the ActuatorCommand these positions answer (-1: none, e.g. safe on
+        # stale input); written after the bytes, so a lockstep simulator can wait for it.
+        ("command_t_us", ctypes.c_int64),
     ]
 
 

@@ -18,6 +18,7 @@ import subprocess
 import sys
 import threading
 import time
+import tomllib
 from collections.abc import Callable
 from pathlib import Path
 
@@ -38,6 +39,7 @@ BRIDGE_START_S = 30.0
 STATUS_PERIOD_S = 0.5
 POLL_S = 0.2
 QUIET_STATUS_PERIOD_S = 10.0  # when stderr is not a terminal: a log line now and then
+NAV_GRID_DEFAULT_HZ = 50.0  # nav.ins_ekf's publish_hz default (tests/sim/test_sim_flight.py checks)
 
 
 class BridgeProcess:
@@ -207,9 +209,26 @@ def status_line(t_us: int, factor: float, health: object, truth: object, mode: s
     )
 
 
+def nav_grid_hz(config: Path) -> float:
+    """The rate of the config's ``nav.ins_ekf`` states (its fixed grid of vehicle time,
+    which lockstep with the control loop follows); 0 when it has none."""
+    try:
+        with config.open("rb") as f:
+            plugins = tomllib.load(f).get("plugins", [])
+    except (OSError, tomllib.TOMLDecodeError):
+        return 0.0  # load_config reports it properly
+    for spec in plugins:
+        if isinstance(spec, dict) and spec.get("plugin") == "nav.ins_ekf":
+            return float(spec.get("settings", {}).get("publish_hz", NAV_GRID_DEFAULT_HZ))
+    return 0.0
+
+
 def run_sim(req: SimRequest, opts: BridgeOptions, log_level: str = "INFO") -> int:
     """Start the bridge, then the vehicle on its ptys; return when both have stopped."""
-    opts = dataclasses.replace(opts, hold=True)
+    sync_hz = nav_grid_hz(req.config) if opts.exact and opts.speed is None else 0.0
+    if opts.exact and not sync_hz:
+        log.warning("--exact: only lockstep (--speed max) with nav.ins_ekf can follow control")
+    opts = dataclasses.replace(opts, hold=True, sync_hz=sync_hz)
     bridge = BridgeProcess(opts)
     try:
         cfg = vehicle_config(req, opts, bridge.devices)

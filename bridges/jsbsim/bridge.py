@@ -11,21 +11,28 @@ from collections.abc import Callable
 from bridges.jsbsim.device_streams import EmulatedDevices
 from bridges.jsbsim.failures import DeviceFailures
 from bridges.jsbsim.fdm import Flight
-from bridges.jsbsim.lockstep import Lockstep, RealTime
+from bridges.jsbsim.lockstep import (
+    EXACT_STALL_S,
+    STALL_S,
+    FlightSync,
+    Lockstep,
+    RealTime,
+    SampleSync,
+)
 from bridges.jsbsim.options import BridgeOptions
 from bridges.jsbsim.ptys import PtyPort
 from bridges.jsbsim.truth_log import TruthLog
+from bridges.jsbsim.vehicle_commands import VehicleCommands
 from companion.actuators.airframe import load_airframe
 from companion.actuators.minissc import FrameDecoder
 from companion.bus.node import BusNode
-from companion.messages import CommandAck, CommandId, SimClock, SimTruth
+from companion.messages import SimClock, SimTruth
 from companion.simulation.sensor_errors import MagneticField, NoiseModel, SensorErrors
 from companion.simulation.true_state import TrueState
 
 log = logging.getLogger(__name__)
 
 SENSORS = ("gps", "compass", "imu")
-COMMAND_FRAMES = 8  # link/commands is looked at every this many physics frames
 STANDARD_PRESSURE_KPA = 101.325
 
 
@@ -57,14 +64,23 @@ class SimBridge:
         self.order = 0
         self.servo_decoder = FrameDecoder()
         self.by_servo = {c.servo: c for c in self.airframe.channels}
-        self.lockstep = Lockstep([self.ports[n] for n in SENSORS])
+        stall_s = EXACT_STALL_S if opts.sync_hz > 0 else STALL_S
+        self.lockstep = Lockstep([self.ports[n] for n in SENSORS], stall_s)
         self.pacer = RealTime(opts.speed) if opts.speed else None
         self.truth = TruthLog(opts.truth_path) if opts.truth_path else None
         self.bus = BusNode(opts.namespace, "sim_bridge")
         self.clock = self.bus.writer("sim/clock")
         self.truth_out = self.bus.writer("sim/truth")
-        self.commands = self.bus.queue_reader("link/commands")
-        self.acks = self.bus.writer("link/command_acks")
+        self.sync = None
+        if self.pacer is None and opts.sync_hz > 0:
+            period_us = round(1e6 / opts.sync_hz)
+            self.sync = FlightSync(period_us, self.bus.latest_reader("actuators/servos"))
+        self.samples = None
+        if self.sync is not None:
+            channels = {"imu": "sensors/imu", "compass": "sensors/compass", "gps": "sensors/gps"}
+            readers = {n: self.bus.queue_reader(c) for n, c in channels.items()}
+            self.samples = SampleSync(readers)
+        self.commands = VehicleCommands(self.bus, self.failures, self.sync, opts.start_at_s)
         self.frames = 0
         self.stopping = False
         self.clock.publish(SimClock(t_us=0, frame=0))
@@ -82,12 +98,22 @@ class SimBridge:
         while not self.stopping and (end is None or self.flight.t_s < end - 1e-9):
             self.step()
         wall = time.monotonic() - started
+        sync = self.sync
         log.info(
-            "simulated %.1f s in %.1f s wall (%.1fx); lockstep stalls %d",
+            "simulated %.1f s in %.1f s wall (%.1fx); lockstep stalls %d; control stalls %s",
             self.flight.t_s,
             wall,
             self.flight.t_s / wall if wall else 0.0,
             self.lockstep.stalls,
+            "-" if sync is None else self._exact_summary(),
+        )
+
+    def _exact_summary(self) -> str:
+        sync, samples = self.sync, self.samples
+        assert sync is not None and samples is not None
+        return (
+            f"{sync.stalls} (waited {sync.wait_s:.1f} s); late samples {samples.late}"
+            f" (waited {samples.wait_s:.1f} s)"
         )
 
     def stop(self) -> None:
@@ -112,27 +138,21 @@ class SimBridge:
                 continue
             heapq.heappush(self.pending, (release, self.order, name, data))
             self.order += 1
+        written = set()
         while self.pending and self.pending[0][0] <= s.t_s + 1e-9:
             _, _, name, data = heapq.heappop(self.pending)
             self.ports[name].write(data)
+            written.add(name)
         if self.pacer is not None:
             self.pacer.wait(s.t_s)
         else:
             self.lockstep.wait()
+        if self.samples is not None:
+            self.samples.wait(written - self.failures.garbled(), t_us)
+        self.commands.serve(t_us)
+        if self.sync is not None:
+            self.sync.wait(t_us)
         self._apply_servos()
-        if self.frames % COMMAND_FRAMES == 0:
-            self._serve_commands(t_us)
-
-    def _serve_commands(self, t_us: int) -> None:
-        """Answer the commands meant for the simulator (failure injection)."""
-        for cmd in self.commands.drain():
-            if cmd.command != CommandId.INJECT_FAILURE:
-                continue  # the vehicle's plug-ins answer the rest
-            unit, failure_type, instance = (round(v) for v in cmd.param[:3])
-            ack = CommandAck(t_us=t_us, seq=cmd.seq, command=cmd.command)
-            ack.result = int(self.failures.inject(unit, failure_type, instance))
-            ack.source = b"sim_bridge"
-            self.acks.publish(ack)
 
     def _publish_truth(self, s: TrueState, t_us: int) -> None:
         if self.truth is not None:

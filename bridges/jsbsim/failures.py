@@ -55,6 +55,10 @@ class DeviceFailures:
         log.info("failure injection: %s %s", device, SUPPORTED_TYPES[failure_type])
         return CommandResult.ACCEPTED
 
+    def garbled(self) -> set[str]:
+        """The devices whose bytes will not become samples (stuck repeats, garbage)."""
+        return {dev for dev, f in self.active.items() if f != d.FAILURE_TYPE_OFF}
+
     def filter(self, device: str, data: bytes) -> bytes | None:
         """What the device puts on its wire instead of ``data`` (None: nothing)."""
         failure = self.active.get(device)

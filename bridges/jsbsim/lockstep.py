@@ -1,29 +1,41 @@
-"""Pacing: lockstep (wait until the drivers have read every byte) or a real-time factor."""
+"""Pacing: lockstep (wait until the drivers have read every byte and the control loop has
+answered) or a real-time factor."""
 
 from __future__ import annotations
 
 import logging
 import time
+from typing import TYPE_CHECKING, Any
 
 from bridges.jsbsim.ptys import PtyPort
+
+if TYPE_CHECKING:
+    from companion.bus.channels import LatestReader, Reader
+    from companion.messages import ServoOutput
 
 log = logging.getLogger(__name__)
 
 STALL_S = 0.5  # a driver that reads nothing for this long is not waited for
+EXACT_STALL_S = 10.0  # the same, when every frame must be the same run after run
+SAMPLE_GRACE_S = 2.0  # exact: a driver's sample is waited for this long after its bytes
 SPIN_POLLS = 50  # polls that only yield the CPU before sleeping between polls
 POLL_SLEEP_S = 50e-6
+START_FLIGHT_S = 20.0  # the flight plug-ins' start-up after START, at most
+STALL_FLIGHT_S = 5.0  # a running flight plug-in that stops answering is waited for this long
 
 
 class Lockstep:
     """Waits, each frame, until every sensor line is drained by its driver.
 
     A driver that stops reading (it crashed, or is restarting) stalls one frame for at most
-    ``STALL_S``; its line is then left out until the driver drains it again, so one dead
+    ``stall_s`` (a loaded machine can starve a healthy driver for a while, so exact runs
+    wait much longer); its line is then left out until the driver drains it again, so one dead
     driver slows the simulation down once instead of on every frame.
     """
 
-    def __init__(self, ports: list[PtyPort]) -> None:
+    def __init__(self, ports: list[PtyPort], stall_s: float = STALL_S) -> None:
         self.ports = ports
+        self.stall_s = stall_s
         self.waiting_for = {p.name: True for p in ports}
         self.stalls = 0
         self.wait_s = 0.0
@@ -40,7 +52,7 @@ class Lockstep:
             pending = [p for p in pending if p.unread() > 0]
             if not pending:
                 break
-            if time.perf_counter() - started > STALL_S:
+            if time.perf_counter() - started > self.stall_s:
                 for port in pending:
                     log.warning("lockstep: %s driver is not reading; not waiting for it", port.name)
                     self.waiting_for[port.name] = False
@@ -69,3 +81,106 @@ class RealTime:
             time.sleep(delay)
         else:
             self.late_s = max(self.late_s, -delay)
+
+
+class FlightSync:
+    """Lockstep with the control loop, so the same seed flies the same flight.
+
+    The vehicle's navigator publishes on a fixed grid of vehicle time (``period_us``), the
+    controller answers each state, and the servo plug-in says which command its bytes
+    answer (``ServoOutput.command_t_us``). At each grid instant the bridge waits for that
+    answer before it reads the servo line, so every command is applied at the same frame
+    whatever the scheduler did. Only while the flight plug-ins run (from the START ack to
+    STOP); a flight plug-in that does not answer is waited for ``stall_s`` once, then not
+    until it catches up again.
+    """
+
+    def __init__(self, period_us: int, answers: LatestReader[ServoOutput]) -> None:
+        self.period_us = period_us
+        self.answers = answers
+        self.flying = False  # the flight plug-ins were started
+        self.synced = False  # they have answered in step since
+        self.lagging = False  # they stopped answering: not waited for until they catch up
+        self.answered_us = -1
+        self.stalls = 0
+        self.wait_s = 0.0
+
+    def started(self, flying: bool) -> None:
+        """START acknowledged (True) or STOP seen (False)."""
+        self.flying, self.synced, self.lagging = flying, False, False
+
+    def wait(self, t_us: int) -> None:
+        """Return once the answer to the newest grid state at or before ``t_us`` is in."""
+        if not self.flying:
+            return
+        grid = t_us // self.period_us * self.period_us
+        if self._answered(grid) or self.lagging:
+            return
+        limit = STALL_FLIGHT_S if self.synced else START_FLIGHT_S
+        started = time.perf_counter()
+        polls = 0
+        while not self._answered(grid):
+            if time.perf_counter() - started > limit:
+                log.warning(
+                    "lockstep: no servo answer to the state at %.2f s for %.0f s (newest"
+                    " answer: %.2f s); not waiting for it",
+                    grid / 1e6,
+                    limit,
+                    self.answered_us / 1e6,
+                )
+                self.lagging, self.synced = True, False
+                self.stalls += 1
+                break
+            polls += 1
+            time.sleep(0 if polls < SPIN_POLLS else POLL_SLEEP_S)
+        self.wait_s += time.perf_counter() - started
+
+    def _answered(self, grid: int) -> bool:
+        answer = self.answers.get()
+        if answer is not None and answer.command_t_us > self.answered_us:
+            self.answered_us = int(answer.command_t_us)
+        if self.answered_us < grid:
+            return False
+        self.synced, self.lagging = True, False
+        return True
+
+
+class SampleSync:
+    """Exact lockstep with the drivers: wait until each device's bytes became a sample.
+
+    A drained pty only says the driver read the bytes; the kernel may also still hold
+    them in the pty's buffer while reporting nothing unread. Waiting for the sample each
+    write produces on the bus (stamped with this frame's time) closes both gaps, so no
+    driver ever reads two frames as one or publishes one frame late. A device is waited
+    for once it has published anything (the GPS decoder learns its epoch first), and at
+    most ``grace_s`` a frame.
+    """
+
+    def __init__(self, readers: dict[str, Reader[Any]], grace_s: float = SAMPLE_GRACE_S) -> None:
+        self.readers = readers
+        self.newest_us = dict.fromkeys(readers, -1)
+        self.grace_s = grace_s
+        self.late = 0  # frames in which a sample did not come within grace_s
+        self.wait_s = 0.0
+
+    def wait(self, written: set[str], t_us: int) -> None:
+        """Return when every device written this frame has published its sample."""
+        pending = [n for n in written if n in self.readers and self.newest_us[n] >= 0]
+        started = time.perf_counter()
+        polls = 0
+        while True:
+            self._take()
+            pending = [n for n in pending if self.newest_us[n] < t_us]
+            if not pending:
+                break
+            if time.perf_counter() - started > self.grace_s:
+                self.late += 1
+                break
+            polls += 1
+            time.sleep(0 if polls < SPIN_POLLS else POLL_SLEEP_S)
+        self.wait_s += time.perf_counter() - started
+
+    def _take(self) -> None:
+        for name, reader in self.readers.items():
+            for sample in reader.drain():
+                self.newest_us[name] = max(self.newest_us[name], int(sample.t_us))

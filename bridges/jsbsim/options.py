@@ -21,6 +21,9 @@ class BridgeOptions:
     airborne_speed_m_s: float | None = None  # None: the airframe's cruise speed
     speed: float | None = None  # real-time factor; None: lockstep, as fast as consumed
     physics_hz: float = 100.0
+    exact: bool = False  # lockstep also with the control loop (companion sim --exact)
+    start_at_s: float | None = None  # arm and start the mission at this simulated second
+    sync_hz: float = 0.0  # the vehicle's nav/state grid, for exact lockstep; 0: off
     wind_ned: tuple[float, float, float] = (0.0, 0.0, 0.0)
     turbulence: str = "none"
     outages: list[Outage] = field(default_factory=list)

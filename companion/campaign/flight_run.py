@@ -144,7 +144,8 @@ def _fly(job: FlightJob, folder: Path, tl: Timeline) -> None:
             stderr=subprocess.STDOUT, start_new_session=True,
         )  # fmt: skip
         try:
-            _Pilot(gcs, proc, time.monotonic() + job.timeout_s, tl, job.silent_s).fly()
+            pilot = _Pilot(gcs, proc, time.monotonic() + job.timeout_s, tl, job.silent_s)
+            pilot.fly(flight.start_at_s)
         finally:
             _end(proc)
             gcs.close()
@@ -165,7 +166,17 @@ def _sim_command(flight: Flight, folder: Path, port: int, namespace: str) -> lis
         cmd += ["--gps-outage", f"{start:g}:{seconds:g}"]
     if flight.airborne:
         cmd.append("--airborne")
+    if flight.start_at_s is not None:
+        cmd += ["--exact", "--start-at", f"{flight.start_at_s:g}"]
     return cmd
+
+
+def _armed(msg: Any) -> bool:
+    return (
+        msg.get_type() == "HEARTBEAT"
+        and msg.get_srcSystem() == 1
+        and bool(msg.base_mode & d.MAV_MODE_FLAG_SAFETY_ARMED)
+    )
 
 
 class _Pilot:
@@ -179,11 +190,16 @@ class _Pilot:
         self.heard = time.monotonic()
         self.next_beat = 0.0
 
-    def fly(self) -> None:
+    def fly(self, start_at_s: float | None) -> None:
+        """Arm and start (or, when the simulator starts the mission, see it armed)."""
         self._until(lambda m: m.get_type() == "HOME_POSITION", "the vehicle's home position")
-        self._command(d.MAV_CMD_COMPONENT_ARM_DISARM, 1.0)
-        self._command(d.MAV_CMD_MISSION_START, 0.0)
-        self.tl.start_ms = self.tl.last_ms
+        if start_at_s is None:
+            self._command(d.MAV_CMD_COMPONENT_ARM_DISARM, 1.0)
+            self._command(d.MAV_CMD_MISSION_START, 0.0)
+            self.tl.start_ms = self.tl.last_ms
+        else:
+            self._until(_armed, "arming by the simulator")
+            self.tl.start_ms = round(start_at_s * 1000)
         self._until(self._complete, "mission completion")
         tail_end = time.monotonic() + TAIL_S
         while time.monotonic() < tail_end:

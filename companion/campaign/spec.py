@@ -51,6 +51,8 @@ _CAMPAIGN_KEYS: dict[str, Any] = {
     "cpus_per_flight": 1.0,
     "airborne": False,
     "silent_s": 45.0,
+    "exact": True,  # exact lockstep, the mission started by the simulator: same seed, same score
+    "start_at_s": 10.0,  # the simulated second the mission starts at (exact)
 }
 _FLIGHT_KEYS: dict[str, Any] = {
     "plans": None,  # required
@@ -76,6 +78,7 @@ class Flight:
     config: str
     airborne: bool
     max_sim_s: float
+    start_at_s: float | None = None  # exact lockstep, armed and started by the simulator then
 
     @property
     def condition(self) -> str:
@@ -101,7 +104,7 @@ class Flight:
     def _key(self) -> tuple:
         plan, config = Path(self.plan).name, Path(self.config).name
         return (plan, self.airframe, self.wind_ned, self.turbulence, self.outages, self.seed,
-                config, self.airborne, self.max_sim_s)  # fmt: skip
+                config, self.airborne, self.max_sim_s, self.start_at_s)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -178,7 +181,7 @@ def load_spec(path: str | Path) -> CampaignSpec:
             raise spec.error(("campaign", "samples"), "random mode needs samples > 0")
         rng = random.Random(camp["sample_seed"])
         flights = rng.sample(flights, min(camp["samples"], len(flights)))
-    for key in ("flight_timeout_s", "cpus_per_flight", "silent_s"):
+    for key in ("flight_timeout_s", "cpus_per_flight", "silent_s", "start_at_s"):
         if camp[key] <= 0:
             raise spec.error(("campaign", key), f"{key} must be positive")
     return CampaignSpec(path, camp["name"], flights, float(camp["flight_timeout_s"]),
@@ -204,8 +207,9 @@ def _grid(spec: _Spec, camp: dict, dims: dict) -> list[Flight]:
     seeds = _list(spec, dims, "seeds", int)
     configs = [_config(spec, c) for c in _list(spec, dims, "configs", str)]
     grid = itertools.product(plans, airframes, winds, turbulence, outages, seeds, configs)
+    start_at = float(camp["start_at_s"]) if camp["exact"] else None
     return [
-        Flight(str(p), a, w, t, o, s, c, camp["airborne"], float(camp["max_sim_s"]))
+        Flight(str(p), a, w, t, o, s, c, camp["airborne"], float(camp["max_sim_s"]), start_at)
         for p, a, w, t, o, s, c in grid
     ]
 

@@ -114,6 +114,22 @@ def sim(
     ] = None,
     duration: Annotated[float | None, typer.Option(help="simulated seconds, then stop")] = None,
     seed: Annotated[int, typer.Option(help="sensor noise seed")] = 1,
+    exact: Annotated[
+        bool,
+        typer.Option(
+            "--exact/--fast",
+            help="lockstep: also wait for the control loop each step (same seed, same flight;"
+            " about half the speed)",
+        ),
+    ] = False,
+    start_at: Annotated[
+        float | None,
+        typer.Option(
+            min=0,
+            help="arm and start the mission at this simulated second, holding the simulation"
+            " for both acks (every run starts at the same frame)",
+        ),
+    ] = None,
     noise: Annotated[float, typer.Option(help="sensor noise scale (0: perfect)")] = 1.0,
     truth: Annotated[Path | None, typer.Option(help="write the true state CSV here")] = None,
     config: Annotated[Path, CONFIG_OPT] = CONFIGS / "sim.toml",
@@ -156,6 +172,7 @@ def sim(
             airframe=aircraft, home=_home(home), airborne=airborne, speed=_speed(speed),
             wind_ned=_triple(wind), turbulence=turbulence,
             outages=[_outage(o) for o in gps_outage or []], noise_scale=noise, seed=seed,
+            exact=exact, start_at_s=start_at,
             duration_s=duration, truth_path=str(truth) if truth else None,
             namespace=namespace or default_namespace(),
         )  # fmt: skip

@@ -73,10 +73,10 @@ class ReopeningSerial:
     def read_stamped(self, now_us: Callable[[], int], size: int = 4096) -> tuple[bytes, int]:
         """As ``read``, with ``now_us()`` taken when the first byte arrived.
 
-        The time is taken before the rest is read: in a lockstep simulation the bytes still
-        unread hold the simulator at the frame that sent them, so the stamp is that frame's
-        time however late the reader runs after it (and on hardware, the first byte is
-        the closest to when the sentence was sent).
+        The time is taken before the rest is read, and only the bytes already there then are
+        read: in a lockstep simulation the bytes still unread hold the simulator at the
+        frame that sent them, so the stamp is that frame's time however late the reader
+        runs (and on hardware, the first byte is the closest to when the sentence was sent).
         """
         port = self._ensure_open(wait=True)
         if port is None or size <= 0:
@@ -87,8 +87,10 @@ class ReopeningSerial:
             # So wait for one byte, then take only what is already there.
             data = port.read(1)
             t_us = now_us()
-            while data and len(data) < size and (waiting := port.in_waiting):
-                data += port.read(min(waiting, size - len(data)))
+            # Only what is there now: more may arrive while reading, and in lockstep that
+            # is the simulator's next frame, which this stamp does not belong to.
+            if data and size > 1 and (waiting := port.in_waiting):
+                data += port.read(min(waiting, size - 1))
         except _PORT_ERRORS as exc:
             self._lost(exc)
             return b"", now_us()

@@ -159,6 +159,10 @@ class Supervisor:
             for cmd in commands.drain():
                 result = self.handle_command(cmd)
                 if result is not None:
+                    # The new arm state is out before the ack: whoever acts on the ack
+                    # (the commander setting home, a ground station) finds it already.
+                    self.publish_health(health)
+                    next_health = time.monotonic() + HEALTH_PERIOD_S
                     acks.publish(self._ack(cmd, result))
             self.absorb_stats(stats)
             self.restart_dead()

@@ -7,7 +7,6 @@ channel goes to its safe position: throttle off, surfaces at trim.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Mapping
 from typing import Any
 
@@ -64,14 +63,18 @@ class MiniSscOutput(Plugin):
         self.wanted = dict(self.safe)
         self.sent: dict[int, int] = {}
         self.refresh_order = [c.servo for c in self.airframe.channels]
-        self.last_command_at = time.monotonic()
+        self.last_command_at = ctx.clock.now_us() / 1e6
         self.cycle_s = CYCLE_MAX_S
         self.stale = True
+        # Every channel safe at once, so the first command finds the same card every time.
+        if self._send(len(self.safe)):
+            self._publish(-1)
 
     def step(self) -> None:
         self.waiter.wait(WAIT_S)  # the waiter counts its own idle time
         received = list(self.commands.drain())
-        now = time.monotonic()
+        # The wire runs on vehicle time: in a simulation, simulated seconds.
+        now = self.ctx.clock.now_us() / 1e6
         if received:
             gap = now - self.last_command_at
             self.cycle_s = min(CYCLE_MAX_S, max(CYCLE_MIN_S, gap))
@@ -83,12 +86,17 @@ class MiniSscOutput(Plugin):
                 "no command for %.2f s: safe positions", now - self.last_command_at
             )
             self.wanted, self.stale = dict(self.safe), True
-        self._send(self._room())
+        if not received and not self.stale:
+            return  # refreshes ride on the commands' cycles, not on wall-clock timeouts
+        if self._send(self._room()) or received:
+            # Also when nothing changed: a lockstep simulator waits for this answer.
+            self._publish(int(received[-1].t_us) if received else -1)
 
     def close(self) -> None:
         self.wanted = dict(self.safe)
         self.sent = {}  # everything counts as changed: all channels go out
-        self._send(len(self.safe))
+        if self._send(len(self.safe)):
+            self._publish(-1)
         self.waiter.close()
         self.port.close()
 
@@ -102,23 +110,24 @@ class MiniSscOutput(Plugin):
         cycle_frames = max(1, int(self.per_second * self.cycle_s))
         return cycle_frames - self.port.out_waiting() // FRAME_BYTES
 
-    def _send(self, room: int) -> None:
+    def _send(self, room: int) -> bool:
+        """Write the next frames; whether any went out."""
         plan = minissc.plan_cycle(self.wanted, self.sent, self.refresh_order, room)
         if not plan:
-            return
+            return False
         data = b"".join(minissc.frame(s, p) for s, p in plan)
         if self.port.write(data) != len(data):
             self.ctx.health.bad()
-            return
+            return False
         self.ctx.health.ok(len(plan))
         for servo, position in plan:
             self.sent[servo] = position
             self.refresh_order.remove(servo)
             self.refresh_order.append(servo)
-        self._publish()
+        return True
 
-    def _publish(self) -> None:
-        msg = ServoOutput(t_us=self.ctx.clock.now_us())
+    def _publish(self, command_t_us: int) -> None:
+        msg = ServoOutput(t_us=self.ctx.clock.now_us(), command_t_us=command_t_us)
         for servo, position in self.sent.items():
             msg.position[servo] = position
             msg.pulse_us[servo] = minissc.pulse_us(position)

@@ -9,10 +9,11 @@ them in time order to ``companion.estimation.ins_ekf.InsEkf`` (the navigator
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
 
 from companion.estimation.ins_ekf import InsEkfConfig
 from companion.estimation.offline import InsEkfRunner
+from companion.estimation.sample_order import SampleOrder
+from companion.messages import Imu
 from companion.plugin import Plugin, PluginContext, Setting
 
 WAIT_S = 0.5
@@ -54,25 +55,25 @@ class InsEkfPlugin(Plugin):
         self.waiter = ctx.bus.waiter(self.readers)
         self.out = ctx.bus.writer("nav/state")
         self.period_us = round(1e6 / s["publish_hz"])
-        self.next_us: int | None = None
+        self.next_us = 0
+        self.order = SampleOrder()
 
     def step(self) -> None:
         self.waiter.wait(WAIT_S)  # the waiter counts its own idle time
-        samples: list[Any] = [m for r in self.readers for m in r.drain()]
+        samples = self.order.push(m for r in self.readers for m in r.drain())
         if not samples:
             return
-        samples.sort(key=lambda m: m.t_us)
+        nav = self.runner.nav
         for sample in samples:
             self.runner.feed(sample)
+            # On a fixed grid of vehicle time, whatever batches the samples came in, so a
+            # lockstep simulation sees the same states at the same times every run.
+            t = nav.t_us
+            if t is not None and isinstance(sample, Imu) and t >= self.next_us:
+                self.out.publish(nav.state())
+                self.next_us = (t // self.period_us + 1) * self.period_us
         self.ctx.health.ok(len(samples))
-        nav = self.runner.nav
         self.ctx.health.frames_bad = nav.gps_rejected + nav.heading_rejected
-        t = nav.t_us
-        if t is None:
-            return
-        if self.next_us is None or t >= self.next_us:
-            self.out.publish(nav.state())
-            self.next_us = t + self.period_us
 
     def close(self) -> None:
         self.waiter.close()
