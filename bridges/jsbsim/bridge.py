@@ -74,12 +74,13 @@ class SimBridge:
         self.sync = None
         if self.pacer is None and opts.sync_hz > 0:
             period_us = round(1e6 / opts.sync_hz)
-            self.sync = FlightSync(period_us, self.bus.latest_reader("actuators/servos"))
+            answers = self.bus.latest_reader("actuators/servos")
+            self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]))
         self.samples = None
         if self.sync is not None:
             channels = {"imu": "sensors/imu", "compass": "sensors/compass", "gps": "sensors/gps"}
             readers = {n: self.bus.queue_reader(c) for n, c in channels.items()}
-            self.samples = SampleSync(readers)
+            self.samples = SampleSync(readers, self.bus.waiter(list(readers.values())))
         self.commands = VehicleCommands(self.bus, self.failures, self.sync, opts.start_at_s)
         self.frames = 0
         self.stopping = False
@@ -143,12 +144,12 @@ class SimBridge:
             _, _, name, data = heapq.heappop(self.pending)
             self.ports[name].write(data)
             written.add(name)
+        if self.samples is not None:  # sleeps on the bus: the pty check after is quick
+            self.samples.wait(written - self.failures.garbled(), t_us)
         if self.pacer is not None:
             self.pacer.wait(s.t_s)
         else:
             self.lockstep.wait()
-        if self.samples is not None:
-            self.samples.wait(written - self.failures.garbled(), t_us)
         self.commands.serve(t_us)
         if self.sync is not None:
             self.sync.wait(t_us)

@@ -11,12 +11,14 @@ from bridges.jsbsim.ptys import PtyPort
 
 if TYPE_CHECKING:
     from companion.bus.channels import LatestReader, Reader
+    from companion.bus.node import Waiter
     from companion.messages import ServoOutput
 
 log = logging.getLogger(__name__)
 
 STALL_S = 0.5  # a driver that reads nothing for this long is not waited for
 EXACT_STALL_S = 10.0  # the same, when every frame must be the same run after run
+EVENT_WAIT_S = 0.05  # exact: longest sleep on a bus event before looking again
 SAMPLE_GRACE_S = 2.0  # exact: a driver's sample is waited for this long after its bytes
 SPIN_POLLS = 50  # polls that only yield the CPU before sleeping between polls
 POLL_SLEEP_S = 50e-6
@@ -95,9 +97,9 @@ class FlightSync:
     until it catches up again.
     """
 
-    def __init__(self, period_us: int, answers: LatestReader[ServoOutput]) -> None:
+    def __init__(self, period_us: int, answers: LatestReader[ServoOutput], waiter: Waiter) -> None:
         self.period_us = period_us
-        self.answers = answers
+        self.answers, self.waiter = answers, waiter
         self.flying = False  # the flight plug-ins were started
         self.synced = False  # they have answered in step since
         self.lagging = False  # they stopped answering: not waited for until they catch up
@@ -118,9 +120,9 @@ class FlightSync:
             return
         limit = STALL_FLIGHT_S if self.synced else START_FLIGHT_S
         started = time.perf_counter()
-        polls = 0
         while not self._answered(grid):
-            if time.perf_counter() - started > limit:
+            waited = time.perf_counter() - started
+            if waited > limit:
                 log.warning(
                     "lockstep: no servo answer to the state at %.2f s for %.0f s (newest"
                     " answer: %.2f s); not waiting for it",
@@ -131,8 +133,7 @@ class FlightSync:
                 self.lagging, self.synced = True, False
                 self.stalls += 1
                 break
-            polls += 1
-            time.sleep(0 if polls < SPIN_POLLS else POLL_SLEEP_S)
+            self.waiter.wait(min(limit - waited, EVENT_WAIT_S))  # sleeps on the bus event
         self.wait_s += time.perf_counter() - started
 
     def _answered(self, grid: int) -> bool:
@@ -156,8 +157,10 @@ class SampleSync:
     most ``grace_s`` a frame.
     """
 
-    def __init__(self, readers: dict[str, Reader[Any]], grace_s: float = SAMPLE_GRACE_S) -> None:
-        self.readers = readers
+    def __init__(
+        self, readers: dict[str, Reader[Any]], waiter: Waiter, grace_s: float = SAMPLE_GRACE_S
+    ) -> None:
+        self.readers, self.waiter = readers, waiter
         self.newest_us = dict.fromkeys(readers, -1)
         self.grace_s = grace_s
         self.late = 0  # frames in which a sample did not come within grace_s
@@ -167,17 +170,16 @@ class SampleSync:
         """Return when every device written this frame has published its sample."""
         pending = [n for n in written if n in self.readers and self.newest_us[n] >= 0]
         started = time.perf_counter()
-        polls = 0
         while True:
             self._take()
             pending = [n for n in pending if self.newest_us[n] < t_us]
             if not pending:
                 break
-            if time.perf_counter() - started > self.grace_s:
+            waited = time.perf_counter() - started
+            if waited > self.grace_s:
                 self.late += 1
                 break
-            polls += 1
-            time.sleep(0 if polls < SPIN_POLLS else POLL_SLEEP_S)
+            self.waiter.wait(min(self.grace_s - waited, EVENT_WAIT_S))
         self.wait_s += time.perf_counter() - started
 
     def _take(self) -> None:
