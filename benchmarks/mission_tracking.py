@@ -4,9 +4,10 @@ Usage: uv run python benchmarks/mission_tracking.py [--aircraft c172p] [--plan s
 (both repeatable; default: c172p and J3Cub, square.plan and jump.plan)
 
 For each airframe, plan and condition (calm; 5 m/s wind from the west with light
-turbulence) it flies one campaign flight (``companion sim --speed max`` with the plan
-preloaded, armed and started over MAVLink as a ground station would, watched until the
-mission completes; companion/campaign/flight_run.py) and prints from the truth CSV:
+turbulence) it flies one campaign flight (``companion sim --speed max --exact
+--start-at 10`` with the plan preloaded, so every run of the same code flies the same
+flight; watched until the mission completes; companion/campaign/flight_run.py) and
+prints from the truth CSV:
 cross-track error RMS and 95th percentile on the straight part of each
 waypoint-to-waypoint leg (past the turn onto it and before the turn off it), and height
 error RMS and airspeed error RMS over the same samples (companion/campaign/scoring.py).
@@ -28,6 +29,7 @@ from companion.campaign.flight_run import FlightJob, fly_flight  # noqa: E402
 from companion.campaign.spec import PLANS, SIM_CONFIG, Flight  # noqa: E402
 
 CONDITIONS = {"calm": ((0.0, 0.0, 0.0), "none"), "wind 5 m/s W + light": ((0.0, 5.0, 0.0), "light")}
+START_AT_S = 10.0  # exact lockstep: the simulator arms and starts the mission then
 
 
 def main() -> None:
@@ -43,7 +45,7 @@ def main() -> None:
         for plan in plans:
             for cond, (wind, turbulence) in CONDITIONS.items():
                 flight = Flight(str(plan), name, wind, turbulence, (), 1, str(SIM_CONFIG),
-                                False, 900.0)  # fmt: skip
+                                False, 900.0, START_AT_S)  # fmt: skip
                 with tempfile.TemporaryDirectory() as tmp:
                     r = fly_flight(FlightJob(flight, tmp, timeout_s=600.0))
                 done = r["completed"] if r["status"] == "ok" else r["error"]

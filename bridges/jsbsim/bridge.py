@@ -33,6 +33,12 @@ from companion.simulation.true_state import TrueState
 log = logging.getLogger(__name__)
 
 SENSORS = ("gps", "compass", "imu")
+# What the vehicle's driver of each emulated device publishes (the sim config's drivers).
+DEVICE_CHANNELS = {
+    "imu": ("sensors/imu", "sensors/mag", "sensors/baro"),
+    "compass": ("sensors/compass",),
+    "gps": ("sensors/gps",),
+}
 STANDARD_PRESSURE_KPA = 101.325
 
 
@@ -78,9 +84,12 @@ class SimBridge:
             self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]))
         self.samples = None
         if self.sync is not None:
-            channels = {"imu": "sensors/imu", "compass": "sensors/compass", "gps": "sensors/gps"}
-            readers = {n: self.bus.queue_reader(c) for n, c in channels.items()}
-            self.samples = SampleSync(readers, self.bus.waiter(list(readers.values())))
+            readers = {
+                device: {c: self.bus.queue_reader(c) for c in channels}
+                for device, channels in DEVICE_CHANNELS.items()
+            }
+            every = [r for by_channel in readers.values() for r in by_channel.values()]
+            self.samples = SampleSync(readers, self.bus.waiter(every))
         self.commands = VehicleCommands(self.bus, self.failures, self.sync, opts.start_at_s)
         self.frames = 0
         self.stopping = False

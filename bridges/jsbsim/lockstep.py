@@ -20,6 +20,7 @@ STALL_S = 0.5  # a driver that reads nothing for this long is not waited for
 EXACT_STALL_S = 10.0  # the same, when every frame must be the same run after run
 EVENT_WAIT_S = 0.05  # exact: longest sleep on a bus event before looking again
 SAMPLE_GRACE_S = 2.0  # exact: a driver's sample is waited for this long after its bytes
+FIRST_SAMPLE_GRACE_S = 0.3  # ... and this long on a channel that has carried nothing yet
 SPIN_POLLS = 50  # polls that only yield the CPU before sleeping between polls
 POLL_SLEEP_S = 50e-6
 START_FLIGHT_S = 20.0  # the flight plug-ins' start-up after START, at most
@@ -147,42 +148,50 @@ class FlightSync:
 
 
 class SampleSync:
-    """Exact lockstep with the drivers: wait until each device's bytes became a sample.
+    """Exact lockstep with the drivers: wait until each device's bytes became samples.
 
     A drained pty only says the driver read the bytes; the kernel may also still hold
-    them in the pty's buffer while reporting nothing unread. Waiting for the sample each
-    write produces on the bus (stamped with this frame's time) closes both gaps, so no
-    driver ever reads two frames as one or publishes one frame late. A device is waited
-    for once it has published anything (the GPS decoder learns its epoch first), and at
-    most ``grace_s`` a frame.
+    them in the pty's buffer while reporting nothing unread, and the driver may not have
+    published yet. Waiting for every sample a write produces on the bus (each channel the
+    device's driver publishes, stamped with this frame's time) closes these gaps, so no
+    driver reads two frames as one or publishes one late. A channel that has never carried
+    anything (the GPS decoder learns its epoch before its first fix) is waited for only
+    ``first_grace_s``; the others at most ``grace_s`` a frame.
     """
 
     def __init__(
-        self, readers: dict[str, Reader[Any]], waiter: Waiter, grace_s: float = SAMPLE_GRACE_S
+        self,
+        channels: dict[str, dict[str, Reader[Any]]],
+        waiter: Waiter,
+        grace_s: float = SAMPLE_GRACE_S,
+        first_grace_s: float = FIRST_SAMPLE_GRACE_S,
     ) -> None:
-        self.readers, self.waiter = readers, waiter
-        self.newest_us = dict.fromkeys(readers, -1)
-        self.grace_s = grace_s
+        self.channels, self.waiter = channels, waiter  # device → {channel: reader}
+        self.newest_us = {c: -1 for readers in channels.values() for c in readers}
+        self.grace_s, self.first_grace_s = grace_s, first_grace_s
         self.late = 0  # frames in which a sample did not come within grace_s
         self.wait_s = 0.0
 
     def wait(self, written: set[str], t_us: int) -> None:
-        """Return when every device written this frame has published its sample."""
-        pending = [n for n in written if n in self.readers and self.newest_us[n] >= 0]
+        """Return when every device written this frame has published its samples."""
+        pending = [c for dev in written for c in self.channels.get(dev, {})]
+        seen = all(self.newest_us[c] >= 0 for c in pending)
+        grace = self.grace_s if seen else self.first_grace_s
         started = time.perf_counter()
         while True:
             self._take()
-            pending = [n for n in pending if self.newest_us[n] < t_us]
+            pending = [c for c in pending if self.newest_us[c] < t_us]
             if not pending:
                 break
             waited = time.perf_counter() - started
-            if waited > self.grace_s:
-                self.late += 1
+            if waited > grace:
+                self.late += seen
                 break
-            self.waiter.wait(min(self.grace_s - waited, EVENT_WAIT_S))
+            self.waiter.wait(min(grace - waited, EVENT_WAIT_S))
         self.wait_s += time.perf_counter() - started
 
     def _take(self) -> None:
-        for name, reader in self.readers.items():
-            for sample in reader.drain():
-                self.newest_us[name] = max(self.newest_us[name], int(sample.t_us))
+        for readers in self.channels.values():
+            for channel, reader in readers.items():
+                for sample in reader.drain():
+                    self.newest_us[channel] = max(self.newest_us[channel], int(sample.t_us))

@@ -36,6 +36,7 @@ log = logging.getLogger(__name__)
 GCS_SYSID, GCS_COMPID = 255, 190
 TAIL_S = 1.0  # keep flying this long (wall) after completion: the loiter at home is in the truth
 FAILSAFE_PREFIXES = ("Failsafe", "Fence breached")
+TIMING_INTERVAL_US = 20_000  # MISSION_CURRENT and ATTITUDE at 50 Hz (wall) to this station
 
 
 class FlightError(Exception):
@@ -193,6 +194,11 @@ class _Pilot:
     def fly(self, start_at_s: float | None) -> None:
         """Arm and start (or, when the simulator starts the mission, see it armed)."""
         self._until(lambda m: m.get_type() == "HOME_POSITION", "the vehicle's home position")
+        # The completion time is read off the telemetry: the faster it comes, the finer.
+        for msg_id in (d.MAVLINK_MSG_ID_MISSION_CURRENT, d.MAVLINK_MSG_ID_ATTITUDE):
+            self.gcs.mav.command_long_send(
+                1, 1, d.MAV_CMD_SET_MESSAGE_INTERVAL, 0, msg_id, TIMING_INTERVAL_US, 0, 0, 0, 0, 0
+            )
         if start_at_s is None:
             self._command(d.MAV_CMD_COMPONENT_ARM_DISARM, 1.0)
             self._command(d.MAV_CMD_MISSION_START, 0.0)
