@@ -127,8 +127,11 @@ class SimBridge:
         )
 
     def stop(self) -> None:
-        """Ask the loop to end after the current frame."""
+        """Ask the loop to end after the current frame (also ends any wait for the vehicle)."""
         self.stopping = True
+        for waiting in (self.sync, self.samples):
+            if waiting is not None:
+                waiting.cancelled = True
 
     def step(self) -> None:
         """One physics frame, then what the devices say about it, then pacing."""

@@ -107,6 +107,7 @@ class FlightSync:
         self.answered_us = -1
         self.stalls = 0
         self.wait_s = 0.0
+        self.cancelled = False  # the simulation is ending: wait for nothing more
 
     def started(self, flying: bool) -> None:
         """START acknowledged (True) or STOP seen (False)."""
@@ -121,7 +122,7 @@ class FlightSync:
             return
         limit = STALL_FLIGHT_S if self.synced else START_FLIGHT_S
         started = time.perf_counter()
-        while not self._answered(grid):
+        while not self._answered(grid) and not self.cancelled:
             waited = time.perf_counter() - started
             if waited > limit:
                 log.warning(
@@ -171,6 +172,7 @@ class SampleSync:
         self.grace_s, self.first_grace_s = grace_s, first_grace_s
         self.late = 0  # frames in which a sample did not come within grace_s
         self.wait_s = 0.0
+        self.cancelled = False  # the simulation is ending: wait for nothing more
 
     def wait(self, written: set[str], t_us: int) -> None:
         """Return when every device written this frame has published its samples."""
@@ -181,7 +183,7 @@ class SampleSync:
         while True:
             self._take()
             pending = [c for c in pending if self.newest_us[c] < t_us]
-            if not pending:
+            if not pending or self.cancelled:
                 break
             waited = time.perf_counter() - started
             if waited > grace:
