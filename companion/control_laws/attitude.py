@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from companion.control_laws.limits import clamp
 from companion.geodesy import STANDARD_GRAVITY as G
 
 
@@ -40,10 +41,6 @@ class Surfaces:
     rudder: float
 
 
-def _clip(x: float, lo: float, hi: float) -> float:
-    return lo if x < lo else hi if x > hi else x
-
-
 class AttitudeController:
     """Holds the integrators between steps."""
 
@@ -58,7 +55,7 @@ class AttitudeController:
 
     def scaler(self, airspeed: float) -> float:
         """How much to scale the gains at this airspeed (bounded to [0.5, 2])."""
-        return _clip(self.gains.scaling_speed / max(airspeed, 1.0), 0.5, 2.0)
+        return clamp(self.gains.scaling_speed / max(airspeed, 1.0), 0.5, 2.0)
 
     def step(
         self,
@@ -78,17 +75,17 @@ class AttitudeController:
         v = max(airspeed, 5.0)
         roll_err = roll_dem - roll
         # A coordinated turn pitches the body at g·tan φ·sin φ / V.
-        q_turn = G / v * math.tan(_clip(roll, -1.2, 1.2)) * math.sin(roll)
+        q_turn = G / v * math.tan(clamp(roll, -1.2, 1.2)) * math.sin(roll)
         pitch_err = pitch_dem - pitch
         if integrate:
-            self.roll_integ = _clip(
+            self.roll_integ = clamp(
                 self.roll_integ + g.roll_i * k * roll_err * dt, -g.roll_imax, g.roll_imax
             )
-            self.pitch_integ = _clip(
+            self.pitch_integ = clamp(
                 self.pitch_integ + g.pitch_i * k * pitch_err * dt, -g.pitch_imax, g.pitch_imax
             )
         aileron = k * (g.roll_p * roll_err - g.roll_d * p) + self.roll_integ
         elevator = k * (g.pitch_p * pitch_err + g.pitch_d * (q_turn - q)) + self.pitch_integ
         r_turn = G / v * math.sin(roll) * math.cos(pitch)
         rudder = k * g.yaw_damp * (r_turn - r)
-        return Surfaces(_clip(aileron, -1, 1), _clip(elevator, -1, 1), _clip(rudder, -1, 1))
+        return Surfaces(clamp(aileron, -1, 1), clamp(elevator, -1, 1), clamp(rudder, -1, 1))

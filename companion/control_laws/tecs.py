@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from companion.control_laws.limits import clamp
 from companion.geodesy import STANDARD_GRAVITY as G
 
 
@@ -40,10 +41,6 @@ class EnergyDemand:
 
     pitch: float
     throttle: float
-
-
-def _clip(x: float, lo: float, hi: float) -> float:
-    return lo if x < lo else hi if x > hi else x
 
 
 class Tecs:
@@ -82,12 +79,12 @@ class Tecs:
         g = self.gains
         self._track_speed(speed, dt)
         v = max(speed, 5.0)
-        climb_dem = _clip((height_dem - height) / g.time_const, -g.sink_max, g.climb_max)
-        accel_dem = _clip((speed_dem - speed) / g.speed_time_const, -g.accel_max, g.accel_max)
+        climb_dem = clamp((height_dem - height) / g.time_const, -g.sink_max, g.climb_max)
+        accel_dem = clamp((speed_dem - speed) / g.speed_time_const, -g.accel_max, g.accel_max)
         # Specific (per unit weight) energy rates, m/s.
         ste_rate_dem = climb_dem + v * accel_dem / G
         ste_rate = climb_rate + v * self.speed_rate / G
-        w = _clip(g.speed_weight, 0.0, 2.0)
+        w = clamp(g.speed_weight, 0.0, 2.0)
         seb_rate_dem = climb_dem * (2.0 - w) - v * accel_dem / G * w
         seb_rate = climb_rate * (2.0 - w) - v * self.speed_rate / G * w
         throttle = self._throttle(ste_rate_dem, ste_rate, dt)
@@ -102,16 +99,16 @@ class Tecs:
         else:
             ff = g.throttle_trim + (g.throttle_trim - g.throttle_min) * ste_rate_dem / g.sink_max
         error = (ste_rate_dem - ste_rate) / span
-        self.throttle_integ = _clip(self.throttle_integ + g.integ_gain * error * dt, -0.3, 0.3)
+        self.throttle_integ = clamp(self.throttle_integ + g.integ_gain * error * dt, -0.3, 0.3)
         raw = ff + g.throttle_damp * error * 4.0 + self.throttle_integ
-        return _clip(raw, g.throttle_min, g.throttle_max)
+        return clamp(raw, g.throttle_min, g.throttle_max)
 
     def _pitch(self, seb_rate_dem: float, seb_rate: float, v: float, dt: float) -> float:
         g = self.gains
         # A balance rate of v·θ per radian of flight-path angle: divide to get radians.
         error = (seb_rate_dem - seb_rate) / v
-        self.pitch_integ = _clip(
+        self.pitch_integ = clamp(
             self.pitch_integ + g.integ_gain * error * dt * 3.0, g.pitch_min, g.pitch_max
         )
         raw = seb_rate_dem / v + g.pitch_damp * error + self.pitch_integ
-        return _clip(raw, g.pitch_min, g.pitch_max)
+        return clamp(raw, g.pitch_min, g.pitch_max)
