@@ -34,9 +34,7 @@ from companion.bus.namespace import cleanup_namespace, validate_namespace
 from companion.bus.node import BusNode
 from companion.exec_control.plugin_host import die_with_parent
 from companion.geodesy import LocalFrame
-from companion.messages import FlightMode
-from companion.modes import BY_MODE
-from companion.sim_session import status_line
+from companion.sim_session import mode_name, status_line
 
 log = logging.getLogger("companion.fleet")
 
@@ -178,11 +176,7 @@ class VehicleWatch:
         now, t_us = time.monotonic(), 0 if clock is None else int(clock.t_us)
         factor = (t_us - self.last[1]) / 1e6 / max(now - self.last[0], 1e-6)
         self.last = (now, t_us)
-        status = self.status.get()
-        mode = "-"
-        if status is not None:
-            with contextlib.suppress(ValueError, KeyError):
-                mode = BY_MODE[FlightMode(status.mode)].name
+        mode = mode_name(self.status.get())
         text = status_line(t_us, factor, self.health.get(), self.truth.get(), mode)
         return f"v{self.slot.index}  {text}"
 

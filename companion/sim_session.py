@@ -28,9 +28,10 @@ from companion.bus.node import BusNode
 from companion.exec_control.config import VehicleConfig, load_config
 from companion.exec_control.plugin_host import die_with_parent
 from companion.exec_control.supervisor import Supervisor
-from companion.messages import PluginState
+from companion.messages import FlightMode, PluginState
 from companion.mission.items import MissionItem
 from companion.mission.store import MissionStore
+from companion.modes import BY_MODE
 
 log = logging.getLogger("companion.sim")
 
@@ -170,6 +171,7 @@ class Monitor(threading.Thread):
     def _watch(self, bus: BusNode) -> None:
         clock, truth = bus.latest_reader("sim/clock"), bus.latest_reader("sim/truth")
         health = bus.latest_reader("system/health")
+        status = bus.latest_reader("vehicle/status")
         period = STATUS_PERIOD_S if self.tty else QUIET_STATUS_PERIOD_S
         last = (time.monotonic(), 0)
         while not self.finished.is_set() and not self.bridge.finished(POLL_S):
@@ -178,7 +180,8 @@ class Monitor(threading.Thread):
                 continue
             factor = (t_us - last[1]) / 1e6 / max(now - last[0], 1e-6)
             last = (now, t_us)
-            line = status_line(t_us, factor, health.get(), truth.get())
+            mode = mode_name(status.get())
+            line = status_line(t_us, factor, health.get(), truth.get(), mode)
             if self.tty:
                 sys.stderr.write("\r" + line + "\x1b[K")
                 sys.stderr.flush()
@@ -192,10 +195,20 @@ def _t_us(sample: object) -> int:
     return 0 if sample is None else int(sample.t_us)
 
 
+def mode_name(status: object) -> str:
+    """The flight mode's name as ground stations show it, from ``vehicle/status``."""
+    if status is None:
+        return "-"
+    try:
+        return BY_MODE[FlightMode(status.mode)].name  # type: ignore[attr-defined]
+    except (ValueError, KeyError):
+        return "-"
+
+
 def status_line(t_us: int, factor: float, health: object, truth: object, mode: str = "") -> str:
     """``sim 12.3 s  x24.1  ARMED  alt 123 m  air 50.2 m/s  -37.91050 145.13400``.
 
-    A mode name, when given, follows the arm state (the fleet's lines carry it).
+    A mode name, when given, follows the arm state.
     """
     armed = "ARMED" if health is not None and health.flight_running else "disarmed"
     if mode:
