@@ -1,0 +1,162 @@
+"""The mission executor's loiters, RTL, the end of the mission and starting part way.
+
+As in test_executor.py: the aircraft is teleported and the executor stepped at each point.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from companion.mission.executor import ExecutorConfig, Kind, MissionExecutor
+from mavlink_dialect import companion as d
+from tests.unit.mission.executor_flying import (
+    HOME,
+    HOME_ALT,
+    dist,
+    executor,
+    fly_lines,
+    item,
+    on_circle,
+    wp,
+)
+
+# --- loiters -------------------------------------------------------------------------------
+
+
+def test_loiter_time_counts_from_reaching_the_circle():
+    centre, radius = (1_000.0, 0.0), 100.0
+    items = [item(0, d.MAV_CMD_NAV_LOITER_TIME, centre, z=100.0, p1=30.0, p3=radius)]
+    ex = executor(items)
+    for t in range(0, 100, 5):  # a long way off: time does not count
+        sp = ex.step((0.0, 0.0), 180.0, float(t))
+        assert sp.kind == Kind.CIRCLE and not ex.finished
+    assert sp.b == pytest.approx(centre, abs=0.05) and sp.radius == radius and sp.clockwise
+    assert sp.alt_msl == pytest.approx(HOME_ALT + 100.0)
+    # On the circle from t = 100: done at t = 130, not before.
+    t = 100.0
+    while t < 129.9:
+        ex.step(on_circle(centre, radius, 6.0 * (t - 100.0)), 180.0, t)
+        assert ex.drain_reached() == [] and not ex.finished, t
+        t += 0.5
+    sp = ex.step(on_circle(centre, radius, 180.0), 180.0, 130.0)
+    assert ex.drain_reached() == [0]
+    assert ex.finished and sp.kind == Kind.CIRCLE  # the last item: circles its point
+    assert sp.b == pytest.approx(centre, abs=0.05)
+
+
+def test_loiter_time_starts_counting_within_a_quarter_radius_of_the_circle():
+    centre, radius = (1_000.0, 0.0), 100.0
+    items = [item(0, d.MAV_CMD_NAV_LOITER_TIME, centre, z=100.0, p1=10.0, p3=radius)]
+    ex = executor(items)
+    ex.step((870.0, 0.0), 180.0, 0.0)  # 130 m from the centre: not yet on the circle
+    ex.step((880.0, 0.0), 180.0, 5.0)  # 120 m: on it
+    ex.step((880.0, 0.0), 180.0, 14.9)
+    assert not ex.finished
+    ex.step((880.0, 0.0), 180.0, 15.0)
+    assert ex.finished and ex.drain_reached() == [0]
+
+
+@pytest.mark.parametrize("direction", [+1, -1])
+def test_loiter_turns_completes_after_720_degrees(direction: int):
+    centre, radius = (1_000.0, 0.0), 100.0
+    items = [
+        item(0, d.MAV_CMD_NAV_LOITER_TURNS, centre, z=100.0, p1=2.0, p3=radius),
+        wp(1, (2_000.0, 0.0)),
+    ]
+    ex = executor(items)
+    assert ex.step((0.0, 0.0), 180.0, 0.0).kind == Kind.CIRCLE
+    done_at = None
+    for k in range(800):  # one degree per step, from 180° round the circle
+        sp = ex.step(on_circle(centre, radius, 180.0 + direction * k), 180.0, 1.0 + k)
+        if ex.drain_reached() == [0]:
+            done_at = k
+            break
+        assert sp.kind == Kind.CIRCLE
+    assert done_at is not None
+    assert 700 <= done_at <= 722
+    assert sp.kind == Kind.LINE and sp.b == pytest.approx((2_000.0, 0.0), abs=0.05)
+    assert sp.a == pytest.approx(centre, abs=0.05)  # the next leg starts at its centre
+
+
+@pytest.mark.parametrize(
+    "command",
+    [d.MAV_CMD_NAV_LOITER_UNLIM, d.MAV_CMD_NAV_LOITER_TIME, d.MAV_CMD_NAV_LOITER_TURNS],
+)
+@pytest.mark.parametrize(
+    ("p3", "radius", "clockwise"), [(150.0, 150.0, True), (-150.0, 150.0, False), (0.0, 80.0, True)]
+)
+def test_loiter_radius_sign_gives_the_direction(
+    command: int, p3: float, radius: float, clockwise: bool
+):
+    ex = executor([item(0, command, (1_000.0, 0.0), z=100.0, p1=5.0, p3=p3)])
+    sp = ex.step((0.0, 0.0), 180.0, 0.0)
+    assert sp.kind == Kind.CIRCLE
+    assert sp.radius == radius  # 0: the configured default
+    assert sp.clockwise is clockwise
+
+
+def test_loiter_unlimited_never_ends():
+    centre = (1_000.0, 0.0)
+    ex = executor([item(0, d.MAV_CMD_NAV_LOITER_UNLIM, centre, z=100.0, p3=80.0)])
+    for k in range(2_000):
+        sp = ex.step(on_circle(centre, 80.0, 2.0 * k), 180.0, float(k))
+    assert sp.kind == Kind.CIRCLE and not ex.finished and ex.drain_reached() == []
+
+
+# --- RTL and the end of the mission ---------------------------------------------------------
+
+
+def test_rtl_flies_home_at_rtl_altitude_then_circles_home():
+    config = ExecutorConfig(rtl_alt_rel=60.0, loiter_radius=80.0)
+    items = [wp(0, (1_500.0, 0.0), z=120.0), item(1, d.MAV_CMD_NAV_RETURN_TO_LAUNCH)]
+    ex = executor(items, config=config)
+    reached, setpoints, pos = fly_lines(ex, step_m=10.0)
+    assert reached == [0, 1]
+    home_legs = [sp for sp in setpoints if sp.kind == Kind.LINE and sp.b == (0.0, 0.0)]
+    assert home_legs
+    for sp in home_legs:
+        assert sp.a == pytest.approx((1_500.0, 0.0), abs=0.05)  # from the last waypoint
+        assert sp.alt_msl == pytest.approx(HOME_ALT + 60.0)
+        assert not math.isfinite(sp.speed)
+    final = setpoints[-1]
+    assert ex.finished
+    assert final.kind == Kind.CIRCLE
+    assert final.b == (0.0, 0.0) and final.radius == 80.0
+    assert final.alt_msl == pytest.approx(HOME_ALT + 60.0)
+    assert dist(pos, (0.0, 0.0)) <= 120.0  # switched once within 1.5 loiter radii
+    assert dist(pos, (0.0, 0.0)) > 100.0  # ... and not before
+    # Circling home from now on, reported reached only once.
+    for t in range(50):
+        sp = ex.step(on_circle((0.0, 0.0), 80.0, 7.0 * t), 140.0, 1e4 + t)
+        assert sp.kind == Kind.CIRCLE and sp.b == (0.0, 0.0)
+        assert ex.drain_reached() == []
+
+
+def test_after_the_last_item_it_circles_the_last_point():
+    items = [wp(0, (500.0, 0.0), z=50.0), wp(1, (500.0, 500.0), z=70.0)]
+    ex = executor(items)
+    ex.step((0.0, 0.0), 180.0, 0.0)
+    ex.step((490.0, 0.0), 180.0, 1.0)
+    assert ex.drain_reached() == [0] and not ex.finished
+    sp = ex.step((500.0, 480.0), 150.0, 2.0)  # 20 m short: within the acceptance radius
+    assert ex.drain_reached() == [1]
+    assert ex.finished
+    assert sp.kind == Kind.CIRCLE
+    assert sp.b == pytest.approx((500.0, 500.0), abs=0.05)  # the waypoint, not the aircraft
+    assert sp.radius == ExecutorConfig().loiter_radius
+    assert sp.alt_msl == pytest.approx(HOME_ALT + 70.0)
+    # The aircraft moving about does not move the circle.
+    for t in range(3, 20):
+        again = ex.step((500.0 + 10 * t, 500.0), 150.0, float(t))
+        assert again == sp and ex.finished
+
+
+def test_start_part_way_through_skips_the_earlier_items():
+    items = [wp(0, (500.0, 0.0)), wp(1, (500.0, 500.0)), wp(2, (0.0, 500.0))]
+    ex = MissionExecutor(items, HOME, HOME_ALT)
+    ex.start(1, (100.0, 100.0), 180.0)
+    sp = ex.step((100.0, 100.0), 180.0, 0.0)
+    assert sp.a == (100.0, 100.0)  # from where the aircraft is
+    assert sp.b == pytest.approx((500.0, 500.0), abs=0.05)
