@@ -284,3 +284,32 @@ def upload_mission(gcs: GroundStation) -> None:
             round((-37.9105 + dlat) * 1e7), round(145.134 * 1e7), 50, d.MAV_MISSION_TYPE_MISSION,
         )  # fmt: skip
     assert gcs.recv("MISSION_ACK", 10).type == d.MAV_MISSION_ACCEPTED
+
+
+def test_the_vehicle_config_can_start_the_bridge_as_a_plug_in(vehicle_factory, tmp_path):
+    # The same bridge, started and supervised by the execution control with the vehicle.
+    log = tmp_path / "flight.csv"
+    write_flight_log(log)
+    bridge_port, gcs_port = free_udp_port(), free_udp_port()
+    pty = Pty(tmp_path / "ttyRadio")
+    config = VEHICLE.format(state=tmp_path, log=log, bridge_port=bridge_port, gcs_port=gcs_port)
+    config += (
+        '\n[[plugins]]\nname = "legacy"\nplugin = "bridge.legacy_text"\n'
+        f'settings = {{ serial = "{pty.link}", mavlink = "udpout://127.0.0.1:{bridge_port}" }}\n'
+    )
+    vehicle = vehicle_factory(config)
+    gcs = GroundStation(gcs_port)
+    gcs.connect(timeout_s=30)
+    station = OldGroundStation(pty)
+    try:
+        wait_for(lambda: station.read() or len(station.frames()) >= 3, 30, "ATT/POS frames")
+        assert {t.split()[0] for t in texts(station.frames())} <= {"ATT", "POS"}
+        station.send(b"START".ljust(FRAME, b"\x00"))
+        wait_for(lambda: armed(gcs), 10, "armed after START")
+        station.send(b"STOP".ljust(FRAME, b"\x00"))
+        wait_for(lambda: not armed(gcs), 10, "disarmed after STOP")
+        # In the health table like any plug-in (the table is refreshed once a second).
+        wait_for(lambda: vehicle.row("legacy").frames_ok >= 5, 10, "the bridge's counts")
+        assert vehicle.row("legacy").pid > 0
+    finally:
+        gcs.close()
