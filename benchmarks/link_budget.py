@@ -17,6 +17,7 @@ import argparse
 import asyncio
 import fcntl
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -25,6 +26,7 @@ import termios
 import time
 from collections import Counter
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -47,7 +49,27 @@ plugin = "tests.support.plugins:FakeNav"
 name = "imu"
 plugin = "tests.support.plugins:Ticker"
 settings = {{ rate_hz = 200.0 }}
+[[plugins]]
+name = "commander"
+plugin = "vehicle.commander"
+[[plugins]]
+name = "control"
+plugin = "control.fixed_wing"
+group = "flight"
+settings = {{ airframe = "c172p" }}
 """
+
+
+def wait_for_heartbeat(master: int, parser: Any, timeout_s: float = 60.0) -> None:
+    """Read the pty until the vehicle's first HEARTBEAT (the link plug-in is running)."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        ready, _, _ = select.select([master], [], [], 0.2)
+        if ready:
+            msgs = parser.parse_buffer(os.read(master, 4096)) or []
+            if any(msg.get_type() == "HEARTBEAT" for msg in msgs):
+                return
+    raise SystemExit("the vehicle's link did not start on the pty")
 
 
 def start_vehicle(endpoint: str, tmp: Path, namespace: str) -> subprocess.Popen[bytes]:
@@ -77,7 +99,7 @@ def saturated_radio(seconds: float, tmp: Path) -> None:
     parser.robust_parsing = True
     bytes_per_s = 57600 / 10
     try:
-        time.sleep(3.0)
+        wait_for_heartbeat(master, parser)  # the link is up: it hears what is sent now
         for msg_id in (
             m.MAVLINK_MSG_ID_ATTITUDE,
             m.MAVLINK_MSG_ID_GLOBAL_POSITION_INT,
