@@ -15,7 +15,6 @@ import argparse
 import json
 import os
 import re
-import socket
 import subprocess
 import sys
 import tempfile
@@ -27,6 +26,7 @@ import psutil
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink import mavutil
 
+from companion.campaign.flight_run import free_udp_port
 from mavlink_dialect import companion as d
 
 REPO = Path(__file__).resolve().parents[1]
@@ -72,12 +72,6 @@ def cpu_of_tree(proc: psutil.Process, seen: dict[int, tuple[str, float]]) -> Non
             seen[p.pid] = (name, t.user + t.system)
         except psutil.Error:
             pass
-
-
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def arm_and_loiter(station: mavutil.mavfile) -> None:

@@ -40,7 +40,6 @@ BRIDGE_START_S = 30.0
 STATUS_PERIOD_S = 0.5
 POLL_S = 0.2
 QUIET_STATUS_PERIOD_S = 10.0  # when stderr is not a terminal: a log line now and then
-NAV_GRID_DEFAULT_HZ = 50.0  # nav.ins_ekf's publish_hz default (tests/sim/test_sim_flight.py checks)
 
 
 class BridgeProcess:
@@ -232,7 +231,11 @@ def nav_grid_hz(config: Path) -> float:
         return 0.0  # load_config reports it properly
     for spec in plugins:
         if isinstance(spec, dict) and spec.get("plugin") == "nav.ins_ekf":
-            return float(spec.get("settings", {}).get("publish_hz", NAV_GRID_DEFAULT_HZ))
+            # The plug-in's own default, not a copy of it (imported only for --exact).
+            from companion.plugins.nav.ins_ekf import InsEkfPlugin
+
+            default = InsEkfPlugin.settings["publish_hz"].default
+            return float(spec.get("settings", {}).get("publish_hz", default))
     return 0.0
 
 

@@ -70,20 +70,20 @@ class SimBridge:
         self.order = 0
         self.servo_decoder = FrameDecoder()
         self.by_servo = {c.servo: c for c in self.airframe.channels}
-        stall_s = EXACT_STALL_S if opts.sync_hz > 0 else STALL_S
-        self.lockstep = Lockstep([self.ports[n] for n in SENSORS], stall_s)
         self.pacer = RealTime(opts.speed) if opts.speed else None
+        exact = self.pacer is None and opts.sync_hz > 0
+        stall_s = EXACT_STALL_S if exact else STALL_S
+        self.lockstep = Lockstep([self.ports[n] for n in SENSORS], stall_s)
         self.truth = TruthLog(opts.truth_path) if opts.truth_path else None
         self.bus = BusNode(opts.namespace, "sim_bridge")
         self.clock = self.bus.writer("sim/clock")
         self.truth_out = self.bus.writer("sim/truth")
-        self.sync = None
-        if self.pacer is None and opts.sync_hz > 0:
+        self.sync: FlightSync | None = None
+        self.samples: SampleSync | None = None
+        if exact:
             period_us = round(1e6 / opts.sync_hz)
             answers = self.bus.latest_reader("actuators/servos")
             self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]))
-        self.samples = None
-        if self.sync is not None:
             readers = {
                 device: {c: self.bus.queue_reader(c) for c in channels}
                 for device, channels in DEVICE_CHANNELS.items()

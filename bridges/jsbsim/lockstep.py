@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from bridges.jsbsim.ptys import PtyPort
@@ -86,7 +87,31 @@ class RealTime:
             self.late_s = max(self.late_s, -delay)
 
 
-class FlightSync:
+class _BusWait:
+    """Sleeps on bus events until a condition holds, the simulation ends, or time is up."""
+
+    def __init__(self, waiter: Waiter) -> None:
+        self.waiter = waiter
+        self.wait_s = 0.0
+        self.cancelled = False  # the simulation is ending: wait for nothing more
+
+    def _until(self, done: Callable[[], bool], limit_s: float) -> bool:
+        """True once ``done()`` (or cancelled); False when ``limit_s`` passed first."""
+        started = time.perf_counter()
+        try:
+            while not done():
+                if self.cancelled:
+                    return True
+                waited = time.perf_counter() - started
+                if waited > limit_s:
+                    return False
+                self.waiter.wait(min(limit_s - waited, EVENT_WAIT_S))
+            return True
+        finally:
+            self.wait_s += time.perf_counter() - started
+
+
+class FlightSync(_BusWait):
     """Lockstep with the control loop, so the same seed flies the same flight.
 
     The vehicle's navigator publishes on a fixed grid of vehicle time (``period_us``), the
@@ -99,15 +124,14 @@ class FlightSync:
     """
 
     def __init__(self, period_us: int, answers: LatestReader[ServoOutput], waiter: Waiter) -> None:
+        super().__init__(waiter)
         self.period_us = period_us
-        self.answers, self.waiter = answers, waiter
+        self.answers = answers
         self.flying = False  # the flight plug-ins were started
         self.synced = False  # they have answered in step since
         self.lagging = False  # they stopped answering: not waited for until they catch up
         self.answered_us = -1
         self.stalls = 0
-        self.wait_s = 0.0
-        self.cancelled = False  # the simulation is ending: wait for nothing more
 
     def started(self, flying: bool) -> None:
         """START acknowledged (True) or STOP seen (False)."""
@@ -121,22 +145,16 @@ class FlightSync:
         if self._answered(grid) or self.lagging:
             return
         limit = STALL_FLIGHT_S if self.synced else START_FLIGHT_S
-        started = time.perf_counter()
-        while not self._answered(grid) and not self.cancelled:
-            waited = time.perf_counter() - started
-            if waited > limit:
-                log.warning(
-                    "lockstep: no servo answer to the state at %.2f s for %.0f s (newest"
-                    " answer: %.2f s); not waiting for it",
-                    grid / 1e6,
-                    limit,
-                    self.answered_us / 1e6,
-                )
-                self.lagging, self.synced = True, False
-                self.stalls += 1
-                break
-            self.waiter.wait(min(limit - waited, EVENT_WAIT_S))  # sleeps on the bus event
-        self.wait_s += time.perf_counter() - started
+        if not self._until(lambda: self._answered(grid), limit):
+            log.warning(
+                "lockstep: no servo answer to the state at %.2f s for %.0f s (newest"
+                " answer: %.2f s); not waiting for it",
+                grid / 1e6,
+                limit,
+                self.answered_us / 1e6,
+            )
+            self.lagging, self.synced = True, False
+            self.stalls += 1
 
     def _answered(self, grid: int) -> bool:
         answer = self.answers.get()
@@ -148,7 +166,7 @@ class FlightSync:
         return True
 
 
-class SampleSync:
+class SampleSync(_BusWait):
     """Exact lockstep with the drivers: wait until each device's bytes became samples.
 
     A drained pty only says the driver read the bytes; the kernel may also still hold
@@ -167,30 +185,23 @@ class SampleSync:
         grace_s: float = SAMPLE_GRACE_S,
         first_grace_s: float = FIRST_SAMPLE_GRACE_S,
     ) -> None:
-        self.channels, self.waiter = channels, waiter  # device → {channel: reader}
+        super().__init__(waiter)
+        self.channels = channels  # device → {channel: reader}
         self.newest_us = {c: -1 for readers in channels.values() for c in readers}
         self.grace_s, self.first_grace_s = grace_s, first_grace_s
         self.late = 0  # frames in which a sample did not come within grace_s
-        self.wait_s = 0.0
-        self.cancelled = False  # the simulation is ending: wait for nothing more
 
     def wait(self, written: set[str], t_us: int) -> None:
         """Return when every device written this frame has published its samples."""
-        pending = [c for dev in written for c in self.channels.get(dev, {})]
-        seen = all(self.newest_us[c] >= 0 for c in pending)
-        grace = self.grace_s if seen else self.first_grace_s
-        started = time.perf_counter()
-        while True:
+        expected = [c for dev in written for c in self.channels.get(dev, {})]
+        seen = all(self.newest_us[c] >= 0 for c in expected)
+
+        def arrived() -> bool:
             self._take()
-            pending = [c for c in pending if self.newest_us[c] < t_us]
-            if not pending or self.cancelled:
-                break
-            waited = time.perf_counter() - started
-            if waited > grace:
-                self.late += seen
-                break
-            self.waiter.wait(min(grace - waited, EVENT_WAIT_S))
-        self.wait_s += time.perf_counter() - started
+            return all(self.newest_us[c] >= t_us for c in expected)
+
+        if not self._until(arrived, self.grace_s if seen else self.first_grace_s):
+            self.late += seen
 
     def _take(self) -> None:
         for readers in self.channels.values():

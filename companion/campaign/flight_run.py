@@ -133,7 +133,7 @@ def _row(flight: Flight, folder: Path, tl: Timeline, error: str, wall_s: float) 
 
 def _fly(job: FlightJob, folder: Path, tl: Timeline) -> None:
     flight = job.flight
-    port = _free_udp_port()
+    port = free_udp_port()
     namespace = f"camp{os.getpid()}p{port}"
     gcs = mavutil.mavlink_connection(
         f"udpin:127.0.0.1:{port}", source_system=GCS_SYSID, source_component=GCS_COMPID
@@ -291,7 +291,8 @@ def _signal_group(pgid: int, sig: int) -> None:
         pass
 
 
-def _free_udp_port() -> int:
+def free_udp_port() -> int:
+    """A loopback UDP port nothing is bound to now (for a flight's ground-station link)."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
         sock.bind(("127.0.0.1", 0))
         return sock.getsockname()[1]
