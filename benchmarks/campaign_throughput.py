@@ -24,8 +24,8 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from companion.campaign.runner import run_campaign  # noqa: E402
-from companion.campaign.spec import load_spec  # noqa: E402
+from ground.campaign.runner import run_campaign  # noqa: E402
+from ground.campaign.spec import load_spec  # noqa: E402
 
 RESULT = re.compile(r"simulated ([\d.]+) s in ([\d.]+) s wall")
 SPEC = """

@@ -6,11 +6,11 @@ Usage: uv run python benchmarks/mission_tracking.py [--aircraft c172p] [--plan s
 For each airframe, plan and condition (calm; 5 m/s wind from the west with light
 turbulence) it flies one campaign flight (``companion sim --speed max --exact
 --start-at 10`` with the plan preloaded, so every run of the same code flies the same
-flight; watched until the mission completes; companion/campaign/flight_run.py) and
+flight; watched until the mission completes; ground/campaign/flight_run.py) and
 prints from the truth CSV:
 cross-track error RMS and 95th percentile on the straight part of each
 waypoint-to-waypoint leg (past the turn onto it and before the turn off it), and height
-error RMS and airspeed error RMS over the same samples (companion/campaign/scoring.py).
+error RMS and airspeed error RMS over the same samples (ground/campaign/scoring.py).
 Targets (issue 8): calm cross-track RMS ≤ 3 m, height RMS ≤ 3 m; in wind the mission
 completes and cross-track p95 ≤ 10 m.
 """
@@ -25,8 +25,8 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from companion.campaign.flight_run import FlightJob, fly_flight  # noqa: E402
-from companion.campaign.spec import PLANS, SIM_CONFIG, Flight  # noqa: E402
+from ground.campaign.flight_run import FlightJob, fly_flight  # noqa: E402
+from ground.campaign.spec import PLANS, SIM_CONFIG, Flight  # noqa: E402
 
 CONDITIONS = {"calm": ((0.0, 0.0, 0.0), "none"), "wind 5 m/s W + light": ((0.0, 5.0, 0.0), "light")}
 START_AT_S = 10.0  # exact lockstep: the simulator arms and starts the mission then

@@ -2,7 +2,7 @@
 
 Usage: uv run python benchmarks/nav_accuracy.py [--seeds 4] [--sim-log S.csv --sim-truth T.csv]
 
-Each seed flies the six-minute circuit of ``companion.simulation.synthetic_flight`` with a
+Each seed flies the six-minute circuit of ``ground.simulation.synthetic_flight`` with a
 VN-100-class IMU (noise, turn-on biases, drift), a magnetometer, an OS-3000 that levels
 itself with its accelerometer, and a GPS whose error wanders (1 m per axis, 60 s), with a
 30 s GPS outage in a turn. Printed per navigator: RMS and 95th percentile of tilt (roll
@@ -23,12 +23,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from companion.estimation.estimate_csv import read_estimate
-from companion.estimation.scoring import EARTH_RADIUS_M, Errors
 from companion.messages import GpsFix
-from companion.simulation.evaluation import fly, messages, truth_columns
-from companion.simulation.synthetic_flight import FlightSpec
-from companion.simulation.synthetic_log import synthesize
+from companion.navigation.estimate_csv import read_estimate
+from companion.navigation.scoring import EARTH_RADIUS_M, Errors
+from ground.simulation.evaluation import fly, messages, truth_columns
+from ground.simulation.synthetic_flight import FlightSpec
+from ground.simulation.synthetic_log import synthesize
 
 OUTAGE = (150.0, 30.0)
 DECLINATION = 11.7  # the synthetic field's
@@ -75,7 +75,7 @@ def main() -> None:
     table(f"synthetic circuit, {args.seeds} seeds, 30 s GPS outage at 150 s", rows)
     print(f"\nGPS alone: horizontal RMS {np.mean(gps):.2f} m (mean over seeds)")
     if args.sim_estimate and args.sim_truth:
-        from companion.estimation.scoring import score
+        from companion.navigation.scoring import score
 
         errors = score(read_estimate(args.sim_estimate), read_estimate(args.sim_truth))
         table("simulator run", {"estimate": [errors]})

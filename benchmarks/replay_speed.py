@@ -15,10 +15,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from companion.replay import replay_log
-from companion.sensorlog import read_sensor_log
-from companion.simulation.synthetic_flight import CIRCUIT, FlightSpec
-from companion.simulation.synthetic_log import synthesize
+from companion.sensors.sensorlog import read_sensor_log
+from ground.replay.single import replay_log
+from ground.simulation.synthetic_flight import CIRCUIT, FlightSpec
+from ground.simulation.synthetic_log import synthesize
 
 
 def main() -> None:

@@ -26,7 +26,7 @@ import psutil
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink import mavutil
 
-from companion.campaign.flight_run import free_udp_port
+from ground.campaign.flight_run import free_udp_port
 from mavlink_dialect import companion as d
 
 REPO = Path(__file__).resolve().parents[1]
@@ -38,8 +38,8 @@ RESULT = re.compile(
 
 def jsbsim_alone(aircraft: str, seconds: float) -> float:
     """Speed factor of the flight dynamics with nothing else (the ceiling)."""
-    from bridges.jsbsim.fdm import Flight, Home
     from companion.actuators.airframe import load_airframe
+    from ground.sitl.bridge.fdm import Flight, Home
 
     frame = load_airframe(aircraft)
     saved = os.dup(1)  # JSBSim prints a banner on stdout

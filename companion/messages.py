@@ -342,7 +342,7 @@ class SystemHealth(Message):
 
 
 class FlightMode(enum.IntEnum):
-    """The vehicle's flight modes (``companion.modes`` maps them to MAVLink's encodings)."""
+    """The vehicle's flight modes (``companion.control.modes`` maps them to MAVLink's encodings)."""
 
     MANUAL = 1  # surfaces follow the pilot (no RC here: held neutral)
     STABILIZED = 2  # wings level, height held

@@ -14,7 +14,7 @@ def run(*argv: str) -> subprocess.CompletedProcess[str]:
 
 
 def test_ruff_finds_nothing():
-    done = run(sys.executable, "-m", "ruff", "check", "companion", "bridges", "tests", "benchmarks")
+    done = run(sys.executable, "-m", "ruff", "check", "companion", "ground", "tests", "benchmarks")
     assert done.returncode == 0, done.stdout + done.stderr
 
 

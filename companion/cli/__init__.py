@@ -12,8 +12,14 @@ from companion.cli.app import app
 
 __all__ = ["app", "main"]
 
-for _module in ("vehicle", "sim", "replay", "campaign", "bridge"):
-    importlib.import_module(f"companion.cli.{_module}")
+for _module in (
+    "companion.cli.vehicle",
+    "ground.cli.sim",
+    "ground.cli.replay",
+    "ground.cli.campaign",
+    "companion.cli.bridge",
+):
+    importlib.import_module(_module)
 
 
 def main() -> None:

@@ -41,7 +41,7 @@ def load_checked(config: Path, namespace: str | None):
 
 
 def plan_or_exit(plan: Path):
-    from companion.mission.plan import PlanError, checked_plan
+    from companion.control.mission.plan import PlanError, checked_plan
 
     try:
         return checked_plan(plan)

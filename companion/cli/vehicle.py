@@ -60,7 +60,7 @@ def status(
 ) -> None:
     """Print the health table of a running vehicle (read from its bus)."""
     from companion.bus import default_namespace
-    from companion.status_view import health_dict, health_table, read_health
+    from companion.cli.status_view import health_dict, health_table, read_health
 
     ns = namespace or default_namespace()
     msg = read_health(ns, timeout)
@@ -121,7 +121,7 @@ app.add_typer(mission_app, name="mission")
 
 
 def _mission_store(config: Path):
-    from companion.mission.store import MissionStore
+    from companion.control.mission.store import MissionStore
 
     cfg = load_checked(config, None)
     return MissionStore(Path(cfg.vehicle["state_dir"]) / "missions")
@@ -149,7 +149,7 @@ def mission_save(
     config: Annotated[Path, CONFIG_OPT],
 ) -> None:
     """Write the vehicle's stored mission and rally points as a .plan file."""
-    from companion.mission.plan import save_plan
+    from companion.control.mission.plan import save_plan
 
     store = _mission_store(config)
     save_plan(plan, store.items)

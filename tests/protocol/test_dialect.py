@@ -46,8 +46,8 @@ def test_ids_of_our_own_are_in_the_private_range():
 
 
 def test_protocol_version_is_mavlink2_only():
-    from companion.mavlink.codec import new_encoder, new_parser
-    from companion.mavlink.identity import IdentityService
+    from companion.link.codec import new_encoder, new_parser
+    from companion.link.identity import IdentityService
 
     mav = new_encoder(1)
     identity = IdentityService(mav, 1, dialect.MAV_AUTOPILOT_GENERIC, 0)

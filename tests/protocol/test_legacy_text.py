@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from companion.modes import MODES, FlightMode
+from companion.control.modes import MODES, FlightMode
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.support.pty import Pty

@@ -7,7 +7,7 @@ import time
 from pymavlink import mavutil
 from pymavlink.dialects.v20 import common as m
 
-from companion.mavlink.link_budget import LinkBudget
+from companion.link.link_budget import LinkBudget
 from tests.protocol.mav_client import LINK_VEHICLE, GroundStation, free_udp_port
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from companion.failsafe import FAILSAFE_PARAMS
+from companion.control.failsafe import FAILSAFE_PARAMS
 from companion.plugins.link.mavlink_link import MavlinkLink
 from tests.protocol.mav_client import client_vehicle, free_udp_port
 from tests.support.vehicle import wait_for

@@ -7,10 +7,10 @@ import json
 
 import pytest
 
+from companion.control.mission.plan import checked_plan
+from companion.control.mission.store import MissionStore
+from companion.control.modes import BY_MODE, MODES
 from companion.messages import FlightMode
-from companion.mission.plan import checked_plan
-from companion.mission.store import MissionStore
-from companion.modes import BY_MODE, MODES
 from mavlink_dialect import companion as m
 from tests.protocol.mav_client import GroundStation, client_vehicle, free_udp_port
 from tests.support.vehicle import REPO, wait_for

@@ -16,9 +16,9 @@ from pathlib import Path
 
 import pytest
 
-from companion.replay_batch import LogsError, find_logs, is_batch
-from companion.simulation.synthetic_flight import FlightSpec, Leg
-from companion.simulation.synthetic_log import synthesize
+from ground.replay.batch import LogsError, find_logs, is_batch
+from ground.simulation.synthetic_flight import FlightSpec, Leg
+from ground.simulation.synthetic_log import synthesize
 from tests.support.vehicle import REPO
 
 LEGS = (Leg(15), Leg(10, turn_deg_s=8), Leg(10))

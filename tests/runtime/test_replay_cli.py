@@ -8,9 +8,9 @@ import sys
 import numpy as np
 import pytest
 
-from companion.estimation.estimate_csv import COLUMNS, read_estimate
-from companion.simulation.synthetic_flight import FlightSpec, Leg
-from companion.simulation.synthetic_log import synthesize
+from companion.navigation.estimate_csv import COLUMNS, read_estimate
+from ground.simulation.synthetic_flight import FlightSpec, Leg
+from ground.simulation.synthetic_log import synthesize
 from tests.support.vehicle import REPO
 
 

@@ -103,8 +103,8 @@ def test_replayed_gps_and_compass_reach_nav_state_through_gps_compass(vehicle_fa
 def test_replayed_imu_gps_and_magnetometer_reach_nav_state_through_ins_ekf(
     vehicle_factory, tmp_path
 ):
-    from companion.simulation.synthetic_flight import FlightSpec, Leg
-    from companion.simulation.synthetic_log import synthesize
+    from ground.simulation.synthetic_flight import FlightSpec, Leg
+    from ground.simulation.synthetic_log import synthesize
 
     log = tmp_path / "flight.csv"
     synthetic = synthesize(FlightSpec(legs=(Leg(12),), heading_deg=90.0, seed=2))

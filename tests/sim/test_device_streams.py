@@ -7,25 +7,25 @@ import math
 import numpy as np
 import pytest
 
-from bridges.jsbsim.device_streams import (
+from companion.messages import GpsFixType
+from companion.sensors.line_framer import LineFramer
+from companion.sensors.nmea_gps import NmeaGpsDecoder
+from companion.sensors.os3000 import Os3000Decoder
+from companion.sensors.vectornav import VectorNavDecoder
+from ground.simulation.sensor_errors import (
+    MagneticField,
+    NoiseModel,
+    SensorErrors,
+    body_from_ned,
+)
+from ground.simulation.true_state import TrueState
+from ground.sitl.bridge.device_streams import (
     DeviceRates,
     EmulatedDevices,
     Outage,
     nmea_epoch,
     os3000_sentence,
 )
-from companion.devices.line_framer import LineFramer
-from companion.devices.nmea_gps import NmeaGpsDecoder
-from companion.devices.os3000 import Os3000Decoder
-from companion.devices.vectornav import VectorNavDecoder
-from companion.messages import GpsFixType
-from companion.simulation.sensor_errors import (
-    MagneticField,
-    NoiseModel,
-    SensorErrors,
-    body_from_ned,
-)
-from companion.simulation.true_state import TrueState
 
 FIELD = MagneticField()
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from companion.estimation.estimate_csv import read_estimate as read_truth
+from companion.navigation.estimate_csv import read_estimate as read_truth
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
 from tests.support.vehicle import REPO

@@ -11,7 +11,7 @@ import pytest
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink import mavutil
 
-from companion.estimation.estimate_csv import read_estimate as read_truth
+from companion.navigation.estimate_csv import read_estimate as read_truth
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
 

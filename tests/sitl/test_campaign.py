@@ -16,8 +16,8 @@ from pathlib import Path
 
 import psutil
 
-from companion.campaign.flight_run import FlightJob, fly_flight
-from companion.campaign.spec import Flight
+from ground.campaign.flight_run import FlightJob, fly_flight
+from ground.campaign.spec import Flight
 from tests.support.vehicle import REPO, companion_env
 
 SPEC = """

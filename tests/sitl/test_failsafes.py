@@ -17,8 +17,8 @@ import pytest
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink import mavutil
 
+from companion.control.modes import BY_MODE
 from companion.messages import FlightMode
-from companion.modes import BY_MODE
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim

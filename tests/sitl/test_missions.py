@@ -19,8 +19,8 @@ from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
 from mavsdk.component_type import ComponentType
 from mavsdk.plugins.action import ActionError
 
-from companion.estimation.estimate_csv import read_estimate as read_truth
 from companion.geodesy import LocalFrame
+from companion.navigation.estimate_csv import read_estimate as read_truth
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
 from tests.support.vehicle import REPO

@@ -10,12 +10,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from bridges.jsbsim.fdm import Flight, Home
 from companion.actuators.airframe import load_airframe
-from companion.flight.controller import ControlOutput, FlightController
-from companion.flight.params import control_params, flight_config
+from companion.control.flight.controller import ControlOutput, FlightController
+from companion.control.flight.params import control_params, flight_config
+from companion.control.mission.items import MissionItem
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
-from companion.mission.items import MissionItem
+from ground.sitl.bridge.fdm import Flight, Home
 
 PHYSICS_HZ = 100
 CONTROL_EVERY = 2  # control at 50 Hz

@@ -8,12 +8,12 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from bridges.jsbsim.device_streams import Outage
-from bridges.jsbsim.options import BridgeOptions
 from companion.cli import app
 from companion.exec_control.config import ConfigError, load_config, load_sections
-from companion.fleet import FleetRequest, plan_slots, shared_args, vehicle_command
 from companion.geodesy import LocalFrame
+from ground.sitl.bridge.device_streams import Outage
+from ground.sitl.bridge.options import BridgeOptions
+from ground.sitl.fleet import FleetRequest, plan_slots, shared_args, vehicle_command
 from tests.support.vehicle import REPO
 
 SIM_TOML = REPO / "companion" / "configs" / "sim.toml"
@@ -68,7 +68,7 @@ def test_the_vehicle_command_line_means_what_the_fleet_planned(tmp_path, monkeyp
         seen.update(req=sim_req, opts=opts)
         return 0
 
-    monkeypatch.setattr("companion.sim_session.run_sim", fake_run_sim)
+    monkeypatch.setattr("ground.sitl.session.run_sim", fake_run_sim)
     argv = vehicle_command(slot, shared_args(req))[3:]  # after "python -m companion"
     result = CliRunner().invoke(app, argv)
     assert result.exit_code == 0, result.output

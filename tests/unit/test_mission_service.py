@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from companion.mavlink.codec import new_encoder, new_parser
-from companion.mavlink.mission_service import MAX_RETRIES, MissionService
-from companion.mavlink.service import Peer
-from companion.mission.store import MissionStore
+from companion.control.mission.store import MissionStore
+from companion.link.codec import new_encoder, new_parser
+from companion.link.mission_service import MAX_RETRIES, MissionService
+from companion.link.service import Peer
 from mavlink_dialect import companion as d
 
 GCS = Peer(255, 190, 0)

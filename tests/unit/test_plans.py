@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from companion.mission.items import check_mission
-from companion.mission.plan import PlanError, load_plan, save_plan
+from companion.control.mission.items import check_mission
+from companion.control.mission.plan import PlanError, load_plan, save_plan
 from mavlink_dialect import companion as d
 from tests.support.vehicle import REPO
 

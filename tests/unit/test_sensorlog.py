@@ -7,7 +7,7 @@ import math
 import pytest
 
 from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
-from companion.sensorlog import LogStats, read_sensor_log
+from companion.sensors.sensorlog import LogStats, read_sensor_log
 
 HEADER = (
     "t,kind,ax,ay,az,gx,gy,gz,lat,lon,alt_m,vn,ve,vd,fix,hdop,mx,my,mz,baro_alt_m,"

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
+from companion.control.modes import BY_MODE
 from companion.messages import FlightMode, SimTruth, SystemHealth, VehicleStatus
-from companion.modes import BY_MODE
-from companion.sim_session import mode_name, status_line
+from ground.sitl.session import mode_name, status_line
 
 
 def test_the_line_names_the_mode_and_says_armed_height_speed_and_position():

@@ -5,8 +5,8 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from companion.mavlink.codec import new_encoder, new_parser
-from companion.mavlink.telemetry import STREAMS, Snapshot
+from companion.link.codec import new_encoder, new_parser
+from companion.link.telemetry import STREAMS, Snapshot
 from companion.messages import GpsFix, Imu, NavFlags, NavState
 
 floats = st.floats(allow_nan=True, allow_infinity=True, width=64)

@@ -12,9 +12,9 @@ from typing import Any
 
 from companion.actuators import minissc
 from companion.actuators.airframe import Airframe, AirframeError, load_airframe
-from companion.devices.serial_port import ReopeningSerial
 from companion.messages import ActuatorCommand, ServoOutput
 from companion.plugin import Plugin, PluginContext, Setting
+from companion.sensors.serial_port import ReopeningSerial
 
 WAIT_S = 0.1  # also the refresh cadence when no command arrives
 CYCLE_MIN_S, CYCLE_MAX_S = 0.01, 0.1

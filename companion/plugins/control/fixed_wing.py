@@ -15,8 +15,9 @@ from pathlib import Path
 from typing import Any
 
 from companion.actuators.airframe import AirframeError, load_airframe
-from companion.flight.controller import ControlOutput, FlightController
-from companion.flight.params import control_params, flight_config
+from companion.control.flight.controller import ControlOutput, FlightController
+from companion.control.flight.params import control_params, flight_config
+from companion.control.mission.store import MissionStore
 from companion.messages import (
     ActuatorCommand,
     ControlStatus,
@@ -24,7 +25,6 @@ from companion.messages import (
     MissionState,
     VehicleStatus,
 )
-from companion.mission.store import MissionStore
 from companion.params import ParamDecl
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext, Setting

@@ -5,12 +5,12 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from companion.mavlink.codec import dialect as d
-from companion.mavlink.command_service import SET_MODE_MESSAGE, CommandArgs, Outcome
-from companion.mavlink.mode_messages import available_modes
-from companion.mavlink.telemetry import STREAMS
+from companion.control.modes import decode_set_mode, from_standard
+from companion.link.codec import dialect as d
+from companion.link.command_service import SET_MODE_MESSAGE, CommandArgs, Outcome
+from companion.link.mode_messages import available_modes
+from companion.link.telemetry import STREAMS
 from companion.messages import CommandId, FlightMode
-from companion.modes import decode_set_mode, from_standard
 
 if TYPE_CHECKING:
     from companion.plugins.link.mavlink_link import MavlinkLink

@@ -15,28 +15,28 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from companion.mavlink.codec import dialect as d
-from companion.mavlink.codec import new_encoder
-from companion.mavlink.command_service import CommandService
-from companion.mavlink.endpoints import (
+from companion.control.mission.store import MissionStore
+from companion.link.codec import dialect as d
+from companion.link.codec import new_encoder
+from companion.link.command_service import CommandService
+from companion.link.endpoints import (
     SCHEMES,
     Endpoint,
     EndpointError,
     open_endpoint,
     split_options,
 )
-from companion.mavlink.gcs_watch import GcsWatch
-from companion.mavlink.identity import IdentityService
-from companion.mavlink.link_router import LinkRouter
-from companion.mavlink.mission_service import MissionService
-from companion.mavlink.mode_messages import current_mode, heartbeat_mode
-from companion.mavlink.params_service import ParamsService
-from companion.mavlink.service import Outgoing
-from companion.mavlink.signing import key_from
-from companion.mavlink.telemetry import Snapshot
-from companion.mavlink.timesync import TimesyncService
+from companion.link.gcs_watch import GcsWatch
+from companion.link.identity import IdentityService
+from companion.link.link_router import LinkRouter
+from companion.link.mission_service import MissionService
+from companion.link.mode_messages import current_mode, heartbeat_mode
+from companion.link.params_service import ParamsService
+from companion.link.service import Outgoing
+from companion.link.signing import key_from
+from companion.link.telemetry import Snapshot
+from companion.link.timesync import TimesyncService
 from companion.messages import ControlStatus, LinkStatus, NavFlags, ParamChange, VehicleCommand
-from companion.mission.store import MissionStore
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 from companion.plugins.link.commands import register_commands

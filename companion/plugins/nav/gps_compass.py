@@ -1,14 +1,14 @@
 """``nav.gps_compass``: the thesis's final configuration as a plug-in.
 
 Reads GPS fixes and compass readings, feeds them in time order to the navigator in
-``companion.estimation.gps_compass``, and publishes ``nav/state`` at the compass rate (and
+``companion.navigation.gps_compass``, and publishes ``nav/state`` at the compass rate (and
 on each fix). The same navigator runs in ``companion replay``.
 """
 
 from __future__ import annotations
 
-from companion.estimation.gps_compass import GpsCompassNavigator
 from companion.messages import Compass, GpsFix
+from companion.navigation.gps_compass import GpsCompassNavigator
 from companion.plugin import Plugin, PluginContext
 
 WAIT_S = 0.5

@@ -1,7 +1,7 @@
 """``nav.ins_ekf``: the strapdown INS with its error-state EKF as a plug-in.
 
 Reads the IMU, GPS and whichever heading sources exist (magnetometer, compass), feeds
-them in time order to ``companion.estimation.ins_ekf.InsEkf`` (the navigator
+them in time order to ``companion.navigation.ins_ekf.InsEkf`` (the navigator
 ``companion replay --navigator ins_ekf`` runs), and publishes ``nav/state`` at
 ``publish_hz`` of vehicle time.
 """
@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import dataclasses
 
-from companion.estimation.ins_ekf import InsEkfConfig
-from companion.estimation.offline import InsEkfRunner
-from companion.estimation.sample_order import SampleOrder
 from companion.messages import Imu
+from companion.navigation.ins_ekf import InsEkfConfig
+from companion.navigation.offline import InsEkfRunner
+from companion.navigation.sample_order import SampleOrder
 from companion.plugin import Plugin, PluginContext, Setting
 
 WAIT_S = 0.5

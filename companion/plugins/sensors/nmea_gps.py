@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from companion.devices.line_framer import LineFramer
-from companion.devices.nmea_gps import NmeaGpsDecoder
-from companion.devices.serial_port import ReopeningSerial
 from companion.plugin import Plugin, PluginContext, Setting
+from companion.sensors.line_framer import LineFramer
+from companion.sensors.nmea_gps import NmeaGpsDecoder
+from companion.sensors.serial_port import ReopeningSerial
 
 
 class NmeaGps(Plugin):

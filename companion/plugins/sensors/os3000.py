@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import math
 
-from companion.devices.line_framer import LineFramer
-from companion.devices.os3000 import Os3000Decoder
-from companion.devices.serial_port import ReopeningSerial
 from companion.plugin import Plugin, PluginContext, Setting
+from companion.sensors.line_framer import LineFramer
+from companion.sensors.os3000 import Os3000Decoder
+from companion.sensors.serial_port import ReopeningSerial
 
 
 class Os3000Compass(Plugin):

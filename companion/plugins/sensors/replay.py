@@ -12,10 +12,10 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
-from companion.estimation.offline import true_headings
 from companion.messages import Message
+from companion.navigation.offline import true_headings
 from companion.plugin import Plugin, PluginContext, Setting
-from companion.sensorlog import CHANNEL_OF, LogStats, read_sensor_log
+from companion.sensors.sensorlog import CHANNEL_OF, LogStats, read_sensor_log
 
 
 class ReplaySensors(Plugin):

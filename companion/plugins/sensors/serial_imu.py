@@ -3,7 +3,7 @@
 VectorNav's ASCII protocol is public (the VN-100 user manual documents every register and
 both checksums), is plain text a person can read on a terminal, and its ``$VNIMU`` and
 ``$VNYMR`` outputs carry accelerometer, gyro and magnetometer together; the sensor is common
-on small UAVs. The codec is ``companion.devices.vectornav``.
+on small UAVs. The codec is ``companion.sensors.vectornav``.
 """
 
 from __future__ import annotations
@@ -12,12 +12,12 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from companion.devices.barometer import pressure_altitude_m
-from companion.devices.line_framer import LineFramer
-from companion.devices.serial_port import ReopeningSerial
-from companion.devices.vectornav import VectorNavDecoder
 from companion.messages import Baro
 from companion.plugin import Plugin, PluginContext, Ports, Setting
+from companion.sensors.barometer import pressure_altitude_m
+from companion.sensors.line_framer import LineFramer
+from companion.sensors.serial_port import ReopeningSerial
+from companion.sensors.vectornav import VectorNavDecoder
 
 
 class SerialImu(Plugin):

@@ -2,7 +2,7 @@
 
 Takes the mode commands off ``link/commands`` (SET_MODE, MISSION_START, RTL, REPOSITION,
 LOITER, SET_HOME), answers each on ``link/command_acks`` (with the reason when refused),
-applies the failsafes (ground-station link, GPS, geofence; ``companion.failsafe``) and
+applies the failsafes (ground-station link, GPS, geofence; ``companion.control.failsafe``) and
 publishes ``vehicle/status`` on every change and four times a second, and what the
 operator should read on ``vehicle/statustext``.
 """
@@ -13,11 +13,11 @@ import math
 from pathlib import Path
 from typing import Any
 
-from companion.commander import MODE_COMMANDS, Commander
-from companion.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
+from companion.control.commander import MODE_COMMANDS, Commander
+from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
+from companion.control.mission.fence import Fence
+from companion.control.mission.store import MissionStore
 from companion.messages import NAME_LEN, CommandAck, FlightMode, NavFlags, StatusText
-from companion.mission.fence import Fence
-from companion.mission.store import MissionStore
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
 from mavlink_dialect import companion as d

@@ -5,7 +5,13 @@ from __future__ import annotations
 
 import pytest
 
-from bridges.legacy_text.frames import FrameError, FrameReader, att_text, encode_frame, pos_text
+from companion.link.legacy_text.frames import (
+    FrameError,
+    FrameReader,
+    att_text,
+    encode_frame,
+    pos_text,
+)
 
 START = b"START".ljust(25, b"\x00")
 STOP = b"STOP".ljust(25, b"\x00")

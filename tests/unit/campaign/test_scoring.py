@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from companion.campaign.scoring import leg_margin_m, score_track
+from companion.control.mission.items import MissionItem
 from companion.geodesy import LocalFrame
-from companion.mission.items import MissionItem
+from ground.campaign.scoring import leg_margin_m, score_track
 from mavlink_dialect import companion as d
 
 HOME = (-37.9105, 145.134)

@@ -6,8 +6,8 @@ import textwrap
 
 import pytest
 
-from companion.campaign.spec import SIM_CONFIG, load_spec
 from companion.exec_control.config import ConfigError
+from ground.campaign.spec import SIM_CONFIG, load_spec
 
 GRID = """
 [campaign]

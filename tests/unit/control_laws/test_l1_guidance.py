@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from companion.control_laws.l1_guidance import G, L1Guidance, bank_for
+from companion.control.laws.l1_guidance import G, L1Guidance, bank_for
 
 V = 30.0  # m/s
 DT = 0.02  # s

@@ -14,8 +14,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from companion.control_laws.attitude import AttitudeController, AttitudeGains
-from companion.control_laws.tecs import G, Tecs, TecsGains
+from companion.control.laws.attitude import AttitudeController, AttitudeGains
+from companion.control.laws.tecs import G, Tecs, TecsGains
 
 DT = 0.02
 ALPHA = math.radians(3.0)  # angle of attack: pitch = flight-path angle + α

@@ -13,7 +13,7 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from companion.control_laws.wind import WindEstimator
+from companion.control.laws.wind import WindEstimator
 
 DT = 0.02  # 50 Hz
 NOISE = 0.3  # m/s, 1 σ per ground velocity axis

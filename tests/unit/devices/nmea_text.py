@@ -9,8 +9,8 @@ from __future__ import annotations
 import datetime as dt
 from functools import reduce
 
-from companion.devices.nmea_gps import NmeaGpsDecoder
 from companion.messages import GpsFix
+from companion.sensors.nmea_gps import NmeaGpsDecoder
 
 LAT_TEXT, LAT = "3754.630738", -37.9105123  # S
 LON_TEXT, LON = "14508.042736", 145.1340456  # E

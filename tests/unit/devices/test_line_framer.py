@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import given
 from hypothesis import strategies as st
 
-from companion.devices.line_framer import LineFramer
+from companion.sensors.line_framer import LineFramer
 
 GGA = b"$GPGGA,120000.00,3754.630738,S,14508.042736,E,1,09,0.9,123.4,M,0.0,M,,*47"
 RMC = b"$GPRMC,120000.00,A,3754.630738,S,14508.042736,E,40.0,90.0,231126,,*1F"

@@ -7,8 +7,8 @@ import math
 import pynmea2
 import pytest
 
-from companion.devices.nmea_gps import NmeaGpsDecoder
 from companion.messages import GpsFixType
+from companion.sensors.nmea_gps import NmeaGpsDecoder
 from tests.unit.devices.nmea_text import (
     GSV,
     KNOT,

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from companion.devices.nmea_gps import NmeaGpsDecoder
+from companion.sensors.nmea_gps import NmeaGpsDecoder
 from tests.unit.devices.nmea_text import GSV, gga, gsa, nmea, rmc, vtg
 
 GOOD = [gga("120000.00"), rmc("120000.00"), vtg(), gsa()]

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from companion.devices.nmea_gps import NmeaGpsDecoder
+from companion.sensors.nmea_gps import NmeaGpsDecoder
 from tests.unit.devices.nmea_text import decode_all, gga, rmc, utc_us
 
 

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from companion.devices.os3000 import Os3000Decoder
+from companion.sensors.os3000 import Os3000Decoder
 
 G = 9.80665
 # The two examples printed in the OS5000 Compass Manual, checksums as printed there.

@@ -9,7 +9,7 @@ from collections.abc import Callable
 
 import pytest
 
-from companion.devices.serial_port import ReopeningSerial, split_device
+from companion.sensors.serial_port import ReopeningSerial, split_device
 from tests.support.pty import Pty
 
 TIMEOUT_S = 0.1

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from companion.devices.vectornav import VectorNavDecoder
+from companion.sensors.vectornav import VectorNavDecoder
 
 # The numbers of the manual's register-27 example: a level, still sensor.
 YMR = (

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import functools
 
-from companion.estimation.offline import Navigator
-from companion.estimation.scoring import Errors
 from companion.messages import NavState
-from companion.simulation import evaluation
-from companion.simulation.synthetic_flight import FlightSpec, Leg
-from companion.simulation.synthetic_log import SyntheticFlight, synthesize
+from companion.navigation.offline import Navigator
+from companion.navigation.scoring import Errors
+from ground.simulation import evaluation
+from ground.simulation.synthetic_flight import FlightSpec, Leg
+from ground.simulation.synthetic_log import SyntheticFlight, synthesize
 
 DECLINATION = 11.7  # the synthetic field's (Melbourne)
 SHORT = (  # 3 minutes: a straight, turns both ways, a climb, a speed change, an outage turn

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from companion.estimation.baro_datum import BaroDatum
+from companion.navigation.baro_datum import BaroDatum
 
 
 def test_the_first_reading_joins_the_ins_height_and_later_ones_move_with_the_barometer():

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from companion.estimation.gps_compass import EARTH_RADIUS_M, GpsCompassNavigator
 from companion.messages import Compass, GpsFix, NavFlags
+from companion.navigation.gps_compass import EARTH_RADIUS_M, GpsCompassNavigator
 
 LAT0, LON0, ALT0 = -37.9105, 145.1340, 100.0
 VN, VE, VD = 18.0, 12.0, -1.0  # a steady climbing leg

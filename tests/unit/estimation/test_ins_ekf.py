@@ -7,9 +7,9 @@ import math
 
 import pytest
 
-from companion.estimation.ins_ekf import InsEkfConfig
-from companion.estimation.offline import InsEkfRunner
 from companion.messages import GpsFix, Imu, NavFlags
+from companion.navigation.ins_ekf import InsEkfConfig
+from companion.navigation.offline import InsEkfRunner
 from tests.unit.estimation.flights import DECLINATION, OUTAGE, flight, fly
 
 

@@ -1,9 +1,9 @@
-"""The navigator's time-ordering buffer (companion/estimation/sample_order.py)."""
+"""The navigator's time-ordering buffer (companion/navigation/sample_order.py)."""
 
 from __future__ import annotations
 
-from companion.estimation.sample_order import SampleOrder
 from companion.messages import Baro, GpsFix, Imu
+from companion.navigation.sample_order import SampleOrder
 
 
 def _kinds(samples) -> list[tuple[str, int]]:

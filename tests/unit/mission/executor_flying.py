@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import math
 
-from companion.geodesy import LocalFrame
-from companion.mission.executor import (
+from companion.control.mission.executor import (
     ExecutorConfig,
     Kind,
     MissionExecutor,
     Setpoint,
 )
-from companion.mission.items import MissionItem, check_mission
+from companion.control.mission.items import MissionItem, check_mission
+from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
 
 HOME = LocalFrame(-37.9105, 145.1340)

@@ -12,7 +12,7 @@ import math
 
 import pytest
 
-from companion.mission.executor import Kind
+from companion.control.mission.executor import Kind
 from mavlink_dialect import companion as d
 from tests.unit.mission.executor_flying import (
     HOME_ALT,

@@ -9,7 +9,7 @@ import math
 
 import pytest
 
-from companion.mission.executor import ExecutorConfig, Kind, MissionExecutor
+from companion.control.mission.executor import ExecutorConfig, Kind, MissionExecutor
 from mavlink_dialect import companion as d
 from tests.unit.mission.executor_flying import (
     HOME,

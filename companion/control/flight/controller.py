@@ -1,0 +1,332 @@
+"""The fixed-wing flight controller: mode → guidance target → energy and attitude → surfaces.
+
+Pure: a navigation solution, the vehicle status and the time in; surface commands and
+what NAV_CONTROLLER_OUTPUT / MISSION_CURRENT report out. The ``control.fixed_wing``
+plug-in runs it on the bus; tests and benchmarks run it against JSBSim directly.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from companion.control.flight.params import FlightConfig
+from companion.control.flight.takeoff import Phase, RunwayTakeoff
+from companion.control.laws.attitude import AttitudeController
+from companion.control.laws.l1_guidance import L1Guidance, LateralDemand, bank_for
+from companion.control.laws.tecs import Tecs
+from companion.control.laws.wind import WindEstimator
+from companion.control.mission.executor import Kind, MissionExecutor, Setpoint, past_point
+from companion.control.mission.items import MissionItem
+from companion.geodesy import STANDARD_GRAVITY as G
+from companion.geodesy import LocalFrame
+from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
+
+AIRBORNE_AGL_M = 10.0
+LANDED_SPEED = 8.0  # m/s: slower than this near the ground is "on the ground"
+
+
+@dataclass
+class ControlOutput:
+    """Surfaces (stick convention) and what the ground station is told."""
+
+    aileron: float = 0.0
+    elevator: float = 0.0
+    rudder: float = 0.0
+    throttle: float = 0.0
+    nav_roll: float = 0.0
+    nav_pitch: float = 0.0
+    target_bearing: float = 0.0
+    wp_dist: float = 0.0
+    alt_error: float = 0.0
+    aspd_error: float = 0.0
+    xtrack: float = 0.0
+    airspeed: float = 0.0
+    mission_seq: int = 0
+    mission_finished: bool = False
+    reached: list[int] = field(default_factory=list)
+    landed: bool = True
+
+
+class FlightController:
+    """One aircraft's controller; ``step()`` once per navigation solution."""
+
+    def __init__(self, config: FlightConfig, items: list[MissionItem] | None = None) -> None:
+        self.items = list(items or [])
+        self.config = config
+        self.wind = WindEstimator()
+        self.frame: LocalFrame | None = None
+        self.home_alt = 0.0
+        self.executor: MissionExecutor | None = None
+        self.takeoff: RunwayTakeoff | None = None
+        self.landed: bool | None = None
+        self._last_t: float | None = None
+        self._mode_key: tuple[int, int] | None = None
+        self._mode_setpoint: Setpoint | None = None
+        self._hold_course: Setpoint | None = None
+        self.attitude = AttitudeController(config.attitude)
+        self.tecs = Tecs(config.tecs)
+        self.l1 = L1Guidance(
+            config["NAVL1_PERIOD"], config["NAVL1_DAMPING"], config["NAVL1_XTRACK_I"]
+        )
+
+    def set_config(self, config: FlightConfig) -> None:
+        """New parameter values; the laws keep their integrators and memory."""
+        self.config = config
+        self.attitude.gains = config.attitude
+        self.tecs.gains = config.tecs
+        self.l1.period_s, self.l1.damping = config["NAVL1_PERIOD"], config["NAVL1_DAMPING"]
+        self.l1.xtrack_i = config["NAVL1_XTRACK_I"]
+        if self.executor is not None:
+            self.executor.config = config.executor
+
+    def set_mission(self, items: list[MissionItem]) -> None:
+        """A new mission was stored: the next MISSION start uses it."""
+        self.items = list(items)
+        self.executor = None
+
+    def _ensure_frame(self, nav: NavState, status: VehicleStatus) -> LocalFrame:
+        if status.home_valid:
+            home = (status.home_lat_deg, status.home_lon_deg, status.home_alt_msl_m)
+        else:
+            home = (nav.lat_deg, nav.lon_deg, nav.alt_msl_m)
+        if self.frame is None or (self.frame.lat0, self.frame.lon0) != home[:2]:
+            self.frame = LocalFrame(home[0], home[1])
+            self.executor = None
+            self._mode_key = None
+        self.home_alt = home[2]
+        return self.frame
+
+    def step(self, nav: NavState, status: VehicleStatus, t_s: float) -> ControlOutput:
+        """Surface commands for this navigation solution."""
+        dt = 0.0 if self._last_t is None else max(0.0, min(t_s - self._last_t, 0.2))
+        self._last_t = t_s
+        if not status.home_valid and (self.landed is None or self.landed):
+            return ControlOutput()  # no home yet: nothing to fly from or back to
+        frame = self._ensure_frame(nav, status)
+        pos = frame.ne(nav.lat_deg, nav.lon_deg)
+        vel = (nav.vn_m_s, nav.ve_m_s)
+        if self.landed:
+            self.wind.on_ground(vel, nav.yaw_rad)
+        else:
+            self.wind.update(vel, nav.yaw_rad, dt)
+        airspeed = self.wind.airspeed
+        self._update_landed(nav, airspeed)
+        out = ControlOutput(airspeed=airspeed, landed=bool(self.landed))
+        mode = FlightMode(status.mode) if status.mode else FlightMode.LOITER
+        if mode == FlightMode.MANUAL:
+            out.throttle = self.config["TRIM_THROTTLE"] if not self.landed else 0.0
+            return out
+        setpoint = self._dead_reckoning(self._setpoint(mode, status, pos, nav, t_s, out), pos, nav)
+        if setpoint is None:
+            self.attitude.reset()
+            return out  # on the ground with nothing that flies from there: idle
+        if setpoint.kind == Kind.TAKEOFF or self._taking_off(nav):
+            return self._fly_takeoff(setpoint, pos, nav, airspeed, dt, out)
+        self.takeoff = None
+        return self._fly(setpoint, pos, vel, nav, airspeed, dt, out)
+
+    def _dead_reckoning(
+        self, setpoint: Setpoint | None, pos: tuple[float, float], nav: NavState
+    ) -> Setpoint | None:
+        """Without GPS, hold the course and height the aircraft had when it was lost.
+
+        Dead-reckoned positions drift, so following waypoints with them would steer by a
+        growing error; a straight course at a known height is the safe thing until GPS
+        returns (then the commander has the aircraft loiter).
+        """
+        if not nav.flags & NavFlags.DEAD_RECKONING or self.landed:
+            self._hold_course = None
+            return setpoint
+        if self._hold_course is None:
+            course = math.atan2(nav.ve_m_s, nav.vn_m_s)
+            ahead = (pos[0] + 1e5 * math.cos(course), pos[1] + 1e5 * math.sin(course))
+            alt = setpoint.alt_msl if setpoint is not None else nav.alt_msl_m
+            self._hold_course = Setpoint(Kind.LINE, pos, ahead, alt)
+        return self._hold_course
+
+    def _update_landed(self, nav: NavState, airspeed: float) -> None:
+        agl = nav.alt_msl_m - self.home_alt
+        if self.landed is None:  # first solution: started on the runway or in the air?
+            self.landed = agl < AIRBORNE_AGL_M and airspeed < self.config["AIRSPEED_MIN"] * 0.7
+        elif self.landed and agl > AIRBORNE_AGL_M:
+            self.landed = False
+        elif not self.landed and agl < 2.0 and math.hypot(nav.vn_m_s, nav.ve_m_s) < LANDED_SPEED:
+            self.landed = True
+
+    def _taking_off(self, nav: NavState) -> bool:
+        return self.takeoff is not None and self.takeoff.phase != Phase.CLIMB_OUT
+
+    def _setpoint(
+        self,
+        mode: FlightMode,
+        status: VehicleStatus,
+        pos: tuple[float, float],
+        nav: NavState,
+        t_s: float,
+        out: ControlOutput,
+    ) -> Setpoint | None:
+        key = (int(mode), int(status.changes))
+        entered = key != self._mode_key
+        self._mode_key = key
+        if mode == FlightMode.MISSION:
+            return self._mission(status, pos, nav, t_s, entered, out)
+        if self.landed and mode != FlightMode.TAKEOFF:
+            return None
+        if entered or self._mode_setpoint is None:
+            self._mode_setpoint = self._mode_target(mode, status, pos, nav)
+        self._mode_setpoint = self._arrive(self._mode_setpoint, mode, pos, nav.alt_msl_m)
+        return self._mode_setpoint
+
+    def _arrive(
+        self, sp: Setpoint, mode: FlightMode, pos: tuple[float, float], alt: float
+    ) -> Setpoint:
+        """Return and go-to circle their point on arrival; a take-off circles when high."""
+        radius = self.config["WP_LOITER_RAD"]
+        reach = max(radius, self._turn_radius()) * 1.5
+        near = math.hypot(sp.b[0] - pos[0], sp.b[1] - pos[1]) < reach
+        # Passing the point counts too: the line goes on past it for ever.
+        arrived = near or past_point(sp.a, sp.b, pos)
+        if sp.kind == Kind.LINE and mode in (FlightMode.RTL, FlightMode.GUIDED) and arrived:
+            return Setpoint(Kind.CIRCLE, sp.b, sp.b, sp.alt_msl, radius)
+        if sp.kind == Kind.TAKEOFF and alt >= sp.alt_msl - 5.0:
+            return Setpoint(Kind.CIRCLE, pos, pos, sp.alt_msl, radius)
+        return sp
+
+    def _mission(
+        self,
+        status: VehicleStatus,
+        pos: tuple[float, float],
+        nav: NavState,
+        t_s: float,
+        entered: bool,
+        out: ControlOutput,
+    ) -> Setpoint | None:
+        ex = self.executor
+        if ex is None or (entered and ex.finished):
+            assert self.frame is not None
+            ex = MissionExecutor(self.items, self.frame, self.home_alt, self.config.executor)
+            ex.start(status.mission_first, pos, nav.alt_msl_m)
+            self.executor = ex
+        setpoint = ex.step(pos, nav.alt_msl_m, t_s, self._turn_radius())
+        out.mission_seq = ex.current
+        out.mission_finished = ex.finished
+        out.reached = ex.drain_reached()
+        if self.landed and setpoint.kind != Kind.TAKEOFF:
+            return None  # a mission must start with a take-off from the ground
+        return setpoint
+
+    def _mode_target(
+        self, mode: FlightMode, status: VehicleStatus, pos: tuple[float, float], nav: NavState
+    ) -> Setpoint:
+        assert self.frame is not None
+        radius = self.config["WP_LOITER_RAD"]
+        alt = nav.alt_msl_m
+        if mode == FlightMode.TAKEOFF:
+            return Setpoint(Kind.TAKEOFF, pos, pos, self.home_alt + self.config["RTL_ALT_M"])
+        if mode == FlightMode.RTL:
+            rtl_alt = self.home_alt + self.config["RTL_ALT_M"]
+            return Setpoint(Kind.LINE, pos, (0.0, 0.0), rtl_alt, radius)
+        target = (status.target_lat_deg, status.target_lon_deg, status.target_alt_msl_m)
+        if mode in (FlightMode.GUIDED, FlightMode.LOITER) and math.isfinite(target[0]):
+            point = self.frame.ne(target[0], target[1])
+            alt = target[2] if math.isfinite(target[2]) else alt
+            if mode == FlightMode.GUIDED:
+                return Setpoint(Kind.LINE, pos, point, alt, radius)
+            return Setpoint(Kind.CIRCLE, point, point, alt, radius)
+        if mode == FlightMode.STABILIZED:  # straight on, height held
+            course = math.atan2(nav.ve_m_s, nav.vn_m_s)
+            ahead = (pos[0] + 1e5 * math.cos(course), pos[1] + 1e5 * math.sin(course))
+            return Setpoint(Kind.LINE, pos, ahead, alt)
+        return Setpoint(Kind.CIRCLE, pos, pos, alt, radius)
+
+    def _fly_takeoff(
+        self,
+        setpoint: Setpoint,
+        pos: tuple[float, float],
+        nav: NavState,
+        airspeed: float,
+        dt: float,
+        out: ControlOutput,
+    ) -> ControlOutput:
+        if self.takeoff is None:
+            self.takeoff = RunwayTakeoff(pos, nav.yaw_rad, self.home_alt)
+            self.attitude.reset()
+        to = self.takeoff
+        demand = to.step(pos, nav.alt_msl_m, nav.yaw_rad, nav.yaw_rate_rad_s, airspeed, self.config)
+        if demand.phase == Phase.CLIMB_OUT:
+            # Climb straight out along the runway with normal energy control.
+            far = to.centreline_point(1e5)
+            line = Setpoint(Kind.LINE, to.start, far, setpoint.alt_msl, speed=setpoint.speed)
+            return self._fly(line, pos, (nav.vn_m_s, nav.ve_m_s), nav, airspeed, dt, out)
+        ground = demand.phase == Phase.GROUND_ROLL
+        surfaces = self.attitude.step(
+            demand.roll,
+            demand.pitch,
+            (nav.roll_rad, nav.pitch_rad),
+            (nav.roll_rate_rad_s, nav.pitch_rate_rad_s, nav.yaw_rate_rad_s),
+            max(airspeed, self.config["TKOFF_ROTATE_SPD"]),
+            dt,
+            integrate=not ground,
+        )
+        self.tecs.reset(demand.pitch)
+        out.aileron, out.elevator = surfaces.aileron, surfaces.elevator
+        out.rudder = demand.rudder
+        out.throttle = demand.throttle
+        out.nav_roll, out.nav_pitch = demand.roll, demand.pitch
+        out.target_bearing = to.heading
+        out.xtrack = to.xtrack(pos)
+        out.alt_error = setpoint.alt_msl - nav.alt_msl_m
+        return out
+
+    def _fly(
+        self,
+        sp: Setpoint,
+        pos: tuple[float, float],
+        vel: tuple[float, float],
+        nav: NavState,
+        airspeed: float,
+        dt: float,
+        out: ControlOutput,
+    ) -> ControlOutput:
+        cfg = self.config
+        speed_dem = sp.speed if math.isfinite(sp.speed) else cfg["AIRSPEED_CRUISE"]
+        speed_dem = max(cfg["AIRSPEED_MIN"], min(cfg["AIRSPEED_MAX"], speed_dem))
+        lateral = self._lateral(sp, pos, vel, dt)
+        roll_dem = bank_for(lateral.lat_acc, cfg.roll_limit)
+        energy = self.tecs.step(nav.alt_msl_m, -nav.vd_m_s, airspeed, sp.alt_msl, speed_dem, dt)
+        surfaces = self.attitude.step(
+            roll_dem,
+            energy.pitch,
+            (nav.roll_rad, nav.pitch_rad),
+            (nav.roll_rate_rad_s, nav.pitch_rate_rad_s, nav.yaw_rate_rad_s),
+            airspeed,
+            dt,
+        )
+        out.aileron, out.elevator, out.rudder = surfaces.aileron, surfaces.elevator, surfaces.rudder
+        out.throttle = energy.throttle
+        out.nav_roll, out.nav_pitch = roll_dem, energy.pitch
+        out.target_bearing = lateral.target_bearing
+        out.wp_dist = lateral.distance
+        out.xtrack = lateral.xtrack
+        out.alt_error = sp.alt_msl - nav.alt_msl_m
+        out.aspd_error = speed_dem - airspeed
+        return out
+
+    def _turn_radius(self) -> float:
+        """The radius of a turn at cruise speed and 80 % of the bank limit.
+
+        From the planned speed, not the measured one: a circle whose radius followed every
+        gust would never be flown round.
+        """
+        v = self.config["AIRSPEED_CRUISE"]
+        return v * v / (G * math.tan(self.config.roll_limit * 0.8))
+
+    def _lateral(
+        self, sp: Setpoint, pos: tuple[float, float], vel: tuple[float, float], dt: float
+    ) -> LateralDemand:
+        if sp.kind == Kind.CIRCLE:
+            # A circle tighter than the bank limit allows is flown at the tightest it can.
+            radius = max(sp.radius, self._turn_radius())
+            return self.l1.circle(pos, vel, sp.b, radius, sp.clockwise)
+        return self.l1.line(pos, vel, sp.a, sp.b, dt)

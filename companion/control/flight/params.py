@@ -1,0 +1,115 @@
+"""Every gain, limit and speed of the flight controller, as ground-station parameters.
+
+Names follow ArduPlane's where one exists, so a user of QGroundControl finds them. An
+airframe file's ``[control]`` table changes the defaults (the same plans fly a Cessna or
+a Cub by changing only that file); a value set from the ground station overrides both.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+
+from companion.control.laws.attitude import AttitudeGains
+from companion.control.laws.tecs import TecsGains
+from companion.control.mission.executor import ExecutorConfig
+from companion.params import ParamDecl
+
+
+def _p(name: str, default: float, lo: float, hi: float, unit: str, doc: str) -> ParamDecl:
+    return ParamDecl(name, default, lo, hi, unit, doc)
+
+
+CONTROL_PARAMS = (
+    _p("RLL_P", 1.0, 0.0, 5.0, "", "roll loop: aileron per radian of roll error"),
+    _p("RLL_D", 0.1, 0.0, 2.0, "s", "roll loop: aileron per rad/s of roll rate"),
+    _p("RLL_I", 0.2, 0.0, 2.0, "1/s", "roll loop: integrator gain"),
+    _p("RLL_IMAX", 0.2, 0.0, 1.0, "", "roll loop: integrator limit (aileron fraction)"),
+    _p("PTCH_P", 1.5, 0.0, 5.0, "", "pitch loop: elevator per radian of pitch error"),
+    _p("PTCH_D", 0.2, 0.0, 2.0, "s", "pitch loop: elevator per rad/s of pitch rate"),
+    _p("PTCH_I", 0.3, 0.0, 2.0, "1/s", "pitch loop: integrator gain"),
+    _p("PTCH_IMAX", 0.3, 0.0, 1.0, "", "pitch loop: integrator limit (elevator fraction)"),
+    _p("YAW_DAMP", 0.5, 0.0, 5.0, "s", "rudder per rad/s of yaw-rate error in a turn"),
+    _p("SCALING_SPEED", 30.0, 5.0, 100.0, "m/s", "airspeed at which the loop gains apply as set"),
+    _p("ROLL_LIMIT_DEG", 35.0, 5.0, 60.0, "deg", "largest bank angle"),
+    _p("PTCH_LIM_MAX_DEG", 20.0, 0.0, 45.0, "deg", "largest nose-up pitch"),
+    _p("PTCH_LIM_MIN_DEG", -15.0, -45.0, 0.0, "deg", "largest nose-down pitch"),
+    _p("NAVL1_PERIOD", 17.0, 5.0, 60.0, "s", "L1 guidance period: larger is gentler"),
+    _p("NAVL1_DAMPING", 0.75, 0.5, 1.0, "", "L1 guidance damping"),
+    _p("NAVL1_XTRACK_I", 0.02, 0.0, 0.1, "1/s", "L1 cross-track integrator gain"),
+    _p("TECS_TIME_CONST", 5.0, 2.0, 20.0, "s", "height error → climb rate time constant"),
+    _p("TECS_SPD_TC", 3.0, 1.0, 20.0, "s", "speed error → acceleration time constant"),
+    _p("TECS_CLMB_MAX", 3.0, 0.5, 15.0, "m/s", "climb rate at full throttle"),
+    _p("TECS_SINK_MAX", 3.0, 0.5, 15.0, "m/s", "sink rate at idle"),
+    _p("TECS_THR_DAMP", 0.3, 0.0, 2.0, "", "throttle damping of the energy-rate error"),
+    _p("TECS_PTCH_DAMP", 0.3, 0.0, 2.0, "", "pitch damping of the balance-rate error"),
+    _p("TECS_INTEG_GAIN", 0.1, 0.0, 1.0, "", "energy integrators' gain"),
+    _p("TECS_SPDWEIGHT", 1.0, 0.0, 2.0, "", "pitch looks after height (0), both (1), speed (2)"),
+    _p("TRIM_THROTTLE", 0.6, 0.0, 1.0, "", "throttle for level flight at cruise speed"),
+    _p("THR_MIN", 0.0, 0.0, 1.0, "", "least throttle in flight"),
+    _p("THR_MAX", 1.0, 0.0, 1.0, "", "most throttle"),
+    _p("AIRSPEED_CRUISE", 30.0, 5.0, 100.0, "m/s", "cruise airspeed"),
+    _p("AIRSPEED_MIN", 25.0, 5.0, 100.0, "m/s", "least airspeed any speed demand gives"),
+    _p("AIRSPEED_MAX", 45.0, 5.0, 120.0, "m/s", "most airspeed any speed demand gives"),
+    _p("TKOFF_ROTATE_SPD", 27.0, 3.0, 60.0, "m/s", "take-off: airspeed at which to rotate"),
+    _p("TKOFF_PITCH_DEG", 8.0, 0.0, 25.0, "deg", "take-off: pitch held after rotating"),
+    _p("TKOFF_GND_PITCH", 0.0, -10.0, 20.0, "deg", "take-off: pitch held on the ground roll"),
+    _p("TKOFF_STEER_P", 1.0, 0.0, 5.0, "", "take-off: rudder per radian of heading error"),
+    _p("WP_RADIUS", 30.0, 1.0, 500.0, "m", "waypoint acceptance radius"),
+    _p("WP_LOITER_RAD", 80.0, 10.0, 2000.0, "m", "loiter radius when an item gives none"),
+    _p("RTL_ALT_M", 100.0, 10.0, 1000.0, "m", "return altitude above home"),
+)
+BY_NAME = {p.name: p for p in CONTROL_PARAMS}
+
+
+def control_params(defaults: Mapping[str, float]) -> tuple[ParamDecl, ...]:
+    """The declarations with an airframe's defaults; unknown names raise KeyError."""
+    unknown = sorted(set(defaults) - set(BY_NAME))
+    if unknown:
+        raise KeyError(f"unknown control parameter(s): {', '.join(unknown)}")
+    return tuple(replace(p, default=float(defaults.get(p.name, p.default))) for p in CONTROL_PARAMS)
+
+
+@dataclass(frozen=True)
+class FlightConfig:
+    """The parameter values, grouped the way the laws take them."""
+
+    attitude: AttitudeGains
+    tecs: TecsGains
+    executor: ExecutorConfig
+    values: Mapping[str, float]
+
+    @property
+    def roll_limit(self) -> float:
+        return math.radians(self.values["ROLL_LIMIT_DEG"])
+
+    def __getitem__(self, name: str) -> float:
+        return self.values[name]
+
+
+def flight_config(values: Mapping[str, float]) -> FlightConfig:
+    """Group parameter values (name → value) for the controller."""
+    v = {p.name: float(values.get(p.name, p.default)) for p in CONTROL_PARAMS}
+    attitude = AttitudeGains(
+        v["RLL_P"], v["RLL_D"], v["RLL_I"], v["RLL_IMAX"],
+        v["PTCH_P"], v["PTCH_D"], v["PTCH_I"], v["PTCH_IMAX"],
+        v["YAW_DAMP"], v["SCALING_SPEED"],
+    )  # fmt: skip
+    tecs = TecsGains(
+        time_const=v["TECS_TIME_CONST"],
+        speed_time_const=v["TECS_SPD_TC"],
+        climb_max=v["TECS_CLMB_MAX"],
+        sink_max=v["TECS_SINK_MAX"],
+        throttle_trim=v["TRIM_THROTTLE"],
+        throttle_min=v["THR_MIN"],
+        throttle_max=v["THR_MAX"],
+        throttle_damp=v["TECS_THR_DAMP"],
+        integ_gain=v["TECS_INTEG_GAIN"],
+        pitch_damp=v["TECS_PTCH_DAMP"],
+        pitch_max=math.radians(v["PTCH_LIM_MAX_DEG"]),
+        pitch_min=math.radians(v["PTCH_LIM_MIN_DEG"]),
+        speed_weight=v["TECS_SPDWEIGHT"],
+    )
+    executor = ExecutorConfig(v["WP_RADIUS"], v["WP_LOITER_RAD"], v["RTL_ALT_M"])
+    return FlightConfig(attitude, tecs, executor, v)

@@ -1,0 +1,285 @@
+"""The mission executor: which item is current, what to fly for it, and when it is done.
+
+Pure and replayable: positions in, a ``Setpoint`` and events out. Items as ArduPlane and
+PX4 fly them: NAV_TAKEOFF climbs to its altitude; NAV_WAYPOINT is reached inside its
+acceptance radius or when the aircraft crosses the line through the waypoint square to
+the leg (so an overshoot never makes it circle back); loiters circle their point (radius
+param3, negative for counter-clockwise) forever, for param1 seconds or param1 turns once
+on the circle; NAV_RETURN_TO_LAUNCH flies home and circles there; DO_CHANGE_SPEED and
+DO_JUMP act at once. After the last item the aircraft circles the last point (PX4).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+
+from companion.control.mission.items import MissionItem
+from companion.geodesy import LocalFrame, wrap_pi
+from mavlink_dialect import companion as d
+
+RELATIVE_FRAMES = (d.MAV_FRAME_GLOBAL_RELATIVE_ALT, d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT)
+ON_CIRCLE = 0.25  # within this fraction of the radius the aircraft counts as circling
+TAKEOFF_MARGIN_M = 5.0
+MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
+
+
+class Kind(enum.IntEnum):
+    """What the controller is asked to fly."""
+
+    TAKEOFF = 1  # runway take-off, then climb along the runway heading
+    LINE = 2  # track a → b
+    CIRCLE = 3  # circle b
+
+
+@dataclass(frozen=True)
+class Setpoint:
+    """One guidance target in the home-centred north/east frame (metres, MSL altitude)."""
+
+    kind: Kind
+    a: tuple[float, float]
+    b: tuple[float, float]
+    alt_msl: float
+    radius: float = 0.0
+    clockwise: bool = True
+    speed: float = math.nan  # NaN: the cruise speed
+
+
+@dataclass
+class ExecutorConfig:
+    """Defaults for items that leave them open (ArduPlane's WP_RADIUS, WP_LOITER_RAD, ...)."""
+
+    wp_radius: float = 30.0
+    loiter_radius: float = 80.0
+    rtl_alt_rel: float = 100.0
+
+
+@dataclass
+class _Loiter:
+    swept: float = 0.0
+    last_angle: float | None = None
+    started_s: float | None = None
+
+
+@dataclass
+class MissionExecutor:
+    """Runs a mission from ``start(first)``; ``step()`` once per control cycle."""
+
+    items: list[MissionItem]
+    frame: LocalFrame  # centred on home
+    home_alt_msl: float
+    config: ExecutorConfig = field(default_factory=ExecutorConfig)
+    current: int = 0
+    speed: float = math.nan
+    finished: bool = False
+    reached: list[int] = field(default_factory=list)  # items reached since the last drain
+
+    def __post_init__(self) -> None:
+        self._jumps_done: dict[int, int] = {}
+        self._loiter = _Loiter()
+        self._prev: tuple[float, float] = (0.0, 0.0)
+        self._prev_alt = self.home_alt_msl
+        self._hold: Setpoint | None = None
+        self._turn_radius = 0.0
+
+    def start(self, first: int, pos: tuple[float, float], alt_msl: float) -> None:
+        """Begin at item ``first`` from where the aircraft is."""
+        self.current = max(0, min(first, len(self.items)))
+        self._prev, self._prev_alt = pos, alt_msl
+        self._jumps_done.clear()
+        self.finished = False
+        self._hold = None
+        self._loiter = _Loiter()
+
+    def drain_reached(self) -> list[int]:
+        """Items reached since the last call (for MISSION_ITEM_REACHED)."""
+        out, self.reached = self.reached, []
+        return out
+
+    def alt_of(self, item: MissionItem) -> float:
+        """An item's altitude above MSL."""
+        return item.z + (self.home_alt_msl if item.frame in RELATIVE_FRAMES else 0.0)
+
+    def point_of(self, item: MissionItem, pos: tuple[float, float]) -> tuple[float, float]:
+        """An item's point in the local frame (lat = lon = 0 means here)."""
+        if item.x == 0 and item.y == 0:
+            return pos
+        return self.frame.ne(item.x / 1e7, item.y / 1e7)
+
+    def step(
+        self, pos: tuple[float, float], alt_msl: float, t_s: float, turn_radius: float = 0.0
+    ) -> Setpoint:
+        """The setpoint for now; advances through items that are done.
+
+        ``turn_radius`` (m) lets a waypoint count as reached early enough that the turn onto
+        the next leg ends on that leg instead of overshooting it.
+        """
+        self._turn_radius = turn_radius
+        seen: set[tuple[int, tuple[tuple[int, int], ...]]] = set()
+        for _ in range(MAX_JUMPS_PER_STEP):
+            if self.current >= len(self.items):
+                return self._end(pos)
+            # Back at an item with every finite jump counter unchanged: an endless loop of
+            # DO items that never flies anywhere. End the mission rather than spin.
+            state = (self.current, tuple(sorted(self._jumps_done.items())))
+            if state in seen:
+                return self._end(pos)
+            seen.add(state)
+            item = self.items[self.current]
+            setpoint = self._item(item, pos, alt_msl, t_s)
+            if setpoint is not None:
+                return setpoint
+        return self._end(pos)  # a DO_JUMP loop without a NAV item: stop, don't spin
+
+    def _advance(self, reached: bool, pos: tuple[float, float], alt: float) -> None:
+        if reached:
+            self.reached.append(self.items[self.current].seq)
+        self.current += 1
+        self._prev, self._prev_alt = pos, alt
+        self._loiter = _Loiter()
+
+    def _end(self, pos: tuple[float, float]) -> Setpoint:
+        if self._hold is None:
+            self.finished = True
+            self._hold = Setpoint(
+                Kind.CIRCLE,
+                self._prev,
+                self._prev,
+                self._prev_alt,
+                self.config.loiter_radius,
+                speed=self.speed,
+            )
+        return self._hold
+
+    def _item(
+        self, item: MissionItem, pos: tuple[float, float], alt: float, t_s: float
+    ) -> Setpoint | None:
+        """The setpoint of ``item``, or None when it is done (and the next is current)."""
+        cmd = item.command
+        if cmd == d.MAV_CMD_DO_CHANGE_SPEED:
+            self.speed = item.param2 if item.param2 > 0 else math.nan
+            self._advance(False, self._prev, self._prev_alt)
+            return None
+        if cmd == d.MAV_CMD_DO_JUMP:
+            return self._jump(item)
+        if cmd == d.MAV_CMD_NAV_TAKEOFF:
+            return self._takeoff(item, pos, alt)
+        if cmd == d.MAV_CMD_NAV_WAYPOINT:
+            return self._waypoint(item, pos, alt)
+        if cmd == d.MAV_CMD_NAV_RETURN_TO_LAUNCH:
+            return self._return(item, pos, alt)
+        return self._loiter_item(item, pos, alt, t_s)
+
+    def _jump(self, item: MissionItem) -> None:
+        repeats = round(item.param2)
+        done = self._jumps_done.get(item.seq, 0)
+        if repeats < 0 or done < repeats:
+            if repeats >= 0:  # an endless jump keeps no count (see the loop check in step)
+                self._jumps_done[item.seq] = done + 1
+            self.current = max(0, min(round(item.param1), len(self.items)))
+        else:
+            self.current += 1
+        return None
+
+    def _takeoff(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
+        target = self.alt_of(item)
+        if alt >= target - TAKEOFF_MARGIN_M:
+            self._advance(True, pos, target)
+            return None
+        return Setpoint(Kind.TAKEOFF, pos, pos, target, speed=self.speed)
+
+    def _waypoint(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
+        b = self.point_of(item, pos)
+        radius = item.param2 if item.param2 > 0 else self.config.wp_radius
+        radius = max(radius, self._turn_lead(self._prev, b))
+        if _distance(pos, b) <= radius or past_point(self._prev, b, pos):
+            self._advance(True, b, self.alt_of(item))
+            return None
+        return Setpoint(Kind.LINE, self._prev, b, self.alt_of(item), speed=self.speed)
+
+    def _turn_lead(self, a: tuple[float, float], b: tuple[float, float]) -> float:
+        """How far before ``b`` to start turning onto the next leg: R·tan(turn / 2)."""
+        nxt = self._next_point(b)
+        if nxt is None or self._turn_radius <= 0.0:
+            return 0.0
+        leg_in = math.atan2(b[1] - a[1], b[0] - a[0])
+        leg_out = math.atan2(nxt[1] - b[1], nxt[0] - b[0])
+        turn = min(abs(wrap_pi(leg_out - leg_in)), math.radians(120.0))
+        lead = self._turn_radius * math.tan(turn / 2.0)
+        return min(lead, 0.5 * _distance(a, b), 0.5 * _distance(b, nxt))
+
+    def _next_point(self, here: tuple[float, float]) -> tuple[float, float] | None:
+        """Where the leg after the current waypoint goes (None when it is not a leg)."""
+        seq, jumps = self.current + 1, dict(self._jumps_done)
+        for _ in range(MAX_JUMPS_PER_STEP):
+            if seq >= len(self.items):
+                return None
+            item = self.items[seq]
+            if item.command == d.MAV_CMD_DO_CHANGE_SPEED:
+                seq += 1
+            elif item.command == d.MAV_CMD_DO_JUMP:
+                done, repeats = jumps.get(item.seq, 0), round(item.param2)
+                jumps[item.seq] = done + 1
+                seq = round(item.param1) if repeats < 0 or done < repeats else seq + 1
+            elif item.command == d.MAV_CMD_NAV_RETURN_TO_LAUNCH:
+                return (0.0, 0.0)
+            elif item.command == d.MAV_CMD_NAV_WAYPOINT:
+                return self.point_of(item, here)
+            else:
+                return None
+        return None
+
+    def _return(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint:
+        home = (0.0, 0.0)
+        rtl_alt = self.home_alt_msl + self.config.rtl_alt_rel
+        radius = self.config.loiter_radius
+        reach = max(radius, self._turn_radius) * 1.5
+        there = _distance(pos, home) <= reach or past_point(self._prev, home, pos)
+        if not self.finished and there:
+            self.finished = True
+            self.reached.append(item.seq)
+        if self.finished:
+            return Setpoint(Kind.CIRCLE, home, home, rtl_alt, radius, speed=self.speed)
+        return Setpoint(Kind.LINE, self._prev, home, rtl_alt, speed=self.speed)
+
+    def _loiter_item(
+        self, item: MissionItem, pos: tuple[float, float], alt: float, t_s: float
+    ) -> Setpoint | None:
+        centre = self.point_of(item, self._prev)
+        radius = abs(item.param3) if item.param3 else self.config.loiter_radius
+        clockwise = item.param3 >= 0
+        target_alt = self.alt_of(item) if item.z or item.frame not in RELATIVE_FRAMES else alt
+        circle = Setpoint(Kind.CIRCLE, centre, centre, target_alt, radius, clockwise, self.speed)
+        if item.command == d.MAV_CMD_NAV_LOITER_UNLIM:
+            return circle
+        dist = _distance(pos, centre)
+        state = self._loiter
+        if abs(dist - radius) > radius * ON_CIRCLE and state.started_s is None:
+            return circle  # still getting onto the circle: nothing counts yet
+        if state.started_s is None:
+            state.started_s = t_s
+        angle = math.atan2(pos[1] - centre[1], pos[0] - centre[0])
+        if state.last_angle is not None:
+            state.swept += abs(wrap_pi(angle - state.last_angle))
+        state.last_angle = angle
+        if item.command == d.MAV_CMD_NAV_LOITER_TIME:
+            done = t_s - state.started_s >= item.param1
+        else:  # NAV_LOITER_TURNS
+            done = state.swept >= math.tau * max(item.param1, 0.0)
+        if done:
+            self._advance(True, centre, target_alt)
+            return None
+        return circle
+
+
+def _distance(a: tuple[float, float], b: tuple[float, float]) -> float:
+    return math.hypot(b[0] - a[0], b[1] - a[1])
+
+
+def past_point(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> bool:
+    """True once ``pos`` is beyond the line through ``b`` square to the leg a→b."""
+    leg = (b[0] - a[0], b[1] - a[1])
+    if math.hypot(*leg) < 1.0:
+        return False
+    return (pos[0] - b[0]) * leg[0] + (pos[1] - b[1]) * leg[1] > 0.0

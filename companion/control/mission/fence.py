@@ -1,0 +1,74 @@
+"""The geofence from the fence mission type: where the aircraft may and may not fly.
+
+Inclusion polygons and circles: the aircraft must be inside every one of them (one is
+the usual case); exclusion polygons and circles: it must be outside all of them. Polygons are kept
+in a north/east frame in metres around the first fence point, where shapely answers containment.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from shapely.geometry import Point, Polygon
+
+from companion.control.mission.items import MissionItem
+from companion.geodesy import LocalFrame
+from mavlink_dialect import companion as d
+
+POLYGONS = {
+    d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION: True,
+    d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_EXCLUSION: False,
+}
+CIRCLES = {
+    d.MAV_CMD_NAV_FENCE_CIRCLE_INCLUSION: True,
+    d.MAV_CMD_NAV_FENCE_CIRCLE_EXCLUSION: False,
+}
+
+
+@dataclass
+class Fence:
+    """Zones in metres north/east of the frame's origin."""
+
+    frame: LocalFrame
+    inclusions: list[Polygon] = field(default_factory=list)
+    exclusions: list[Polygon] = field(default_factory=list)
+
+    @classmethod
+    def from_items(cls, items: list[MissionItem]) -> Fence:
+        """Build from stored fence items (polygon vertices carry their count in param1)."""
+        origin = (items[0].x / 1e7, items[0].y / 1e7) if items else (0.0, 0.0)
+        fence = cls(LocalFrame(*origin))
+        frame = fence.frame
+        i = 0
+        while i < len(items):
+            item = items[i]
+            if item.command in POLYGONS:
+                count = max(3, round(item.param1))
+                vertices = [frame.ne(v.x / 1e7, v.y / 1e7) for v in items[i : i + count]]
+                zone = Polygon(vertices)
+                i += count
+                (fence.inclusions if POLYGONS[item.command] else fence.exclusions).append(zone)
+                continue
+            if item.command in CIRCLES:
+                centre = frame.ne(item.x / 1e7, item.y / 1e7)
+                zone = Point(centre).buffer(abs(item.param1), quad_segs=32)
+                (fence.inclusions if CIRCLES[item.command] else fence.exclusions).append(zone)
+            i += 1
+        return fence
+
+    @property
+    def empty(self) -> bool:
+        """No zone at all: nothing to breach."""
+        return not self.inclusions and not self.exclusions
+
+    def breach(self, lat_deg: float, lon_deg: float) -> str | None:
+        """Why this position breaches the fence, or None when it is allowed."""
+        if not (math.isfinite(lat_deg) and math.isfinite(lon_deg)):
+            return None
+        here = Point(self.frame.ne(lat_deg, lon_deg))
+        if any(not zone.covers(here) for zone in self.inclusions):
+            return "outside the fence"
+        if any(zone.contains(here) for zone in self.exclusions):
+            return "inside an exclusion zone"
+        return None

@@ -1,0 +1,199 @@
+"""QGroundControl ``.plan`` files: import to mission/fence/rally items and export back.
+
+A plan is JSON: ``mission.items`` (SimpleItems with command, frame, params[7],
+autoContinue; ComplexItems are not flown and are refused by name), ``geoFence`` (polygons
+with inclusion flags, circles) and ``rallyPoints.points``. Exported plans always carry
+``geoFence`` and ``rallyPoints`` objects, which MAVSDK's importer requires.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from companion.control.mission.items import MissionItem, check_mission
+from mavlink_dialect import companion as d
+
+
+class PlanError(ValueError):
+    """A plan the vehicle cannot take, with the reason."""
+
+
+def _num(value: Any) -> float:
+    return math.nan if value is None else float(value)
+
+
+def _simple(raw: dict[str, Any], seq: int) -> MissionItem:
+    params = [_num(p) for p in (raw.get("params") or [])] + [0.0] * 7
+    lat, lon = params[4], params[5]
+    return MissionItem(
+        seq=seq,
+        frame=int(raw.get("frame", d.MAV_FRAME_GLOBAL_RELATIVE_ALT)),
+        command=int(raw["command"]),
+        current=0,
+        autocontinue=int(bool(raw.get("autoContinue", True))),
+        param1=params[0],
+        param2=params[1],
+        param3=params[2],
+        param4=params[3],
+        x=0 if math.isnan(lat) else round(lat * 1e7),
+        y=0 if math.isnan(lon) else round(lon * 1e7),
+        z=0.0 if math.isnan(params[6]) else params[6],
+    )
+
+
+def _mission_items(plan: dict[str, Any], path: Path) -> list[MissionItem]:
+    items: list[MissionItem] = []
+    jump_ids: dict[int, int] = {}  # QGroundControl's doJumpId → our sequence number
+    for index, raw in enumerate(plan.get("mission", {}).get("items", [])):
+        if raw.get("type") != "SimpleItem":
+            kind = raw.get("complexItemType", raw.get("type"))
+            raise PlanError(f"{path}: mission item {index}: {kind} items are not supported")
+        try:
+            items.append(_simple(raw, len(items)))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise PlanError(f"{path}: mission item {index}: {exc}") from None
+        if "doJumpId" in raw:
+            jump_ids[int(raw["doJumpId"])] = len(items) - 1
+    for i, item in enumerate(items):
+        if item.command == d.MAV_CMD_DO_JUMP:
+            target = jump_ids.get(round(item.param1))
+            if target is None:
+                raise PlanError(
+                    f"{path}: mission item {i}: DO_JUMP to unknown item {item.param1:g}"
+                )
+            items[i] = replace(item, param1=float(target))
+    return items
+
+
+def _fence_items(plan: dict[str, Any]) -> list[MissionItem]:
+    fence = plan.get("geoFence", {})
+    items: list[MissionItem] = []
+    for poly in fence.get("polygons", []):
+        points = poly.get("polygon", [])
+        inclusion = poly.get("inclusion", True)
+        cmd = (
+            d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION
+            if inclusion
+            else d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_EXCLUSION
+        )
+        for lat, lon in points:
+            items.append(_fence_item(len(items), cmd, len(points), lat, lon, 1))
+    for circle in fence.get("circles", []):
+        cmd = (
+            d.MAV_CMD_NAV_FENCE_CIRCLE_INCLUSION
+            if circle.get("inclusion", True)
+            else d.MAV_CMD_NAV_FENCE_CIRCLE_EXCLUSION
+        )
+        lat, lon = circle["circle"]["center"]
+        items.append(_fence_item(len(items), cmd, circle["circle"]["radius"], lat, lon, 1))
+    return items
+
+
+def _fence_item(seq: int, cmd: int, p1: float, lat: float, lon: float, mtype: int) -> MissionItem:
+    return MissionItem(
+        seq,
+        d.MAV_FRAME_GLOBAL_INT,
+        cmd,
+        0,
+        1,
+        float(p1),
+        0.0,
+        0.0,
+        0.0,
+        round(lat * 1e7),
+        round(lon * 1e7),
+        0.0,
+        mtype,
+    )
+
+
+def load_plan(path: str | Path) -> dict[int, list[MissionItem]]:
+    """The items of each mission type (0 mission, 1 fence, 2 rally) in a .plan file."""
+    path = Path(path)
+    try:
+        plan = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise PlanError(f"{path}: not a readable plan: {exc}") from None
+    if plan.get("fileType") != "Plan":
+        raise PlanError(f"{path}: fileType is not 'Plan'")
+    rally = [
+        MissionItem(
+            i,
+            d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+            d.MAV_CMD_NAV_RALLY_POINT,
+            0,
+            1,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            round(p[0] * 1e7),
+            round(p[1] * 1e7),
+            float(p[2]),
+            2,
+        )
+        for i, p in enumerate(plan.get("rallyPoints", {}).get("points", []))
+    ]
+    fence = _fence_items(plan)
+    mission = _mission_items(plan, path)
+    return {0: mission, 1: fence, 2: rally}
+
+
+def plan_json(items: dict[int, list[MissionItem]]) -> dict[str, Any]:
+    """A QGroundControl plan holding these items (fences and rally as items lists)."""
+    mission = [
+        {
+            "type": "SimpleItem",
+            "command": it.command,
+            "frame": it.frame,
+            "autoContinue": bool(it.autocontinue),
+            "doJumpId": it.seq + 1,
+            "params": _export_params(it),
+        }
+        for it in items.get(0, [])
+    ]
+    first = items.get(0, [None])[0] if items.get(0) else None
+    home = [first.x / 1e7, first.y / 1e7, 0.0] if first else [0.0, 0.0, 0.0]
+    rally = [[it.x / 1e7, it.y / 1e7, it.z] for it in items.get(2, [])]
+    return {
+        "fileType": "Plan",
+        "version": 1,
+        "groundStation": "companion",
+        "mission": {
+            "version": 2,
+            "firmwareType": 0,
+            "vehicleType": 1,
+            "cruiseSpeed": 22,
+            "hoverSpeed": 5,
+            "plannedHomePosition": home,
+            "items": mission,
+        },
+        "geoFence": {"version": 2, "polygons": [], "circles": []},
+        "rallyPoints": {"version": 2, "points": rally},
+    }
+
+
+def _export_params(it: MissionItem) -> list[float | None]:
+    p1 = it.param1 + 1 if it.command == d.MAV_CMD_DO_JUMP else it.param1  # back to doJumpId
+    values = [p1, it.param2, it.param3, it.param4, it.x / 1e7, it.y / 1e7, it.z]
+    return [None if isinstance(v, float) and math.isnan(v) else v for v in values]
+
+
+def save_plan(path: str | Path, items: dict[int, list[MissionItem]]) -> None:
+    """Write a .plan file (fence items are not exported yet: only mission and rally)."""
+    Path(path).write_text(json.dumps(plan_json(items), indent=2))
+
+
+def checked_plan(path: str | Path) -> dict[int, list[MissionItem]]:
+    """``load_plan``, then every list checked as an upload would be; PlanError on refusal."""
+    lists = load_plan(path)
+    for mission_type, items in lists.items():
+        result = check_mission(items)
+        if result != d.MAV_MISSION_ACCEPTED:
+            name = d.enums["MAV_MISSION_RESULT"][result].name
+            raise PlanError(f"{path}: mission type {mission_type} refused: {name}")
+    return lists

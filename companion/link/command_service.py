@@ -1,0 +1,160 @@
+"""The command microservice: COMMAND_LONG and COMMAND_INT in, exactly one COMMAND_ACK out.
+
+Handlers are registered per MAV_CMD. A handler answers at once, or defers: the command
+went onto the bus for another plug-in and the ack follows when that plug-in answers (or
+FAILED when nobody does in time). Unknown commands get UNSUPPORTED at once, and a
+retransmission (confirmation > 0) is never executed twice.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from companion.link.codec import dialect as d
+from companion.link.service import Outgoing, Peer
+
+log = logging.getLogger(__name__)
+
+RETRY_MEMORY_S = 10.0  # how long a finished command's result is kept for retransmissions
+SET_MODE_MESSAGE = 11  # the SET_MODE message's id, used as its command number
+
+
+@dataclass(frozen=True)
+class CommandArgs:
+    """A decoded command, the same for COMMAND_LONG and COMMAND_INT."""
+
+    command: int
+    params: tuple[float, ...]  # param1..param7 (x, y as degrees for COMMAND_INT)
+    confirmation: int
+    peer: Peer
+    is_int: bool = False
+    frame: int = 0  # COMMAND_INT's frame (MAV_FRAME_GLOBAL for COMMAND_LONG)
+
+
+@dataclass
+class Outcome:
+    """What a handler decided: a final result, or a deferral keyed by a bus sequence."""
+
+    result: int = d.MAV_RESULT_ACCEPTED
+    extra: list[Any] = field(default_factory=list)  # messages to send after the ack
+    defer_seq: int | None = None
+    timeout_s: float = 3.0
+
+
+Handler = Callable[[CommandArgs], Outcome]
+
+
+@dataclass
+class _Pending:
+    args: CommandArgs
+    deadline: float
+
+
+class CommandService:
+    """Dispatches commands to handlers and answers each one exactly once."""
+
+    handles = frozenset({"COMMAND_LONG", "COMMAND_INT", "SET_MODE"})
+
+    def __init__(self, mav: Any, sysid: int, compid: int = 1) -> None:
+        self.mav = mav
+        self.sysid = sysid
+        self.compid = compid
+        self.handlers: dict[int, Handler] = {}
+        self.pending: dict[int, _Pending] = {}
+        self._done: dict[tuple[int, int, int], tuple[float, int | None]] = {}
+        self.rejected_target = 0
+
+    def register(self, command: int, handler: Handler) -> None:
+        self.handlers[command] = handler
+
+    def _args(self, msg: Any, peer: Peer) -> CommandArgs:
+        if msg.get_type() == "COMMAND_INT":
+            params = (
+                msg.param1,
+                msg.param2,
+                msg.param3,
+                msg.param4,
+                msg.x / 1e7,
+                msg.y / 1e7,
+                msg.z,
+            )
+            return CommandArgs(msg.command, params, 0, peer, True, msg.frame)
+        params = (
+            msg.param1,
+            msg.param2,
+            msg.param3,
+            msg.param4,
+            msg.param5,
+            msg.param6,
+            msg.param7,
+        )
+        return CommandArgs(msg.command, params, msg.confirmation, peer)
+
+    def ack(self, args: CommandArgs, result: int, progress: int = 0) -> Outgoing:
+        msg = self.mav.command_ack_encode(
+            args.command, result, progress, 0, args.peer.sysid, args.peer.compid
+        )
+        return Outgoing(msg, args.peer)
+
+    def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
+        if msg.get_type() == "SET_MODE":
+            # The old SET_MODE message: answered, as ArduPilot does, by a COMMAND_ACK whose
+            # command is the message id (11).
+            if msg.target_system not in (0, self.sysid):
+                self.rejected_target += 1
+                return []
+            params = (float(msg.base_mode), float(msg.custom_mode), 0.0, 0.0, 0.0, 0.0, 0.0)
+            return self.dispatch(CommandArgs(SET_MODE_MESSAGE, params, 0, peer), now_s)
+        if msg.target_system not in (0, self.sysid) or msg.target_component not in (0, self.compid):
+            self.rejected_target += 1
+            return []
+        return self.dispatch(self._args(msg, peer), now_s)
+
+    def dispatch(self, args: CommandArgs, now_s: float) -> list[Outgoing]:
+        """Run a decoded command through its handler; exactly one ack, retries remembered."""
+        peer = args.peer
+        key = (peer.sysid, peer.compid, args.command)
+        previous = self._done.get(key)
+        if args.confirmation > 0 and previous and now_s - previous[0] < RETRY_MEMORY_S:
+            # A retransmission: answer again with the first result, never act twice.
+            if previous[1] is None:
+                return []  # still in progress: the final ack is on its way
+            return [self.ack(args, previous[1])]
+        handler = self.handlers.get(args.command)
+        if handler is None:
+            self._done[key] = (now_s, d.MAV_RESULT_UNSUPPORTED)
+            return [self.ack(args, d.MAV_RESULT_UNSUPPORTED)]
+        try:
+            outcome = handler(args)
+        except Exception:  # a handler bug must not take the link down
+            log.exception("command %d handler failed", args.command)
+            outcome = Outcome(d.MAV_RESULT_FAILED)
+        if outcome.defer_seq is not None:
+            self.pending[outcome.defer_seq] = _Pending(args, now_s + outcome.timeout_s)
+            self._done[key] = (now_s, None)
+            return []
+        self._done[key] = (now_s, outcome.result)
+        return [self.ack(args, outcome.result)] + [Outgoing(m, peer) for m in outcome.extra]
+
+    def complete(self, seq: int, result: int, now_s: float) -> list[Outgoing]:
+        """The bus answered a deferred command: send its final ack."""
+        pending = self.pending.pop(seq, None)
+        if pending is None:
+            return []
+        args = pending.args
+        self._done[(args.peer.sysid, args.peer.compid, args.command)] = (now_s, result)
+        return [self.ack(args, result)]
+
+    def tick(self, now_s: float) -> list[Outgoing]:
+        out = []
+        for seq, pending in list(self.pending.items()):
+            if now_s >= pending.deadline:
+                log.warning("command %d: no answer from the vehicle in time", pending.args.command)
+                out += self.complete(seq, d.MAV_RESULT_FAILED, now_s)
+        stale = [k for k, (t, _) in self._done.items() if now_s - t > RETRY_MEMORY_S]
+        for k in stale:
+            del self._done[k]
+        return out

@@ -1,0 +1,306 @@
+"""The vehicle's MAVLink endpoints, given as URLs, several at once.
+
+``udpout://HOST:PORT`` sends to a ground station (and hears its replies on the same
+socket), ``udpin://HOST:PORT`` listens and answers whoever speaks, ``tcpin://HOST:PORT``
+accepts TCP clients, ``serial:///dev/ttyUSB0:57600`` is a radio modem. Endpoints move
+bytes only; framing, CRC and signing are pymavlink's, one parser per remote.
+"""
+
+from __future__ import annotations
+
+import logging
+import socket
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from urllib.parse import parse_qs, urlparse
+
+import serial
+
+log = logging.getLogger(__name__)
+
+Remote = tuple[str, int] | str  # a UDP/TCP peer address, or the serial device
+MAX_DATAGRAM = 65535
+
+
+class EndpointError(ValueError):
+    """An endpoint URL that cannot be used."""
+
+
+class Endpoint(ABC):
+    """One transport. ``read_ready`` returns what arrived, keyed by the remote it came from."""
+
+    options: EndpointOptions
+
+    def __init__(self, url: str) -> None:
+        self.url = url
+        self.options = EndpointOptions()
+        self.bytes_in = 0
+        self.bytes_out = 0
+        self.write_errors = 0
+
+    @abstractmethod
+    def filenos(self) -> list[int]:
+        """File descriptors to wait on."""
+
+    @abstractmethod
+    def read_ready(self, fd: int) -> list[tuple[Remote, bytes]]:
+        """Read what is waiting on ``fd`` (never blocks)."""
+
+    @abstractmethod
+    def send(self, data: bytes) -> int:
+        """Send to every remote of this endpoint; never blocks, never raises."""
+
+    @abstractmethod
+    def close(self) -> None:
+        """Release the transport."""
+
+    def has_remote(self) -> bool:
+        """True when there is someone to send to."""
+        return True
+
+
+def _host_port(url: str) -> tuple[str, int]:
+    parsed = urlparse(url)
+    if not parsed.hostname or parsed.port is None:
+        raise EndpointError(f"{url!r}: expected SCHEME://HOST:PORT")
+    return parsed.hostname, parsed.port
+
+
+class UdpOut(Endpoint):
+    """Sends to a fixed address (a ground station); its replies come back to our port."""
+
+    def __init__(self, url: str) -> None:
+        super().__init__(url)
+        self.target = _host_port(url)
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.setblocking(False)
+        self.sock.bind(("0.0.0.0", 0))
+
+    def filenos(self) -> list[int]:
+        return [self.sock.fileno()]
+
+    def read_ready(self, fd: int) -> list[tuple[Remote, bytes]]:
+        out: list[tuple[Remote, bytes]] = []
+        while True:
+            try:
+                data, addr = self.sock.recvfrom(MAX_DATAGRAM)
+            except (BlockingIOError, InterruptedError):
+                return out
+            except OSError:  # ICMP port unreachable while nobody listens: not an error
+                return out
+            self.bytes_in += len(data)
+            out.append((addr, data))
+
+    def send(self, data: bytes) -> int:
+        try:
+            sent = self.sock.sendto(data, self.target)
+        except OSError:
+            self.write_errors += 1
+            return 0
+        self.bytes_out += sent
+        return sent
+
+    def close(self) -> None:
+        self.sock.close()
+
+
+class UdpIn(UdpOut):
+    """Listens on an address and answers every remote that has spoken to it."""
+
+    def __init__(self, url: str) -> None:
+        Endpoint.__init__(self, url)
+        self.remotes: list[tuple[str, int]] = []
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self.sock.setblocking(False)
+        self.sock.bind(_host_port(url))
+
+    def read_ready(self, fd: int) -> list[tuple[Remote, bytes]]:
+        got = super().read_ready(fd)
+        for addr, _ in got:
+            if addr not in self.remotes:
+                self.remotes.append(addr)  # type: ignore[arg-type]
+                log.info("%s: new remote %s:%d", self.url, *addr)
+        return got
+
+    def has_remote(self) -> bool:
+        return bool(self.remotes)
+
+    def send(self, data: bytes) -> int:
+        sent = 0
+        for addr in self.remotes:
+            try:
+                sent = self.sock.sendto(data, addr)
+                self.bytes_out += sent
+            except OSError:
+                self.write_errors += 1
+        return sent
+
+
+class TcpIn(Endpoint):
+    """Accepts TCP clients; each is a remote with its own byte stream."""
+
+    def __init__(self, url: str) -> None:
+        super().__init__(url)
+        self.server = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        self.server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self.server.bind(_host_port(url))
+        self.server.listen(4)
+        self.server.setblocking(False)
+        self.clients: dict[int, socket.socket] = {}
+
+    def filenos(self) -> list[int]:
+        return [self.server.fileno(), *self.clients]
+
+    def read_ready(self, fd: int) -> list[tuple[Remote, bytes]]:
+        if fd == self.server.fileno():
+            try:
+                conn, addr = self.server.accept()
+            except OSError:
+                return []
+            conn.setblocking(False)
+            self.clients[conn.fileno()] = conn
+            log.info("%s: client %s:%d connected", self.url, *addr)
+            return []
+        conn = self.clients.get(fd)
+        if conn is None:
+            return []
+        try:
+            data = conn.recv(MAX_DATAGRAM)
+        except (BlockingIOError, InterruptedError):
+            return []
+        except OSError:
+            data = b""
+        if not data:
+            self._drop(fd)
+            return []
+        self.bytes_in += len(data)
+        return [(f"tcp{fd}", data)]
+
+    def _drop(self, fd: int) -> None:
+        conn = self.clients.pop(fd, None)
+        if conn is not None:
+            conn.close()
+
+    def has_remote(self) -> bool:
+        return bool(self.clients)
+
+    def send(self, data: bytes) -> int:
+        for fd, conn in list(self.clients.items()):
+            try:
+                self.bytes_out += conn.send(data)
+            except (BlockingIOError, InterruptedError):
+                self.write_errors += 1  # a slow client loses this frame, not the vehicle's time
+            except OSError:
+                self._drop(fd)
+        return len(data)
+
+    def close(self) -> None:
+        for fd in list(self.clients):
+            self._drop(fd)
+        self.server.close()
+
+
+class SerialEndpoint(Endpoint):
+    """A radio modem or cable: ``serial:///dev/ttyUSB0:57600``."""
+
+    def __init__(self, url: str) -> None:
+        super().__init__(url)
+        path, baud = parse_serial_url(url)
+        self.baud = baud
+        self.port = serial.serial_for_url(path, baudrate=baud, timeout=0, write_timeout=0)
+
+    def filenos(self) -> list[int]:
+        return [self.port.fileno()]
+
+    def read_ready(self, fd: int) -> list[tuple[Remote, bytes]]:
+        try:
+            data = self.port.read(4096)
+        except (serial.SerialException, OSError):
+            return []
+        self.bytes_in += len(data)
+        return [(self.port.port, data)] if data else []
+
+    def send(self, data: bytes) -> int:
+        try:
+            sent = self.port.write(data) or 0
+        except (serial.SerialTimeoutException, serial.SerialException, OSError):
+            self.write_errors += 1
+            return 0
+        self.bytes_out += sent
+        return sent
+
+    def close(self) -> None:
+        self.port.close()
+
+
+def parse_serial_url(url: str) -> tuple[str, int]:
+    """``serial:///dev/ttyUSB0:57600`` → ("/dev/ttyUSB0", 57600)."""
+    rest = url.removeprefix("serial://")
+    path, sep, baud = rest.rpartition(":")
+    if not sep or not baud.isdigit() or not path:
+        raise EndpointError(f"{url!r}: expected serial:///dev/DEVICE:BAUD")
+    return path, int(baud)
+
+
+DEFAULT_NETWORK_BYTES_S = 1_000_000.0
+SERIAL_SHARE = 0.8
+SCHEMES = frozenset({"udpout", "udpin", "tcpin", "serial"})
+
+
+@dataclass(frozen=True)
+class EndpointOptions:
+    """Per-endpoint options, given as a URL query: ``udpin://0.0.0.0:14550?budget=20000``.
+
+    budget: bytes per second for this endpoint (serial default: baud / 10);
+    tlog: path of a .tlog recording of this endpoint's traffic;
+    signing: off, optional or required (see companion.link.signing).
+    """
+
+    budget_bytes_s: float | None = None
+    tlog: str | None = None
+    signing: str = "off"
+
+
+def split_options(url: str) -> tuple[str, EndpointOptions]:
+    """The URL without its query, and the options the query sets."""
+    base, _, query = url.partition("?")
+    known = {"budget", "tlog", "signing"}
+    fields = parse_qs(query, keep_blank_values=True) if query else {}
+    unknown = set(fields) - known
+    if unknown:
+        raise EndpointError(f"{url!r}: unknown option(s) {sorted(unknown)}; known: {sorted(known)}")
+    budget = None
+    if "budget" in fields:
+        try:
+            budget = float(fields["budget"][-1])
+        except ValueError:
+            raise EndpointError(f"{url!r}: budget must be bytes per second") from None
+    tlog = fields["tlog"][-1] if "tlog" in fields else None
+    signing = fields["signing"][-1] if "signing" in fields else "off"
+    if signing not in ("off", "optional", "required"):
+        raise EndpointError(f"{url!r}: signing must be off, optional or required")
+    return base, EndpointOptions(budget, tlog, signing)
+
+
+def open_endpoint(url: str) -> Endpoint:
+    """Open the endpoint a URL names; EndpointError for an unknown scheme or option."""
+    base, options = split_options(url)
+    scheme = base.split("://", 1)[0] if "://" in base else ""
+    kinds = {"udpout": UdpOut, "udpin": UdpIn, "tcpin": TcpIn, "serial": SerialEndpoint}
+    if scheme not in kinds:
+        raise EndpointError(f"{url!r}: scheme must be one of {sorted(SCHEMES)}")
+    endpoint = kinds[scheme](base)
+    endpoint.options = options
+    return endpoint
+
+
+def default_budget(endpoint: Endpoint) -> float:
+    """Bytes per second the endpoint may carry."""
+    if endpoint.options.budget_bytes_s is not None:
+        return endpoint.options.budget_bytes_s
+    if isinstance(endpoint, SerialEndpoint):
+        # 8N1 is ten bits a byte; keep a fifth of the wire free so the radio's buffer
+        # drains and acknowledgements never wait behind a backlog.
+        return endpoint.baud / 10.0 * SERIAL_SHARE
+    return DEFAULT_NETWORK_BYTES_S

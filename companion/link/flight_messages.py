@@ -1,0 +1,51 @@
+"""What the flight controller reports, as MAVLink: NAV_CONTROLLER_OUTPUT, MISSION_CURRENT
+while a mission runs, MISSION_ITEM_REACHED, and the landed state."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from companion.link.codec import dialect as d
+from companion.messages import ControlStatus, MissionState
+
+
+def _deg(rad: float) -> float:
+    return math.degrees(rad) if math.isfinite(rad) else 0.0
+
+
+def _finite(x: float) -> float:
+    return x if math.isfinite(x) else 0.0
+
+
+def nav_controller_output(mav: Any, c: ControlStatus | None) -> Any:
+    """Guidance demands and errors (bearings in whole degrees, as the message has them)."""
+    if c is None:
+        return None
+    return mav.nav_controller_output_encode(
+        _deg(c.nav_roll_rad),
+        _deg(c.nav_pitch_rad),
+        round(_deg(c.target_bearing_rad)) % 360,
+        round(_deg(c.target_bearing_rad)) % 360,
+        max(0, min(65535, round(_finite(c.wp_dist_m)))),
+        _finite(c.alt_error_m),
+        _finite(c.aspd_error_m_s),
+        _finite(c.xtrack_error_m),
+    )
+
+
+def mission_current(mav: Any, stored_seq: int, total: int, c: ControlStatus | None) -> Any:
+    """MISSION_CURRENT: the executor's item and state while it runs, else the stored one."""
+    if total == 0:
+        return mav.mission_current_encode(stored_seq, 0, d.MISSION_STATE_NO_MISSION)
+    if c is None or c.mission_state == MissionState.NOT_STARTED:
+        return mav.mission_current_encode(stored_seq, total, d.MISSION_STATE_NOT_STARTED)
+    seq = max(0, min(int(c.mission_seq), total - 1))
+    return mav.mission_current_encode(seq, total, int(c.mission_state))
+
+
+def landed_state(c: ControlStatus | None) -> int | None:
+    """MAV_LANDED_STATE from the controller, or None when it is not running."""
+    if c is None:
+        return None
+    return d.MAV_LANDED_STATE_ON_GROUND if c.landed else d.MAV_LANDED_STATE_IN_AIR

@@ -1,0 +1,35 @@
+"""Which ground stations the vehicle hears, and how long since the last one spoke.
+
+A ground station is whatever sends a HEARTBEAT with type MAV_TYPE_GCS (QGroundControl,
+MAVProxy, MAVSDK configured as a ground station). The failsafe that returns home when the
+link is lost reads the silence.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from companion.link.codec import dialect as d
+from companion.link.service import Outgoing, Peer
+
+
+class GcsWatch:
+    """A service that only listens."""
+
+    handles = frozenset({"HEARTBEAT"})
+
+    def __init__(self) -> None:
+        self.last_heard_s: float | None = None
+
+    def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
+        if msg.type == d.MAV_TYPE_GCS:
+            self.last_heard_s = now_s
+        return []
+
+    def tick(self, now_s: float) -> list[Outgoing]:
+        return []
+
+    def silence_s(self, now_s: float) -> float:
+        """Seconds since the last ground-station heartbeat; NaN before the first."""
+        return math.nan if self.last_heard_s is None else now_s - self.last_heard_s

@@ -1,0 +1,191 @@
+"""Frames in, messages routed: parsers per remote, forwarding, dispatch, sending.
+
+Messages addressed to another system are forwarded to the endpoints where that system
+was heard (every other endpoint if unknown), as mavlink-router does; broadcasts are both
+forwarded and handled. Replies go to the endpoint of the peer that asked.
+"""
+
+from __future__ import annotations
+
+import logging
+import struct
+from dataclasses import dataclass
+from typing import Any
+
+from companion.link.codec import discard_partial, new_encoder, new_parser
+from companion.link.endpoints import Endpoint, Remote, UdpOut, default_budget
+from companion.link.link_budget import LinkBudget
+from companion.link.service import Outgoing, Peer, Service
+from companion.link.signing import configure_parser, shared_state, signing_encoder
+from companion.link.telemetry import STREAMS, Snapshot, StreamSchedule
+from companion.link.tlog import TlogWriter
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class LinkCounters:
+    ok: int = 0  # frames decoded
+    bad: int = 0  # CRC failures, truncated frames, garbage
+    forwarded: int = 0
+    foreign: int = 0  # addressed to another system
+    stream_errors: int = 0  # telemetry samples that could not be encoded
+
+
+class LinkRouter:
+    """Routing and dispatch for all endpoints of the link."""
+
+    def __init__(
+        self,
+        mav: Any,
+        endpoints: list[Endpoint],
+        services: list[Service],
+        signing_key: bytes | None = None,
+    ) -> None:
+        self.mav = mav
+        self.endpoints = endpoints
+        self.services = list(services)
+        self.parsers: dict[tuple[int, Remote], Any] = {}
+        self.routes: dict[int, set[int]] = {}  # sysid → endpoint indexes it was heard on
+        self.schedules = [StreamSchedule() for _ in endpoints]
+        self.budgets = [LinkBudget(default_budget(e)) for e in endpoints]
+        self.tlogs = [TlogWriter(e.options.tlog) if e.options.tlog else None for e in endpoints]
+        self.counters = LinkCounters()
+        self.signing = shared_state(signing_key) if signing_key else None
+        self.packers = [self._packer(i, e, signing_key) for i, e in enumerate(endpoints)]
+        self.by_type: dict[str, list[Service]] = {}
+        for service in self.services:
+            self.add_service(service)
+
+    def _packer(self, index: int, endpoint: Endpoint, key: bytes | None) -> Any:
+        """The encoder that frames what goes out of an endpoint (signed or not)."""
+        if endpoint.options.signing == "off" or key is None:
+            return self.mav
+        packer = new_encoder(self.mav.srcSystem, self.mav.srcComponent)
+        signing_encoder(packer, key, link_id=index + 1)
+        return packer
+
+    def add_service(self, service: Service) -> None:
+        if service not in self.services:
+            self.services.append(service)
+        for name in service.handles:
+            self.by_type.setdefault(name, []).append(service)
+
+    def receive(self, endpoint: Endpoint, fd: int, now_s: float) -> None:
+        index = self.endpoints.index(endpoint)
+        for remote, data in endpoint.read_ready(fd):
+            parser = self.parsers.get((index, remote))
+            if parser is None:
+                parser = self.parsers[(index, remote)] = new_parser()
+                configure_parser(parser, self.signing, endpoint.options.signing)
+            try:
+                messages = parser.parse_buffer(data) or []
+            except Exception:  # pymavlink raises on some malformed input even when robust
+                self.counters.bad += 1
+                discard_partial(parser)
+                continue
+            if isinstance(endpoint, UdpOut) and discard_partial(parser):
+                self.counters.bad += 1
+            for msg in messages:
+                self._route(msg, index, now_s)
+
+    def _route(self, msg: Any, index: int, now_s: float) -> None:
+        if msg.get_type() == "BAD_DATA":
+            self.counters.bad += 1
+            return
+        self.counters.ok += 1
+        tlog = self.tlogs[index]
+        if tlog is not None:
+            tlog.write(bytes(msg.get_msgbuf()))
+        if msg.get_type() == "RADIO_STATUS":
+            self.budgets[index].radio_status(msg.txbuf)
+        sysid, compid = msg.get_srcSystem(), msg.get_srcComponent()
+        if sysid == self.mav.srcSystem:
+            return  # our own traffic looped back by another router
+        self.routes.setdefault(sysid, set()).add(index)
+        target = getattr(msg, "target_system", 0)
+        if target not in (0, self.mav.srcSystem):
+            self.counters.foreign += 1
+            self._forward(msg, index, self.routes.get(target))
+            return
+        if target == 0:
+            self._forward(msg, index, None)
+        peer = Peer(sysid, compid, index)
+        out: list[Outgoing] = []
+        for service in self.by_type.get(msg.get_type(), []):
+            out += service.handle(msg, peer, now_s)
+        self.send(out, now_s)
+
+    def _forward(self, msg: Any, came_from: int, to: set[int] | None) -> None:
+        raw = bytes(msg.get_msgbuf())
+        for i, endpoint in enumerate(self.endpoints):
+            if i != came_from and (to is None or i in to):
+                endpoint.send(raw)
+                self.counters.forwarded += 1
+
+    def _emit(self, index: int, raw: bytes, priority: bool, now_s: float) -> bool:
+        budget = self.budgets[index]
+        if priority:
+            budget.take_priority(len(raw), now_s)
+        elif not budget.take_telemetry(len(raw), now_s):
+            return False
+        self.endpoints[index].send(raw)
+        tlog = self.tlogs[index]
+        if tlog is not None:
+            tlog.write(raw)
+        return True
+
+    def send(self, out: list[Outgoing], now_s: float) -> None:
+        """Frame and send; telemetry only where the endpoint's budget allows."""
+        for item in out:
+            targets = range(len(self.endpoints)) if item.to is None else [item.to.endpoint]
+            frames: dict[int, bytes] = {}
+            for index in targets:
+                packer = self.packers[index]
+                if id(packer) not in frames:
+                    frames[id(packer)] = self._pack(packer, item.msg)
+                self._emit(index, frames[id(packer)], item.priority, now_s)
+            self.mav.seq = (self.mav.seq + 1) % 256
+
+    def tick(self, now_s: float) -> list[Outgoing]:
+        out: list[Outgoing] = []
+        for service in self.services:
+            out += service.tick(now_s)
+        return out
+
+    def stream_telemetry(self, snapshot: Snapshot, now_s: float) -> None:
+        for index, endpoint in enumerate(self.endpoints):
+            if not endpoint.has_remote():
+                continue
+            for msg_id in self.schedules[index].due(now_s):
+                try:
+                    msg = STREAMS[msg_id].build(self.mav, snapshot)
+                    # Framed once, for this endpoint; values out of a field's range raise here.
+                    raw = None if msg is None else self._pack(self.packers[index], msg)
+                except (ValueError, OverflowError, struct.error) as exc:
+                    self.counters.stream_errors += 1
+                    log.debug("stream %s: %s", STREAMS[msg_id].name, exc)
+                    continue
+                if raw is None:
+                    continue
+                self.mav.seq = (self.mav.seq + 1) % 256
+                if not self._emit(index, raw, False, now_s):
+                    # Out of budget: stop here rather than let smaller, younger streams slip
+                    # past, or a large frame would never find enough budget left for it.
+                    break
+                self.schedules[index].mark_sent(msg_id, now_s)
+
+    def _pack(self, packer: Any, msg: Any) -> bytes:
+        """Frame a message with the vehicle's current sequence number (signed or not)."""
+        packer.seq = self.mav.seq
+        return msg.pack(packer)
+
+    def next_due(self) -> float:
+        times = [s.next_time() for s in self.schedules]
+        nexts = [getattr(s, "next_due", lambda: float("inf"))() for s in self.services]
+        return min([*times, *nexts, float("inf")])
+
+    def close(self) -> None:
+        for tlog in self.tlogs:
+            if tlog is not None:
+                tlog.close()

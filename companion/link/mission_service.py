@@ -1,0 +1,200 @@
+"""The mission microservice, vehicle side, for missions, fences and rally points.
+
+Upload: MISSION_COUNT, then the vehicle asks for each item in order (MISSION_REQUEST_INT),
+re-asking after a timeout, and commits the whole list atomically only when every item
+arrived and can be flown; otherwise the old list stays and MISSION_ACK says why.
+Download: MISSION_REQUEST_LIST → MISSION_COUNT, then items on request (INT or legacy).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from companion.control.mission.items import MISSION_TYPES, MissionItem, check_mission
+from companion.control.mission.store import MissionStore
+from companion.link.service import Outgoing, Peer
+from mavlink_dialect import companion as d
+
+log = logging.getLogger(__name__)
+
+ITEM_TIMEOUT_S = 0.5  # re-ask for an item after this long
+MAX_RETRIES = 5
+MAX_ITEMS = 1000
+
+
+def mission_current_message(mav: Any, seq: int, total: int) -> Any:
+    """MISSION_CURRENT for the stored mission (the executor will add the running states)."""
+    state = d.MISSION_STATE_NO_MISSION if total == 0 else d.MISSION_STATE_NOT_STARTED
+    return mav.mission_current_encode(seq, total, state)
+
+
+@dataclass
+class _Upload:
+    peer: Peer
+    mission_type: int
+    count: int
+    items: list[MissionItem] = field(default_factory=list)
+    asked_at: float = 0.0
+    retries: int = 0
+
+
+class MissionService:
+    """Transfers missions between ground stations and the MissionStore."""
+
+    handles = frozenset(
+        {
+            "MISSION_COUNT",
+            "MISSION_ITEM_INT",
+            "MISSION_ITEM",
+            "MISSION_REQUEST_LIST",
+            "MISSION_REQUEST_INT",
+            "MISSION_REQUEST",
+            "MISSION_CLEAR_ALL",
+            "MISSION_SET_CURRENT",
+            "MISSION_ACK",
+        }
+    )
+
+    def __init__(self, mav: Any, store: MissionStore, sysid: int, compid: int = 1) -> None:
+        self.mav = mav
+        self.store = store
+        self.sysid = sysid
+        self.compid = compid
+        self.uploads: dict[int, _Upload] = {}
+        self.current = 0
+        self.on_change: Callable[[int], None] = lambda mission_type: None
+        self.refused = 0
+
+    def _ack(self, peer: Peer, result: int, mission_type: int) -> Outgoing:
+        msg = self.mav.mission_ack_encode(peer.sysid, peer.compid, result, mission_type)
+        return Outgoing(msg, peer)
+
+    def _request(self, upload: _Upload, now_s: float) -> Outgoing:
+        upload.asked_at = now_s
+        seq = len(upload.items)
+        peer = upload.peer
+        msg = self.mav.mission_request_int_encode(peer.sysid, peer.compid, seq, upload.mission_type)
+        return Outgoing(msg, peer)
+
+    def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
+        # Broadcasts count too: MAVProxy addresses sysid 0 until it has heard a heartbeat.
+        if msg.target_system not in (0, self.sysid) or msg.target_component not in (0, self.compid):
+            return []
+        mission_type = getattr(msg, "mission_type", 0)
+        if mission_type not in MISSION_TYPES:
+            return [self._ack(peer, d.MAV_MISSION_UNSUPPORTED, mission_type)]
+        kind = msg.get_type()
+        if kind == "MISSION_COUNT":
+            return self._start_upload(msg.count, mission_type, peer, now_s)
+        if kind in ("MISSION_ITEM_INT", "MISSION_ITEM"):
+            return self._item(msg, mission_type, peer, now_s)
+        if kind == "MISSION_REQUEST_LIST":
+            count = len(self.store.items[mission_type])
+            return [
+                Outgoing(
+                    self.mav.mission_count_encode(peer.sysid, peer.compid, count, mission_type),
+                    peer,
+                )
+            ]
+        if kind in ("MISSION_REQUEST_INT", "MISSION_REQUEST"):
+            return self._send_item(msg.seq, mission_type, peer, legacy=kind == "MISSION_REQUEST")
+        if kind == "MISSION_CLEAR_ALL":
+            self.store.replace(mission_type, [])
+            self.on_change(mission_type)
+            return [self._ack(peer, d.MAV_MISSION_ACCEPTED, mission_type)]
+        if kind == "MISSION_SET_CURRENT":
+            return self._set_current(msg.seq)
+        return []  # MISSION_ACK closing a download: nothing to do
+
+    def _start_upload(
+        self, count: int, mission_type: int, peer: Peer, now_s: float
+    ) -> list[Outgoing]:
+        busy = self.uploads.get(mission_type)
+        if busy is not None and busy.peer != peer:
+            return [self._ack(peer, d.MAV_MISSION_DENIED, mission_type)]
+        if count > MAX_ITEMS:
+            self.refused += 1
+            return [self._ack(peer, d.MAV_MISSION_NO_SPACE, mission_type)]
+        if count == 0:
+            self.uploads.pop(mission_type, None)
+            self.store.replace(mission_type, [])
+            self.on_change(mission_type)
+            return [self._ack(peer, d.MAV_MISSION_ACCEPTED, mission_type)]
+        upload = self.uploads[mission_type] = _Upload(peer, mission_type, count)
+        return [self._request(upload, now_s)]
+
+    def _item(self, msg: Any, mission_type: int, peer: Peer, now_s: float) -> list[Outgoing]:
+        upload = self.uploads.get(mission_type)
+        if upload is None or upload.peer != peer:
+            return []
+        if msg.seq != len(upload.items):
+            return [self._request(upload, now_s)]  # out of order or a duplicate: re-ask
+        try:
+            upload.items.append(MissionItem.from_message(msg))
+        except (TypeError, ValueError):
+            del self.uploads[mission_type]
+            return [self._ack(peer, d.MAV_MISSION_ERROR, mission_type)]
+        upload.retries = 0
+        if len(upload.items) < upload.count:
+            return [self._request(upload, now_s)]
+        del self.uploads[mission_type]
+        result = check_mission(upload.items)
+        if result == d.MAV_MISSION_ACCEPTED:
+            self.store.replace(mission_type, upload.items)
+            self.current = 0 if mission_type == 0 else self.current
+            self.on_change(mission_type)
+        else:
+            self.refused += 1
+            log.warning("mission upload refused: %s", d.enums["MAV_MISSION_RESULT"][result].name)
+        return [self._ack(peer, result, mission_type)]
+
+    def _send_item(self, seq: int, mission_type: int, peer: Peer, legacy: bool) -> list[Outgoing]:
+        items = self.store.items[mission_type]
+        if not 0 <= seq < len(items):
+            return [self._ack(peer, d.MAV_MISSION_INVALID_SEQUENCE, mission_type)]
+        it = items[seq]
+        current = int(mission_type == 0 and seq == self.current)
+        common = (it.seq, it.frame, it.command, current, it.autocontinue)
+        params = (it.param1, it.param2, it.param3, it.param4)
+        if legacy:
+            msg = self.mav.mission_item_encode(
+                peer.sysid,
+                peer.compid,
+                *common,
+                *params,
+                it.x / 1e7,
+                it.y / 1e7,
+                it.z,
+                mission_type,
+            )
+        else:
+            msg = self.mav.mission_item_int_encode(
+                peer.sysid, peer.compid, *common, *params, it.x, it.y, it.z, mission_type
+            )
+        return [Outgoing(msg, peer)]
+
+    def _set_current(self, seq: int) -> list[Outgoing]:
+        if 0 <= seq < len(self.store.items[0]):
+            self.current = seq
+            self.on_change(0)
+        return [Outgoing(self.mission_current(), None)]
+
+    def mission_current(self) -> Any:
+        return mission_current_message(self.mav, self.current, len(self.store.items[0]))
+
+    def tick(self, now_s: float) -> list[Outgoing]:
+        out: list[Outgoing] = []
+        for mission_type, upload in list(self.uploads.items()):
+            if now_s - upload.asked_at < ITEM_TIMEOUT_S:
+                continue
+            if upload.retries >= MAX_RETRIES:
+                del self.uploads[mission_type]
+                log.warning("mission upload timed out at item %d", len(upload.items))
+                out.append(self._ack(upload.peer, d.MAV_MISSION_OPERATION_CANCELLED, mission_type))
+                continue
+            upload.retries += 1
+            out.append(self._request(upload, now_s))
+        return out

@@ -1,0 +1,59 @@
+"""The standard modes protocol and the heartbeat's view of the mode.
+
+CURRENT_MODE is streamed and sent on every change; AVAILABLE_MODES is sent on request, all
+of them (param2 = 0) or one by its 1-based index, as QGroundControl asks; the monitor's
+sequence number never changes because the set of modes never does.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from companion.control.modes import BY_MODE, MODES, ModeInfo
+from companion.messages import FlightMode, VehicleStatus
+from mavlink_dialect import companion as d
+
+MODES_SEQ = 1
+
+
+def _info(status: VehicleStatus | None) -> ModeInfo | None:
+    if status is None:
+        return None
+    try:
+        return BY_MODE[FlightMode(status.mode)]
+    except ValueError:
+        return None
+
+
+def heartbeat_mode(status: VehicleStatus | None) -> tuple[int, int]:
+    """(custom_mode, extra base_mode flags) for the heartbeat."""
+    info = _info(status)
+    return (info.px4, info.base_flags) if info else (0, 0)
+
+
+def current_mode(mav: Any, status: VehicleStatus | None) -> Any:
+    """CURRENT_MODE, or None before the commander has spoken."""
+    info = _info(status)
+    return None if info is None else mav.current_mode_encode(info.standard, info.px4, info.px4)
+
+
+def available_modes(mav: Any, index: int) -> list[Any]:
+    """AVAILABLE_MODES: every mode for index 0, else the one at that 1-based index."""
+    chosen = range(1, len(MODES) + 1) if index == 0 else [index]
+    out = []
+    for i in chosen:
+        if not 1 <= i <= len(MODES):
+            continue
+        info = MODES[i - 1]
+        props = 0 if info.user_selectable else d.MAV_MODE_PROPERTY_NOT_USER_SELECTABLE
+        out.append(
+            mav.available_modes_encode(
+                len(MODES), i, info.standard, info.px4, props, info.name.encode()
+            )
+        )
+    return out
+
+
+def available_modes_monitor(mav: Any) -> Any:
+    """AVAILABLE_MODES_MONITOR with the (constant) sequence of the mode set."""
+    return mav.available_modes_monitor_encode(MODES_SEQ)

@@ -1,0 +1,101 @@
+"""The parameter microservice: list, read by name or index, set with echo.
+
+A full list is streamed a few PARAM_VALUEs per tick so a slow radio is not flooded;
+``param_count`` and indexes are fixed (0..count-1) so QGroundControl can re-read gaps.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import deque
+from collections.abc import Callable
+from typing import Any
+
+from companion.link.service import Outgoing, Peer
+from companion.params.store import ParamError, ParamStore
+
+log = logging.getLogger(__name__)
+REAL32 = 9
+PER_TICK = 25
+
+
+def _name(raw: Any) -> str:
+    if isinstance(raw, bytes):
+        raw = raw.decode(errors="replace")
+    return str(raw).split("\0", 1)[0]
+
+
+class ParamsService:
+    """Serves a ParamStore to ground stations."""
+
+    handles = frozenset({"PARAM_REQUEST_LIST", "PARAM_REQUEST_READ", "PARAM_SET"})
+
+    def __init__(
+        self,
+        mav: Any,
+        store: ParamStore,
+        sysid: int,
+        compid: int = 1,
+        on_refusal: Callable[[str], None] | None = None,
+    ) -> None:
+        self.mav = mav
+        self.store = store
+        self.sysid = sysid
+        self.compid = compid
+        self.on_refusal = on_refusal or (lambda text: None)
+        self.on_change: Callable[[str, float], None] = lambda name, value: None
+        self._queue: deque[tuple[int, Peer | None]] = deque()
+        self.refused = 0
+
+    def _for_us(self, msg: Any) -> bool:
+        targets = (0, self.sysid)  # broadcasts included, as for missions
+        return msg.target_system in targets and msg.target_component in (0, self.compid)
+
+    def value(self, index: int) -> Any:
+        name = self.store.names[index]
+        return self.mav.param_value_encode(
+            name.encode(), self.store.get(name), REAL32, len(self.store), index
+        )
+
+    def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
+        if not self._for_us(msg):
+            return []
+        kind = msg.get_type()
+        if kind == "PARAM_REQUEST_LIST":
+            self._queue = deque((i, peer) for i in range(len(self.store)))
+            return self.tick(now_s)
+        if kind == "PARAM_REQUEST_READ":
+            return self._read(msg, peer)
+        return self._set(msg)
+
+    def _read(self, msg: Any, peer: Peer) -> list[Outgoing]:
+        index = msg.param_index
+        if index < 0:
+            name = _name(msg.param_id)
+            if name not in self.store.decls:
+                return []
+            index = self.store.index_of(name)
+        if index >= len(self.store):
+            return []
+        return [Outgoing(self.value(index), peer)]
+
+    def _set(self, msg: Any) -> list[Outgoing]:
+        name = _name(msg.param_id)
+        if name not in self.store.decls:
+            self.refused += 1
+            self.on_refusal(f"Unknown parameter {name}")
+            return []
+        try:
+            self.on_change(name, self.store.set(name, msg.param_value))
+        except ParamError as exc:
+            self.refused += 1
+            self.on_refusal(f"Param refused: {exc}"[:50])
+        # Echo the value in force (the old one when refused) to every ground station.
+        return [Outgoing(self.value(self.store.index_of(name)), None)]
+
+    def tick(self, now_s: float) -> list[Outgoing]:
+        out = []
+        for _ in range(min(PER_TICK, len(self._queue))):
+            index, peer = self._queue.popleft()
+            out.append(Outgoing(self.value(index), peer))
+        return out

@@ -1,0 +1,386 @@
+"""Telemetry streams: each a small named mapping from bus values to one MAVLink message.
+
+The vehicle streams from boot (ground stations do not ask), at default rates that a
+ground station changes per endpoint with MAV_CMD_SET_MESSAGE_INTERVAL.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from companion.link.codec import dialect as d
+from companion.link.flight_messages import landed_state, mission_current, nav_controller_output
+from companion.link.mode_messages import available_modes_monitor, current_mode
+from companion.messages import (
+    ControlStatus,
+    GpsFix,
+    Imu,
+    NavFlags,
+    NavState,
+    ServoOutput,
+    SystemHealth,
+    VehicleStatus,
+)
+
+
+@dataclass
+class Snapshot:
+    """The newest bus values the streams are built from."""
+
+    time_boot_ms: int = 0
+    unix_us: int = 0
+    nav: NavState | None = None
+    gps: GpsFix | None = None
+    imu: Imu | None = None
+    health: SystemHealth | None = None
+    servos: ServoOutput | None = None
+    status: VehicleStatus | None = None
+    control: ControlStatus | None = None  # None while the flight controller is not running
+    home_alt_m: float = math.nan
+    mission_seq: int = 0
+    mission_total: int = 0
+    home: tuple[float, float, float] | None = None  # lat_deg, lon_deg, alt_msl_m
+    health_cursor: int = 0  # PLUGIN_HEALTH sends one row at a time, round the table
+
+
+Builder = Callable[[Any, Snapshot], Any]
+
+
+def _finite(x: float, fallback: float = 0.0) -> float:
+    return x if math.isfinite(x) else fallback
+
+
+def _int16(x: float) -> int:
+    """Saturate to an int16 field (a sensor beyond its range must not break the link)."""
+    return max(-32768, min(32767, round(_finite(x))))
+
+
+def _deg360(rad: float) -> float:
+    """An angle in degrees within [0, 360); 0 for values that are not finite."""
+    return _finite(math.degrees(_finite(rad)) % 360.0) % 360.0
+
+
+def _int32(x: float) -> int:
+    return max(-(2**31), min(2**31 - 1, round(_finite(x))))
+
+
+def _f32(x: float) -> float:
+    """Keep a value inside float32 (NaN stays NaN: MAVLink's 'unknown')."""
+    return x if math.isnan(x) else max(-3.0e38, min(3.0e38, x))
+
+
+def _attitude(mav: Any, s: Snapshot) -> Any:
+    n = s.nav
+    if n is None or not n.flags & NavFlags.ATTITUDE_VALID:
+        return None
+    return mav.attitude_encode(
+        s.time_boot_ms,
+        _f32(n.roll_rad),
+        _f32(n.pitch_rad),
+        _f32(n.yaw_rad),
+        _f32(_finite(n.roll_rate_rad_s)),
+        _f32(_finite(n.pitch_rate_rad_s)),
+        _f32(_finite(n.yaw_rate_rad_s)),
+    )
+
+
+def _attitude_quaternion(mav: Any, s: Snapshot) -> Any:
+    n = s.nav
+    if n is None or not n.flags & NavFlags.ATTITUDE_VALID:
+        return None
+    q = [_f32(v) for v in n.q]
+    rates = tuple(
+        _f32(_finite(r)) for r in (n.roll_rate_rad_s, n.pitch_rate_rad_s, n.yaw_rate_rad_s)
+    )
+    return mav.attitude_quaternion_encode(s.time_boot_ms, *q, *rates, [0.0] * 4)
+
+
+def _global_position(mav: Any, s: Snapshot) -> Any:
+    n = s.nav
+    if n is None or not n.flags & NavFlags.POSITION_VALID:
+        return None
+    rel = n.alt_msl_m - s.home_alt_m if math.isfinite(s.home_alt_m) else 0.0
+    heading = _deg360(n.yaw_rad)
+    return mav.global_position_int_encode(
+        s.time_boot_ms,
+        _int32(n.lat_deg * 1e7),
+        _int32(n.lon_deg * 1e7),
+        _int32(n.alt_msl_m * 1000),
+        _int32(rel * 1000),
+        _int16(_finite(n.vn_m_s) * 100),
+        _int16(_finite(n.ve_m_s) * 100),
+        _int16(_finite(n.vd_m_s) * 100),
+        round(heading * 100) % 36000,
+    )
+
+
+def _gps_raw(mav: Any, s: Snapshot) -> Any:
+    g = s.gps
+    if g is None:
+        return mav.gps_raw_int_encode(
+            s.time_boot_ms * 1000, d.GPS_FIX_TYPE_NO_GPS, 0, 0, 0, 65535, 65535, 65535, 65535, 255
+        )
+
+    def u16(v: float, scale: float) -> int:
+        x = v * scale
+        return 65535 if not math.isfinite(x) else max(0, min(65534, round(x)))
+
+    cog = 65535 if not math.isfinite(g.course_rad) else round(_deg360(g.course_rad) * 100) % 36000
+    return mav.gps_raw_int_encode(
+        g.t_us,
+        g.fix_type,
+        _int32(g.lat_deg * 1e7),
+        _int32(g.lon_deg * 1e7),
+        _int32(_finite(g.alt_msl_m) * 1000),
+        u16(g.hdop, 100),
+        u16(g.vdop, 100),
+        u16(g.ground_speed_m_s, 100),
+        cog,
+        g.satellites,
+    )
+
+
+def _vfr_hud(mav: Any, s: Snapshot) -> Any:
+    n = s.nav
+    if n is None:
+        return None
+    ground = _f32(math.hypot(_finite(n.vn_m_s), _finite(n.ve_m_s)))
+    heading = round(_deg360(n.yaw_rad)) % 360
+    throttle = 0
+    alt, climb = _f32(_finite(n.alt_msl_m)), _f32(-_finite(n.vd_m_s))
+    return mav.vfr_hud_encode(ground, ground, heading, throttle, alt, climb)
+
+
+def _sys_status(mav: Any, s: Snapshot) -> Any:
+    present, healthy = sensor_bits(s)
+    load = 0
+    if s.health is not None:
+        load = min(1000, round(sum(r.cpu_pct for r in s.health.rows()) * 10 / 2))
+    return mav.sys_status_encode(present, present, healthy, load, 0, -1, -1, 0, 0, 0, 0, 0, 0)
+
+
+def sensor_bits(s: Snapshot) -> tuple[int, int]:
+    """SYS_STATUS present and healthy bits, true to what the bus shows."""
+    present = healthy = 0
+    if s.imu is not None:
+        bits = d.MAV_SYS_STATUS_SENSOR_3D_ACCEL | d.MAV_SYS_STATUS_SENSOR_3D_GYRO
+        present |= bits
+        healthy |= bits
+    if s.gps is not None:
+        present |= d.MAV_SYS_STATUS_SENSOR_GPS
+        if s.gps.fix_type >= 3:
+            healthy |= d.MAV_SYS_STATUS_SENSOR_GPS
+    if s.nav is not None:
+        bits = d.MAV_SYS_STATUS_AHRS
+        present |= bits
+        if s.nav.flags & NavFlags.ATTITUDE_VALID:
+            healthy |= bits
+    return present, healthy
+
+
+def _system_time(mav: Any, s: Snapshot) -> Any:
+    return mav.system_time_encode(s.unix_us, s.time_boot_ms)
+
+
+def _servo_output(mav: Any, s: Snapshot) -> Any:
+    if s.servos is None:
+        return None
+    return mav.servo_output_raw_encode(s.servos.t_us & 0xFFFFFFFF, 0, *list(s.servos.pulse_us))
+
+
+def _scaled_imu(mav: Any, s: Snapshot) -> Any:
+    i = s.imu
+    if i is None:
+        return None
+    mg = lambda a: _int16(a / 9.80665 * 1000)  # noqa: E731
+    mrad = lambda w: _int16(w * 1000)  # noqa: E731
+    return mav.scaled_imu_encode(
+        s.time_boot_ms,
+        mg(i.ax_m_s2),
+        mg(i.ay_m_s2),
+        mg(i.az_m_s2),
+        mrad(i.gx_rad_s),
+        mrad(i.gy_rad_s),
+        mrad(i.gz_rad_s),
+        0,
+        0,
+        0,
+    )
+
+
+def _extended_sys_state(mav: Any, s: Snapshot) -> Any:
+    landed = d.MAV_LANDED_STATE_UNDEFINED
+    if (controlled := landed_state(s.control)) is not None:
+        landed = controlled
+    elif s.nav is not None and s.nav.flags & NavFlags.VELOCITY_VALID:
+        moving = math.hypot(_finite(s.nav.vn_m_s), _finite(s.nav.ve_m_s)) > 5.0
+        landed = d.MAV_LANDED_STATE_IN_AIR if moving else d.MAV_LANDED_STATE_ON_GROUND
+    return mav.extended_sys_state_encode(d.MAV_VTOL_STATE_UNDEFINED, landed)
+
+
+def _mission_current(mav: Any, s: Snapshot) -> Any:
+    return mission_current(mav, s.mission_seq, s.mission_total, s.control)
+
+
+def _home_position(mav: Any, s: Snapshot) -> Any:
+    if s.home is None:
+        return None
+    lat, lon, alt = s.home
+    q = [1.0, 0.0, 0.0, 0.0]
+    return mav.home_position_encode(
+        _int32(lat * 1e7), _int32(lon * 1e7), _int32(alt * 1000), 0, 0, 0, q, 0, 0, 0
+    )
+
+
+def _u32(x: int) -> int:
+    return max(0, min(2**32 - 1, int(x)))
+
+
+def _plugin_health(mav: Any, s: Snapshot) -> Any:
+    rows = s.health.rows() if s.health is not None else []
+    if not rows:
+        return None
+    index = s.health_cursor % len(rows)
+    s.health_cursor = index + 1
+    r = rows[index]
+    return mav.plugin_health_encode(
+        s.time_boot_ms,
+        _u32(r.pid),
+        _u32(r.restarts),
+        _u32(r.frames_ok),
+        _u32(r.frames_bad),
+        _u32(r.dropped),
+        _f32(_finite(r.cpu_pct)),
+        _f32(_finite(r.step_p99_us)),
+        index,
+        len(rows),
+        r.state,
+        r.name[:24],
+    )
+
+
+def _navigator_name(s: Snapshot) -> bytes:
+    for row in s.health.rows() if s.health is not None else []:
+        if row.kind.startswith(b"nav."):
+            return row.kind[4:20]
+    return b""
+
+
+def _nav_status(mav: Any, s: Snapshot) -> Any:
+    n = s.nav
+    if n is None:
+        return None
+    std = [
+        [_f32(_finite(v, math.nan)) for v in arr]
+        for arr in (n.pos_std_m, n.vel_std_m_s, n.att_std_rad)
+    ]
+    return mav.nav_status_encode(
+        s.time_boot_ms, n.flags, n.gps_rejected, n.heading_rejected, *std, 0.0, _navigator_name(s)
+    )
+
+
+@dataclass(frozen=True)
+class Stream:
+    name: str
+    msg_id: int
+    default_hz: float
+    build: Builder
+
+
+STREAMS: dict[int, Stream] = {
+    s.msg_id: s
+    for s in (
+        Stream("ATTITUDE", d.MAVLINK_MSG_ID_ATTITUDE, 10.0, _attitude),
+        Stream(
+            "ATTITUDE_QUATERNION", d.MAVLINK_MSG_ID_ATTITUDE_QUATERNION, 0.0, _attitude_quaternion
+        ),
+        Stream("GLOBAL_POSITION_INT", d.MAVLINK_MSG_ID_GLOBAL_POSITION_INT, 5.0, _global_position),
+        Stream("GPS_RAW_INT", d.MAVLINK_MSG_ID_GPS_RAW_INT, 2.0, _gps_raw),
+        Stream("VFR_HUD", d.MAVLINK_MSG_ID_VFR_HUD, 4.0, _vfr_hud),
+        Stream("SYS_STATUS", d.MAVLINK_MSG_ID_SYS_STATUS, 1.0, _sys_status),
+        Stream("SYSTEM_TIME", d.MAVLINK_MSG_ID_SYSTEM_TIME, 0.5, _system_time),
+        Stream("SERVO_OUTPUT_RAW", d.MAVLINK_MSG_ID_SERVO_OUTPUT_RAW, 2.0, _servo_output),
+        Stream("SCALED_IMU", d.MAVLINK_MSG_ID_SCALED_IMU, 2.0, _scaled_imu),
+        Stream("EXTENDED_SYS_STATE", d.MAVLINK_MSG_ID_EXTENDED_SYS_STATE, 1.0, _extended_sys_state),
+        Stream("MISSION_CURRENT", d.MAVLINK_MSG_ID_MISSION_CURRENT, 1.0, _mission_current),
+        Stream(
+            "NAV_CONTROLLER_OUTPUT",
+            d.MAVLINK_MSG_ID_NAV_CONTROLLER_OUTPUT,
+            2.0,
+            lambda m, s: nav_controller_output(m, s.control),
+        ),
+        Stream("HOME_POSITION", d.MAVLINK_MSG_ID_HOME_POSITION, 0.2, _home_position),
+        Stream("PLUGIN_HEALTH", d.MAVLINK_MSG_ID_PLUGIN_HEALTH, 2.0, _plugin_health),
+        Stream("NAV_STATUS", d.MAVLINK_MSG_ID_NAV_STATUS, 1.0, _nav_status),
+        Stream(
+            "CURRENT_MODE",
+            d.MAVLINK_MSG_ID_CURRENT_MODE,
+            0.5,
+            lambda m, s: current_mode(m, s.status),
+        ),
+        Stream(
+            "AVAILABLE_MODES_MONITOR",
+            d.MAVLINK_MSG_ID_AVAILABLE_MODES_MONITOR,
+            0.2,
+            lambda m, s: available_modes_monitor(m),
+        ),
+    )
+}
+
+
+def _default_period(msg_id: int) -> float:
+    """Seconds between samples at the stream's default rate; 0 when off by default."""
+    hz = STREAMS[msg_id].default_hz
+    return 1.0 / hz if hz > 0 else 0.0
+
+
+class StreamSchedule:
+    """Per-endpoint rates and due times of every stream."""
+
+    def __init__(self) -> None:
+        self.period_s = {mid: _default_period(mid) for mid in STREAMS}
+        self.next_due = dict.fromkeys(STREAMS, 0.0)
+        self.last_sent = dict.fromkeys(STREAMS, 0.0)
+
+    def set_interval(self, msg_id: int, interval_us: float) -> bool:
+        """MAV_CMD_SET_MESSAGE_INTERVAL semantics: -1 off, 0 default, else µs."""
+        if msg_id not in STREAMS:
+            return False
+        if interval_us < 0:
+            self.period_s[msg_id] = 0.0
+        elif interval_us == 0:
+            self.period_s[msg_id] = _default_period(msg_id)
+        else:
+            self.period_s[msg_id] = interval_us / 1e6
+        self.next_due[msg_id] = 0.0
+        return True
+
+    def interval_us(self, msg_id: int) -> int:
+        """The current interval (MESSAGE_INTERVAL): -1 when off, 0 when unknown."""
+        if msg_id not in STREAMS:
+            return 0
+        period = self.period_s[msg_id]
+        return -1 if period <= 0 else round(period * 1e6)
+
+    def due(self, now_s: float) -> list[int]:
+        """The streams to send now, least recently sent first; schedules their next time.
+
+        When the link's budget cannot carry every stream, the ones it had to skip come
+        first next time, so a fast stream cannot starve the slow ones.
+        """
+        out = []
+        for mid, period in self.period_s.items():
+            if period > 0 and now_s >= self.next_due[mid]:
+                out.append(mid)
+                self.next_due[mid] = max(self.next_due[mid] + period, now_s - period)
+        return sorted(out, key=self.last_sent.__getitem__)
+
+    def mark_sent(self, msg_id: int, now_s: float) -> None:
+        self.last_sent[msg_id] = now_s
+
+    def next_time(self) -> float:
+        times = [self.next_due[m] for m, p in self.period_s.items() if p > 0]
+        return min(times) if times else float("inf")

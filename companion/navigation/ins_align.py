@@ -1,0 +1,90 @@
+"""Initial attitude for the INS, on the ground or already in the air.
+
+- Roll and pitch: on the ground (ground speed under 2 m/s) from the mean specific force,
+  which then points straight up. In the air the accelerometer cannot tell a coordinated
+  turn from level flight (it reads no sideways force in either), so roll comes from the
+  turn rate instead: tan φ = V ψ̇ / g, with ψ̇ from the gyros; pitch from the forward
+  specific force as on the ground.
+- Heading: the magnetometer levelled with that tilt, else the compass, else (in the air only,
+  above 5 m/s) the GPS course, which ignores the wind's crab angle: it starts with a
+  larger uncertainty and the heading updates correct it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from companion.navigation.rotations import tilt_compensated_heading
+
+STILL_SPEED_M_S = 2.0
+COURSE_MIN_SPEED_M_S = 5.0
+
+
+@dataclass(frozen=True)
+class Alignment:
+    """Initial attitude and how much to trust it (1-σ, radians)."""
+
+    roll: float
+    pitch: float
+    yaw: float
+    tilt_std: float
+    yaw_std: float
+
+
+class Aligner:
+    """Collects a short window of IMU samples; ``align`` decides once a fix is known."""
+
+    def __init__(self, window_s: float, gravity: float) -> None:
+        self.window_us = window_s * 1e6
+        self.samples: deque[tuple[int, np.ndarray, np.ndarray]] = deque()
+        self.g = gravity
+
+    def add_imu(self, t_us: int, accel: np.ndarray, gyro: np.ndarray) -> None:
+        """One IMU sample; samples older than the window are forgotten."""
+        self.samples.append((t_us, accel, gyro))
+        while t_us - self.samples[0][0] > self.window_us:
+            self.samples.popleft()
+
+    def ready(self) -> bool:
+        """The window is (nearly) full."""
+        span = self.samples[-1][0] - self.samples[0][0] if self.samples else 0
+        return len(self.samples) >= 2 and span >= 0.8 * self.window_us
+
+    def tilt(self, ground_speed: float) -> tuple[float, float, float]:
+        """(roll, pitch, 1-σ) from the window."""
+        f = np.mean([s[1] for s in self.samples], axis=0)
+        pitch = math.atan2(f[0], math.hypot(f[1], f[2]))
+        if ground_speed < STILL_SPEED_M_S:
+            return math.atan2(-f[1], -f[2]), pitch, math.radians(2.0)
+        q, r = np.mean([s[2] for s in self.samples], axis=0)[1:3]
+        roll = 0.0
+        for _ in range(3):  # ψ̇ = (q sin φ + r cos φ) / cos θ, φ = atan(V ψ̇ / g)
+            yaw_rate = (q * math.sin(roll) + r * math.cos(roll)) / math.cos(pitch)
+            roll = math.atan(ground_speed * yaw_rate / self.g)
+        return roll, pitch, math.radians(5.0)
+
+    def align(
+        self,
+        vel_ned: np.ndarray,
+        compass_heading: float | None,
+        mag_body: np.ndarray | None,
+        declination: float,
+    ) -> Alignment | None:
+        """The alignment, or None while a heading source is still missing."""
+        if not self.ready():
+            return None
+        speed = math.hypot(vel_ned[0], vel_ned[1]) if np.all(np.isfinite(vel_ned[:2])) else 0.0
+        roll, pitch, tilt_std = self.tilt(speed)
+        if mag_body is not None:
+            yaw = tilt_compensated_heading(mag_body, roll, pitch) + declination
+            return Alignment(roll, pitch, yaw, tilt_std, 3 * tilt_std)
+        if compass_heading is not None:
+            return Alignment(roll, pitch, compass_heading, tilt_std, math.radians(15.0))
+        if speed > COURSE_MIN_SPEED_M_S:
+            course = math.atan2(vel_ned[1], vel_ned[0])
+            return Alignment(roll, pitch, course, tilt_std, math.radians(20.0))
+        return None

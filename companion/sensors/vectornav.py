@@ -1,0 +1,147 @@
+"""VectorNav VN-100/VN-200 ASCII output (``$VNYMR``, ``$VNIMU``) into bus messages.
+
+- ``$VNYMR,yaw,pitch,roll,magX,magY,magZ,accX,accY,accZ,gyroX,gyroY,gyroZ*cs``:
+  attitude in degrees, compensated magnetic field in gauss, acceleration in m/s²,
+  angular rate in rad/s (register 27).
+- ``$VNIMU,magX,magY,magZ,accX,accY,accZ,gyroX,gyroY,gyroZ,temp,pressure*cs``: the
+  calibrated but uncompensated sensor values, temperature in °C, pressure in kPa
+  (register 54).
+- The sensor may append a counter (``,T1162704``) or status field (``,S…``) before the
+  checksum (SerialCount/SerialStatus); they are accepted and ignored.
+- Checksum: two hex digits are VectorNav's 8-bit XOR of the characters between ``$`` and
+  ``*`` (as in NMEA); four are its 16-bit CRC over the same characters, CRC16-CCITT with
+  polynomial 0x1021 and initial value 0 (the manual's C routine; the XMODEM variant, which
+  is ``binascii.crc_hqx(data, 0)``). ``*XX`` / ``*XXXX``, the placeholders VectorNav
+  accepts when checksums are off, are counted as bad checksums: we cannot trust them.
+
+Axes: the sensor's body frame is x forward, y right, z down, and the accelerometer gives
+specific force: the manual's example response for a level, still sensor (pitch 0.02°,
+roll -1.95°) reads ``+00.005,+00.344,-09.758``. That is exactly ``messages.Imu``'s
+convention (level and still: az ≈ -9.81), so values pass through unchanged.
+Pure: no port, no clock; ``decode`` never raises.
+"""
+
+from __future__ import annotations
+
+import binascii
+import math
+import re
+from dataclasses import dataclass
+
+from companion.messages import Imu, Magnetometer
+from companion.sensors.ascii_sentence import sentence_text, xor8
+
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_APPENDED = re.compile(r"[TS][0-9A-Fa-f]+")  # SerialCount / SerialStatus fields
+_HEADER = re.compile(r"VN[A-Z]{3}")
+_HEX = frozenset("0123456789abcdefABCDEF")
+_FIELD_COUNTS = {"VNYMR": 12, "VNIMU": 11}
+_PLACEHOLDERS = ("XX", "XXXX")
+
+
+@dataclass
+class VectorNavCounters:
+    """What the decoder has seen since it was made."""
+
+    ok: int = 0
+    bad_checksum: int = 0  # wrong, or a checksum placeholder
+    garbage: int = 0  # not a VectorNav sentence, truncated, or bad fields
+    ignored: int = 0  # valid VectorNav sentences we do not use ($VNYPR, $VNRRG …)
+
+
+@dataclass(frozen=True)
+class Attitude:
+    """The sensor's own attitude estimate (``$VNYMR``), radians."""
+
+    yaw_rad: float  # [-π, π] from north
+    pitch_rad: float
+    roll_rad: float
+
+
+@dataclass(frozen=True)
+class VectorNavReading:
+    """One sentence: IMU and magnetometer, plus what that sentence adds."""
+
+    imu: Imu
+    mag: Magnetometer
+    attitude: Attitude | None  # $VNYMR only
+    pressure_pa: float  # $VNIMU only, NaN otherwise
+
+
+def crc16(payload: str) -> int:
+    """VectorNav's 16-bit CRC (CCITT polynomial 0x1021, initial value 0)."""
+    return binascii.crc_hqx(payload.encode("ascii"), 0)
+
+
+class VectorNavDecoder:
+    """ASCII sentences into readings; rejects are counted, never raised."""
+
+    def __init__(self) -> None:
+        self.counters = VectorNavCounters()
+
+    def decode(self, sentence: bytes | str, t_us: int) -> VectorNavReading | None:
+        """One sentence (line ending optional) received at ``t_us``."""
+        fields = self._checked_fields(sentence)
+        if fields is None:
+            return None
+        header, values = fields[0], fields[1:]
+        count = _FIELD_COUNTS.get(header)
+        if count is None:
+            self.counters.ignored += 1
+            return None
+        numbers = _numbers(values, count)
+        if numbers is None or not _angles_in_range(header, numbers):
+            self.counters.garbage += 1
+            return None
+        self.counters.ok += 1
+        return _reading(header, numbers, t_us)
+
+    def _checked_fields(self, sentence: bytes | str) -> list[str] | None:
+        """The comma-separated fields of a whole VectorNav sentence whose checksum is right."""
+        text = sentence_text(sentence)
+        payload, star, given = text[1:].rpartition("*")
+        header = payload.split(",", 1)[0]
+        if not (text.startswith("$") and text.isascii() and star and _HEADER.fullmatch(header)):
+            self.counters.garbage += 1
+            return None
+        if given.upper() in _PLACEHOLDERS:
+            self.counters.bad_checksum += 1
+            return None
+        if len(given) not in (2, 4) or not _HEX.issuperset(given):
+            self.counters.garbage += 1
+            return None
+        expected = xor8(payload) if len(given) == 2 else crc16(payload)
+        if int(given, 16) != expected:
+            self.counters.bad_checksum += 1
+            return None
+        return payload.split(",")
+
+
+def _numbers(values: list[str], count: int) -> list[float] | None:
+    """The first ``count`` fields as finite numbers; only appended T/S fields may follow."""
+    if len(values) < count or not all(_APPENDED.fullmatch(v) for v in values[count:]):
+        return None
+    if not all(_NUMBER.fullmatch(v) for v in values[:count]):
+        return None
+    numbers = [float(v) for v in values[:count]]
+    return numbers if all(math.isfinite(n) for n in numbers) else None
+
+
+def _angles_in_range(header: str, numbers: list[float]) -> bool:
+    if header != "VNYMR":
+        return True
+    yaw, pitch, roll = numbers[:3]
+    return abs(yaw) <= 180.0 and abs(pitch) <= 90.0 and abs(roll) <= 180.0
+
+
+def _reading(header: str, numbers: list[float], t_us: int) -> VectorNavReading:
+    if header == "VNYMR":
+        yaw, pitch, roll, *rest = numbers
+        attitude = Attitude(math.radians(yaw), math.radians(pitch), math.radians(roll))
+        temp_c = pressure_pa = math.nan
+    else:
+        *rest, temp_c, pressure_kpa = numbers
+        attitude, pressure_pa = None, pressure_kpa * 1000.0
+    mx, my, mz, ax, ay, az, gx, gy, gz = rest
+    imu = Imu(t_us, ax, ay, az, gx, gy, gz, temp_c)
+    return VectorNavReading(imu, Magnetometer(t_us, mx, my, mz), attitude, pressure_pa)

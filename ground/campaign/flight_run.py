@@ -1,0 +1,298 @@
+"""One campaign flight: ``companion sim --speed max`` with the plan, flown as a ground
+station would fly it, watched until the mission completes, then scored from the truth.
+
+Each flight has its own bus namespace, UDP port, state dir and process group, so flights
+on one machine never meet; its directory keeps the simulator's log, the truth CSV and
+the timeline (mission progress, STATUSTEXTs). A flight that dies, stalls or runs past its
+wall-clock limit ends as ``failed`` with the reason; its processes are ended by their own
+process group.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from companion.bus.namespace import cleanup_namespace
+from ground.campaign.scoring import TrackScore, score_track
+from ground.campaign.spec import REPO, Flight
+
+os.environ.setdefault("MAVLINK20", "1")
+from pymavlink import mavutil
+
+from mavlink_dialect import companion as d
+
+log = logging.getLogger(__name__)
+GCS_SYSID, GCS_COMPID = 255, 190
+TAIL_S = 1.0  # keep flying this long (wall) after completion: the loiter at home is in the truth
+FAILSAFE_PREFIXES = ("Failsafe", "Fence breached")
+TIMING_INTERVAL_US = 20_000  # MISSION_CURRENT and ATTITUDE at 50 Hz (wall) to this station
+
+
+class FlightError(Exception):
+    """The flight could not be flown to an end (a crash, a stall, a refusal)."""
+
+
+@dataclass
+class Timeline:
+    """What the ground station saw."""
+
+    completed: bool = False
+    start_ms: int | None = None  # vehicle (simulation) time of MISSION_START's ack
+    complete_ms: int | None = None
+    last_ms: int = 0
+    seqs: list[int] = field(default_factory=list)
+    texts: list[str] = field(default_factory=list)
+
+    def time_to_complete_s(self) -> float:
+        if self.start_ms is None or self.complete_ms is None:
+            return math.nan
+        return (self.complete_ms - self.start_ms) / 1000.0
+
+    def failsafes(self) -> list[str]:
+        return [t for t in self.texts if t.startswith(FAILSAFE_PREFIXES)]
+
+
+@dataclass(frozen=True)
+class FlightJob:
+    """A Ray task's argument: the flight, where to put its files, its wall-clock limit."""
+
+    flight: Flight
+    out_dir: str
+    timeout_s: float
+    silent_s: float = 45.0  # no MAVLink from the vehicle this long (wall): it has stalled
+
+
+def fly_flight(job: FlightJob) -> dict[str, Any]:
+    """Fly, score and return the flight's results row (``status`` ok or failed)."""
+    flight = job.flight
+    folder = Path(job.out_dir) / flight.flight_id
+    folder.mkdir(parents=True, exist_ok=True)
+    started = time.monotonic()
+    timeline = Timeline()
+    error = ""
+    try:
+        _fly(job, folder, timeline)
+    except FlightError as exc:
+        error = str(exc)
+    (folder / "timeline.json").write_text(json.dumps(timeline.__dict__, indent=1))
+    row = _row(flight, folder, timeline, error, time.monotonic() - started)
+    return row
+
+
+def failed_row(job: FlightJob, error: str) -> dict[str, Any]:
+    """The row of a flight whose task itself failed (the worker died, it was cancelled)."""
+    folder = Path(job.out_dir) / job.flight.flight_id
+    return _row(job.flight, folder, Timeline(), error, math.nan)
+
+
+def _row(flight: Flight, folder: Path, tl: Timeline, error: str, wall_s: float) -> dict[str, Any]:
+    score = TrackScore(math.nan, math.nan, math.nan, math.nan, 0)
+    truth_path = folder / "truth.csv"
+    if not error:
+        try:
+            from companion.navigation.estimate_csv import read_estimate
+
+            score = score_track(read_estimate(truth_path), Path(flight.plan), flight.airframe,
+                                flight.wind_ned)  # fmt: skip
+        except (OSError, ValueError, KeyError) as exc:
+            error = f"cannot score the truth: {exc}"
+    sim_s = tl.last_ms / 1000.0
+    return {
+        "flight_id": flight.flight_id,
+        "plan": Path(flight.plan).stem,
+        "plan_path": flight.plan,
+        "airframe": flight.airframe,
+        "condition": flight.condition,
+        "wind_n": flight.wind_ned[0], "wind_e": flight.wind_ned[1], "wind_d": flight.wind_ned[2],
+        "turbulence": flight.turbulence,
+        "gps_outages": ";".join(f"{s:g}:{d:g}" for s, d in flight.outages),
+        "seed": flight.seed,
+        "config": Path(flight.config).name,
+        "status": "failed" if error else "ok",
+        "error": error,
+        "completed": tl.completed,
+        **score.as_row(),
+        "time_to_complete_s": tl.time_to_complete_s(),
+        "sim_s": sim_s,
+        "wall_s": wall_s,
+        "failsafes": ";".join(tl.failsafes()),
+        "log": str(folder / "sim.log"),
+    }  # fmt: skip
+
+
+def _fly(job: FlightJob, folder: Path, tl: Timeline) -> None:
+    flight = job.flight
+    port = free_udp_port()
+    namespace = f"camp{os.getpid()}p{port}"
+    gcs = mavutil.mavlink_connection(
+        f"udpin:127.0.0.1:{port}", source_system=GCS_SYSID, source_component=GCS_COMPID
+    )
+    gcs.mav = d.MAVLink(gcs, srcSystem=GCS_SYSID, srcComponent=GCS_COMPID)
+    with (folder / "sim.log").open("w") as sim_log:
+        proc = subprocess.Popen(
+            _sim_command(flight, folder, port, namespace), cwd=REPO, stdout=sim_log,
+            stderr=subprocess.STDOUT, start_new_session=True,
+        )  # fmt: skip
+        try:
+            pilot = _Pilot(gcs, proc, time.monotonic() + job.timeout_s, tl, job.silent_s)
+            pilot.fly(flight.start_at_s)
+        finally:
+            _end(proc)
+            gcs.close()
+            cleanup_namespace(namespace)  # what a killed vehicle may have left in /dev/shm
+
+
+def _sim_command(flight: Flight, folder: Path, port: int, namespace: str) -> list[str]:
+    cmd = [
+        sys.executable, "-m", "companion", "sim", "--speed", "max",
+        "--config", flight.config, "--aircraft", flight.airframe, "--plan", flight.plan,
+        "--wind", ",".join(f"{v:g}" for v in flight.wind_ned),
+        "--turbulence", flight.turbulence, "--seed", str(flight.seed),
+        "--duration", f"{flight.max_sim_s:g}", "--truth", str(folder / "truth.csv"),
+        "--state-dir", str(folder / "state"), "--link", f"udpout://127.0.0.1:{port}",
+        "--namespace", namespace, "--log-level", "WARNING",
+    ]  # fmt: skip
+    for start, seconds in flight.outages:
+        cmd += ["--gps-outage", f"{start:g}:{seconds:g}"]
+    if flight.airborne:
+        cmd.append("--airborne")
+    if flight.start_at_s is not None:
+        cmd += ["--exact", "--start-at", f"{flight.start_at_s:g}"]
+    return cmd
+
+
+def _armed(msg: Any) -> bool:
+    return (
+        msg.get_type() == "HEARTBEAT"
+        and msg.get_srcSystem() == 1
+        and bool(msg.base_mode & d.MAV_MODE_FLAG_SAFETY_ARMED)
+    )
+
+
+class _Pilot:
+    """The ground station's side: heartbeats, arm, start, follow the mission."""
+
+    def __init__(
+        self, gcs: Any, proc: subprocess.Popen, deadline: float, tl: Timeline, silent_s: float
+    ) -> None:
+        self.gcs, self.proc, self.deadline, self.tl = gcs, proc, deadline, tl
+        self.silent_s = silent_s
+        self.heard = time.monotonic()
+        self.next_beat = 0.0
+
+    def fly(self, start_at_s: float | None) -> None:
+        """Arm and start (or, when the simulator starts the mission, see it armed)."""
+        self._until(lambda m: m.get_type() == "HOME_POSITION", "the vehicle's home position")
+        # The completion time is read off the telemetry: the faster it comes, the finer.
+        for msg_id in (d.MAVLINK_MSG_ID_MISSION_CURRENT, d.MAVLINK_MSG_ID_ATTITUDE):
+            self.gcs.mav.command_long_send(
+                1, 1, d.MAV_CMD_SET_MESSAGE_INTERVAL, 0, msg_id, TIMING_INTERVAL_US, 0, 0, 0, 0, 0
+            )
+        if start_at_s is None:
+            self._command(d.MAV_CMD_COMPONENT_ARM_DISARM, 1.0)
+            self._command(d.MAV_CMD_MISSION_START, 0.0)
+            self.tl.start_ms = self.tl.last_ms
+        else:
+            self._until(_armed, "arming by the simulator")
+            self.tl.start_ms = round(start_at_s * 1000)
+        self._until(self._complete, "mission completion")
+        tail_end = time.monotonic() + TAIL_S
+        while time.monotonic() < tail_end:
+            self._next()
+
+    def _complete(self, msg: Any) -> bool:
+        if msg.get_type() != "MISSION_CURRENT":
+            return False
+        if not self.tl.seqs or self.tl.seqs[-1] != msg.seq:
+            self.tl.seqs.append(msg.seq)
+        if msg.mission_state == d.MISSION_STATE_COMPLETE:
+            self.tl.completed, self.tl.complete_ms = True, self.tl.last_ms
+            return True
+        return False
+
+    def _command(self, command: int, p1: float) -> None:
+        for attempt in range(3):
+            self.gcs.mav.command_long_send(1, 1, command, attempt, p1, 0, 0, 0, 0, 0, 0)
+            ack = self._until(
+                lambda m: m.get_type() == "COMMAND_ACK" and m.command == command,
+                f"command {command}'s ack", within_s=3.0, required=False,
+            )  # fmt: skip
+            if ack is not None:
+                if ack.result != d.MAV_RESULT_ACCEPTED:
+                    name = d.enums["MAV_RESULT"][ack.result].name
+                    raise FlightError(f"command {command} refused: {name}")
+                return
+        raise FlightError(f"command {command}: no answer")
+
+    def _until(self, want, what: str, within_s: float | None = None, required: bool = True):
+        end = self.deadline if within_s is None else min(self.deadline, time.monotonic() + within_s)
+        while time.monotonic() < end:
+            msg = self._next()
+            if msg is not None and want(msg):
+                return msg
+        if required or time.monotonic() >= self.deadline:
+            raise FlightError(f"hung: no {what} within the flight's time limit")
+        return None
+
+    def _next(self) -> Any:
+        now = time.monotonic()
+        if now >= self.next_beat:  # a ground station's heartbeat, as QGroundControl sends
+            self.gcs.mav.heartbeat_send(d.MAV_TYPE_GCS, d.MAV_AUTOPILOT_INVALID, 0, 0, 0)
+            self.next_beat = now + 1.0
+        msg = self.gcs.recv_match(blocking=True, timeout=0.2)
+        if msg is None:
+            self._check_alive(now)
+            return None
+        self.heard = now
+        self._note(msg)
+        return msg
+
+    def _check_alive(self, now: float) -> None:
+        if self.proc.poll() is not None:
+            raise FlightError(f"the simulation ended (exit {self.proc.returncode}) before the end")
+        if now - self.heard > self.silent_s:
+            raise FlightError(f"hung: the vehicle was silent for {self.silent_s:.0f} s")
+
+    def _note(self, msg: Any) -> None:
+        ms = getattr(msg, "time_boot_ms", None)
+        if ms is not None and msg.get_srcSystem() == 1:
+            self.tl.last_ms = max(self.tl.last_ms, int(ms))
+        if msg.get_type() == "STATUSTEXT":
+            self.tl.texts.append(msg.text)
+
+
+def _end(proc: subprocess.Popen) -> None:
+    """SIGTERM the flight's process group, then SIGKILL what is left of it."""
+    if proc.poll() is None:
+        _signal_group(proc.pid, signal.SIGTERM)
+        try:
+            proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            log.warning("flight pid %d did not stop: killing its group", proc.pid)
+    _signal_group(proc.pid, signal.SIGKILL)  # the group outlives a clean leader sometimes
+    proc.wait()
+
+
+def _signal_group(pgid: int, sig: int) -> None:
+    try:
+        os.killpg(pgid, sig)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
+def free_udp_port() -> int:
+    """A loopback UDP port nothing is bound to now (for a flight's ground-station link)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]

@@ -1,0 +1,1 @@
+"""The ground commands of ``companion``: sim, replay, campaign."""

@@ -1,0 +1,198 @@
+"""``companion sim``: one vehicle, or a fleet, flying in JSBSim."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from companion.cli.app import (
+    CONFIG_OPT,
+    EXIT_CONFIG,
+    NS_OPT,
+    app,
+    err,
+    plan_or_exit,
+    setup_logging,
+)
+
+CONFIGS = Path(__file__).resolve().parents[2] / "companion" / "configs"
+
+
+def _speed(text: str) -> float | None:
+    if text == "max":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = 0.0
+    if value <= 0:
+        raise typer.BadParameter("1 (real time), a factor such as 4, or max (lockstep)")
+    return value
+
+
+def _triple(text: str) -> tuple[float, float, float]:
+    try:
+        n, e, d = (float(v) for v in text.split(","))
+    except ValueError:
+        raise typer.BadParameter("expected N,E,D in m/s, e.g. 5,0,0") from None
+    return n, e, d
+
+
+def _outage(text: str):
+    from ground.sitl.bridge.device_streams import Outage
+
+    try:
+        start, seconds = (float(v) for v in text.split(":"))
+    except ValueError:
+        raise typer.BadParameter("expected START:SECONDS, e.g. 60:30") from None
+    return Outage(start, seconds)
+
+
+def _home(text: str | None):
+    from ground.sitl.bridge.fdm import Home
+
+    if text is None:
+        return Home()
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if not 2 <= len(values) <= 4:
+        raise typer.BadParameter("expected LAT,LON[,GROUND_MSL_M[,HEADING_DEG]]")
+    names = ("lat_deg", "lon_deg", "ground_msl_m", "heading_deg")
+    return Home(**dict(zip(names, values, strict=False)))
+
+
+def _single_links(link: list[str] | None, api_port_base: int | None) -> list[str]:
+    """One vehicle: ``--link`` replaces the config's endpoints, as always; an explicit
+    ``--api-port-base`` adds the API port (and the default ground station if no ``--link``)."""
+    from ground.sitl.fleet import GCS_LINK
+
+    links = list(link or [])
+    if api_port_base is not None:
+        links = links or [GCS_LINK]
+        links += [f"udpout://127.0.0.1:{api_port_base}"] if api_port_base else []
+    return links
+
+
+def _fleet_settings(config: Path) -> tuple[dict, dict]:
+    from companion.exec_control.config import ConfigError, load_sections
+
+    try:
+        return load_sections(config)
+    except ConfigError as exc:
+        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+
+
+def _run_fleet(req) -> int:
+    from ground.sitl.fleet import Fleet
+
+    try:
+        fleet = Fleet(req)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc)) from None
+    return fleet.run()
+
+
+@app.command()
+def sim(
+    aircraft: Annotated[str, typer.Option(help="airframe: c172p, J3Cub, or a TOML path")] = "c172p",
+    plan: Annotated[Path | None, typer.Option(help="QGroundControl .plan to preload")] = None,
+    speed: Annotated[str, typer.Option(help="1 = real time, N = N times, max = lockstep")] = "1",
+    link: Annotated[
+        list[str] | None,
+        typer.Option(help="MAVLink endpoint URL, repeatable (default udpout 14550 and 14540)"),
+    ] = None,
+    airborne: Annotated[bool, typer.Option(help="start in the air at cruise speed")] = False,
+    wind: Annotated[str, typer.Option(help="steady wind N,E,D m/s (blowing towards)")] = "0,0,0",
+    turbulence: Annotated[str, typer.Option(help="none, light, moderate, severe")] = "none",
+    gps_outage: Annotated[
+        list[str] | None, typer.Option(help="START:SECONDS of no GPS fix, repeatable")
+    ] = None,
+    duration: Annotated[float | None, typer.Option(help="simulated seconds, then stop")] = None,
+    seed: Annotated[int, typer.Option(help="sensor noise seed")] = 1,
+    exact: Annotated[
+        bool,
+        typer.Option(
+            "--exact/--fast",
+            help="lockstep: also wait for the control loop each step (same seed, same flight;"
+            " about half the speed)",
+        ),
+    ] = False,
+    start_at: Annotated[
+        float | None,
+        typer.Option(
+            min=0,
+            help="arm and start the mission at this simulated second, holding the simulation"
+            " for both acks (every run starts at the same frame)",
+        ),
+    ] = None,
+    noise: Annotated[float, typer.Option(help="sensor noise scale (0: perfect)")] = 1.0,
+    truth: Annotated[Path | None, typer.Option(help="write the true state CSV here")] = None,
+    config: Annotated[Path, CONFIG_OPT] = CONFIGS / "sim.toml",
+    namespace: Annotated[str | None, NS_OPT] = None,
+    state_dir: Annotated[str | None, typer.Option(help="parameters and missions dir")] = None,
+    log_level: Annotated[str, typer.Option(help="DEBUG, INFO, WARNING")] = "INFO",
+    home: Annotated[
+        str | None, typer.Option(help="LAT,LON[,GROUND_MSL_M[,HEADING_DEG]] of the start")
+    ] = None,
+    sysid: Annotated[
+        int | None, typer.Option(min=1, max=255, help="MAVLink system id (default: config)")
+    ] = None,
+    count: Annotated[
+        int | None, typer.Option(min=1, max=254, help="vehicles to fly (default: [fleet] or 1)")
+    ] = None,
+    spacing: Annotated[
+        float | None, typer.Option(min=0, help="metres east between vehicles (default 50)")
+    ] = None,
+    api_port_base: Annotated[
+        int | None,
+        typer.Option(min=0, max=65535, help="vehicle i also sends to udpout 14540+i-1; 0: none"),
+    ] = None,
+) -> None:
+    """Fly the whole vehicle in JSBSim: devices on ptys, servos read back, MAVLink out.
+
+    With --count N, N vehicles: sysid i, bus NAMESPACE_v<i>, state STATE_DIR/v<i>, each
+    (i-1)*spacing m east of home, all on the --link endpoints, each on its own API port.
+    """
+    from companion.bus.namespace import default_namespace
+    from companion.exec_control.config import ConfigError
+    from ground.sitl.bridge.options import BridgeOptions
+    from ground.sitl.fleet import GCS_LINK, FleetRequest
+    from ground.sitl.session import SimRequest, run_sim
+
+    setup_logging(log_level)
+    lists = plan_or_exit(plan) if plan is not None else None
+    vehicle, fleet = _fleet_settings(config)
+    try:
+        opts = BridgeOptions(
+            airframe=aircraft, home=_home(home), airborne=airborne, speed=_speed(speed),
+            wind_ned=_triple(wind), turbulence=turbulence,
+            outages=[_outage(o) for o in gps_outage or []], noise_scale=noise, seed=seed,
+            exact=exact, start_at_s=start_at,
+            duration_s=duration, truth_path=str(truth) if truth else None,
+            namespace=namespace or default_namespace(),
+        )  # fmt: skip
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc)) from None
+    count = count if count is not None else fleet["count"]
+    if count > 1:
+        if sysid is not None:
+            raise typer.BadParameter("a fleet's vehicles are sysid 1..N; --sysid is for one")
+        raise typer.Exit(_run_fleet(FleetRequest(
+            count=count, opts=opts, config=config, links=list(link or [GCS_LINK]),
+            state_dir=Path(state_dir or vehicle["state_dir"]).expanduser(),
+            spacing_m=fleet["spacing_m"] if spacing is None else spacing,
+            api_port_base=fleet["api_port_base"] if api_port_base is None else api_port_base,
+            plan=plan, log_level=log_level,
+        )))  # fmt: skip
+    req = SimRequest(config, _single_links(link, api_port_base), state_dir, lists, sysid)
+    try:
+        code = run_sim(req, opts, log_level)
+    except ConfigError as exc:
+        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+    raise typer.Exit(code)

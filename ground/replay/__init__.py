@@ -1,0 +1,1 @@
+"""``companion replay`` over one log or many, and its plots."""

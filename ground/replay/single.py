@@ -1,0 +1,145 @@
+"""``companion replay``: a navigator over a recorded sensor log, offline, in one process.
+
+The navigator is the plug-in's own (``companion.navigation.offline.NAVIGATORS``); this
+reads the log, shows progress, writes the estimate CSV and, on request, a plot.
+"""
+
+from __future__ import annotations
+
+import gc
+import math
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from companion.messages import GpsFix, Message, NavFlags, NavState
+from companion.navigation.estimate_csv import EstimateWriter
+from companion.navigation.offline import NAVIGATORS, run_navigator, true_headings
+from companion.sensors.sensorlog import LogStats, read_sensor_log
+
+PROGRESS_ROWS = 2000
+# A gap between fixes counts as an outage beyond this: twice the period of the slowest
+# GPS receivers logged (1 Hz), so ordinary jitter is never one.
+OUTAGE_MIN_S = 2.0
+_POSITION_VALID = int(NavFlags.POSITION_VALID)
+
+
+@dataclass
+class ReplaySummary:
+    """What a replay did and found."""
+
+    log: Path
+    navigator: str
+    rows: int = 0
+    bad_rows: int = 0
+    estimates: int = 0
+    log_seconds: float = 0.0
+    wall_seconds: float = 0.0
+    gps_rejected: int = 0
+    heading_rejected: int = 0
+    longest_outage_s: float = 0.0  # longest gap between fixes, outage or not
+    outages: int = 0  # gaps longer than OUTAGE_MIN_S
+    outage_total_s: float = 0.0
+    final_pos_std_m: float = math.nan  # horizontal 1-sigma
+    final_alt_std_m: float = math.nan
+    final_vel_std_m_s: float = math.nan
+    final_tilt_std_deg: float = math.nan  # the larger of roll and pitch
+    final_yaw_std_deg: float = math.nan
+    flagged: dict[str, int] = field(default_factory=dict)
+
+    @property
+    def speed(self) -> float:
+        """Log time per wall time."""
+        return self.log_seconds / self.wall_seconds if self.wall_seconds else math.inf
+
+
+def count_rows(path: Path) -> int:
+    """Data rows in a CSV file (for the progress bar)."""
+    with path.open("rb") as handle:
+        return max(
+            0, sum(chunk.count(b"\n") for chunk in iter(lambda: handle.read(1 << 20), b"")) - 1
+        )
+
+
+def _watch_gps(
+    samples: Iterator[Message], summary: ReplaySummary, fixes: list[GpsFix] | None
+) -> Iterator[Message]:
+    """Pass samples through, measuring the longest gap between GPS fixes (and keeping them)."""
+    last: int | None = None
+    for sample in samples:
+        if isinstance(sample, GpsFix) and sample.fix_type >= 2:
+            if fixes is not None:
+                fixes.append(sample)
+            if last is not None:
+                gap = (sample.t_us - last) / 1e6
+                summary.longest_outage_s = max(summary.longest_outage_s, gap)
+                if gap > OUTAGE_MIN_S:
+                    summary.outages += 1
+                    summary.outage_total_s += gap
+            last = sample.t_us
+        yield sample
+
+
+def replay_log(
+    log: Path,
+    navigator: str,
+    out: Path,
+    rate_hz: float = 50.0,
+    declination_deg: float = 0.0,
+    progress: Callable[[int], None] | None = None,
+    fixes: list[GpsFix] | None = None,
+) -> tuple[ReplaySummary, list[NavState]]:
+    """Run the navigator over the log; write the estimate; return a summary and the states."""
+    summary = ReplaySummary(log, navigator)
+    stats = LogStats()
+    nav = NAVIGATORS[navigator](declination_deg)
+    samples = _watch_gps(
+        true_headings(read_sensor_log(log, stats), declination_deg), summary, fixes
+    )
+    writer = EstimateWriter(out)
+    states: list[NavState] = []
+    started = time.perf_counter()
+    # The loop makes hundreds of thousands of short-lived objects and no cycles: the
+    # cyclic collector would only rescan the growing list of states (a quarter of the time).
+    gc_was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        for state in run_navigator(nav, samples, rate_hz):
+            states.append(state)
+            if state.flags & _POSITION_VALID:
+                writer.add(state.t_us / 1e6, state.roll_rad, state.pitch_rad, state.yaw_rad,
+                           state.lat_deg, state.lon_deg, state.alt_msl_m,
+                           state.vn_m_s, state.ve_m_s, state.vd_m_s)  # fmt: skip
+            if progress is not None and stats.rows - summary.rows >= PROGRESS_ROWS:
+                progress(stats.rows - summary.rows)
+                summary.rows = stats.rows
+    finally:
+        if gc_was_enabled:
+            gc.enable()
+        writer.close()
+    if progress is not None:
+        progress(stats.rows - summary.rows)
+    summary.wall_seconds = time.perf_counter() - started
+    _summarise(summary, stats, writer.rows, states)
+    return summary, states
+
+
+def _summarise(summary: ReplaySummary, stats: LogStats, rows: int, states: list[NavState]) -> None:
+    summary.rows, summary.bad_rows, summary.estimates = stats.rows, stats.bad, rows
+    if not states:
+        return
+    end = states[-1]
+    summary.log_seconds = (end.t_us - states[0].t_us) / 1e6
+    summary.gps_rejected, summary.heading_rejected = end.gps_rejected, end.heading_rejected
+    summary.final_pos_std_m = math.hypot(end.pos_std_m[0], end.pos_std_m[1])
+    summary.final_alt_std_m = end.pos_std_m[2]
+    summary.final_vel_std_m_s = math.hypot(*end.vel_std_m_s)
+    # A navigator that does not estimate its attitude's uncertainty leaves it at zero,
+    # which no filter's sigma ever is: unknown, not perfect.
+    if any(end.att_std_rad):
+        summary.final_tilt_std_deg = math.degrees(max(end.att_std_rad[0], end.att_std_rad[1]))
+        summary.final_yaw_std_deg = math.degrees(end.att_std_rad[2])
+    for flag in (NavFlags.DEAD_RECKONING, NavFlags.GPS_REJECTED, NavFlags.ALIGNING):
+        bit = int(flag)
+        summary.flagged[str(flag.name)] = sum(1 for s in states if s.flags & bit)

@@ -1,0 +1,145 @@
+"""What the emulated sensors get wrong: noise, bias drift, GPS error, the Earth's field.
+
+All randomness comes from one seeded numpy Generator, so a seed gives the same errors.
+``scale`` multiplies every noise and bias (0: perfect sensors).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from companion.navigation.rotations import tilt_compensated_heading
+from ground.simulation.true_state import TrueState
+
+EARTH_RADIUS_M = 6378137.0
+
+
+@dataclass(frozen=True)
+class NoiseModel:
+    """1-σ figures of a VN-100-class IMU, an OS-3000 and a consumer GPS."""
+
+    scale: float = 1.0
+    accel_noise_m_s2: float = 0.03
+    accel_bias_m_s2: float = 0.05  # turn-on bias
+    accel_walk_m_s2_rt_s: float = 0.0005
+    gyro_noise_rad_s: float = 0.003
+    gyro_bias_rad_s: float = 0.003
+    gyro_walk_rad_s_rt_s: float = 2e-5
+    mag_noise_gauss: float = 0.002
+    baro_noise_pa: float = 3.0  # about 0.25 m of height
+    compass_heading_deg: float = 0.5
+    compass_tilt_deg: float = 0.2
+    gps_horizontal_m: float = 1.0  # slowly wandering error (Gauss-Markov), per axis
+    gps_vertical_m: float = 2.0
+    gps_correlation_s: float = 60.0
+    gps_white_m: float = 0.3
+    gps_velocity_m_s: float = 0.1
+
+
+@dataclass(frozen=True)
+class MagneticField:
+    """A uniform field (near enough over a flight); defaults: Melbourne, 2026."""
+
+    declination_deg: float = 11.7
+    inclination_deg: float = -68.9
+    intensity_gauss: float = 0.583
+
+    def ned(self) -> np.ndarray:
+        """The field vector in NED, gauss."""
+        d, i = math.radians(self.declination_deg), math.radians(self.inclination_deg)
+        return self.intensity_gauss * np.array(
+            [math.cos(i) * math.cos(d), math.cos(i) * math.sin(d), math.sin(i)]
+        )
+
+
+def body_from_ned(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """Rotation taking NED vectors into body FRD (ZYX Euler angles)."""
+    cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    return np.array(
+        [
+            [cp * cy, cp * sy, -sp],
+            [sr * sp * cy - cr * sy, sr * sp * sy + cr * cy, sr * cp],
+            [cr * sp * cy + sr * sy, cr * sp * sy - sr * cy, cr * cp],
+        ]
+    )
+
+
+@dataclass
+class ImuSample:
+    """What the IMU measures: specific force, rate and field, body FRD."""
+
+    accel: np.ndarray
+    gyro: np.ndarray
+    mag: np.ndarray
+    temp_c: float
+    pressure_kpa: float
+
+
+class SensorErrors:
+    """The sensors' error processes, advanced in simulation time."""
+
+    def __init__(self, model: NoiseModel, field: MagneticField, seed: int) -> None:
+        self.m, self.field = model, field
+        self.rng = np.random.default_rng(seed)
+        k = model.scale
+        self.accel_bias = self.rng.normal(0.0, model.accel_bias_m_s2 * k, 3)
+        self.gyro_bias = self.rng.normal(0.0, model.gyro_bias_rad_s * k, 3)
+        self.gps_error = self.rng.normal(0.0, 1.0, 3) * self._gps_sigma()
+        self.field_ned = field.ned()
+
+    def _gps_sigma(self) -> np.ndarray:
+        k = self.m.scale
+        return (
+            np.array([self.m.gps_horizontal_m, self.m.gps_horizontal_m, self.m.gps_vertical_m]) * k
+        )
+
+    def imu(self, s: TrueState, dt: float, pressure_kpa: float) -> ImuSample:
+        """One IMU sample; the biases walk by ``dt`` seconds first."""
+        m = self.m
+        root = math.sqrt(max(dt, 0.0))
+        # One draw for all sixteen: the IMU runs at 100 Hz and more.
+        z = self.rng.standard_normal(16) * m.scale
+        self.accel_bias += z[0:3] * (m.accel_walk_m_s2_rt_s * root)
+        self.gyro_bias += z[3:6] * (m.gyro_walk_rad_s_rt_s * root)
+        accel = np.array(s.f_body) + self.accel_bias + z[6:9] * m.accel_noise_m_s2
+        gyro = np.array((s.p, s.q, s.r)) + self.gyro_bias + z[9:12] * m.gyro_noise_rad_s
+        mag = body_from_ned(s.roll, s.pitch, s.yaw) @ self.field_ned
+        mag = mag + z[12:15] * m.mag_noise_gauss
+        pressure_kpa += z[15] * m.baro_noise_pa / 1000.0
+        return ImuSample(accel, gyro, mag, 25.0, pressure_kpa)
+
+    def compass(self, s: TrueState) -> tuple[float, float, float]:
+        """(magnetic heading [0, 360), pitch, roll) in degrees, as an OS-3000 reports them.
+
+        Like the real part, it levels itself with its accelerometer: in a turn or while
+        accelerating the specific force is not vertical, so pitch and roll are wrong
+        (a coordinated turn reads wings level) and the tilt-compensated heading with them.
+        """
+        k, rng = self.m.scale, self.rng
+        fx, fy, fz = s.f_body
+        roll = math.atan2(-fy, -fz) + math.radians(rng.normal(0.0, self.m.compass_tilt_deg * k))
+        pitch = math.atan2(fx, math.hypot(fy, fz))
+        pitch += math.radians(rng.normal(0.0, self.m.compass_tilt_deg * k))
+        mag = body_from_ned(s.roll, s.pitch, s.yaw) @ self.field_ned
+        heading = math.degrees(tilt_compensated_heading(mag, roll, pitch))
+        heading += rng.normal(0.0, self.m.compass_heading_deg * k)
+        return heading % 360.0, math.degrees(pitch), math.degrees(roll)
+
+    def gps(self, s: TrueState, dt: float) -> tuple[float, float, float, np.ndarray]:
+        """(lat, lon, alt MSL, NED velocity) with the receiver's error; error evolves by dt."""
+        m, rng = self.m, self.rng
+        a = math.exp(-dt / m.gps_correlation_s) if m.gps_correlation_s > 0 else 0.0
+        self.gps_error = (
+            a * self.gps_error + math.sqrt(1 - a * a) * rng.normal(0.0, 1.0, 3) * self._gps_sigma()
+        )
+        err = self.gps_error + rng.normal(0.0, m.gps_white_m * m.scale, 3)
+        lat = s.lat_deg + math.degrees(err[0] / EARTH_RADIUS_M)
+        lon = s.lon_deg + math.degrees(
+            err[1] / (EARTH_RADIUS_M * math.cos(math.radians(s.lat_deg)))
+        )
+        vel = np.array([s.vn, s.ve, s.vd]) + rng.normal(0.0, m.gps_velocity_m_s * m.scale, 3)
+        return lat, lon, s.alt_msl_m - err[2], vel

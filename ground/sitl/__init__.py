@@ -1,0 +1,1 @@
+"""The vehicle flying in JSBSim: the simulator bridge, one vehicle session, fleets."""

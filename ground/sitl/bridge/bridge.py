@@ -1,0 +1,207 @@
+"""The simulator bridge's loop: physics, device bytes, servo bytes, the clock, pacing."""
+
+from __future__ import annotations
+
+import heapq
+import logging
+import math
+import time
+from collections.abc import Callable
+
+from companion.actuators.airframe import load_airframe
+from companion.actuators.minissc import FrameDecoder
+from companion.bus.node import BusNode
+from companion.messages import SimClock, SimTruth
+from ground.simulation.sensor_errors import MagneticField, NoiseModel, SensorErrors
+from ground.simulation.true_state import TrueState
+from ground.sitl.bridge.device_streams import EmulatedDevices
+from ground.sitl.bridge.failures import DeviceFailures
+from ground.sitl.bridge.fdm import Flight
+from ground.sitl.bridge.lockstep import (
+    EXACT_STALL_S,
+    STALL_S,
+    FlightSync,
+    Lockstep,
+    RealTime,
+    SampleSync,
+)
+from ground.sitl.bridge.options import BridgeOptions
+from ground.sitl.bridge.ptys import PtyPort
+from ground.sitl.bridge.truth_log import TruthLog
+from ground.sitl.bridge.vehicle_commands import VehicleCommands
+
+log = logging.getLogger(__name__)
+
+SENSORS = ("gps", "compass", "imu")
+# What the vehicle's driver of each emulated device publishes (the sim config's drivers).
+DEVICE_CHANNELS = {
+    "imu": ("sensors/imu", "sensors/mag", "sensors/baro"),
+    "compass": ("sensors/compass",),
+    "gps": ("sensors/gps",),
+}
+STANDARD_PRESSURE_KPA = 101.325
+
+
+def pressure_kpa(alt_msl_m: float) -> float:
+    """ISA pressure at an altitude (troposphere)."""
+    return STANDARD_PRESSURE_KPA * (1.0 - 2.25577e-5 * alt_msl_m) ** 5.25588
+
+
+class SimBridge:
+    """One simulated aircraft with its devices on ptys."""
+
+    def __init__(self, opts: BridgeOptions) -> None:
+        self.opts = opts
+        self.airframe = load_airframe(opts.airframe)
+        self.flight = Flight(
+            self.airframe.jsbsim_model,
+            opts.physics_hz,
+            opts.home,
+            opts.airborne_agl_m if opts.airborne else None,
+            opts.airborne_speed_m_s or self.airframe.cruise_speed_m_s,
+        )
+        self.flight.set_wind(*opts.wind_ned)
+        self.flight.set_turbulence(opts.turbulence)
+        errors = SensorErrors(NoiseModel(scale=opts.noise_scale), MagneticField(), opts.seed)
+        self.devices = EmulatedDevices(errors, opts.rates, opts.outages)
+        self.failures = DeviceFailures(opts.seed)
+        self.ports = {name: PtyPort(name) for name in (*SENSORS, "servos")}
+        self.pending: list[tuple[float, int, str, bytes]] = []  # (release, order, port, data)
+        self.order = 0
+        self.servo_decoder = FrameDecoder()
+        self.by_servo = {c.servo: c for c in self.airframe.channels}
+        self.pacer = RealTime(opts.speed) if opts.speed else None
+        exact = self.pacer is None and opts.sync_hz > 0
+        stall_s = EXACT_STALL_S if exact else STALL_S
+        self.lockstep = Lockstep([self.ports[n] for n in SENSORS], stall_s)
+        self.truth = TruthLog(opts.truth_path) if opts.truth_path else None
+        self.bus = BusNode(opts.namespace, "sim_bridge")
+        self.clock = self.bus.writer("sim/clock")
+        self.truth_out = self.bus.writer("sim/truth")
+        self.sync: FlightSync | None = None
+        self.samples: SampleSync | None = None
+        if exact:
+            period_us = round(1e6 / opts.sync_hz)
+            answers = self.bus.latest_reader("actuators/servos")
+            self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]))
+            readers = {
+                device: {c: self.bus.queue_reader(c) for c in channels}
+                for device, channels in DEVICE_CHANNELS.items()
+            }
+            every = [r for by_channel in readers.values() for r in by_channel.values()]
+            self.samples = SampleSync(readers, self.bus.waiter(every))
+        self.commands = VehicleCommands(self.bus, self.failures, self.sync, opts.start_at_s)
+        self.frames = 0
+        self.stopping = False
+        self.clock.publish(SimClock(t_us=0, frame=0))
+
+    def device_paths(self) -> dict[str, str]:
+        """Device name → the pty path the vehicle's driver opens."""
+        return {name: port.path for name, port in self.ports.items()}
+
+    def run(self, hold: Callable[[], None] | None = None) -> None:
+        """Fly until ``duration_s`` of simulation time or ``stop()``."""
+        if hold is not None:
+            hold()
+        started = time.monotonic()
+        end = self.opts.duration_s
+        while not self.stopping and (end is None or self.flight.t_s < end - 1e-9):
+            self.step()
+        wall = time.monotonic() - started
+        sync = self.sync
+        log.info(
+            "simulated %.1f s in %.1f s wall (%.1fx); lockstep stalls %d; control stalls %s",
+            self.flight.t_s,
+            wall,
+            self.flight.t_s / wall if wall else 0.0,
+            self.lockstep.stalls,
+            "-" if sync is None else self._exact_summary(),
+        )
+
+    def _exact_summary(self) -> str:
+        sync, samples = self.sync, self.samples
+        assert sync is not None and samples is not None
+        return (
+            f"{sync.stalls} (waited {sync.wait_s:.1f} s); late samples {samples.late}"
+            f" (waited {samples.wait_s:.1f} s)"
+        )
+
+    def stop(self) -> None:
+        """Ask the loop to end after the current frame (also ends any wait for the vehicle)."""
+        self.stopping = True
+        for waiting in (self.sync, self.samples):
+            if waiting is not None:
+                waiting.cancelled = True
+
+    def step(self) -> None:
+        """One physics frame, then what the devices say about it, then pacing."""
+        self.flight.step()
+        self.frames += 1
+        s = self.flight.state()
+        if not all(math.isfinite(v) for v in (s.lat_deg, s.lon_deg, s.alt_msl_m, s.vn, s.vd)):
+            log.error("JSBSim's flight model diverged at %.2f s: stopping the simulation", s.t_s)
+            self.stopping = True
+            return
+        t_us = round(s.t_s * 1e6)
+        self.clock.publish(SimClock(t_us=t_us, frame=self.frames))
+        self._publish_truth(s, t_us)
+        for name, release, measured in self.devices.due(s, pressure_kpa(s.alt_msl_m)):
+            data = self.failures.filter(name, measured)
+            if data is None:
+                continue
+            heapq.heappush(self.pending, (release, self.order, name, data))
+            self.order += 1
+        written = set()
+        while self.pending and self.pending[0][0] <= s.t_s + 1e-9:
+            _, _, name, data = heapq.heappop(self.pending)
+            self.ports[name].write(data)
+            written.add(name)
+        if self.samples is not None:  # sleeps on the bus: the pty check after is quick
+            self.samples.wait(written - self.failures.garbled(), t_us)
+        if self.pacer is not None:
+            self.pacer.wait(s.t_s)
+        else:
+            self.lockstep.wait()
+        self.commands.serve(t_us)
+        if self.sync is not None:
+            self.sync.wait(t_us)
+        self._apply_servos()
+
+    def _publish_truth(self, s: TrueState, t_us: int) -> None:
+        if self.truth is not None:
+            self.truth.add_state(s)
+        self.truth_out.publish(
+            SimTruth(
+                t_us,
+                s.roll,
+                s.pitch,
+                s.yaw,
+                s.lat_deg,
+                s.lon_deg,
+                s.alt_msl_m,
+                s.alt_agl_m,
+                s.vn,
+                s.ve,
+                s.vd,
+                s.airspeed_m_s,
+            )
+        )
+
+    def _apply_servos(self) -> None:
+        frames = self.servo_decoder.feed(self.ports["servos"].read())
+        if not frames:
+            return
+        controls = {}
+        for servo, position in frames:
+            channel = self.by_servo.get(servo)
+            if channel is not None:
+                controls[channel.surface] = channel.command(position)
+        self.flight.set_controls(controls)
+
+    def close(self) -> None:
+        """Release the ptys, the truth file and the bus."""
+        if self.truth is not None:
+            self.truth.close()
+        for port in self.ports.values():
+            port.close()
+        self.bus.close()

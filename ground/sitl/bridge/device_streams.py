@@ -1,0 +1,152 @@
+"""The emulated devices' bytes: NMEA GPS, the OS-3000 ``$C`` sentence, VectorNav ``$VNIMU``.
+
+Each device turns the true state (through ``SensorErrors``) into the exact text the real
+part sends, at its own rate; NMEA is rendered by pynmea2.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+from dataclasses import dataclass
+
+import pynmea2
+
+from companion.sensors.ascii_sentence import xor8
+from ground.simulation.sensor_errors import ImuSample, SensorErrors
+from ground.simulation.true_state import TrueState
+
+KNOT_M_S = 0.514444
+_VNIMU_FORMAT = "VNIMU," + ",".join(["%+.4f"] * 9) + ",%+.1f,%+.3f"
+UTC_EPOCH = dt.datetime(2026, 1, 1, tzinfo=dt.UTC)  # simulation time 0
+
+
+def _ddmm(value: float, positive: str, negative: str, width: int) -> tuple[str, str]:
+    hemi = positive if value >= 0 else negative
+    value = abs(value)
+    degrees = int(value)
+    return f"{degrees:0{width}d}{(value - degrees) * 60:09.6f}", hemi
+
+
+def nmea_epoch(
+    t_s: float, lat: float, lon: float, alt_msl: float, vn: float, ve: float, fix: bool
+) -> bytes:
+    """One receiver epoch: GGA then RMC, CR LF terminated."""
+    utc = UTC_EPOCH + dt.timedelta(seconds=t_s)
+    hhmmss = utc.strftime("%H%M%S.") + f"{utc.microsecond // 10000:02d}"
+    date = utc.strftime("%d%m%y")
+    la, ns = _ddmm(lat, "N", "S", 2) if fix else ("", "")
+    lo, ew = _ddmm(lon, "E", "W", 3) if fix else ("", "")
+    speed_kn = math.hypot(vn, ve) / KNOT_M_S
+    course = math.degrees(math.atan2(ve, vn)) % 360.0
+    gga = pynmea2.GGA(
+        "GP",
+        "GGA",
+        (
+            hhmmss,
+            la,
+            ns,
+            lo,
+            ew,
+            "1" if fix else "0",
+            "09" if fix else "00",
+            "0.9" if fix else "",
+            f"{alt_msl:.1f}" if fix else "",
+            "M",
+            "0.0",
+            "M",
+            "",
+            "",
+        ),
+    )
+    rmc = pynmea2.RMC(
+        "GP",
+        "RMC",
+        (
+            hhmmss,
+            "A" if fix else "V",
+            la,
+            ns,
+            lo,
+            ew,
+            f"{speed_kn:.2f}" if fix else "",
+            f"{course:.1f}" if fix else "",
+            date,
+            "",
+            "",
+            "A",
+        ),
+    )
+    return f"{gga}\r\n{rmc}\r\n".encode()
+
+
+def checked(body: str) -> bytes:
+    """``$body*hh`` CR LF with the XOR checksum NMEA, the OS-3000 and VectorNav all use."""
+    return f"${body}*{xor8(body):02X}\r\n".encode()
+
+
+def os3000_sentence(heading: float, pitch: float, roll: float, temp_c: float) -> bytes:
+    """The compass's default ``$C`` sentence (heading, pitch, roll, temperature)."""
+    heading = round(heading, 1) % 360.0  # 359.96 reads 0.0, as the compass shows it
+    return checked(f"C{heading:.1f}P{pitch:.1f}R{roll:.1f}T{temp_c:.1f}")
+
+
+def vnimu_sentence(s: ImuSample) -> bytes:
+    """``$VNIMU``: mag (gauss), accel (m/s²), gyro (rad/s), temperature, pressure (kPa)."""
+    text = _VNIMU_FORMAT % (*s.mag, *s.accel, *s.gyro, s.temp_c, s.pressure_kpa)
+    return checked(text)
+
+
+@dataclass
+class Outage:
+    """A window of simulation time with no GPS fix."""
+
+    start_s: float
+    duration_s: float
+
+    def covers(self, t_s: float) -> bool:
+        """Whether ``t_s`` falls in the window."""
+        return self.start_s <= t_s < self.start_s + self.duration_s
+
+
+@dataclass
+class DeviceRates:
+    """How often each device talks, and the GPS's latency."""
+
+    imu_hz: float = 100.0
+    compass_hz: float = 20.0
+    gps_hz: float = 5.0
+    gps_latency_s: float = 0.1
+
+
+class EmulatedDevices:
+    """Decides, frame by frame, which device says what and when it reaches the wire."""
+
+    def __init__(self, errors: SensorErrors, rates: DeviceRates, outages: list[Outage]) -> None:
+        self.errors, self.rates, self.outages = errors, rates, outages
+        self.next_s = {"imu": 0.0, "compass": 0.0, "gps": 0.0}
+        self.last_imu_s = 0.0
+        self.last_gps_s = 0.0
+
+    def due(self, s: TrueState, pressure_kpa: float) -> list[tuple[str, float, bytes]]:
+        """(device, release time, bytes) for everything measured at ``s.t_s``."""
+        out: list[tuple[str, float, bytes]] = []
+        t = s.t_s
+        if t + 1e-9 >= self.next_s["imu"]:
+            sample = self.errors.imu(s, t - self.last_imu_s, pressure_kpa)
+            out.append(("imu", t, vnimu_sentence(sample)))
+            self.last_imu_s = t
+            self.next_s["imu"] += 1.0 / self.rates.imu_hz
+        if t + 1e-9 >= self.next_s["compass"]:
+            out.append(("compass", t, os3000_sentence(*self.errors.compass(s), 25.0)))
+            self.next_s["compass"] += 1.0 / self.rates.compass_hz
+        if t + 1e-9 >= self.next_s["gps"]:
+            out.append(("gps", t + self.rates.gps_latency_s, self._gps(s)))
+            self.next_s["gps"] += 1.0 / self.rates.gps_hz
+        return out
+
+    def _gps(self, s: TrueState) -> bytes:
+        lat, lon, alt, vel = self.errors.gps(s, s.t_s - self.last_gps_s)
+        self.last_gps_s = s.t_s
+        fix = not any(o.covers(s.t_s) for o in self.outages)
+        return nmea_epoch(s.t_s, lat, lon, alt, vel[0], vel[1], fix)

@@ -1,0 +1,186 @@
+"""JSBSim as the bridge uses it: one aircraft, its initial conditions, wind, the true state."""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import jsbsim
+
+from ground.simulation.true_state import TrueState
+
+log = logging.getLogger(__name__)
+
+FT = 0.3048  # metres per foot
+
+# MIL-F-8785C probabilities of exceedance (JSBSim's table rows) and 20 ft wind speeds.
+TURBULENCE = {"none": (0, 0.0), "light": (2, 15.0), "moderate": (3, 30.0), "severe": (5, 45.0)}
+KT = 0.514444
+MILSPEC = 3  # atmosphere/turb-type: FGWinds::ttMilspec
+IDLE_THROTTLE = 0.05
+TURBULENCE_MIN_AGL_M = 5.0
+DROP_HEIGHT_FT = 4.0  # above the resting height of the shipped airframes' gear
+SETTLE_S = 3.0
+
+
+@dataclass(frozen=True)
+class Home:
+    """Where the aircraft starts: WGS-84 degrees, ground height above MSL, runway heading."""
+
+    lat_deg: float = -37.9105
+    lon_deg: float = 145.1340
+    ground_msl_m: float = 80.0
+    heading_deg: float = 90.0
+
+
+class Flight:
+    """One JSBSim aircraft stepping at a fixed rate."""
+
+    def __init__(
+        self,
+        model: str,
+        rate_hz: float,
+        home: Home,
+        airborne_agl_m: float | None = None,
+        speed_m_s: float = 0.0,
+    ) -> None:
+        self.fdm = jsbsim.FGFDMExec(None)
+        self.fdm.set_debug_level(0)
+        if not self.fdm.load_model(model):
+            raise ValueError(f"JSBSim has no aircraft {model!r}")
+        self.fdm.set_dt(1.0 / rate_hz)
+        self.home = home
+        self.turbulence = False
+        self._initial_conditions(model, airborne_agl_m, speed_m_s)
+
+    def _initial_conditions(
+        self, model: str, airborne_agl_m: float | None, speed_m_s: float
+    ) -> None:
+        f, h = self.fdm, self.home
+        f["ic/lat-geod-deg"] = h.lat_deg
+        f["ic/long-gc-deg"] = h.lon_deg
+        f["ic/terrain-elevation-ft"] = h.ground_msl_m / FT
+        f["ic/psi-true-deg"] = h.heading_deg
+        f["ic/h-agl-ft"] = (airborne_agl_m or 0.0) / FT
+        f["ic/vc-kts"] = speed_m_s / KT if airborne_agl_m else 0.0
+        if not airborne_agl_m:
+            self._rest_on_gear()
+        elif not f.run_ic():
+            raise RuntimeError("JSBSim refused the initial conditions")
+        f["propulsion/set-running"] = -1  # engines running, as if started on the ground
+        f["fcs/mixture-cmd-norm"] = 1.0
+        if airborne_agl_m:
+            try:
+                f["simulation/do_simple_trim"] = 1  # steady level flight at the given speed
+            except jsbsim.TrimFailureError:
+                log.warning("%s cannot trim at %.1f m/s: starting untrimmed", model, speed_m_s)
+        else:
+            self.set_controls({"throttle": 0.0})
+
+    def _rest_on_gear(self) -> None:
+        """Start at the height and pitch the aircraft rests at on its wheels.
+
+        Placed with its centre of gravity on the ground, JSBSim's gear springs throw the
+        aircraft up and it lands on its nose; dropped from a little height it settles. So
+        it is dropped once, and started again where it came to rest, at time zero.
+        """
+        f = self.fdm
+        f["ic/h-agl-ft"] = DROP_HEIGHT_FT
+        if not f.run_ic():
+            raise RuntimeError("JSBSim refused the initial conditions")
+        for _ in range(round(SETTLE_S / f.get_delta_t())):
+            f.run()
+        rest_agl_ft, rest_pitch_deg = f["position/h-agl-ft"], f["attitude/theta-deg"]
+        h = self.home
+        f["ic/lat-geod-deg"], f["ic/long-gc-deg"] = h.lat_deg, h.lon_deg
+        f["ic/psi-true-deg"] = h.heading_deg
+        f["ic/h-agl-ft"], f["ic/theta-deg"] = rest_agl_ft, rest_pitch_deg
+        if not f.run_ic():
+            raise RuntimeError("JSBSim refused the initial conditions")
+        f.set_sim_time(0.0)
+
+    def set_wind(self, north: float, east: float, down: float) -> None:
+        """Steady wind, m/s, the direction it blows towards."""
+        self.fdm["atmosphere/wind-north-fps"] = north / FT
+        self.fdm["atmosphere/wind-east-fps"] = east / FT
+        self.fdm["atmosphere/wind-down-fps"] = down / FT
+
+    def set_turbulence(self, level: str) -> None:
+        """MIL-F-8785C turbulence: none, light, moderate or severe."""
+        severity, wind_kt = TURBULENCE[level]
+        self.turbulence = severity > 0
+        if severity == 0:
+            self.fdm["atmosphere/turb-type"] = 0
+            return
+        self.fdm["atmosphere/turb-type"] = MILSPEC if self._above_ground() else 0
+        self.fdm["atmosphere/turbulence/milspec/severity"] = severity
+        self.fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = wind_kt * KT / FT
+
+    def set_controls(self, controls: dict[str, float]) -> None:
+        """Normalised commands (stick convention: elevator + is nose up) onto JSBSim's FCS."""
+        f = self.fdm
+        for surface, value in controls.items():
+            if surface == "aileron":
+                f["fcs/aileron-cmd-norm"] = value
+            elif surface == "elevator":
+                f["fcs/elevator-cmd-norm"] = -value  # JSBSim: + is stick forward, nose down
+            elif surface == "rudder":
+                f["fcs/rudder-cmd-norm"] = -value  # JSBSim: + yaws left
+            elif surface == "throttle":
+                f["fcs/throttle-cmd-norm"] = value
+                # A pilot holds the brakes at idle; the servo card has no brake channel.
+                brake = 1.0 if value < IDLE_THROTTLE else 0.0
+                f["fcs/left-brake-cmd-norm"] = f["fcs/right-brake-cmd-norm"] = brake
+            elif surface == "flaps":
+                f["fcs/flap-cmd-norm"] = max(0.0, value)
+
+    def controls(self) -> dict[str, float]:
+        """The commands JSBSim holds now, in the stick convention."""
+        f = self.fdm
+        return {
+            "aileron": f["fcs/aileron-cmd-norm"],
+            "elevator": -f["fcs/elevator-cmd-norm"],
+            "rudder": -f["fcs/rudder-cmd-norm"],
+            "throttle": f["fcs/throttle-cmd-norm"],
+        }
+
+    def _above_ground(self) -> bool:
+        return float(self.fdm["position/h-agl-ft"]) * FT > TURBULENCE_MIN_AGL_M
+
+    def step(self) -> None:
+        """Advance one frame."""
+        if self.turbulence:
+            # JSBSim's MIL-F-8785C scale lengths shrink with height; on the runway they
+            # give gusts that throw a parked Cub into the air and the model into NaNs.
+            self.fdm["atmosphere/turb-type"] = MILSPEC if self._above_ground() else 0
+        self.fdm.run()
+
+    @property
+    def t_s(self) -> float:
+        """Simulation time, seconds."""
+        return float(self.fdm["simulation/sim-time-sec"])
+
+    def state(self) -> TrueState:
+        """The true state now."""
+        f = self.fdm
+        mass = f["inertia/mass-slugs"]
+        yaw = math.remainder(f["attitude/psi-rad"], math.tau)
+        return TrueState(
+            t_s=self.t_s,
+            lat_deg=f["position/lat-geod-deg"],
+            lon_deg=f["position/long-gc-deg"],
+            alt_msl_m=f["position/h-sl-ft"] * FT,
+            alt_agl_m=f["position/h-agl-ft"] * FT,
+            roll=f["attitude/phi-rad"],
+            pitch=f["attitude/theta-rad"],
+            yaw=yaw,
+            vn=f["velocities/v-north-fps"] * FT,
+            ve=f["velocities/v-east-fps"] * FT,
+            vd=f["velocities/v-down-fps"] * FT,
+            p=f["velocities/p-rad_sec"],
+            q=f["velocities/q-rad_sec"],
+            r=f["velocities/r-rad_sec"],
+            f_body=tuple(f[f"forces/fb{a}-total-lbs"] / mass * FT for a in "xyz"),
+            airspeed_m_s=f["velocities/vtrue-fps"] * FT,
+        )

@@ -1,0 +1,210 @@
+"""Pacing: lockstep (wait until the drivers have read every byte and the control loop has
+answered) or a real-time factor."""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from ground.sitl.bridge.ptys import PtyPort
+
+if TYPE_CHECKING:
+    from companion.bus.channels import LatestReader, Reader
+    from companion.bus.node import Waiter
+    from companion.messages import ServoOutput
+
+log = logging.getLogger(__name__)
+
+STALL_S = 0.5  # a driver that reads nothing for this long is not waited for
+EXACT_STALL_S = 10.0  # the same, when every frame must be the same run after run
+EVENT_WAIT_S = 0.05  # exact: longest sleep on a bus event before looking again
+SAMPLE_GRACE_S = 2.0  # exact: a driver's sample is waited for this long after its bytes
+FIRST_SAMPLE_GRACE_S = 0.3  # ... and this long on a channel that has carried nothing yet
+SPIN_POLLS = 50  # polls that only yield the CPU before sleeping between polls
+POLL_SLEEP_S = 50e-6
+START_FLIGHT_S = 20.0  # the flight plug-ins' start-up after START, at most
+STALL_FLIGHT_S = 5.0  # a running flight plug-in that stops answering is waited for this long
+
+
+class Lockstep:
+    """Waits, each frame, until every sensor line is drained by its driver.
+
+    A driver that stops reading (it crashed, or is restarting) stalls one frame for at most
+    ``stall_s`` (a loaded machine can starve a healthy driver for a while, so exact runs
+    wait much longer); its line is then left out until the driver drains it again, so one dead
+    driver slows the simulation down once instead of on every frame.
+    """
+
+    def __init__(self, ports: list[PtyPort], stall_s: float = STALL_S) -> None:
+        self.ports = ports
+        self.stall_s = stall_s
+        self.waiting_for = {p.name: True for p in ports}
+        self.stalls = 0
+        self.wait_s = 0.0
+
+    def wait(self) -> None:
+        """Return when the drivers have read what they were sent (or one stalled)."""
+        started = time.perf_counter()
+        polls = 0
+        for port in self.ports:
+            if not self.waiting_for[port.name]:
+                self.waiting_for[port.name] = port.unread() == 0
+        pending = [p for p in self.ports if self.waiting_for[p.name]]
+        while pending:
+            pending = [p for p in pending if p.unread() > 0]
+            if not pending:
+                break
+            if time.perf_counter() - started > self.stall_s:
+                for port in pending:
+                    log.warning("lockstep: %s driver is not reading; not waiting for it", port.name)
+                    self.waiting_for[port.name] = False
+                self.stalls += 1
+                break
+            polls += 1
+            time.sleep(0 if polls < SPIN_POLLS else POLL_SLEEP_S)
+        self.wait_s += time.perf_counter() - started
+
+
+class RealTime:
+    """Keeps simulation time at ``speed`` times wall time."""
+
+    def __init__(self, speed: float) -> None:
+        self.speed = speed
+        self.start_wall: float | None = None
+        self.late_s = 0.0  # the most the simulation has fallen behind
+
+    def wait(self, t_s: float) -> None:
+        """Sleep until wall time catches up with simulation time ``t_s``."""
+        now = time.monotonic()
+        if self.start_wall is None:
+            self.start_wall = now - t_s / self.speed
+        delay = self.start_wall + t_s / self.speed - now
+        if delay > 0:
+            time.sleep(delay)
+        else:
+            self.late_s = max(self.late_s, -delay)
+
+
+class _BusWait:
+    """Sleeps on bus events until a condition holds, the simulation ends, or time is up."""
+
+    def __init__(self, waiter: Waiter) -> None:
+        self.waiter = waiter
+        self.wait_s = 0.0
+        self.cancelled = False  # the simulation is ending: wait for nothing more
+
+    def _until(self, done: Callable[[], bool], limit_s: float) -> bool:
+        """True once ``done()`` (or cancelled); False when ``limit_s`` passed first."""
+        started = time.perf_counter()
+        try:
+            while not done():
+                if self.cancelled:
+                    return True
+                waited = time.perf_counter() - started
+                if waited > limit_s:
+                    return False
+                self.waiter.wait(min(limit_s - waited, EVENT_WAIT_S))
+            return True
+        finally:
+            self.wait_s += time.perf_counter() - started
+
+
+class FlightSync(_BusWait):
+    """Lockstep with the control loop, so the same seed flies the same flight.
+
+    The vehicle's navigator publishes on a fixed grid of vehicle time (``period_us``), the
+    controller answers each state, and the servo plug-in says which command its bytes
+    answer (``ServoOutput.command_t_us``). At each grid instant the bridge waits for that
+    answer before it reads the servo line, so every command is applied at the same frame
+    whatever the scheduler did. Only while the flight plug-ins run (from the START ack to
+    STOP); a flight plug-in that does not answer is waited for ``stall_s`` once, then not
+    until it catches up again.
+    """
+
+    def __init__(self, period_us: int, answers: LatestReader[ServoOutput], waiter: Waiter) -> None:
+        super().__init__(waiter)
+        self.period_us = period_us
+        self.answers = answers
+        self.flying = False  # the flight plug-ins were started
+        self.synced = False  # they have answered in step since
+        self.lagging = False  # they stopped answering: not waited for until they catch up
+        self.answered_us = -1
+        self.stalls = 0
+
+    def started(self, flying: bool) -> None:
+        """START acknowledged (True) or STOP seen (False)."""
+        self.flying, self.synced, self.lagging = flying, False, False
+
+    def wait(self, t_us: int) -> None:
+        """Return once the answer to the newest grid state at or before ``t_us`` is in."""
+        if not self.flying:
+            return
+        grid = t_us // self.period_us * self.period_us
+        if self._answered(grid) or self.lagging:
+            return
+        limit = STALL_FLIGHT_S if self.synced else START_FLIGHT_S
+        if not self._until(lambda: self._answered(grid), limit):
+            log.warning(
+                "lockstep: no servo answer to the state at %.2f s for %.0f s (newest"
+                " answer: %.2f s); not waiting for it",
+                grid / 1e6,
+                limit,
+                self.answered_us / 1e6,
+            )
+            self.lagging, self.synced = True, False
+            self.stalls += 1
+
+    def _answered(self, grid: int) -> bool:
+        answer = self.answers.get()
+        if answer is not None and answer.command_t_us > self.answered_us:
+            self.answered_us = int(answer.command_t_us)
+        if self.answered_us < grid:
+            return False
+        self.synced, self.lagging = True, False
+        return True
+
+
+class SampleSync(_BusWait):
+    """Exact lockstep with the drivers: wait until each device's bytes became samples.
+
+    A drained pty only says the driver read the bytes; the kernel may also still hold
+    them in the pty's buffer while reporting nothing unread, and the driver may not have
+    published yet. Waiting for every sample a write produces on the bus (each channel the
+    device's driver publishes, stamped with this frame's time) closes these gaps, so no
+    driver reads two frames as one or publishes one late. A channel that has never carried
+    anything (the GPS decoder learns its epoch before its first fix) is waited for only
+    ``first_grace_s``; the others at most ``grace_s`` a frame.
+    """
+
+    def __init__(
+        self,
+        channels: dict[str, dict[str, Reader[Any]]],
+        waiter: Waiter,
+        grace_s: float = SAMPLE_GRACE_S,
+        first_grace_s: float = FIRST_SAMPLE_GRACE_S,
+    ) -> None:
+        super().__init__(waiter)
+        self.channels = channels  # device → {channel: reader}
+        self.newest_us = {c: -1 for readers in channels.values() for c in readers}
+        self.grace_s, self.first_grace_s = grace_s, first_grace_s
+        self.late = 0  # frames in which a sample did not come within grace_s
+
+    def wait(self, written: set[str], t_us: int) -> None:
+        """Return when every device written this frame has published its samples."""
+        expected = [c for dev in written for c in self.channels.get(dev, {})]
+        seen = all(self.newest_us[c] >= 0 for c in expected)
+
+        def arrived() -> bool:
+            self._take()
+            return all(self.newest_us[c] >= t_us for c in expected)
+
+        if not self._until(arrived, self.grace_s if seen else self.first_grace_s):
+            self.late += seen
+
+    def _take(self) -> None:
+        for readers in self.channels.values():
+            for channel, reader in readers.items():
+                for sample in reader.drain():
+                    self.newest_us[channel] = max(self.newest_us[channel], int(sample.t_us))

@@ -1,0 +1,56 @@
+"""Everything a simulation run can be told, in one JSON-able record."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass, field
+
+from ground.sitl.bridge.device_streams import DeviceRates, Outage
+from ground.sitl.bridge.fdm import TURBULENCE, Home
+
+
+@dataclass
+class BridgeOptions:
+    """A simulation run: aircraft, start, weather, sensors, pace."""
+
+    airframe: str = "c172p"  # airframe name or TOML path (its jsbsim_model is flown)
+    home: Home = field(default_factory=Home)
+    airborne: bool = False
+    airborne_agl_m: float = 300.0
+    airborne_speed_m_s: float | None = None  # None: the airframe's cruise speed
+    speed: float | None = None  # real-time factor; None: lockstep, as fast as consumed
+    physics_hz: float = 100.0
+    exact: bool = False  # lockstep also with the control loop (companion sim --exact)
+    start_at_s: float | None = None  # arm and start the mission at this simulated second
+    sync_hz: float = 0.0  # the vehicle's nav/state grid, for exact lockstep; 0: off
+    wind_ned: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    turbulence: str = "none"
+    outages: list[Outage] = field(default_factory=list)
+    rates: DeviceRates = field(default_factory=DeviceRates)
+    noise_scale: float = 1.0
+    seed: int = 1
+    duration_s: float | None = None
+    truth_path: str | None = None
+    namespace: str = "companion"
+    hold: bool = False  # wait for "run" on stdin before the first step
+
+    def __post_init__(self) -> None:
+        if self.turbulence not in TURBULENCE:
+            raise ValueError(f"turbulence must be one of {', '.join(TURBULENCE)}")
+        if self.speed is not None and self.speed <= 0:
+            raise ValueError("speed must be positive (or None for lockstep)")
+
+    def to_json(self) -> str:
+        """The options as one JSON line."""
+        return json.dumps(dataclasses.asdict(self))
+
+    @classmethod
+    def from_json(cls, text: str) -> BridgeOptions:
+        """Inverse of ``to_json``."""
+        data = json.loads(text)
+        data["home"] = Home(**data["home"])
+        data["rates"] = DeviceRates(**data["rates"])
+        data["outages"] = [Outage(**o) for o in data["outages"]]
+        data["wind_ned"] = tuple(data["wind_ned"])
+        return cls(**data)
