@@ -1,25 +1,32 @@
-"""The ``companion`` command: run a vehicle, fly it in simulation, look at it, check it.
+"""The ``companion`` command: run a vehicle, look at it, check it; and, with the ground
+tools installed, fly it in simulation, replay logs and run campaigns.
 
 Each command lives in its own module; importing them here, in the order ``--help`` lists
-them, registers them on ``app``.
+them, registers them on ``app``. The ground commands live in the ``ground`` package, which
+nothing on board imports: they are found through the ``companion.commands`` entry points.
 """
 
 from __future__ import annotations
 
 import importlib
+from importlib.metadata import entry_points
 
 from companion.cli.app import app
 
 __all__ = ["app", "main"]
 
-for _module in (
-    "companion.cli.vehicle",
-    "ground.cli.sim",
-    "ground.cli.replay",
-    "ground.cli.campaign",
-    "companion.cli.bridge",
-):
-    importlib.import_module(_module)
+COMMANDS_GROUP = "companion.commands"
+HELP_ORDER = ("sim", "replay", "campaign")
+
+
+def _help_rank(name: str) -> int:
+    return HELP_ORDER.index(name) if name in HELP_ORDER else len(HELP_ORDER)
+
+
+importlib.import_module("companion.cli.vehicle")
+for _entry in sorted(entry_points(group=COMMANDS_GROUP), key=lambda e: _help_rank(e.name)):
+    importlib.import_module(_entry.value)
+importlib.import_module("companion.cli.bridge")
 
 
 def main() -> None:

@@ -14,6 +14,7 @@ from companion.cli.app import (
     out,
     setup_logging,
 )
+from ground.cli.extras import require_ground_extra
 
 
 @app.command()
@@ -28,6 +29,7 @@ def campaign(
     log_level: Annotated[str, typer.Option(help="DEBUG, INFO, WARNING")] = "WARNING",
 ) -> None:
     """Fly every flight of a campaign in lockstep simulation on Ray; score, tabulate, report."""
+    require_ground_extra("campaign", "jsbsim", "ray")
     from companion.exec_control.config import ConfigError
     from ground.campaign.runner import run_campaign
     from ground.campaign.spec import load_spec

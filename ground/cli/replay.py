@@ -14,6 +14,7 @@ from companion.cli.app import (
     out,
     setup_logging,
 )
+from ground.cli.extras import require_ground_extra
 
 
 @app.command()
@@ -52,7 +53,10 @@ def replay(
     if navigator not in NAVIGATORS:
         raise typer.BadParameter(f"navigator must be one of {', '.join(NAVIGATORS)}")
     setup_logging("WARNING")
+    if plot is not None:
+        require_ground_extra("replay --plot", "matplotlib")
     if is_batch(logs):
+        require_ground_extra("replay (many logs)", "ray")
         if truth is not None:
             raise typer.BadParameter("--truth goes with a single log")
         _replay_batch(logs, out_path, navigator, plot, rate, declination, address, cpus)

@@ -16,6 +16,7 @@ from companion.cli.app import (
     plan_or_exit,
     setup_logging,
 )
+from ground.cli.extras import require_ground_extra
 
 CONFIGS = Path(__file__).resolve().parents[2] / "companion" / "configs"
 
@@ -158,6 +159,7 @@ def sim(
     With --count N, N vehicles: sysid i, bus NAMESPACE_v<i>, state STATE_DIR/v<i>, each
     (i-1)*spacing m east of home, all on the --link endpoints, each on its own API port.
     """
+    require_ground_extra("sim", "jsbsim")
     from companion.bus.namespace import default_namespace
     from companion.exec_control.config import ConfigError
     from ground.sitl.bridge.options import BridgeOptions
