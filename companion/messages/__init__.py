@@ -1,0 +1,72 @@
+"""Every bus message type and the CHANNELS table: the one registry of the vehicle's data.
+
+Each payload is a fixed-size ctypes structure, so it can live in iceoryx2 shared memory.
+Field names carry their units; ``t_us`` (first field of every type) is the time the data
+was measured in the vehicle time base (monotonic µs on hardware, simulation µs in SITL).
+"Not set" for a float is NaN. Frames: body is FRD, navigation is local NED.
+
+The types are split by pipeline stage (sensors, navigation, control, actuators, link,
+system, simulation); ``channels.py`` holds the one CHANNELS table. Import from here.
+"""
+
+from companion.messages.actuators import ActuatorCommand, ServoOutput
+from companion.messages.base import MAX_PLUGINS, NAME_LEN, NAN, Message
+from companion.messages.channels import CHANNELS, Channel, channel
+from companion.messages.control import (
+    CommandAck,
+    CommandId,
+    CommandResult,
+    ControlStatus,
+    FlightMode,
+    MissionState,
+    VehicleCommand,
+    VehicleStatus,
+)
+from companion.messages.link import LinkStatus, StatusText
+from companion.messages.navigation import NavFlags, NavState
+from companion.messages.sensors import Baro, Compass, GpsFix, GpsFixType, Imu, Magnetometer
+from companion.messages.simulation import SimClock, SimTruth
+from companion.messages.system import (
+    ParamChange,
+    PluginHealth,
+    PluginState,
+    PluginStats,
+    SystemHealth,
+)
+
+__all__ = [
+    "CHANNELS",
+    "MAX_PLUGINS",
+    "NAME_LEN",
+    "NAN",
+    "ActuatorCommand",
+    "Baro",
+    "Channel",
+    "CommandAck",
+    "CommandId",
+    "CommandResult",
+    "Compass",
+    "ControlStatus",
+    "FlightMode",
+    "GpsFix",
+    "GpsFixType",
+    "Imu",
+    "LinkStatus",
+    "Magnetometer",
+    "Message",
+    "MissionState",
+    "NavFlags",
+    "NavState",
+    "ParamChange",
+    "PluginHealth",
+    "PluginState",
+    "PluginStats",
+    "ServoOutput",
+    "SimClock",
+    "SimTruth",
+    "StatusText",
+    "SystemHealth",
+    "VehicleCommand",
+    "VehicleStatus",
+    "channel",
+]

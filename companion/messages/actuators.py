@@ -1,0 +1,39 @@
+"""Normalised surface commands and the servo outputs written to the device."""
+
+from __future__ import annotations
+
+import ctypes
+
+from companion.messages.base import Message
+
+
+class ActuatorCommand(Message):
+    """Normalised surface commands from control: surfaces in [-1, 1], throttle in [0, 1].
+
+    Signs follow the stick: aileron + rolls right, elevator + pitches the nose up, rudder +
+    yaws right. ``aux`` carries extra surfaces (flaps first) in [-1, 1]; NaN = not driven.
+    Producers: control. Consumers: actuators.minissc.
+    """
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("aileron", ctypes.c_double),
+        ("elevator", ctypes.c_double),
+        ("rudder", ctypes.c_double),
+        ("throttle", ctypes.c_double),
+        ("aux", ctypes.c_double * 4),
+        ("armed", ctypes.c_uint8),
+    ]
+
+
+class ServoOutput(Message):
+    """What the servo card was told, per channel. Producers: actuators.*. Consumers: link."""
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("pulse_us", ctypes.c_uint16 * 8),  # equivalent PWM pulse width, 0 = channel unused
+        ("position", ctypes.c_uint8 * 8),  # Mini SSC position 0-254
+        # The t_us of the ActuatorCommand these positions answer (-1: none, e.g. safe on
+        # stale input); written after the bytes, so a lockstep simulator can wait for it.
+        ("command_t_us", ctypes.c_int64),
+    ]

@@ -1,0 +1,62 @@
+"""The CHANNELS table: every bus channel by name, with its payload type, pattern and depth."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+from companion.messages.actuators import ActuatorCommand, ServoOutput
+from companion.messages.base import Message
+from companion.messages.control import CommandAck, ControlStatus, VehicleCommand, VehicleStatus
+from companion.messages.link import LinkStatus, StatusText
+from companion.messages.navigation import NavState
+from companion.messages.sensors import Baro, Compass, GpsFix, Imu, Magnetometer
+from companion.messages.simulation import SimClock, SimTruth
+from companion.messages.system import ParamChange, PluginStats, SystemHealth
+
+
+@dataclass(frozen=True)
+class Channel:
+    """A named bus channel: its payload type and pattern (and depth for queues)."""
+
+    name: str
+    type: type[Message]
+    pattern: Literal["queue", "latest"]
+    depth: int = 1
+    doc: str = ""
+    many_producers: bool = False  # every plug-in may publish (e.g. system/plugin_stats)
+
+
+def _channels(*chans: Channel) -> dict[str, Channel]:
+    return {c.name: c for c in chans}
+
+
+CHANNELS: dict[str, Channel] = _channels(
+    Channel("sensors/imu", Imu, "queue", 64, "raw IMU samples"),
+    Channel("sensors/mag", Magnetometer, "queue", 32, "raw magnetometer samples"),
+    Channel("sensors/gps", GpsFix, "queue", 8, "GPS fixes"),
+    Channel("sensors/compass", Compass, "queue", 32, "digital compass attitude"),
+    Channel("sensors/baro", Baro, "queue", 32, "barometric altitude"),
+    Channel("nav/state", NavState, "latest", doc="navigation solution"),
+    Channel("sim/truth", SimTruth, "latest", doc="simulator's true state"),
+    Channel("sim/clock", SimClock, "latest", doc="simulation time"),
+    Channel("vehicle/status", VehicleStatus, "latest", doc="mode, home, guided target"),
+    Channel("control/actuators", ActuatorCommand, "queue", 8, "normalised surfaces"),
+    Channel("control/status", ControlStatus, "latest", doc="guidance and mission progress"),
+    Channel("actuators/servos", ServoOutput, "latest", doc="servo outputs written"),
+    Channel("link/commands", VehicleCommand, "queue", 16, "commands for the vehicle", True),
+    Channel("link/command_acks", CommandAck, "queue", 16, "command outcomes"),
+    Channel("system/plugin_stats", PluginStats, "queue", 64, "per-plug-in counters", True),
+    Channel("system/health", SystemHealth, "latest", doc="the health table"),
+    Channel("params/changes", ParamChange, "queue", 32, "parameters set from the ground"),
+    Channel("link/status", LinkStatus, "latest", doc="ground-station heartbeats heard"),
+    Channel("vehicle/statustext", StatusText, "queue", 16, "messages for the operator", True),
+)
+
+
+def channel(name: str) -> Channel:
+    """The registered channel of that name; KeyError names the unknown channel."""
+    try:
+        return CHANNELS[name]
+    except KeyError:
+        raise KeyError(f"unknown bus channel {name!r}; known: {sorted(CHANNELS)}") from None

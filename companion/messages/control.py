@@ -1,0 +1,137 @@
+"""Commands and their outcomes, the vehicle's mode and status, the flight controller's status."""
+
+from __future__ import annotations
+
+import ctypes
+import enum
+
+from companion.messages.base import NAME_LEN, Message
+
+
+class CommandId(enum.IntEnum):
+    """Vehicle commands carried on ``link/commands``.
+
+    START/STOP are the thesis's uplink commands; the others mirror the MAVLink commands
+    that other plug-ins must act on.
+    """
+
+    START = 1  # start the flight group (arm)
+    STOP = 2  # stop the flight group, servos safe (disarm)
+    SET_MODE = 3  # param1 = FlightMode
+    MISSION_START = 4  # param1 = first item, param2 = last item
+    RETURN_TO_LAUNCH = 5
+    REPOSITION = 6  # param1 = lat_deg, param2 = lon_deg, param3 = alt_msl_m
+    RESTART_PLUGINS = 7  # restart every plug-in (MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN)
+    LOITER = 8  # param1..3 = lat_deg, lon_deg, alt_msl_m (NaN: where it is)
+    SET_HOME = 9  # param1 = 1: here; else param5..7 = lat_deg, lon_deg, alt_msl_m
+    INJECT_FAILURE = 10  # param1..3 = MAVLink FAILURE_UNIT, FAILURE_TYPE, instance (simulator)
+
+
+class CommandResult(enum.IntEnum):
+    """Same numbering as MAVLink's MAV_RESULT."""
+
+    ACCEPTED = 0
+    TEMPORARILY_REJECTED = 1
+    DENIED = 2
+    UNSUPPORTED = 3
+    FAILED = 4
+    IN_PROGRESS = 5
+
+
+class VehicleCommand(Message):
+    """A command for the vehicle. Producers: link, tools. Consumers: exec_control, control."""
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("seq", ctypes.c_uint32),  # chosen by the sender; echoed in the CommandAck
+        ("command", ctypes.c_uint16),  # CommandId
+        ("source_sysid", ctypes.c_uint8),
+        ("source_compid", ctypes.c_uint8),
+        ("param", ctypes.c_double * 7),
+    ]
+
+
+class CommandAck(Message):
+    """Outcome of a VehicleCommand. Producers: exec_control, commander, the simulator bridge.
+    Consumers: link."""
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("seq", ctypes.c_uint32),
+        ("command", ctypes.c_uint16),
+        ("result", ctypes.c_uint8),  # CommandResult
+        ("source", ctypes.c_char * NAME_LEN),  # who answered
+        ("reason", ctypes.c_char * 48),  # why it was refused (told to the ground station)
+    ]
+
+
+class FlightMode(enum.IntEnum):
+    """The vehicle's flight modes (``companion.control.modes`` maps them to MAVLink's encodings)."""
+
+    MANUAL = 1  # surfaces follow the pilot (no RC here: held neutral)
+    STABILIZED = 2  # wings level, height held
+    MISSION = 3  # fly the stored mission
+    LOITER = 4  # circle where it is
+    RTL = 5  # fly home and circle there
+    GUIDED = 6  # fly to a commanded point and circle there
+    TAKEOFF = 7
+
+
+class VehicleStatus(Message):
+    """Mode, home and the guided target. Producer: vehicle.commander. Consumers: link, control."""
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("mode", ctypes.c_uint8),  # FlightMode
+        ("armed", ctypes.c_uint8),
+        ("home_valid", ctypes.c_uint8),
+        ("home_lat_deg", ctypes.c_double),
+        ("home_lon_deg", ctypes.c_double),
+        ("home_alt_msl_m", ctypes.c_double),
+        ("target_lat_deg", ctypes.c_double),  # GUIDED: where to go (NaN otherwise)
+        ("target_lon_deg", ctypes.c_double),
+        ("target_alt_msl_m", ctypes.c_double),
+        ("mission_first", ctypes.c_int32),  # MISSION: the item to start from
+        ("changes", ctypes.c_uint32),  # mode changes since start
+    ]
+
+
+class MissionState(enum.IntEnum):
+    """How far the running mission is (MAVLink's MISSION_STATE numbering)."""
+
+    NOT_STARTED = 2
+    ACTIVE = 3
+    COMPLETE = 5
+
+
+class ControlStatus(Message):
+    """What the flight controller is doing. Producer: control.fixed_wing. Consumer: link.
+
+    Feeds NAV_CONTROLLER_OUTPUT, MISSION_CURRENT and MISSION_ITEM_REACHED (sent when
+    ``reached_count`` grows).
+    """
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("nav_roll_rad", ctypes.c_double),
+        ("nav_pitch_rad", ctypes.c_double),
+        ("target_bearing_rad", ctypes.c_double),
+        ("wp_dist_m", ctypes.c_double),
+        ("alt_error_m", ctypes.c_double),
+        ("aspd_error_m_s", ctypes.c_double),
+        ("xtrack_error_m", ctypes.c_double),
+        ("airspeed_m_s", ctypes.c_double),  # estimated (no airspeed sensor): GPS and wind
+        ("wind_n_m_s", ctypes.c_double),
+        ("wind_e_m_s", ctypes.c_double),
+        ("mission_seq", ctypes.c_int32),
+        ("mission_state", ctypes.c_uint8),  # MissionState
+        ("landed", ctypes.c_uint8),
+        ("reached_count", ctypes.c_uint32),
+        ("last_reached", ctypes.c_int32),
+    ]
+
+    STALE_US = 2_000_000  # no newer status for this long: the controller has stopped
+
+    def fresh(self, now_us: int) -> bool:
+        """Whether the controller is still running (it publishes ten times a second)."""
+        return now_us - self.t_us < self.STALE_US
