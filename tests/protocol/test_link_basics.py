@@ -7,7 +7,7 @@ import time
 import pytest
 from pymavlink.dialects.v20 import common as m
 
-from tests.protocol.mav_client import LINK_VEHICLE, GroundStation, free_udp_port
+from tests.protocol.mav_client import LINK_VEHICLE, GroundStation, client_vehicle, free_udp_port
 from tests.support.plugins import FakeNav
 from tests.support.vehicle import wait_for
 
@@ -117,12 +117,31 @@ def test_garbage_and_bad_crc_are_counted_and_the_link_survives(link):
     assert gcs.recv("AUTOPILOT_VERSION").capabilities != 0
 
 
-def test_home_position_plugin_health_and_nav_status(link):
-    _, gcs, _ = link
+def test_home_is_the_commanders_and_the_link_never_makes_one_up(link, vehicle_factory, tmp_path):
+    _, gcs, _ = link  # a vehicle without a commander has no home, however good its fix
     gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_HOME_POSITION)
-    assert gcs.ack(m.MAV_CMD_REQUEST_MESSAGE).result == m.MAV_RESULT_ACCEPTED
-    home = gcs.recv("HOME_POSITION")
-    assert (home.latitude, home.longitude) == (round(FakeNav.LAT * 1e7), round(FakeNav.LON * 1e7))
+    assert gcs.ack(m.MAV_CMD_REQUEST_MESSAGE).result == m.MAV_RESULT_TEMPORARILY_REJECTED
+    port = free_udp_port()
+    vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path / "with_commander"))
+    station = GroundStation(port)
+    try:
+        station.connect()
+        home = wait_for(lambda: _home_position(station), 10, "HOME_POSITION from the commander")
+        lat_lon = (home.latitude, home.longitude)
+        assert lat_lon == (round(FakeNav.LAT * 1e7), round(FakeNav.LON * 1e7))
+    finally:
+        station.close()
+
+
+def _home_position(gcs: GroundStation):
+    gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_HOME_POSITION)
+    if gcs.ack(m.MAV_CMD_REQUEST_MESSAGE).result != m.MAV_RESULT_ACCEPTED:
+        return None
+    return gcs.recv("HOME_POSITION")
+
+
+def test_plugin_health_and_nav_status(link):
+    _, gcs, _ = link
     names = set()
     deadline = time.monotonic() + 6
     while len(names) < 4 and time.monotonic() < deadline:

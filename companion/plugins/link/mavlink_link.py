@@ -19,6 +19,7 @@ from companion.control.mission.store import MissionStore
 from companion.link.codec import dialect as d
 from companion.link.codec import new_encoder
 from companion.link.command_service import CommandService
+from companion.link.commands import register_commands
 from companion.link.endpoints import (
     SCHEMES,
     Endpoint,
@@ -36,10 +37,9 @@ from companion.link.service import Outgoing
 from companion.link.signing import key_from
 from companion.link.telemetry import Snapshot
 from companion.link.timesync import TimesyncService
-from companion.messages import ControlStatus, LinkStatus, NavFlags, ParamChange, VehicleCommand
+from companion.messages import ControlStatus, LinkStatus, ParamChange, VehicleCommand
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
-from companion.plugins.link.commands import register_commands
 
 MAX_WAIT_S = 0.02
 LINK_STATUS_PERIOD_S = 0.2  # link/status (ground-station silence) five times a second
@@ -152,7 +152,7 @@ class MavlinkLink(Plugin):
         store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
         self.missions = MissionService(self.mav, store, sysid, ctx.settings["compid"])
         self.router.add_service(self.missions)
-        register_commands(self)
+        register_commands(self.commands, self, self.identity, self.router)
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         self._seq = 0
 
@@ -199,14 +199,9 @@ class MavlinkLink(Plugin):
                 pass
             if latest is not None:
                 setattr(s, key, latest)
-        if s.status is not None and s.status.home_valid:
+        if s.status is not None and s.status.home_valid:  # home is the commander's alone
             s.home = (s.status.home_lat_deg, s.status.home_lon_deg, s.status.home_alt_msl_m)
             s.home_alt_m = s.status.home_alt_msl_m
-        elif s.home is None and s.nav is not None and s.nav.flags & NavFlags.POSITION_VALID:
-            # Home is where the first valid position was (ArduPilot and PX4 do the same
-            # at the first fix when disarmed).
-            s.home = (s.nav.lat_deg, s.nav.lon_deg, s.nav.alt_msl_m)
-            s.home_alt_m = s.nav.alt_msl_m
         s.mission_seq = self.missions.current
         s.mission_total = len(self.missions.store.items[0])
         s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
@@ -281,6 +276,15 @@ class MavlinkLink(Plugin):
         health = self.readers["health"].get()
         rows = health.rows() if health is not None else []
         return any(row.kind.decode() == COMMANDER for row in rows)
+
+    def param(self, name: str) -> float:
+        """One of the link's own parameters (VehiclePort)."""
+        return self.store.get(name)
+
+    @property
+    def simulated(self) -> bool:
+        """Whether the vehicle runs on the simulator's clock (VehiclePort)."""
+        return self.ctx.vehicle.get("clock") == "sim"
 
     def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
         """Put a VehicleCommand on the bus; returns its sequence number for the ack."""

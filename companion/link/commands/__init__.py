@@ -1,0 +1,35 @@
+"""The MAV_CMDs the link answers, one class per group of commands.
+
+Each group sees the vehicle only through ``VehiclePort`` (publish a command on the bus,
+tell the operator, read the telemetry snapshot and a parameter), so it is tested and
+read without the link plug-in; ``register_commands`` wires every group into the
+command service.
+"""
+
+from __future__ import annotations
+
+from companion.link.command_service import CommandService
+from companion.link.commands.arming import ArmingCommands
+from companion.link.commands.message_requests import MessageRequests
+from companion.link.commands.modes import ModeCommands
+from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
+from companion.link.identity import IdentityService
+from companion.link.link_router import LinkRouter
+
+__all__ = [
+    "BUS_ACK_TIMEOUT_S",
+    "ArmingCommands",
+    "MessageRequests",
+    "ModeCommands",
+    "VehiclePort",
+    "register_commands",
+]
+
+
+def register_commands(
+    service: CommandService, port: VehiclePort, identity: IdentityService, router: LinkRouter
+) -> None:
+    """Register every supported MAV_CMD with ``service``."""
+    ArmingCommands(port).register(service)
+    ModeCommands(port, identity.autopilot).register(service)
+    MessageRequests(port, identity, router).register(service)

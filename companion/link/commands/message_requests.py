@@ -1,0 +1,56 @@
+"""Requests for messages and their rates: the link answers these itself."""
+
+from __future__ import annotations
+
+from companion.link.codec import dialect as d
+from companion.link.command_service import CommandArgs, CommandService, Outcome
+from companion.link.commands.port import VehiclePort
+from companion.link.identity import IdentityService
+from companion.link.link_router import LinkRouter
+from companion.link.mode_messages import available_modes
+from companion.link.telemetry import STREAMS
+
+
+class MessageRequests:
+    """REQUEST_MESSAGE, REQUEST_AUTOPILOT_CAPABILITIES, SET_ and GET_MESSAGE_INTERVAL."""
+
+    def __init__(self, port: VehiclePort, identity: IdentityService, router: LinkRouter) -> None:
+        self.port = port
+        self.identity = identity
+        self.router = router
+        self.mav = router.mav
+
+    def register(self, service: CommandService) -> None:
+        service.register(d.MAV_CMD_REQUEST_MESSAGE, self.request_message)
+        service.register(d.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES, self.capabilities)
+        service.register(d.MAV_CMD_SET_MESSAGE_INTERVAL, self.set_interval)
+        service.register(d.MAV_CMD_GET_MESSAGE_INTERVAL, self.get_interval)
+
+    def request_message(self, args: CommandArgs) -> Outcome:
+        msg_id = round(args.params[0])
+        if msg_id == d.MAVLINK_MSG_ID_AUTOPILOT_VERSION:
+            return Outcome(extra=[self.identity.autopilot_version()])
+        if msg_id == d.MAVLINK_MSG_ID_PROTOCOL_VERSION:
+            return Outcome(extra=[self.identity.protocol_version()])
+        if msg_id == d.MAVLINK_MSG_ID_AVAILABLE_MODES:
+            modes = available_modes(self.mav, round(args.params[1]))
+            return Outcome(extra=modes) if modes else Outcome(d.MAV_RESULT_DENIED)
+        if msg_id in STREAMS:
+            msg = STREAMS[msg_id].build(self.mav, self.port.snapshot)
+            if msg is None:
+                return Outcome(d.MAV_RESULT_TEMPORARILY_REJECTED)
+            return Outcome(extra=[msg])
+        return Outcome(d.MAV_RESULT_UNSUPPORTED)
+
+    def capabilities(self, args: CommandArgs) -> Outcome:
+        return Outcome(extra=[self.identity.autopilot_version()])
+
+    def set_interval(self, args: CommandArgs) -> Outcome:
+        schedule = self.router.schedules[args.peer.endpoint]
+        ok = schedule.set_interval(round(args.params[0]), args.params[1])
+        return Outcome(d.MAV_RESULT_ACCEPTED if ok else d.MAV_RESULT_UNSUPPORTED)
+
+    def get_interval(self, args: CommandArgs) -> Outcome:
+        msg_id = round(args.params[0])
+        interval = self.router.schedules[args.peer.endpoint].interval_us(msg_id)
+        return Outcome(extra=[self.mav.message_interval_encode(msg_id, interval)])

@@ -1,0 +1,91 @@
+"""Mode and navigation commands: each goes to the commander plug-in, which owns the mode
+and home (UNSUPPORTED when the vehicle has no commander)."""
+
+from __future__ import annotations
+
+import math
+
+from companion.control.modes import decode_set_mode, from_standard
+from companion.link.codec import dialect as d
+from companion.link.command_service import SET_MODE_MESSAGE, CommandArgs, CommandService, Outcome
+from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
+from companion.messages import CommandId, FlightMode
+
+RELATIVE_FRAMES = frozenset(
+    {
+        d.MAV_FRAME_GLOBAL_RELATIVE_ALT,
+        d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+    }
+)
+NO_POINT = (math.nan, math.nan, math.nan)
+
+
+class ModeCommands:
+    """DO_SET_MODE, DO_SET_STANDARD_MODE, SET_MODE, MISSION_START, RTL, DO_REPOSITION,
+    NAV_LOITER_UNLIM and DO_SET_HOME."""
+
+    def __init__(self, port: VehiclePort, autopilot: int) -> None:
+        self.port = port
+        self.px4 = autopilot == d.MAV_AUTOPILOT_PX4
+
+    def register(self, service: CommandService) -> None:
+        service.register(d.MAV_CMD_DO_SET_MODE, self.do_set_mode)
+        service.register(d.MAV_CMD_DO_SET_STANDARD_MODE, self.set_standard_mode)
+        service.register(SET_MODE_MESSAGE, self.set_mode_message)
+        service.register(d.MAV_CMD_MISSION_START, self.mission_start)
+        service.register(d.MAV_CMD_NAV_RETURN_TO_LAUNCH, self.rtl)
+        service.register(d.MAV_CMD_DO_REPOSITION, self.reposition)
+        service.register(d.MAV_CMD_NAV_LOITER_UNLIM, self.loiter)
+        service.register(d.MAV_CMD_DO_SET_HOME, self.set_home)
+
+    def to_commander(self, command: CommandId, params: tuple[float, ...] = ()) -> Outcome:
+        if not self.port.has_commander():
+            return Outcome(d.MAV_RESULT_UNSUPPORTED)
+        seq = self.port.publish_command(command, params)
+        return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)
+
+    def set_mode(self, mode: FlightMode | None, what: str) -> Outcome:
+        if mode is None:
+            self.port.statustext(f"{what}: unknown mode")
+            return Outcome(d.MAV_RESULT_DENIED)
+        return self.to_commander(CommandId.SET_MODE, (float(mode),))
+
+    def do_set_mode(self, args: CommandArgs) -> Outcome:
+        base, custom, sub = (round(v) for v in args.params[:3])
+        return self.set_mode(decode_set_mode(base, custom, sub, self.px4), "Set mode")
+
+    def set_standard_mode(self, args: CommandArgs) -> Outcome:
+        return self.set_mode(from_standard(round(args.params[0])), "Set standard mode")
+
+    def set_mode_message(self, args: CommandArgs) -> Outcome:
+        base, custom = round(args.params[0]), round(args.params[1])
+        return self.set_mode(decode_set_mode(base, custom, 0, self.px4), "SET_MODE")
+
+    def mission_start(self, args: CommandArgs) -> Outcome:
+        return self.to_commander(CommandId.MISSION_START, args.params[:2])
+
+    def rtl(self, args: CommandArgs) -> Outcome:
+        return self.to_commander(CommandId.RETURN_TO_LAUNCH)
+
+    def reposition(self, args: CommandArgs) -> Outcome:
+        target = self.point(args)
+        if not math.isfinite(target[0]):
+            self.port.statustext("Go to: no position given")
+            return Outcome(d.MAV_RESULT_DENIED)
+        return self.to_commander(CommandId.REPOSITION, target)
+
+    def loiter(self, args: CommandArgs) -> Outcome:
+        return self.to_commander(CommandId.LOITER, self.point(args))
+
+    def set_home(self, args: CommandArgs) -> Outcome:
+        return self.to_commander(CommandId.SET_HOME, args.params)
+
+    def point(self, args: CommandArgs) -> tuple[float, float, float]:
+        """(lat, lon, alt AMSL) of params 5-7; NaN where not given (0, 0 = here)."""
+        lat, lon, alt = args.params[4:7]
+        if not (math.isfinite(lat) and math.isfinite(lon)) or (lat == 0 and lon == 0):
+            return NO_POINT
+        status = self.port.snapshot.status
+        if args.frame in RELATIVE_FRAMES and status is not None and status.home_valid:
+            alt += status.home_alt_msl_m
+        return (lat, lon, alt if math.isfinite(alt) else math.nan)

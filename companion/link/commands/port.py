@@ -1,0 +1,37 @@
+"""What a command handler may do to the vehicle: the link's small interface to it."""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+from companion.link.codec import dialect as d
+from companion.link.telemetry import Snapshot
+
+BUS_ACK_TIMEOUT_S = 3.0  # how long a command handed to another plug-in waits for its answer
+
+
+class VehiclePort(Protocol):
+    """The vehicle as command handlers see it (the link plug-in provides it)."""
+
+    snapshot: Snapshot  # the newest bus values, refreshed every step
+
+    def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
+        """Put a VehicleCommand on the bus; returns the sequence its ack will carry."""
+        ...
+
+    def statustext(self, text: str, severity: int = d.MAV_SEVERITY_WARNING) -> None:
+        """Tell every ground station."""
+        ...
+
+    def has_commander(self) -> bool:
+        """Whether a commander plug-in is there to answer mode commands."""
+        ...
+
+    def param(self, name: str) -> float:
+        """The current value of one of the link's own parameters."""
+        ...
+
+    @property
+    def simulated(self) -> bool:
+        """Whether the vehicle runs on the simulator's clock."""
+        ...

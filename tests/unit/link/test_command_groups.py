@@ -1,0 +1,102 @@
+"""The link's command groups against the vehicle as a VehiclePort sees it, in process."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from pymavlink.dialects.v20 import common as m
+
+from companion.link.command_service import CommandArgs
+from companion.link.commands import ArmingCommands, ModeCommands
+from companion.link.service import Peer
+from companion.link.telemetry import Snapshot
+from companion.messages import CommandId, ControlStatus, VehicleStatus
+
+GCS = Peer(255, 190, 0)
+
+
+@dataclass
+class RecordingVehicle:
+    """A VehiclePort that keeps what the handlers did (the bus side is the link's own)."""
+
+    snapshot: Snapshot = field(default_factory=Snapshot)
+    commander: bool = True
+    params: dict[str, float] = field(default_factory=lambda: {"SYS_FAILURE_EN": 0.0})
+    simulated: bool = True
+    published: list[tuple[int, tuple[float, ...]]] = field(default_factory=list)
+    texts: list[str] = field(default_factory=list)
+
+    def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
+        self.published.append((command, tuple(params)))
+        return len(self.published)
+
+    def statustext(self, text: str, severity: int = 4) -> None:
+        self.texts.append(text)
+
+    def has_commander(self) -> bool:
+        return self.commander
+
+    def param(self, name: str) -> float:
+        return self.params[name]
+
+
+def args(command: int, *params: float, frame: int = 0) -> CommandArgs:
+    full = (*params, *[0.0] * (7 - len(params)))
+    return CommandArgs(command, full, 0, GCS, frame=frame)
+
+
+def flying(vehicle: RecordingVehicle) -> None:
+    vehicle.snapshot.control = ControlStatus(landed=0)
+
+
+def test_disarm_in_the_air_needs_the_force_number():
+    vehicle = RecordingVehicle()
+    flying(vehicle)
+    arming = ArmingCommands(vehicle)
+    refused = arming.arm_disarm(args(m.MAV_CMD_COMPONENT_ARM_DISARM, 0))
+    assert refused.result == m.MAV_RESULT_DENIED
+    assert "Disarm refused" in vehicle.texts[0]
+    assert vehicle.published == []
+    forced = arming.arm_disarm(args(m.MAV_CMD_COMPONENT_ARM_DISARM, 0, 21196))
+    assert forced.defer_seq == 1
+    assert vehicle.published == [(CommandId.STOP, ())]
+
+
+def test_failure_injection_is_off_until_its_parameter_and_needs_the_simulator():
+    vehicle = RecordingVehicle()
+    arming = ArmingCommands(vehicle)
+    assert arming.inject_failure(args(m.MAV_CMD_INJECT_FAILURE, 1, 1)).result == (
+        m.MAV_RESULT_DENIED
+    )
+    vehicle.params["SYS_FAILURE_EN"] = 1.0
+    vehicle.simulated = False
+    assert arming.inject_failure(args(m.MAV_CMD_INJECT_FAILURE, 1, 1)).result == (
+        m.MAV_RESULT_UNSUPPORTED
+    )
+    vehicle.simulated = True
+    assert arming.inject_failure(args(m.MAV_CMD_INJECT_FAILURE, 1, 1)).defer_seq == 1
+    assert vehicle.published == [(CommandId.INJECT_FAILURE, (1.0, 1.0, 0.0))]
+
+
+def test_mode_commands_without_a_commander_are_unsupported():
+    vehicle = RecordingVehicle(commander=False)
+    modes = ModeCommands(vehicle, m.MAV_AUTOPILOT_GENERIC)
+    assert modes.rtl(args(m.MAV_CMD_NAV_RETURN_TO_LAUNCH)).result == m.MAV_RESULT_UNSUPPORTED
+    assert vehicle.published == []
+
+
+def test_go_to_needs_a_position_and_relative_heights_are_over_the_commanders_home():
+    vehicle = RecordingVehicle()
+    modes = ModeCommands(vehicle, m.MAV_AUTOPILOT_GENERIC)
+    nowhere = modes.reposition(args(m.MAV_CMD_DO_REPOSITION, -1, 0, 0, math.nan, 0, 0, 100))
+    assert nowhere.result == m.MAV_RESULT_DENIED
+    assert vehicle.texts == ["Go to: no position given"]
+    status = VehicleStatus(home_valid=1, home_alt_msl_m=50.0)
+    vehicle.snapshot.status = status
+    relative = m.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+    there = modes.reposition(
+        args(m.MAV_CMD_DO_REPOSITION, -1, 0, 0, math.nan, -37.9, 145.1, 100, frame=relative)
+    )
+    assert there.defer_seq == 1
+    assert vehicle.published == [(CommandId.REPOSITION, (-37.9, 145.1, 150.0))]
