@@ -47,6 +47,9 @@ MODE_COMMANDS = frozenset(
 )
 
 
+MAX_ALT_M = 100_000.0  # above this an altitude is a broken input, not a target
+
+
 class Commander:
     """Mode state machine; ``mission_count`` says how many mission items are stored."""
 
@@ -80,18 +83,20 @@ class Commander:
         p = list(cmd.param)
         if kind == CommandId.SET_MODE:
             try:
-                mode = FlightMode(round(p[0]))
+                mode = FlightMode(_whole(p[0], -1))
             except ValueError:
                 return Decision(CommandResult.DENIED, f"unknown mode {p[0]:g}")
             return self._enter(mode)
         if kind == CommandId.MISSION_START:
             decision = self._enter(FlightMode.MISSION)
             if decision.result == CommandResult.ACCEPTED:
-                self.mission_first = max(0, round(p[0]))
+                self.mission_first = max(0, _whole(p[0], 0))
             return decision
         if kind == CommandId.RETURN_TO_LAUNCH:
             return self._enter(FlightMode.RTL)
         if kind in (CommandId.REPOSITION, CommandId.LOITER):
+            if not _usable_point(p[0], p[1], p[2]):
+                return Decision(CommandResult.DENIED, "Go to: position out of range")
             mode = FlightMode.GUIDED if kind == CommandId.REPOSITION else FlightMode.LOITER
             return self._enter(mode, (p[0], p[1], p[2]))
         if kind == CommandId.SET_HOME:
@@ -128,11 +133,11 @@ class Commander:
         return here
 
     def _set_home(self, p: list[float]) -> Decision:
-        if round(p[0]) == 1:
+        if _whole(p[0], 0) == 1:
             if self.position is None:
                 return Decision(CommandResult.DENIED, "Home: no position yet")
             self.home = self.position
-        elif all(math.isfinite(v) for v in p[4:7]) and abs(p[4]) <= 90 and abs(p[5]) <= 180:
+        elif all(math.isfinite(v) for v in p[4:7]) and _usable_point(p[4], p[5], p[6]):
             self.home = (p[4], p[5], p[6])
         else:
             return Decision(CommandResult.DENIED, "Home: bad position")
@@ -146,3 +151,16 @@ class Commander:
         msg.target_lat_deg, msg.target_lon_deg, msg.target_alt_msl_m = self.target
         msg.mission_first, msg.changes = self.mission_first, self.changes
         return msg
+
+
+def _whole(value: float, default: int) -> int:
+    """A whole-number command parameter; ``default`` for NaN or infinity (never a crash)."""
+    return round(value) if math.isfinite(value) else default
+
+
+def _usable_point(lat: float, lon: float, alt: float) -> bool:
+    """NaN means "not given"; anything else must be a place on Earth at a sane height."""
+    if math.isinf(lat) or math.isinf(lon) or math.isinf(alt):
+        return False
+    in_range = not (abs(lat) > 90 or abs(lon) > 180 or abs(alt) > MAX_ALT_M)
+    return in_range  # NaN compares False, so a NaN coordinate passes as "not given"

@@ -45,6 +45,7 @@ class Outcome:
 
 
 Handler = Callable[[CommandArgs], Outcome]
+Check = Callable[[CommandArgs], "str | None"]  # why a command is refused, or None
 
 
 @dataclass
@@ -66,6 +67,10 @@ class CommandService:
         self.pending: dict[int, _Pending] = {}
         self._done: dict[tuple[int, int, int], tuple[float, int | None]] = {}
         self.rejected_target = 0
+        self.refused = 0  # commands whose parameters broke their rule (answered DENIED)
+        self.handler_errors = 0  # handlers that raised: bugs, which the tests look for
+        self.check: Check | None = None
+        self.on_refusal: Callable[[str], None] = lambda text: None
 
     def register(self, command: int, handler: Handler) -> None:
         self.handlers[command] = handler
@@ -127,17 +132,26 @@ class CommandService:
         if handler is None:
             self._done[key] = (now_s, d.MAV_RESULT_UNSUPPORTED)
             return [self.ack(args, d.MAV_RESULT_UNSUPPORTED)]
-        try:
-            outcome = handler(args)
-        except Exception:  # a handler bug must not take the link down
-            log.exception("command %d handler failed", args.command)
-            outcome = Outcome(d.MAV_RESULT_FAILED)
+        outcome = self._run(handler, args)
         if outcome.defer_seq is not None:
             self.pending[outcome.defer_seq] = _Pending(args, now_s + outcome.timeout_s)
             self._done[key] = (now_s, None)
             return []
         self._done[key] = (now_s, outcome.result)
         return [self.ack(args, outcome.result)] + [Outgoing(m, peer) for m in outcome.extra]
+
+    def _run(self, handler: Handler, args: CommandArgs) -> Outcome:
+        reason = self.check(args) if self.check is not None else None
+        if reason is not None:
+            self.refused += 1
+            self.on_refusal(f"{command_name(args.command)}: {reason}")
+            return Outcome(d.MAV_RESULT_DENIED)
+        try:
+            return handler(args)
+        except Exception:  # a handler bug must not take the link down
+            self.handler_errors += 1
+            log.exception("command %d handler failed", args.command)
+            return Outcome(d.MAV_RESULT_FAILED)
 
     def complete(self, seq: int, result: int, now_s: float) -> list[Outgoing]:
         """The bus answered a deferred command: send its final ack."""
@@ -158,3 +172,11 @@ class CommandService:
         for k in stale:
             del self._done[k]
         return out
+
+
+def command_name(command: int) -> str:
+    """MAV_CMD_DO_REPOSITION -> DO_REPOSITION (SET_MODE for the message's number)."""
+    if command == SET_MODE_MESSAGE:
+        return "SET_MODE"
+    entry = d.enums["MAV_CMD"].get(command)
+    return entry.name.removeprefix("MAV_CMD_") if entry is not None else f"command {command}"

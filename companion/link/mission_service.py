@@ -9,6 +9,7 @@ Download: MISSION_REQUEST_LIST → MISSION_COUNT, then items on request (INT or 
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -132,11 +133,12 @@ class MissionService:
             return []
         if msg.seq != len(upload.items):
             return [self._request(upload, now_s)]  # out of order or a duplicate: re-ask
-        try:
-            upload.items.append(MissionItem.from_message(msg))
-        except (TypeError, ValueError):
+        bad_xy = _bad_legacy_position(msg)
+        if bad_xy is not None:  # MISSION_ITEM's float degrees: NaN or infinity
             del self.uploads[mission_type]
-            return [self._ack(peer, d.MAV_MISSION_ERROR, mission_type)]
+            self.refused += 1
+            return [self._ack(peer, bad_xy, mission_type)]
+        upload.items.append(MissionItem.from_message(msg))
         upload.retries = 0
         if len(upload.items) < upload.count:
             return [self._request(upload, now_s)]
@@ -198,3 +200,14 @@ class MissionService:
             upload.retries += 1
             out.append(self._request(upload, now_s))
         return out
+
+
+def _bad_legacy_position(msg: Any) -> int | None:
+    """INVALID_PARAM5_X/6_Y for a MISSION_ITEM whose degrees cannot become integers."""
+    if msg.get_type() != "MISSION_ITEM":
+        return None
+    if not math.isfinite(msg.x) or abs(msg.x) > 1e3:
+        return d.MAV_MISSION_INVALID_PARAM5_X
+    if not math.isfinite(msg.y) or abs(msg.y) > 1e3:
+        return d.MAV_MISSION_INVALID_PARAM6_Y
+    return None

@@ -228,9 +228,10 @@ class FlightController:
             rtl_alt = self.home_alt + self.config["RTL_ALT_M"]
             return Setpoint(Kind.LINE, pos, (0.0, 0.0), rtl_alt, radius)
         target = (status.target_lat_deg, status.target_lon_deg, status.target_alt_msl_m)
-        if mode in (FlightMode.GUIDED, FlightMode.LOITER) and math.isfinite(target[0]):
+        has_target = math.isfinite(target[0]) and math.isfinite(target[1])
+        if mode in (FlightMode.GUIDED, FlightMode.LOITER) and has_target:
             point = self.frame.ne(target[0], target[1])
-            alt = target[2] if math.isfinite(target[2]) else alt
+            alt = target[2] if math.isfinite(target[2]) else alt  # NaN: hold the height
             if mode == FlightMode.GUIDED:
                 return Setpoint(Kind.LINE, pos, point, alt, radius)
             return Setpoint(Kind.CIRCLE, point, point, alt, radius)

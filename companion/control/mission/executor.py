@@ -247,7 +247,8 @@ class MissionExecutor:
         self, item: MissionItem, pos: tuple[float, float], alt: float, t_s: float
     ) -> Setpoint | None:
         centre = self.point_of(item, self._prev)
-        radius = abs(item.param3) if item.param3 else self.config.loiter_radius
+        given = math.isfinite(item.param3) and item.param3 != 0
+        radius = abs(item.param3) if given else self.config.loiter_radius
         clockwise = item.param3 >= 0
         target_alt = self.alt_of(item) if item.z or item.frame not in RELATIVE_FRAMES else alt
         circle = Setpoint(Kind.CIRCLE, centre, centre, target_alt, radius, clockwise, self.speed)

@@ -7,6 +7,7 @@ at upload with the matching MAV_MISSION_RESULT instead of being skipped in fligh
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 
 from mavlink_dialect import companion as d
@@ -50,6 +51,27 @@ POSITIONLESS = frozenset(
 )
 
 
+# Parameters (1-based) the executor or the fence reads as numbers: NaN there is refused.
+# Elsewhere NaN means "not given" (yaw, unused parameters); infinity is refused everywhere.
+NEEDS_NUMBER = {
+    d.MAV_CMD_DO_JUMP: (1, 2),
+    d.MAV_CMD_NAV_LOITER_TURNS: (1,),
+    d.MAV_CMD_NAV_LOITER_TIME: (1,),
+    d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION: (1,),
+    d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_EXCLUSION: (1,),
+    d.MAV_CMD_NAV_FENCE_CIRCLE_INCLUSION: (1,),
+    d.MAV_CMD_NAV_FENCE_CIRCLE_EXCLUSION: (1,),
+}
+INVALID_PARAM = (
+    d.MAV_MISSION_INVALID_PARAM1,
+    d.MAV_MISSION_INVALID_PARAM2,
+    d.MAV_MISSION_INVALID_PARAM3,
+    d.MAV_MISSION_INVALID_PARAM4,
+)
+MAX_ALT_M = 100_000.0
+MAX_PARAM = 1e7  # no parameter of a supported item means anything beyond this
+
+
 @dataclass(frozen=True)
 class MissionItem:
     """One item, as MISSION_ITEM_INT carries it (x, y in degrees × 1e7)."""
@@ -81,10 +103,26 @@ class MissionItem:
         return asdict(self)
 
 
+def check_params(item: MissionItem) -> int:
+    """INVALID_PARAMn for a parameter that is infinite, huge, or NaN where a number is read."""
+    needed = NEEDS_NUMBER.get(item.command, ())
+    values = (item.param1, item.param2, item.param3, item.param4)
+    for n, value in enumerate(values, start=1):
+        if math.isnan(value):
+            if n in needed:
+                return INVALID_PARAM[n - 1]
+        elif not abs(value) <= MAX_PARAM:
+            return INVALID_PARAM[n - 1]
+    return d.MAV_MISSION_ACCEPTED
+
+
 def check_item(item: MissionItem, count: int) -> int:
     """MAV_MISSION_ACCEPTED, or the MAV_MISSION_RESULT that says why the item is refused."""
     if item.command not in SUPPORTED.get(item.mission_type, frozenset()):
         return d.MAV_MISSION_UNSUPPORTED
+    params = check_params(item)
+    if params != d.MAV_MISSION_ACCEPTED:
+        return params
     if item.command == d.MAV_CMD_DO_JUMP:
         target = round(item.param1)
         if not 0 <= target < count or target == item.seq:
@@ -100,6 +138,8 @@ def check_item(item: MissionItem, count: int) -> int:
         return d.MAV_MISSION_INVALID_PARAM6_Y
     if item.x == 0 and item.y == 0 and item.command != d.MAV_CMD_NAV_TAKEOFF:
         return d.MAV_MISSION_INVALID_PARAM5_X
+    if not abs(item.z) <= MAX_ALT_M:  # NaN fails too: every positional item needs a height
+        return d.MAV_MISSION_INVALID_PARAM7
     return d.MAV_MISSION_ACCEPTED
 
 

@@ -8,6 +8,7 @@ command service.
 
 from __future__ import annotations
 
+from companion.link.command_rules import refusal
 from companion.link.command_service import CommandService
 from companion.link.commands.arming import ArmingCommands
 from companion.link.commands.message_requests import MessageRequests
@@ -29,7 +30,9 @@ __all__ = [
 def register_commands(
     service: CommandService, port: VehiclePort, identity: IdentityService, router: LinkRouter
 ) -> None:
-    """Register every supported MAV_CMD with ``service``."""
+    """Register every supported MAV_CMD with ``service``, behind the parameter rules."""
+    service.check = refusal
+    service.on_refusal = port.statustext
     ArmingCommands(port).register(service)
     ModeCommands(port, identity.autopilot).register(service)
     MessageRequests(port, identity, router).register(service)

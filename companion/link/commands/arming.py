@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from companion.link.codec import dialect as d
+from companion.link.command_rules import whole_or
 from companion.link.command_service import CommandArgs, CommandService, Outcome
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
 from companion.messages import CommandId
@@ -25,7 +26,7 @@ class ArmingCommands:
         command = CommandId.START if args.params[0] >= 0.5 else CommandId.STOP
         control = self.port.snapshot.control
         in_air = control is not None and not control.landed
-        if command == CommandId.STOP and in_air and round(args.params[1]) != FORCE_DISARM:
+        if command == CommandId.STOP and in_air and whole_or(args.params[1], 0) != FORCE_DISARM:
             # As ArduPilot and PX4: stopping the flight plug-ins in the air drops the
             # aircraft, so it takes the magic number to mean it.
             self.port.statustext("Disarm refused: flying (param2 21196 forces it)")
@@ -46,6 +47,7 @@ class ArmingCommands:
         if not self.port.simulated:
             self.port.statustext("Failure injection needs the simulator")
             return Outcome(d.MAV_RESULT_UNSUPPORTED)
-        params = tuple(float(round(v)) for v in args.params[:3])
+        unit, kind, instance = args.params[:3]
+        params = (float(round(unit)), float(round(kind)), float(whole_or(instance, 0)))
         seq = self.port.publish_command(CommandId.INJECT_FAILURE, params)
         return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from companion.link.codec import dialect as d
+from companion.link.command_rules import whole_or
 from companion.link.command_service import CommandArgs, CommandService, Outcome
 from companion.link.commands.port import VehiclePort
 from companion.link.identity import IdentityService
@@ -33,7 +34,7 @@ class MessageRequests:
         if msg_id == d.MAVLINK_MSG_ID_PROTOCOL_VERSION:
             return Outcome(extra=[self.identity.protocol_version()])
         if msg_id == d.MAVLINK_MSG_ID_AVAILABLE_MODES:
-            modes = available_modes(self.mav, round(args.params[1]))
+            modes = available_modes(self.mav, whole_or(args.params[1], 0))
             return Outcome(extra=modes) if modes else Outcome(d.MAV_RESULT_DENIED)
         if msg_id in STREAMS:
             msg = STREAMS[msg_id].build(self.mav, self.port.snapshot)

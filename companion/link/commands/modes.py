@@ -7,6 +7,7 @@ import math
 
 from companion.control.modes import decode_set_mode, from_standard
 from companion.link.codec import dialect as d
+from companion.link.command_rules import whole_or
 from companion.link.command_service import SET_MODE_MESSAGE, CommandArgs, CommandService, Outcome
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
 from companion.messages import CommandId, FlightMode
@@ -51,7 +52,8 @@ class ModeCommands:
         return self.to_commander(CommandId.SET_MODE, (float(mode),))
 
     def do_set_mode(self, args: CommandArgs) -> Outcome:
-        base, custom, sub = (round(v) for v in args.params[:3])
+        base, custom, sub = args.params[:3]
+        base, custom, sub = round(base), whole_or(custom, 0), whole_or(sub, 0)
         return self.set_mode(decode_set_mode(base, custom, sub, self.px4), "Set mode")
 
     def set_standard_mode(self, args: CommandArgs) -> Outcome:
@@ -62,7 +64,8 @@ class ModeCommands:
         return self.set_mode(decode_set_mode(base, custom, 0, self.px4), "SET_MODE")
 
     def mission_start(self, args: CommandArgs) -> Outcome:
-        return self.to_commander(CommandId.MISSION_START, args.params[:2])
+        first, last = whole_or(args.params[0], 0), whole_or(args.params[1], -1)
+        return self.to_commander(CommandId.MISSION_START, (float(first), float(last)))
 
     def rtl(self, args: CommandArgs) -> Outcome:
         return self.to_commander(CommandId.RETURN_TO_LAUNCH)
@@ -78,7 +81,8 @@ class ModeCommands:
         return self.to_commander(CommandId.LOITER, self.point(args))
 
     def set_home(self, args: CommandArgs) -> Outcome:
-        return self.to_commander(CommandId.SET_HOME, args.params)
+        use_current = float(whole_or(args.params[0], 0))
+        return self.to_commander(CommandId.SET_HOME, (use_current, *args.params[1:]))
 
     def point(self, args: CommandArgs) -> tuple[float, float, float]:
         """(lat, lon, alt AMSL) of params 5-7; NaN where not given (0, 0 = here)."""

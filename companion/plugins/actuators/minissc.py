@@ -7,6 +7,7 @@ channel goes to its safe position: throttle off, surfaces at trim.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -103,7 +104,15 @@ class MiniSscOutput(Plugin):
     def _positions(self, cmd: ActuatorCommand) -> dict[int, int]:
         if not cmd.armed:
             return dict(self.safe)
-        return {c.servo: c.position(surface_value(cmd, c.surface)) for c in self.airframe.channels}
+        positions = {}
+        for c in self.airframe.channels:
+            value = surface_value(cmd, c.surface)
+            if math.isfinite(value):
+                positions[c.servo] = c.position(value)
+            else:  # a broken command: this surface holds its last good position
+                self.ctx.health.frames_bad += 1
+                positions[c.servo] = self.wanted.get(c.servo, self.safe[c.servo])
+        return positions
 
     def _room(self) -> int:
         """Frames that fit in one cycle, less what is still queued for the wire."""

@@ -1,0 +1,147 @@
+"""What each accepted MAV_CMD's parameters may hold, checked before any handler runs.
+
+A rule names the parameter, its range, whether it is a whole number and whether NaN means
+"not given" (the spec gives NaN that meaning in DO_REPOSITION, NAV_LOITER_UNLIM and for
+unused parameters, which MAVSDK sends as NaN). Parameters a handler does not read have no
+rule and may hold anything. A broken rule is answered MAV_RESULT_DENIED with a status
+text that names the field; the handler never sees the command.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from companion.link.codec import dialect as d
+from companion.link.command_service import SET_MODE_MESSAGE, CommandArgs
+
+MAX_MSG_ID = 16_777_215  # MAVLink 2 message ids are 24 bits
+MAX_INTERVAL_US = 2**31 - 1
+MAX_ALT_M = 100_000.0
+
+
+@dataclass(frozen=True)
+class Param:
+    """One parameter's rule: 1-based index as the spec numbers them."""
+
+    index: int
+    name: str
+    lo: float
+    hi: float
+    optional: bool = False  # NaN means "not given"
+    whole: bool = False
+
+    def problem(self, value: float) -> str | None:
+        if math.isnan(value):
+            return None if self.optional else f"{self._label()} is NaN"
+        if math.isinf(value):
+            return f"{self._label()} is infinite"
+        if not self.lo <= value <= self.hi:
+            return f"{self._label()} {value:g} outside [{self.lo:g}, {self.hi:g}]"
+        if self.whole and value != round(value):
+            return f"{self._label()} {value:g} is not a whole number"
+        return None
+
+    def _label(self) -> str:
+        return f"param{self.index} ({self.name})"
+
+
+def _lat(i: int) -> Param:
+    return Param(i, "latitude", -90.0, 90.0, optional=True)
+
+
+def _lon(i: int) -> Param:
+    return Param(i, "longitude", -180.0, 180.0, optional=True)
+
+
+def _alt(i: int) -> Param:
+    return Param(i, "altitude", -MAX_ALT_M, MAX_ALT_M, optional=True)
+
+
+def _yaw(i: int) -> Param:
+    return Param(i, "yaw", -360.0, 360.0, optional=True)
+
+
+MSG_ID = Param(1, "message id", 0, MAX_MSG_ID, whole=True)
+POINT = (_lat(5), _lon(6), _alt(7))
+
+RULES: dict[int, tuple[Param, ...]] = {
+    d.MAV_CMD_COMPONENT_ARM_DISARM: (
+        Param(1, "arm", 0, 1),
+        Param(2, "force", -1e9, 1e9, optional=True, whole=True),
+    ),
+    d.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN: (Param(1, "autopilot", 0, 3, whole=True),),
+    d.MAV_CMD_INJECT_FAILURE: (
+        Param(1, "failure unit", 0, 255, whole=True),
+        Param(2, "failure type", 0, 255, whole=True),
+        Param(3, "instance", 0, 255, optional=True, whole=True),
+    ),
+    d.MAV_CMD_REQUEST_MESSAGE: (MSG_ID, Param(2, "index", 0, 65535, optional=True, whole=True)),
+    d.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES: (),
+    d.MAV_CMD_SET_MESSAGE_INTERVAL: (MSG_ID, Param(2, "interval", -1, MAX_INTERVAL_US)),
+    d.MAV_CMD_GET_MESSAGE_INTERVAL: (MSG_ID,),
+    d.MAV_CMD_DO_SET_MODE: (
+        Param(1, "base mode", 0, 255, whole=True),
+        Param(2, "custom mode", 0, 2**32 - 1, optional=True, whole=True),
+        Param(3, "custom sub mode", 0, 2**32 - 1, optional=True, whole=True),
+    ),
+    d.MAV_CMD_DO_SET_STANDARD_MODE: (Param(1, "standard mode", 0, 255, whole=True),),
+    SET_MODE_MESSAGE: (),  # integers on the wire: nothing to check
+    d.MAV_CMD_MISSION_START: (
+        Param(1, "first item", 0, 65535, optional=True, whole=True),
+        Param(2, "last item", 0, 65535, optional=True, whole=True),
+    ),
+    d.MAV_CMD_NAV_RETURN_TO_LAUNCH: (),
+    d.MAV_CMD_DO_REPOSITION: (
+        Param(1, "ground speed", -1, 1000, optional=True),
+        Param(3, "loiter radius", -1e5, 1e5, optional=True),
+        _yaw(4),
+        *POINT,
+    ),
+    d.MAV_CMD_NAV_LOITER_UNLIM: (Param(3, "radius", -1e5, 1e5, optional=True), _yaw(4), *POINT),
+    d.MAV_CMD_DO_SET_HOME: (Param(1, "use current", 0, 1, optional=True, whole=True), *POINT),
+}
+
+
+def _home_needs_a_point(args: CommandArgs) -> str | None:
+    if whole_or(args.params[0], 0) == 1:
+        return None
+    if any(math.isnan(v) for v in args.params[4:7]):
+        return "param5-7 (home position) not given"
+    return None
+
+
+EXTRA_CHECKS: dict[int, Callable[[CommandArgs], str | None]] = {
+    d.MAV_CMD_DO_SET_HOME: _home_needs_a_point,
+}
+
+
+GLOBAL_FRAMES = frozenset(
+    {
+        d.MAV_FRAME_GLOBAL,
+        d.MAV_FRAME_GLOBAL_INT,
+        d.MAV_FRAME_GLOBAL_RELATIVE_ALT,
+        d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+    }
+)
+POSITION_COMMANDS = frozenset(
+    {d.MAV_CMD_DO_REPOSITION, d.MAV_CMD_NAV_LOITER_UNLIM, d.MAV_CMD_DO_SET_HOME}
+)
+
+
+def refusal(args: CommandArgs) -> str | None:
+    """Why this command's parameters are refused, or None if they may go to its handler."""
+    if args.is_int and args.command in POSITION_COMMANDS and args.frame not in GLOBAL_FRAMES:
+        return f"frame {args.frame} not supported (global frames only)"
+    for rule in RULES.get(args.command, ()):
+        problem = rule.problem(args.params[rule.index - 1])
+        if problem is not None:
+            return problem
+    extra = EXTRA_CHECKS.get(args.command)
+    return extra(args) if extra is not None else None
+
+
+def whole_or(value: float, default: int) -> int:
+    """A checked optional whole-number parameter: its value, or ``default`` when NaN."""
+    return default if math.isnan(value) else round(value)
