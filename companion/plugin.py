@@ -55,6 +55,7 @@ class HealthCounters:
     frames_ok: int = 0
     frames_bad: int = 0
     dropped: int = 0
+    refused: int = 0  # well-formed input refused by its rules (NaN, out of range)
 
     def ok(self, n: int = 1) -> None:
         """Count good frames (or samples) accepted."""

@@ -51,7 +51,7 @@ def health_table(msg: SystemHealth) -> Table:
     table = Table(title=f"companion (supervisor pid {data['supervisor_pid']}, {armed})")
     for col in ("plug-in", "kind", "group", "state", "pid", "restarts", "CPU %", "RSS MiB"):
         table.add_column(col, justify="right" if col[0].isupper() or col == "pid" else "left")
-    for col in ("ok", "bad", "dropped", "step p50 µs", "p99 µs"):
+    for col in ("ok", "bad", "refused", "dropped", "step p50 µs", "p99 µs"):
         table.add_column(col, justify="right")
     for p in data["plugins"]:
         table.add_row(
@@ -65,6 +65,7 @@ def health_table(msg: SystemHealth) -> Table:
             f"{p['rss_kib'] / 1024:.0f}",
             str(p["frames_ok"]),
             str(p["frames_bad"]),
+            str(p["refused"]),
             str(p["dropped"]),
             _us(p["step_p50_us"]),
             _us(p["step_p99_us"]),

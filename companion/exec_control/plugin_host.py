@@ -97,6 +97,7 @@ class PluginHost:
         health = self.ctx.health
         msg.frames_ok, msg.frames_bad = health.frames_ok, health.frames_bad
         msg.dropped = health.dropped + self.bus.total_lost()
+        msg.refused = health.refused
         msg.step_p50_us = self.timer.percentile(0.5)
         msg.step_p99_us = self.timer.percentile(0.99)
         self.stats.publish(msg)

@@ -87,7 +87,10 @@ RULES: dict[int, tuple[Param, ...]] = {
         Param(3, "custom sub mode", 0, 2**32 - 1, optional=True, whole=True),
     ),
     d.MAV_CMD_DO_SET_STANDARD_MODE: (Param(1, "standard mode", 0, 255, whole=True),),
-    SET_MODE_MESSAGE: (),  # integers on the wire: nothing to check
+    SET_MODE_MESSAGE: (  # integers on the wire, unless a COMMAND_LONG borrows its number
+        Param(1, "base mode", 0, 255, whole=True),
+        Param(2, "custom mode", 0, 2**32 - 1, whole=True),
+    ),
     d.MAV_CMD_MISSION_START: (
         Param(1, "first item", 0, 65535, optional=True, whole=True),
         Param(2, "last item", 0, 65535, optional=True, whole=True),

@@ -32,6 +32,7 @@ class PluginStats(Message):
         ("frames_ok", ctypes.c_uint64),
         ("frames_bad", ctypes.c_uint64),  # checksum failures and garbage
         ("dropped", ctypes.c_uint64),  # samples lost on queue overflow
+        ("refused", ctypes.c_uint64),  # well-formed input refused by its rules
         ("step_p50_us", ctypes.c_double),
         ("step_p99_us", ctypes.c_double),
     ]
@@ -52,6 +53,7 @@ class PluginHealth(Message):
         ("frames_ok", ctypes.c_uint64),
         ("frames_bad", ctypes.c_uint64),
         ("dropped", ctypes.c_uint64),
+        ("refused", ctypes.c_uint64),
         ("step_p50_us", ctypes.c_double),
         ("step_p99_us", ctypes.c_double),
     ]

@@ -110,7 +110,7 @@ class MiniSscOutput(Plugin):
             if math.isfinite(value):
                 positions[c.servo] = c.position(value)
             else:  # a broken command: this surface holds its last good position
-                self.ctx.health.frames_bad += 1
+                self.ctx.health.refused += 1
                 positions[c.servo] = self.wanted.get(c.servo, self.safe[c.servo])
         return positions
 

@@ -268,6 +268,9 @@ class MavlinkLink(Plugin):
         self.router.stream_telemetry(self.snapshot, now_s)
         counts = self.router.counters
         self.ctx.health.frames_ok, self.ctx.health.frames_bad = counts.ok, counts.bad
+        self.ctx.health.refused = (
+            self.commands.refused + self._params_service.refused + self.missions.refused
+        )
 
     def has_commander(self) -> bool:
         """Whether the vehicle runs a commander to answer mode commands."""

@@ -3,42 +3,16 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 from pymavlink.dialects.v20 import common as m
 
 from companion.link.command_service import CommandArgs
 from companion.link.commands import ArmingCommands, ModeCommands
 from companion.link.service import Peer
-from companion.link.telemetry import Snapshot
 from companion.messages import CommandId, ControlStatus, VehicleStatus
+from tests.support.vehicle_port import RecordingVehicle
 
 GCS = Peer(255, 190, 0)
-
-
-@dataclass
-class RecordingVehicle:
-    """A VehiclePort that keeps what the handlers did (the bus side is the link's own)."""
-
-    snapshot: Snapshot = field(default_factory=Snapshot)
-    commander: bool = True
-    params: dict[str, float] = field(default_factory=lambda: {"SYS_FAILURE_EN": 0.0})
-    simulated: bool = True
-    published: list[tuple[int, tuple[float, ...]]] = field(default_factory=list)
-    texts: list[str] = field(default_factory=list)
-
-    def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
-        self.published.append((command, tuple(params)))
-        return len(self.published)
-
-    def statustext(self, text: str, severity: int = 4) -> None:
-        self.texts.append(text)
-
-    def has_commander(self) -> bool:
-        return self.commander
-
-    def param(self, name: str) -> float:
-        return self.params[name]
 
 
 def args(command: int, *params: float, frame: int = 0) -> CommandArgs:

@@ -1,0 +1,32 @@
+"""A VehiclePort for the link's command groups in process: it records what they did."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from companion.link.telemetry import Snapshot
+
+
+@dataclass
+class RecordingVehicle:
+    """A VehiclePort that keeps what the handlers did (the bus side is the link's own)."""
+
+    snapshot: Snapshot = field(default_factory=Snapshot)
+    commander: bool = True
+    params: dict[str, float] = field(default_factory=lambda: {"SYS_FAILURE_EN": 0.0})
+    simulated: bool = True
+    published: list[tuple[int, tuple[float, ...]]] = field(default_factory=list)
+    texts: list[str] = field(default_factory=list)
+
+    def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
+        self.published.append((command, tuple(params)))
+        return len(self.published)
+
+    def statustext(self, text: str, severity: int = 4) -> None:
+        self.texts.append(text)
+
+    def has_commander(self) -> bool:
+        return self.commander
+
+    def param(self, name: str) -> float:
+        return self.params[name]
