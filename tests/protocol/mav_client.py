@@ -11,6 +11,7 @@ os.environ.setdefault("MAVLINK20", "1")
 
 from pymavlink import mavutil
 
+from mavlink_dialect import companion as d
 from mavlink_dialect import companion as dialect
 
 
@@ -120,3 +121,18 @@ class GroundStation:
 
     def close(self) -> None:
         self.conn.close()
+
+
+def upload_mission(gcs: GroundStation) -> None:
+    """Upload a two-item mission (take-off, one waypoint) as QGroundControl does."""
+    mav = gcs.mav
+    items = [(d.MAV_CMD_NAV_TAKEOFF, 0.0), (d.MAV_CMD_NAV_WAYPOINT, 0.002)]
+    mav.mission_count_send(1, 1, len(items), d.MAV_MISSION_TYPE_MISSION)
+    for _ in items:
+        req = gcs.recv(["MISSION_REQUEST_INT", "MISSION_REQUEST"], 10)
+        cmd, dlat = items[req.seq]
+        mav.mission_item_int_send(
+            1, 1, req.seq, d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, cmd, 0, 1, 0, 0, 0, 0,
+            round((-37.9105 + dlat) * 1e7), round(145.134 * 1e7), 50, d.MAV_MISSION_TYPE_MISSION,
+        )  # fmt: skip
+    assert gcs.recv("MISSION_ACK", 10).type == d.MAV_MISSION_ACCEPTED

@@ -20,7 +20,7 @@ import pytest
 
 from companion.control.modes import MODES, FlightMode
 from mavlink_dialect import companion as d
-from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.protocol.mav_client import GroundStation, free_udp_port, upload_mission
 from tests.support.pty import Pty
 from tests.support.vehicle import REPO, companion_env, wait_for
 
@@ -270,20 +270,6 @@ def heartbeat(gcs: GroundStation):
 def armed(gcs: GroundStation) -> bool:
     beat = heartbeat(gcs)
     return beat is not None and bool(beat.base_mode & ARMED)
-
-
-def upload_mission(gcs: GroundStation) -> None:
-    mav = gcs.mav
-    items = [(d.MAV_CMD_NAV_TAKEOFF, 0.0), (d.MAV_CMD_NAV_WAYPOINT, 0.002)]
-    mav.mission_count_send(1, 1, len(items), d.MAV_MISSION_TYPE_MISSION)
-    for _ in items:
-        req = gcs.recv(["MISSION_REQUEST_INT", "MISSION_REQUEST"], 10)
-        cmd, dlat = items[req.seq]
-        mav.mission_item_int_send(
-            1, 1, req.seq, d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, cmd, 0, 1, 0, 0, 0, 0,
-            round((-37.9105 + dlat) * 1e7), round(145.134 * 1e7), 50, d.MAV_MISSION_TYPE_MISSION,
-        )  # fmt: skip
-    assert gcs.recv("MISSION_ACK", 10).type == d.MAV_MISSION_ACCEPTED
 
 
 def test_the_vehicle_config_can_start_the_bridge_as_a_plug_in(vehicle_factory, tmp_path):

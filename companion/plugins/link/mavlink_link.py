@@ -33,6 +33,7 @@ from companion.link.link_router import LinkRouter
 from companion.link.mission_service import MissionService
 from companion.link.mode_messages import current_mode, heartbeat_mode
 from companion.link.params_service import ParamsService
+from companion.link.refusal_texts import RefusalTexts
 from companion.link.service import Outgoing
 from companion.link.signing import key_from
 from companion.link.telemetry import Snapshot
@@ -145,6 +146,7 @@ class MavlinkLink(Plugin):
         services = [self.identity, self.commands, timesync]
         secret = ctx.settings["signing_key"]
         key = key_from(secret) if secret else None
+        self.refusal_text = RefusalTexts(self.statustext, time.monotonic)
         self.router = LinkRouter(self.mav, self.endpoints, services, key)
         self.gcs = GcsWatch()
         self.router.add_service(self.gcs)
@@ -153,6 +155,7 @@ class MavlinkLink(Plugin):
         self.missions = MissionService(self.mav, store, sysid, ctx.settings["compid"])
         self.router.add_service(self.missions)
         register_commands(self.commands, self, self.identity, self.router)
+        self.commands.on_refusal = self.refusal_text
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         self._seq = 0
 
@@ -160,7 +163,7 @@ class MavlinkLink(Plugin):
         path = Path(ctx.vehicle.get("state_dir", ".")) / "params.json"
         self.store = ParamStore(ctx.param_decls or self.params, path)
         service = ParamsService(self.mav, self.store, sysid, ctx.settings["compid"])
-        service.on_refusal = self.statustext
+        service.on_refusal = self.refusal_text
         service.on_change = self._param_changed
         self.router.add_service(service)
         self._apply_rates()

@@ -1,0 +1,81 @@
+"""A running vehicle under a hostile ground station's stream on UDP: nothing restarts,
+every command is answered, telemetry goes on, the stored mission and parameters stay."""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from collections import Counter
+from pathlib import Path
+
+from companion.messages import PluginState
+from mavlink_dialect import companion as d
+from tests.protocol.mav_client import GroundStation, client_vehicle, free_udp_port, upload_mission
+from tests.support.hostile import HostileStream
+from tests.support.vehicle import wait_for
+
+FRAMES = 6000
+BURST = 40  # frames sent between reads of what came back
+
+
+def state_digest(state: Path) -> dict[str, str]:
+    """Every stored file (missions, parameters) by its SHA-256."""
+    files = sorted(p for p in state.rglob("*") if p.is_file())
+    return {str(p.relative_to(state)): hashlib.sha256(p.read_bytes()).hexdigest() for p in files}
+
+
+def drain(gcs: GroundStation, acks: Counter, seen: Counter) -> None:
+    while (msg := gcs.conn.recv_match(blocking=False)) is not None:
+        seen[msg.get_type()] += 1
+        if msg.get_type() == "COMMAND_ACK":
+            acks[msg.command] += 1
+
+
+def attitude_rate(gcs: GroundStation, seconds: float) -> float:
+    count, end = 0, time.monotonic() + seconds
+    while time.monotonic() < end:
+        if gcs.conn.recv_match(type="ATTITUDE", blocking=True, timeout=0.1) is not None:
+            count += 1
+    return count / seconds
+
+
+def test_a_hostile_stream_changes_nothing_and_every_command_is_answered(vehicle_factory, tmp_path):
+    port, state = free_udp_port(), tmp_path / "state"
+    vehicle = vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", state))
+    gcs = GroundStation(port)
+    gcs.connect()
+    upload_mission(gcs)
+    gcs.mav.param_set_send(1, 1, b"SR_GPS", 3.0, 9)
+    gcs.recv("PARAM_VALUE", param_id="SR_GPS", param_value=3.0)
+    before = state_digest(state)
+    assert any("mission" in name for name in before) and "params.json" in before
+    rate_before = attitude_rate(gcs, 2.0)
+
+    stream, sent, acks, seen = HostileStream(seed=7), Counter(), Counter(), Counter()
+    for i in range(FRAMES):
+        frame = stream.frame()
+        gcs.conn.port.sendto(frame.data, gcs.conn.destination_addr)
+        if frame.command is not None:
+            sent[frame.command] += 1
+        if i % BURST == BURST - 1:
+            drain(gcs, acks, seen)
+            time.sleep(0.002)
+    try:
+        wait_for(lambda: drain(gcs, acks, seen) or acks == sent, 20, "an answer to every command")
+    except AssertionError:
+        missing = {c: (n, acks[c]) for c, n in sent.items() if acks[c] != n}
+        raise AssertionError(f"sent vs answered: {missing}; seen {dict(seen)}") from None
+
+    wait_for(lambda: vehicle.row("link").refused > 0, 10, "the link's refusals counted")
+    rows = {row.name.decode(): row for row in vehicle.health().rows()}
+    assert {name: row.restarts for name, row in rows.items()} == dict.fromkeys(rows, 0)
+    core = [row for row in rows.values() if row.group.decode() == "core"]
+    assert all(row.state == PluginState.RUNNING for row in core)
+    assert rows["flight"].state == PluginState.STOPPED  # nothing armed the vehicle
+    assert rows["link"].frames_bad > 0 and rows["link"].refused > 0
+    assert seen["ATTITUDE"] > 0  # telemetry went on during the stream
+    assert attitude_rate(gcs, 2.0) >= 0.5 * rate_before
+    assert state_digest(state) == before
+    gcs.mav.mission_request_list_send(1, 1, d.MAV_MISSION_TYPE_MISSION)
+    assert gcs.recv("MISSION_COUNT", 5, mission_type=0).count == 2
+    gcs.close()
