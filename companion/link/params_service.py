@@ -66,7 +66,7 @@ class ParamsService:
             return self.tick(now_s)
         if kind == "PARAM_REQUEST_READ":
             return self._read(msg, peer)
-        return self._set(msg)
+        return self._set(msg, peer)
 
     def _read(self, msg: Any, peer: Peer) -> list[Outgoing]:
         index = msg.param_index
@@ -79,7 +79,7 @@ class ParamsService:
             return []
         return [Outgoing(self.value(index), peer)]
 
-    def _set(self, msg: Any) -> list[Outgoing]:
+    def _set(self, msg: Any, peer: Peer) -> list[Outgoing]:
         name = _name(msg.param_id)
         if name not in self.store.decls:
             self.refused += 1
@@ -90,7 +90,10 @@ class ParamsService:
         except ParamError as exc:
             self.refused += 1
             self.on_refusal(f"Param refused: {exc}"[:50])
-        # Echo the value in force (the old one when refused) to every ground station.
+            # The old value, to the sender only: nothing changed for anyone else, and a
+            # flood of bad writes on one link must not be repeated on every other one.
+            return [Outgoing(self.value(self.store.index_of(name)), peer)]
+        # A change is news for every ground station.
         return [Outgoing(self.value(self.store.index_of(name)), None)]
 
     def tick(self, now_s: float) -> list[Outgoing]:
