@@ -89,7 +89,7 @@ class ParamsService:
             self.on_change(name, self.store.set(name, msg.param_value))
         except ParamError as exc:
             self.refused += 1
-            self.on_refusal(f"Param refused: {exc}"[:50])
+            self.on_refusal(f"Param refused: {exc}")
             # The old value, to the sender only: nothing changed for anyone else, and a
             # flood of bad writes on one link must not be repeated on every other one.
             return [Outgoing(self.value(self.store.index_of(name)), peer)]

@@ -149,9 +149,11 @@ def _vfr_hud(mav: Any, s: Snapshot) -> Any:
         return None
     ground = _f32(math.hypot(_finite(n.vn_m_s), _finite(n.ve_m_s)))
     heading = round(_deg360(n.yaw_rad)) % 360
-    throttle = 0
+    c = s.control  # while the flight controller runs: its airspeed estimate and throttle
+    airspeed = _f32(c.airspeed_m_s) if c is not None and math.isfinite(c.airspeed_m_s) else ground
+    throttle = round(100 * min(1.0, max(0.0, _finite(c.throttle)))) if c is not None else 0
     alt, climb = _f32(_finite(n.alt_msl_m)), _f32(-_finite(n.vd_m_s))
-    return mav.vfr_hud_encode(ground, ground, heading, throttle, alt, climb)
+    return mav.vfr_hud_encode(airspeed, ground, heading, throttle, alt, climb)
 
 
 def _sys_status(mav: Any, s: Snapshot) -> Any:

@@ -123,6 +123,7 @@ class ControlStatus(Message):
         ("airspeed_m_s", ctypes.c_double),  # estimated (no airspeed sensor): GPS and wind
         ("wind_n_m_s", ctypes.c_double),
         ("wind_e_m_s", ctypes.c_double),
+        ("throttle", ctypes.c_double),  # the throttle command, 0-1
         ("mission_seq", ctypes.c_int32),
         ("mission_state", ctypes.c_uint8),  # MissionState
         ("landed", ctypes.c_uint8),

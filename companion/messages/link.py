@@ -25,5 +25,5 @@ class StatusText(Message):
     _fields_ = [
         ("t_us", ctypes.c_int64),
         ("severity", ctypes.c_uint8),  # MAV_SEVERITY
-        ("text", ctypes.c_char * 51),
+        ("text", ctypes.c_char * 200),  # sent on MAVLink in 50-byte chunks when longer
     ]

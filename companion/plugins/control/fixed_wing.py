@@ -118,6 +118,7 @@ class FixedWingPlugin(Plugin):
         msg.alt_error_m, msg.aspd_error_m_s = out.alt_error, out.aspd_error
         msg.xtrack_error_m, msg.airspeed_m_s = out.xtrack, out.airspeed
         msg.wind_n_m_s, msg.wind_e_m_s = self.controller.wind.wind_ne
+        msg.throttle = out.throttle
         running = self.controller.executor is not None
         msg.mission_seq = self.controller.executor.current if running else 0
         if out.mission_finished:

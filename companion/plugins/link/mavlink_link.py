@@ -36,6 +36,7 @@ from companion.link.params_service import ParamsService
 from companion.link.refusal_texts import RefusalTexts
 from companion.link.service import Outgoing
 from companion.link.signing import key_from
+from companion.link.statustext import StatusTexts
 from companion.link.telemetry import Snapshot
 from companion.link.timesync import TimesyncService
 from companion.messages import ControlStatus, LinkStatus, ParamChange, VehicleCommand
@@ -147,6 +148,7 @@ class MavlinkLink(Plugin):
         secret = ctx.settings["signing_key"]
         key = key_from(secret) if secret else None
         self.refusal_text = RefusalTexts(self.statustext, time.monotonic)
+        self.texts_out = StatusTexts(self.mav)
         self.router = LinkRouter(self.mav, self.endpoints, services, key)
         self.gcs = GcsWatch()
         self.router.add_service(self.gcs)
@@ -188,8 +190,8 @@ class MavlinkLink(Plugin):
 
     def statustext(self, text: str, severity: int = d.MAV_SEVERITY_WARNING) -> None:
         """Tell every ground station (refusals, failsafes)."""
-        msg = self.mav.statustext_encode(severity, text.encode()[:50])
-        self.router.send([Outgoing(msg, None)], time.monotonic())
+        out = [Outgoing(msg, None) for msg in self.texts_out.encode(text, severity)]
+        self.router.send(out, time.monotonic())
 
     def _refresh_snapshot(self) -> None:
         s, r = self.snapshot, self.readers

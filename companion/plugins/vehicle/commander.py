@@ -118,7 +118,7 @@ class CommanderPlugin(Plugin):
         for action in self.failsafes.step(situation):
             self.ctx.log.warning("%s", action.text)
             msg = StatusText(t_us=now, severity=action.severity)
-            msg.text = action.text.encode()[:50]
+            msg.text = action.text.encode()[:199]
             self.texts.publish(msg)
             if action.mode is not None and action.mode != c.mode:
                 changed |= c.failsafe(FlightMode(action.mode)).result == 0
