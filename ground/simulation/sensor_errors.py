@@ -11,7 +11,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from companion.navigation.rotations import tilt_compensated_heading
 from ground.simulation.true_state import TrueState
 
 EARTH_RADIUS_M = 6378137.0
@@ -66,6 +65,16 @@ def body_from_ned(roll: float, pitch: float, yaw: float) -> np.ndarray:
             [cr * sp * cy + sr * sy, cr * sp * sy - sr * cy, cr * cp],
         ]
     )
+
+
+def levelled_heading_deg(mag_body: np.ndarray, roll: float, pitch: float) -> float:
+    """The heading a compass finds from its field, levelled by its own roll and pitch.
+
+    Rotating the body field back through roll and pitch leaves it in the heading frame
+    (x forward and level, y right), where magnetic north lies at minus the heading.
+    """
+    level = body_from_ned(roll, pitch, 0.0).T @ mag_body
+    return math.degrees(math.atan2(-level[1], level[0]))
 
 
 @dataclass
@@ -125,7 +134,7 @@ class SensorErrors:
         pitch = math.atan2(fx, math.hypot(fy, fz))
         pitch += math.radians(rng.normal(0.0, self.m.compass_tilt_deg * k))
         mag = body_from_ned(s.roll, s.pitch, s.yaw) @ self.field_ned
-        heading = math.degrees(tilt_compensated_heading(mag, roll, pitch))
+        heading = levelled_heading_deg(mag, roll, pitch)
         heading += rng.normal(0.0, self.m.compass_heading_deg * k)
         return heading % 360.0, math.degrees(pitch), math.degrees(roll)
 

@@ -8,12 +8,11 @@ import math
 import time
 from collections.abc import Callable
 
-from companion.actuators.airframe import load_airframe
-from companion.actuators.minissc import FrameDecoder
 from companion.bus.node import BusNode
 from companion.messages import SimClock, SimTruth
 from ground.simulation.sensor_errors import MagneticField, NoiseModel, SensorErrors
 from ground.simulation.true_state import TrueState
+from ground.sitl.bridge.airframe_file import read_airframe
 from ground.sitl.bridge.device_streams import EmulatedDevices
 from ground.sitl.bridge.failures import DeviceFailures
 from ground.sitl.bridge.fdm import Flight
@@ -27,6 +26,7 @@ from ground.sitl.bridge.lockstep import (
 )
 from ground.sitl.bridge.options import BridgeOptions
 from ground.sitl.bridge.ptys import PtyPort
+from ground.sitl.bridge.servo_card import MiniSscReader
 from ground.sitl.bridge.truth_log import TruthLog
 from ground.sitl.bridge.vehicle_commands import VehicleCommands
 
@@ -52,7 +52,7 @@ class SimBridge:
 
     def __init__(self, opts: BridgeOptions) -> None:
         self.opts = opts
-        self.airframe = load_airframe(opts.airframe)
+        self.airframe = read_airframe(opts.airframe)
         self.flight = Flight(
             self.airframe.jsbsim_model,
             opts.physics_hz,
@@ -68,8 +68,7 @@ class SimBridge:
         self.ports = {name: PtyPort(name) for name in (*SENSORS, "servos")}
         self.pending: list[tuple[float, int, str, bytes]] = []  # (release, order, port, data)
         self.order = 0
-        self.servo_decoder = FrameDecoder()
-        self.by_servo = {c.servo: c for c in self.airframe.channels}
+        self.servo_card = MiniSscReader()
         self.pacer = RealTime(opts.speed) if opts.speed else None
         exact = self.pacer is None and opts.sync_hz > 0
         stall_s = EXACT_STALL_S if exact else STALL_S
@@ -188,14 +187,14 @@ class SimBridge:
         )
 
     def _apply_servos(self) -> None:
-        frames = self.servo_decoder.feed(self.ports["servos"].read())
-        if not frames:
+        commands = self.servo_card.read(self.ports["servos"].read())
+        if not commands:
             return
         controls = {}
-        for servo, position in frames:
-            channel = self.by_servo.get(servo)
-            if channel is not None:
-                controls[channel.surface] = channel.command(position)
+        for received in commands:
+            servo = self.airframe.servos.get(received.servo)
+            if servo is not None:
+                controls[servo.surface] = servo.command(received.position)
         self.flight.set_controls(controls)
 
     def close(self) -> None:

@@ -1,7 +1,9 @@
 """The emulated devices' bytes: NMEA GPS, the OS-3000 ``$C`` sentence, VectorNav ``$VNIMU``.
 
 Each device turns the true state (through ``SensorErrors``) into the exact text the real
-part sends, at its own rate; NMEA is rendered by pynmea2.
+part sends, at its own rate. NMEA is rendered by pynmea2 and the other sentences are
+written here from the devices' manuals, with pynmea2's checksum: nothing is shared with
+the vehicle's parsers, so a parser bug cannot hide behind a matching writer.
 """
 
 from __future__ import annotations
@@ -12,7 +14,6 @@ from dataclasses import dataclass
 
 import pynmea2
 
-from companion.sensors.ascii_sentence import xor8
 from ground.simulation.sensor_errors import ImuSample, SensorErrors
 from ground.simulation.true_state import TrueState
 
@@ -25,7 +26,10 @@ def _ddmm(value: float, positive: str, negative: str, width: int) -> tuple[str, 
     hemi = positive if value >= 0 else negative
     value = abs(value)
     degrees = int(value)
-    return f"{degrees:0{width}d}{(value - degrees) * 60:09.6f}", hemi
+    minutes = (value - degrees) * 60
+    if round(minutes, 6) >= 60.0:  # would print as 60.000000, which no receiver sends
+        degrees, minutes = degrees + 1, 0.0
+    return f"{degrees:0{width}d}{minutes:09.6f}", hemi
 
 
 def nmea_epoch(
@@ -82,7 +86,7 @@ def nmea_epoch(
 
 def checked(body: str) -> bytes:
     """``$body*hh`` CR LF with the XOR checksum NMEA, the OS-3000 and VectorNav all use."""
-    return f"${body}*{xor8(body):02X}\r\n".encode()
+    return f"${body}*{pynmea2.NMEASentence.checksum(body):02X}\r\n".encode()
 
 
 def os3000_sentence(heading: float, pitch: float, roll: float, temp_c: float) -> bytes:

@@ -1,14 +1,40 @@
-"""The simulator's true state as a CSV in the design's estimate format."""
+"""The simulator's true state as a CSV in the design's estimate format.
+
+Columns ``t,roll,pitch,yaw,lat,lon,alt,vn,ve,vd``: seconds, radians (yaw in [-π, π] from
+north), degrees, metres above MSL, m/s (DESIGN.md). Written here rather than with the
+navigator's writer, so the truth and the estimate it judges come from separate code.
+"""
 
 from __future__ import annotations
 
-from companion.navigation.estimate_csv import EstimateWriter
+import math
+from pathlib import Path
+from typing import TextIO
+
 from ground.simulation.true_state import TrueState
 
+HEADER = "t,roll,pitch,yaw,lat,lon,alt,vn,ve,vd\n"
 
-class TruthLog(EstimateWriter):
-    """One row a frame."""
+
+class TruthLog:
+    """One row a frame; close() flushes (a crash loses at most the buffer)."""
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._file: TextIO = self.path.open("w", buffering=1 << 16)
+        self._file.write(HEADER)
+        self.rows = 0
 
     def add_state(self, s: TrueState) -> None:
-        """The true state as a row of the estimate format."""
-        self.add(s.t_s, s.roll, s.pitch, s.yaw, s.lat_deg, s.lon_deg, s.alt_msl_m, s.vn, s.ve, s.vd)
+        """The true state as a row."""
+        yaw = math.remainder(s.yaw, math.tau)
+        self._file.write(
+            f"{s.t_s:.4f},{s.roll:.6f},{s.pitch:.6f},{yaw:.6f},{s.lat_deg:.8f},"
+            f"{s.lon_deg:.8f},{s.alt_msl_m:.3f},{s.vn:.4f},{s.ve:.4f},{s.vd:.4f}\n"
+        )
+        self.rows += 1
+
+    def close(self) -> None:
+        """Flush and close."""
+        self._file.close()
