@@ -2,39 +2,27 @@
 
 from __future__ import annotations
 
-from companion.plugin import Plugin, PluginContext, Setting
-from companion.sensors.line_framer import LineFramer
+from collections.abc import Mapping
+from typing import Any
+
+from companion.messages import GpsFix
+from companion.plugin import PluginContext
+from companion.plugins.sensors.serial_sensor import SerialSensor, serial_settings
 from companion.sensors.nmea_gps import NmeaGpsDecoder
-from companion.sensors.serial_port import ReopeningSerial
 
 
-class NmeaGps(Plugin):
+class NmeaGps(SerialSensor[GpsFix]):
     """Reads sentences, publishes one GpsFix per epoch on sensors/gps."""
 
-    settings = {
-        "device": Setting(str, doc="serial:///dev/ttyUSB0:4800, a pty path or a pyserial URL"),
-        "baud": Setting(int, 4800, "baud rate when the URL does not give one", min=300),
-    }
+    settings = serial_settings("serial:///dev/ttyUSB0:4800", 4800)
     outputs = ("sensors/gps",)
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
-        self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"])
-        self.framer = LineFramer()
-        self.decoder = NmeaGpsDecoder()
         self.out = ctx.bus.writer("sensors/gps")
 
-    def step(self) -> None:
-        with self.ctx.bus.idle:  # waiting for the device is not busy time
-            data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
-        for sentence in self.framer.feed(data):
-            fix = self.decoder.decode(sentence, t_us)
-            if fix is not None:
-                self.out.publish(fix)
-        c = self.decoder.counters
-        self.ctx.health.frames_ok = c.ok
-        f = self.framer.counters
-        self.ctx.health.frames_bad = c.bad_checksum + c.garbage + f.overlong + f.garbage_runs
+    def make_decoder(self, settings: Mapping[str, Any]) -> NmeaGpsDecoder:
+        return NmeaGpsDecoder()
 
-    def close(self) -> None:
-        self.port.close()
+    def publish(self, reading: GpsFix, t_us: int) -> None:
+        self.out.publish(reading)

@@ -3,19 +3,19 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from typing import Any
 
-from companion.plugin import Plugin, PluginContext, Setting
-from companion.sensors.line_framer import LineFramer
-from companion.sensors.os3000 import Os3000Decoder
-from companion.sensors.serial_port import ReopeningSerial
+from companion.plugin import PluginContext, Setting
+from companion.plugins.sensors.serial_sensor import SerialSensor, serial_settings
+from companion.sensors.os3000 import Os3000Decoder, Os3000Reading
 
 
-class Os3000Compass(Plugin):
+class Os3000Compass(SerialSensor[Os3000Reading]):
     """Publishes compass attitude, and magnetometer readings when the sentence has them."""
 
     settings = {
-        "device": Setting(str, doc="serial:///dev/ttyS0:19200, a pty path or a pyserial URL"),
-        "baud": Setting(int, 19200, "baud rate when the URL does not give one", min=300),
+        **serial_settings("serial:///dev/ttyS0:19200", 19200),
         "mag_unit_gauss": Setting(float, 1e-3, "gauss per unit of the Mx/My/Mz fields", min=0.0),
         "declination_deg": Setting(
             float,
@@ -29,28 +29,16 @@ class Os3000Compass(Plugin):
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
-        self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"])
-        self.framer = LineFramer()
-        self.decoder = Os3000Decoder(ctx.settings["mag_unit_gauss"])
         self.compass = ctx.bus.writer("sensors/compass")
         self.mag = ctx.bus.writer("sensors/mag")
         self.declination_rad = math.radians(ctx.settings["declination_deg"])
 
-    def step(self) -> None:
-        with self.ctx.bus.idle:
-            data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
-        for sentence in self.framer.feed(data):
-            reading = self.decoder.decode(sentence, t_us)
-            if reading is None:
-                continue
-            heading = reading.compass.heading_rad + self.declination_rad
-            reading.compass.heading_rad = heading % math.tau
-            self.compass.publish(reading.compass)
-            if reading.mag is not None:
-                self.mag.publish(reading.mag)
-        c, f = self.decoder.counters, self.framer.counters
-        self.ctx.health.frames_ok = c.ok
-        self.ctx.health.frames_bad = c.bad_checksum + c.garbage + f.overlong + f.garbage_runs
+    def make_decoder(self, settings: Mapping[str, Any]) -> Os3000Decoder:
+        return Os3000Decoder(settings["mag_unit_gauss"])
 
-    def close(self) -> None:
-        self.port.close()
+    def publish(self, reading: Os3000Reading, t_us: int) -> None:
+        heading = reading.compass.heading_rad + self.declination_rad
+        reading.compass.heading_rad = heading % math.tau
+        self.compass.publish(reading.compass)
+        if reading.mag is not None:
+            self.mag.publish(reading.mag)

@@ -1,0 +1,82 @@
+"""What every line-based serial sensor plug-in does: read, frame, decode, publish, count.
+
+A subclass names its decoder (``make_decoder``) and what a reading becomes on the bus
+(``publish``); the port, the line framing, the time stamp and the health counters are
+here, once.
+"""
+
+from __future__ import annotations
+
+from abc import abstractmethod
+from collections.abc import Mapping
+from typing import Any, Generic, Protocol, TypeVar
+
+from companion.plugin import Plugin, PluginContext, Setting
+from companion.sensors.line_framer import LineFramer
+from companion.sensors.serial_port import ReopeningSerial
+
+ReadingT = TypeVar("ReadingT")
+ReadingT_co = TypeVar("ReadingT_co", covariant=True)
+
+
+class DecoderCounters(Protocol):
+    """The counters every sentence decoder keeps."""
+
+    ok: int
+    bad_checksum: int
+    garbage: int
+
+
+class SentenceDecoder(Protocol[ReadingT_co]):
+    """A pure decoder: one sentence and its reception time in, a reading or None out."""
+
+    @property
+    def counters(self) -> DecoderCounters:
+        """What it has accepted and refused."""
+        ...
+
+    def decode(self, sentence: bytes, t_us: int) -> ReadingT_co | None:
+        """The reading in one sentence; None when refused (and counted)."""
+        ...
+
+
+def serial_settings(example_url: str, baud: int) -> dict[str, Setting]:
+    """The ``device`` and ``baud`` settings, with the device's usual URL and rate."""
+    return {
+        "device": Setting(str, doc=f"{example_url}, a pty path or a pyserial URL"),
+        "baud": Setting(int, baud, "baud rate when the URL does not give one", min=300),
+    }
+
+
+class SerialSensor(Plugin, Generic[ReadingT]):
+    """A sensor that sends text lines on a serial port (or pty, socket, loop)."""
+
+    decoder: SentenceDecoder[ReadingT]
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"])
+        self.framer = LineFramer()
+        self.decoder = self.make_decoder(ctx.settings)
+
+    @abstractmethod
+    def make_decoder(self, settings: Mapping[str, Any]) -> SentenceDecoder[ReadingT]:
+        """The device's decoder, configured from the plug-in's settings."""
+
+    @abstractmethod
+    def publish(self, reading: ReadingT, t_us: int) -> None:
+        """Put one decoded reading on the bus."""
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:  # waiting for the device is not busy time
+            data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
+        for sentence in self.framer.feed(data):
+            reading = self.decoder.decode(sentence, t_us)
+            if reading is not None:
+                self.publish(reading, t_us)
+        c, f = self.decoder.counters, self.framer.counters
+        self.ctx.health.frames_ok = c.ok
+        self.ctx.health.frames_bad = c.bad_checksum + c.garbage + f.overlong + f.garbage_runs
+
+    def close(self) -> None:
+        self.port.close()
