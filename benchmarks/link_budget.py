@@ -34,30 +34,20 @@ os.environ.setdefault("MAVLINK20", "1")
 from mavlink_dialect import companion as m
 
 REPO = Path(__file__).resolve().parents[1]
-VEHICLE = """
-[vehicle]
-name = "linkbench"
-state_dir = "{state}"
-[[plugins]]
-name = "link"
-plugin = "link.mavlink"
-settings = {{ endpoints = ["{endpoint}"] }}
-[[plugins]]
-name = "nav"
-plugin = "tests.support.plugins:FakeNav"
-[[plugins]]
-name = "imu"
-plugin = "tests.support.plugins:Ticker"
-settings = {{ rate_hz = 200.0 }}
-[[plugins]]
-name = "commander"
-plugin = "vehicle.commander"
-[[plugins]]
-name = "control"
-plugin = "control.fixed_wing"
-group = "flight"
-settings = {{ airframe = "c172p" }}
-"""
+sys.path.insert(0, str(REPO))
+from tests.support.configs import TICKER, client_vehicle, plugin  # noqa: E402
+
+
+def vehicle(endpoint: str, state: Path) -> str:
+    """A known navigation solution, a 200 Hz IMU, the commander and the real controller
+    (whose parameters the ground station downloads)."""
+    return client_vehicle(
+        endpoint,
+        state,
+        extra=(plugin("imu", TICKER, rate_hz=200.0),),
+        flight=plugin("control", "control.fixed_wing", "flight", airframe="c172p"),
+        name="linkbench",
+    )
 
 
 def wait_for_heartbeat(master: int, parser: Any, timeout_s: float = 60.0) -> None:
@@ -74,7 +64,7 @@ def wait_for_heartbeat(master: int, parser: Any, timeout_s: float = 60.0) -> Non
 
 def start_vehicle(endpoint: str, tmp: Path, namespace: str) -> subprocess.Popen[bytes]:
     config = tmp / f"{namespace}.toml"
-    config.write_text(VEHICLE.format(state=tmp / namespace, endpoint=endpoint))
+    config.write_text(vehicle(endpoint, tmp / namespace))
     env = {**os.environ, "COMPANION_BUS": namespace, "PYTHONPATH": str(REPO)}
     return subprocess.Popen(
         [sys.executable, "-m", "companion", "run", "-c", str(config), "--log-level", "WARNING"],

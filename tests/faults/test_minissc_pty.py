@@ -9,6 +9,7 @@ import pytest
 from companion.actuators.airframe import load_airframe
 from companion.actuators.minissc import FrameDecoder, pulse_us
 from companion.messages import ActuatorCommand, CommandId, VehicleCommand
+from tests.support.configs import plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
 
@@ -43,17 +44,10 @@ def command(**surfaces: float) -> ActuatorCommand:
 
 def start_servos(vehicle_factory, tmp_path, airframe: str):
     pty = Pty(tmp_path / "ttyServo")
-    vehicle = vehicle_factory(
-        f"""
-        [vehicle]
-        name = "servos"
-        [[plugins]]
-        name = "servos"
-        plugin = "actuators.minissc"
-        group = "flight"
-        settings = {{ device = "{pty.link}", airframe = "{airframe}", stale_s = 0.3 }}
-        """
+    servos = plugin(
+        "servos", "actuators.minissc", "flight", device=pty.link, airframe=airframe, stale_s=0.3
     )
+    vehicle = vehicle_factory(vehicle_config("servos", servos))
     card = CardEnd(pty)
     commands = vehicle.bus.writer("link/commands")
     wait_for(vehicle.health, 10, "the execution control's health table")

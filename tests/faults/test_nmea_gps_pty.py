@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 
+from tests.support.configs import plugin, vehicle_config
 from tests.support.nmea import gga, rmc
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
@@ -16,16 +17,8 @@ LAT, LON = -37.9105, 145.134
 def test_fixes_junk_and_a_device_that_vanishes_and_returns(vehicle_factory, tmp_path):
     device = tmp_path / "ttyGPS"
     pty = Pty(device)
-    vehicle = vehicle_factory(
-        f"""
-        [vehicle]
-        name = "gps"
-        [[plugins]]
-        name = "gps"
-        plugin = "sensors.nmea_gps"
-        settings = {{ device = "serial://{device}:9600" }}
-        """
-    )
+    gps = plugin("gps", "sensors.nmea_gps", device=f"serial://{device}:9600")
+    vehicle = vehicle_factory(vehicle_config("gps", gps))
     fixes = vehicle.bus.queue_reader("sensors/gps")
     vehicle.wait_running("gps")
     got = []

@@ -6,6 +6,7 @@ import math
 
 import pytest
 
+from tests.support.configs import plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
 from tests.unit.devices.test_os3000 import sentence
@@ -14,16 +15,8 @@ from tests.unit.devices.test_os3000 import sentence
 @pytest.mark.timeout(60)
 def test_compass_and_magnetometer_from_a_pty(vehicle_factory, tmp_path):
     pty = Pty(tmp_path / "ttyCompass")
-    vehicle = vehicle_factory(
-        f"""
-        [vehicle]
-        name = "compass"
-        [[plugins]]
-        name = "compass"
-        plugin = "sensors.os3000"
-        settings = {{ device = "{pty.link}" }}
-        """
-    )
+    compass_plugin = plugin("compass", "sensors.os3000", device=pty.link)
+    vehicle = vehicle_factory(vehicle_config("compass", compass_plugin))
     compass = vehicle.bus.queue_reader("sensors/compass")
     mag = vehicle.bus.queue_reader("sensors/mag")
     vehicle.wait_running("compass")

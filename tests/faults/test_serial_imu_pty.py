@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from tests.support.configs import plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
 from tests.unit.devices.test_vectornav import IMU, crc16, xor8
@@ -16,14 +17,7 @@ TRUNCATED = GOOD[:30] + "\r\n"
 
 def imu_vehicle(vehicle_factory, pty: Pty):
     return vehicle_factory(
-        f"""
-        [vehicle]
-        name = "imu"
-        [[plugins]]
-        name = "imu"
-        plugin = "sensors.serial_imu"
-        settings = {{ device = "{pty.link}" }}
-        """
+        vehicle_config("imu", plugin("imu", "sensors.serial_imu", device=pty.link))
     )
 
 

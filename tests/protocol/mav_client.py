@@ -21,62 +21,6 @@ def free_udp_port() -> int:
         return sock.getsockname()[1]
 
 
-LINK_VEHICLE = """
-[vehicle]
-name = "linktest"
-sysid = 1
-state_dir = "{state}"
-
-[[plugins]]
-name = "link"
-plugin = "link.mavlink"
-settings = {{ endpoints = ["udpin://127.0.0.1:{port}{query}"] }}
-
-[[plugins]]
-name = "nav"
-plugin = "tests.support.plugins:FakeNav"
-
-[[plugins]]
-name = "imu"
-plugin = "tests.support.plugins:Ticker"
-
-[[plugins]]
-name = "relay_in_flight"
-plugin = "tests.support.plugins:Waiting"
-group = "flight"
-"""
-
-
-CLIENT_VEHICLE = """
-[vehicle]
-name = "client"
-state_dir = "{state}"
-
-[[plugins]]
-name = "link"
-plugin = "link.mavlink"
-settings = {{ endpoints = ["{endpoint}"] }}
-
-[[plugins]]
-name = "nav"
-plugin = "tests.support.plugins:FakeNav"
-
-[[plugins]]
-name = "commander"
-plugin = "vehicle.commander"
-
-[[plugins]]
-name = "flight"
-plugin = "tests.support.plugins:Waiting"
-group = "flight"
-"""
-
-
-def client_vehicle(endpoint: str, state: object) -> str:
-    """A vehicle with the link on ``endpoint``, a known navigation solution, a flight group."""
-    return CLIENT_VEHICLE.format(endpoint=endpoint, state=state)
-
-
 class GroundStation:
     """QGroundControl's identity (sysid 255, compid 190) speaking to the vehicle's udpin."""
 

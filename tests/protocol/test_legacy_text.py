@@ -21,6 +21,7 @@ import pytest
 from companion.control.modes import MODES, FlightMode
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import GroundStation, free_udp_port, upload_mission
+from tests.support.configs import PluginEntry, flight_group, link, plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import REPO, companion_env, wait_for
 
@@ -30,35 +31,22 @@ MISSION_MODES = {m.px4 for m in MODES if m.mode == FlightMode.MISSION} | {
     m.arduplane for m in MODES if m.mode == FlightMode.MISSION
 }
 
-VEHICLE = """
-[vehicle]
-name = "legacy"
-sysid = 1
-state_dir = "{state}"
 
-[[plugins]]
-name = "link"
-plugin = "link.mavlink"
-settings = {{ endpoints = ["udpin://127.0.0.1:{bridge_port}", "udpin://127.0.0.1:{gcs_port}"] }}
-
-[[plugins]]
-name = "replay"
-plugin = "sensors.replay"
-settings = {{ file = "{log}", speed = 1.0, loop = true }}
-
-[[plugins]]
-name = "nav"
-plugin = "nav.gps_compass"
-
-[[plugins]]
-name = "commander"
-plugin = "vehicle.commander"
-
-[[plugins]]
-name = "flight"
-plugin = "tests.support.plugins:Waiting"
-group = "flight"
-"""
+def legacy_vehicle(
+    state: Path, log: Path, bridge_port: int, gcs_port: int, *more: PluginEntry
+) -> str:
+    """A replayed flight, the GPS-compass navigator, the commander, and a link for each side."""
+    return vehicle_config(
+        "legacy",
+        link(f"udpin://127.0.0.1:{bridge_port}", f"udpin://127.0.0.1:{gcs_port}"),
+        plugin("replay", "sensors.replay", file=log, speed=1.0, loop=True),
+        plugin("nav", "nav.gps_compass"),
+        plugin("commander", "vehicle.commander"),
+        flight_group(),
+        *more,
+        sysid=1,
+        state_dir=state,
+    )
 
 
 def write_flight_log(path: Path, seconds: float = 120.0) -> None:
@@ -140,7 +128,7 @@ def setup(vehicle_factory, tmp_path):
     log = tmp_path / "flight.csv"
     write_flight_log(log)
     bridge_port, gcs_port = free_udp_port(), free_udp_port()
-    config = VEHICLE.format(state=tmp_path, log=log, bridge_port=bridge_port, gcs_port=gcs_port)
+    config = legacy_vehicle(tmp_path, log, bridge_port, gcs_port)
     vehicle_factory(config)
     gcs = GroundStation(gcs_port)
     gcs.connect(timeout_s=30)
@@ -278,12 +266,13 @@ def test_the_vehicle_config_can_start_the_bridge_as_a_plug_in(vehicle_factory, t
     write_flight_log(log)
     bridge_port, gcs_port = free_udp_port(), free_udp_port()
     pty = Pty(tmp_path / "ttyRadio")
-    config = VEHICLE.format(state=tmp_path, log=log, bridge_port=bridge_port, gcs_port=gcs_port)
-    config += (
-        '\n[[plugins]]\nname = "legacy"\nplugin = "bridge.legacy_text"\n'
-        f'settings = {{ serial = "{pty.link}", mavlink = "udpout://127.0.0.1:{bridge_port}" }}\n'
+    bridge = plugin(
+        "legacy",
+        "bridge.legacy_text",
+        serial=pty.link,
+        mavlink=f"udpout://127.0.0.1:{bridge_port}",
     )
-    vehicle = vehicle_factory(config)
+    vehicle = vehicle_factory(legacy_vehicle(tmp_path, log, bridge_port, gcs_port, bridge))
     gcs = GroundStation(gcs_port)
     gcs.connect(timeout_s=30)
     station = OldGroundStation(pty)

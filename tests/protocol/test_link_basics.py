@@ -7,7 +7,8 @@ import time
 import pytest
 from pymavlink.dialects.v20 import common as m
 
-from tests.protocol.mav_client import LINK_VEHICLE, GroundStation, client_vehicle, free_udp_port
+from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.support.configs import client_vehicle, link_vehicle
 from tests.support.plugins import FakeNav
 from tests.support.vehicle import wait_for
 
@@ -15,7 +16,7 @@ from tests.support.vehicle import wait_for
 @pytest.fixture
 def link(vehicle_factory, tmp_path):
     port = free_udp_port()
-    vehicle = vehicle_factory(LINK_VEHICLE.format(port=port, query="", state=tmp_path))
+    vehicle = vehicle_factory(link_vehicle(f"udpin://127.0.0.1:{port}", tmp_path))
     gcs = GroundStation(port)
     heartbeat = gcs.connect()
     yield vehicle, gcs, heartbeat

@@ -8,12 +8,13 @@ from pymavlink import mavutil
 from pymavlink.dialects.v20 import common as m
 
 from companion.link.link_budget import LinkBudget
-from tests.protocol.mav_client import LINK_VEHICLE, GroundStation, free_udp_port
+from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.support.configs import link_vehicle
 
 
 def start(vehicle_factory, query: str, tmp_path) -> GroundStation:
     port = free_udp_port()
-    vehicle_factory(LINK_VEHICLE.format(port=port, query=query, state=tmp_path))
+    vehicle_factory(link_vehicle(f"udpin://127.0.0.1:{port}{query}", tmp_path))
     gcs = GroundStation(port)
     gcs.connect()
     return gcs

@@ -14,7 +14,8 @@ import pytest
 
 from companion.control.failsafe import FAILSAFE_PARAMS
 from companion.plugins.link.mavlink_link import MavlinkLink
-from tests.protocol.mav_client import client_vehicle, free_udp_port
+from tests.protocol.mav_client import free_udp_port
+from tests.support.configs import client_vehicle
 from tests.support.vehicle import wait_for
 
 WAYPOINTS = """QGC WPL 110

@@ -15,7 +15,8 @@ from mavsdk.component_type import ComponentType
 from mavsdk.plugins.failure import FailureError, FailureType, FailureUnit
 from mavsdk.plugins.mission_raw import MissionItem
 
-from tests.protocol.mav_client import client_vehicle, free_udp_port
+from tests.protocol.mav_client import free_udp_port
+from tests.support.configs import client_vehicle
 from tests.support.plugins import FakeNav
 from tests.support.vehicle import wait_for
 

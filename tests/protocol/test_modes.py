@@ -12,7 +12,8 @@ from companion.control.mission.store import MissionStore
 from companion.control.modes import BY_MODE, MODES
 from companion.messages import FlightMode
 from mavlink_dialect import companion as m
-from tests.protocol.mav_client import GroundStation, client_vehicle, free_udp_port
+from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.support.configs import client_vehicle
 from tests.support.vehicle import REPO, wait_for
 
 PX4 = {mode: BY_MODE[mode].px4 for mode in FlightMode}

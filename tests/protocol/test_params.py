@@ -7,14 +7,15 @@ import time
 import pytest
 from pymavlink.dialects.v20 import common as m
 
-from tests.protocol.mav_client import LINK_VEHICLE, GroundStation, free_udp_port
+from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.support.configs import link_vehicle
 
 
 @pytest.fixture
 def vehicle_and_gcs(vehicle_factory, tmp_path):
     def start():
         port = free_udp_port()
-        vehicle = vehicle_factory(LINK_VEHICLE.format(port=port, query="", state=tmp_path))
+        vehicle = vehicle_factory(link_vehicle(f"udpin://127.0.0.1:{port}", tmp_path))
         gcs = GroundStation(port)
         gcs.connect()
         return vehicle, gcs

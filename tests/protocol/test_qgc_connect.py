@@ -5,7 +5,8 @@ from __future__ import annotations
 import time
 
 from mavlink_dialect import companion as m
-from tests.protocol.mav_client import LINK_VEHICLE, GroundStation, free_udp_port
+from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.support.configs import link_vehicle
 
 
 def ask(gcs: GroundStation, msg_id: int, expect: int, timeout_s: float = 1.0):
@@ -19,7 +20,7 @@ def ask(gcs: GroundStation, msg_id: int, expect: int, timeout_s: float = 1.0):
 
 def test_qgroundcontrol_connect_sequence_gets_every_answer_at_once(vehicle_factory, tmp_path):
     port = free_udp_port()
-    vehicle_factory(LINK_VEHICLE.format(port=port, query="", state=tmp_path))
+    vehicle_factory(link_vehicle(f"udpin://127.0.0.1:{port}", tmp_path))
     gcs = GroundStation(port)  # sysid 255, compid 190, as QGroundControl
     gcs.connect()
 

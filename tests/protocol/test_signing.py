@@ -9,21 +9,15 @@ import pytest
 from pymavlink.dialects.v20 import common as m
 
 from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.support.configs import FAKE_NAV, link, plugin, vehicle_config
 from tests.support.vehicle import wait_for
 
-SIGNED_VEHICLE = """
-[vehicle]
-name = "signed"
 
-[[plugins]]
-name = "link"
-plugin = "link.mavlink"
-settings = {{ endpoints = ["udpin://127.0.0.1:{port}?signing=required"], signing_key = "{key}" }}
+def signed_vehicle(port: int, key: str, scheme: str = "udpin") -> str:
+    endpoint = f"{scheme}://127.0.0.1:{port}?signing=required"
+    return vehicle_config("signed", link(endpoint, signing_key=key), plugin("nav", FAKE_NAV))
 
-[[plugins]]
-name = "nav"
-plugin = "tests.support.plugins:FakeNav"
-"""
+
 PASSPHRASE = "monash clayton 2006"
 
 
@@ -38,7 +32,7 @@ def no_ack(gcs: GroundStation, command: int, wait_s: float = 1.0) -> bool:
 @pytest.fixture
 def signed(vehicle_factory):
     port = free_udp_port()
-    vehicle = vehicle_factory(SIGNED_VEHICLE.format(port=port, key=PASSPHRASE))
+    vehicle = vehicle_factory(signed_vehicle(port, PASSPHRASE))
     yield vehicle, port
 
 
@@ -89,9 +83,9 @@ def test_required_signing_without_a_key_is_a_config_error(tmp_path):
     from companion.exec_control.config import ConfigError, load_config
 
     path = tmp_path / "v.toml"
-    path.write_text(SIGNED_VEHICLE.format(port=14999, key=""))
+    path.write_text(signed_vehicle(14999, ""))
     with pytest.raises(ConfigError, match="asks for signing but signing_key is empty"):
         load_config(path)
-    path.write_text(SIGNED_VEHICLE.format(port=14999, key=PASSPHRASE).replace("udpin", "udpp"))
+    path.write_text(signed_vehicle(14999, PASSPHRASE, scheme="udpp"))
     with pytest.raises(ConfigError, match="scheme must be one of"):
         load_config(path)

@@ -11,6 +11,7 @@ import pytest
 
 from companion.bus import BusNode, cleanup_namespace
 from companion.messages import Imu, NavState
+from tests.support.configs import PUBLISH_ONCE, plugin, vehicle_config
 from tests.support.vehicle import REPO, assert_clean, unique_namespace, wait_for
 
 WRITER = textwrap.dedent(
@@ -99,16 +100,7 @@ def test_latest_reader_that_joins_late_still_gets_the_newest_value(namespace):
 
 
 def test_a_value_published_once_reaches_a_reader_that_connects_much_later(vehicle_factory):
-    vehicle = vehicle_factory(
-        """
-        [vehicle]
-        name = "once"
-
-        [[plugins]]
-        name = "once"
-        plugin = "tests.support.plugins:PublishOnce"
-        """
-    )
+    vehicle = vehicle_factory(vehicle_config("once", plugin("once", PUBLISH_ONCE)))
     vehicle.wait_running("once")
     time.sleep(0.5)  # long after the only publication
     late = vehicle.bus.latest_reader("nav/state")

@@ -11,22 +11,13 @@ import pytest
 
 from companion.exec_control.config import ConfigError, load_config
 from companion.exec_control.topology import check_topology
+from tests.support.configs import RELAY, TICKER, WAITING, plugin, vehicle_config
 from tests.support.vehicle import REPO, companion_env
 
-GOOD = """\
-[vehicle]
-name = "v"
-
-[[plugins]]
-name = "imu"
-plugin = "tests.support.plugins:Ticker"
-settings = { rate_hz = 20.0 }
-
-[[plugins]]
-name = "relay"
-plugin = "tests.support.plugins:Relay"
-group = "flight"
-"""
+# The line numbers below are those of this layout (see tests.support.configs).
+GOOD = vehicle_config(
+    "v", plugin("imu", TICKER, rate_hz=20.0), plugin("relay", RELAY, group="flight")
+)
 
 
 def write(tmp_path: Path, text: str) -> Path:
@@ -93,10 +84,10 @@ def test_topology_errors(tmp_path):
         ),
     )
     assert "reads 'sensors/imu' but no plug-in in the config writes it" in str(err)
-    twice = GOOD + '\n[[plugins]]\nname = "relay2"\nplugin = "tests.support.plugins:Relay"\n'
+    twice = GOOD + "\n" + plugin("relay2", RELAY).toml()
     err = refuse(tmp_path, twice)
     assert "two producers" in str(err) and err.line == 14
-    dup = GOOD + '\n[[plugins]]\nname = "imu"\nplugin = "tests.support.plugins:Waiting"\n'
+    dup = GOOD + "\n" + plugin("imu", WAITING).toml()
     assert "used twice" in str(refuse(tmp_path, dup))
 
 
@@ -140,15 +131,7 @@ def test_registered_short_names_resolve_and_misspellings_get_a_suggestion(tmp_pa
     assert "did you mean 'link.mavlink'" in str(err)
 
 
-SIM_DEVICE = """\
-[vehicle]
-name = "v"
-
-[[plugins]]
-name = "gps"
-plugin = "sensors.nmea_gps"
-settings = { device = "sim://gps" }
-"""
+SIM_DEVICE = vehicle_config("v", plugin("gps", "sensors.nmea_gps", device="sim://gps"))
 
 
 def test_simulated_devices_outside_the_simulator_are_refused(tmp_path):

@@ -9,7 +9,7 @@ import time
 
 import psutil
 
-from tests.runtime.configs import pipeline
+from tests.support.configs import pipeline
 from tests.support.vehicle import REPO, assert_clean, companion_env, unique_namespace, wait_for
 
 

@@ -7,9 +7,15 @@ import math
 import pytest
 
 from companion.messages import CommandId, NavFlags, VehicleCommand
+from tests.support.configs import PluginEntry, plugin, vehicle_config
 from tests.support.vehicle import wait_for
 
 ROWS = 100
+
+
+def replay(log, speed: float) -> PluginEntry:
+    """The replay in the flight group: it starts only once the readers exist."""
+    return plugin("replay", "sensors.replay", group="flight", file=log, speed=speed)
 
 
 def make_log(path):
@@ -27,17 +33,7 @@ def make_log(path):
 def test_replay_publishes_every_sample_in_order_with_log_times(vehicle_factory, tmp_path):
     log = tmp_path / "flight.csv"
     make_log(log)
-    vehicle = vehicle_factory(
-        f"""
-        [vehicle]
-        name = "replay"
-        [[plugins]]
-        name = "replay"
-        plugin = "sensors.replay"
-        group = "flight"
-        settings = {{ file = "{log}", speed = 4.0 }}
-        """
-    )
+    vehicle = vehicle_factory(vehicle_config("replay", replay(log, 4.0)))
     imu = vehicle.bus.queue_reader("sensors/imu")
     gps = vehicle.bus.queue_reader("sensors/gps")
     commands = vehicle.bus.writer("link/commands")
@@ -71,18 +67,7 @@ def test_replayed_gps_and_compass_reach_nav_state_through_gps_compass(vehicle_fa
         lines.append(f"{t:.2f},compass,,,,,,,,,,,,,,,,,,,5.0,1.0,-2.0")
     log.write_text("\n".join(lines) + "\n")
     vehicle = vehicle_factory(
-        f"""
-        [vehicle]
-        name = "navchain"
-        [[plugins]]
-        name = "nav"
-        plugin = "nav.gps_compass"
-        [[plugins]]
-        name = "replay"
-        plugin = "sensors.replay"
-        group = "flight"
-        settings = {{ file = "{log}", speed = 2.0 }}
-        """
+        vehicle_config("navchain", plugin("nav", "nav.gps_compass"), replay(log, 2.0))
     )
     nav = vehicle.bus.latest_reader("nav/state")
     # Start the replay only once the navigator has its inputs open (its first step done):
@@ -109,21 +94,8 @@ def test_replayed_imu_gps_and_magnetometer_reach_nav_state_through_ins_ekf(
     log = tmp_path / "flight.csv"
     synthetic = synthesize(FlightSpec(legs=(Leg(12),), heading_deg=90.0, seed=2))
     synthetic.write(log)
-    vehicle = vehicle_factory(
-        f"""
-        [vehicle]
-        name = "inschain"
-        [[plugins]]
-        name = "nav"
-        plugin = "nav.ins_ekf"
-        settings = {{ declination_deg = 11.7 }}
-        [[plugins]]
-        name = "replay"
-        plugin = "sensors.replay"
-        group = "flight"
-        settings = {{ file = "{log}", speed = 2.0 }}
-        """
-    )
+    nav_plugin = plugin("nav", "nav.ins_ekf", declination_deg=11.7)
+    vehicle = vehicle_factory(vehicle_config("inschain", nav_plugin, replay(log, 2.0)))
     nav = vehicle.bus.latest_reader("nav/state")
     wait_for(lambda: (r := vehicle.row("nav")) is not None and r.step_p50_us > 0, 30, "nav up")
     vehicle.bus.writer("link/commands").publish(

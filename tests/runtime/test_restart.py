@@ -6,7 +6,7 @@ import os
 import signal
 import time
 
-from tests.runtime.configs import pipeline
+from tests.support.configs import CRASH_AFTER, pipeline, plugin, vehicle_config
 from tests.support.vehicle import wait_for
 
 
@@ -60,15 +60,6 @@ def test_restart_happens_within_one_second_of_the_death(vehicle_factory):
 
 
 def test_a_plugin_that_raises_is_restarted_with_back_off(vehicle_factory):
-    vehicle = vehicle_factory(
-        """
-        [vehicle]
-        name = "crashy"
-        [[plugins]]
-        name = "crash"
-        plugin = "tests.support.plugins:CrashAfter"
-        settings = { steps = 3 }
-        """
-    )
+    vehicle = vehicle_factory(vehicle_config("crashy", plugin("crash", CRASH_AFTER, steps=3)))
     wait_for(lambda: (r := vehicle.row("crash")) and r.restarts >= 3, 15, "three restarts")
     assert vehicle.proc.poll() is None, "the supervisor must survive its plug-ins"

@@ -8,7 +8,7 @@ import signal
 import psutil
 import pytest
 
-from tests.runtime.configs import pipeline
+from tests.support.configs import pipeline
 from tests.support.vehicle import assert_clean, wait_for
 
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from companion.messages import CommandId, CommandResult, PluginState, VehicleCommand
-from tests.runtime.configs import pipeline
+from tests.support.configs import pipeline
 from tests.support.vehicle import wait_for
 
 

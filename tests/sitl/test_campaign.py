@@ -18,6 +18,7 @@ import psutil
 
 from ground.campaign.flight_run import FlightJob, fly_flight
 from ground.campaign.spec import Flight
+from tests.support.configs import vehicle_config
 from tests.support.vehicle import REPO, companion_env
 
 SPEC = """
@@ -109,7 +110,7 @@ def test_a_small_campaign_scores_each_flight_and_survives_hung_ones(tmp_path):
 
 def test_a_flight_whose_vehicle_cannot_start_is_failed_with_its_log(tmp_path):
     broken = tmp_path / "broken.toml"
-    broken.write_text('[vehicle]\nname = "sim"\nclokc = "sim"\n')  # a typo: the vehicle refuses
+    broken.write_text(vehicle_config("sim", clokc="sim"))  # a typo: the vehicle refuses
     flight = Flight(str(REPO / "qgc_plans" / "short_leg.plan"), "c172p", (0.0, 0.0, 0.0), "none",
                     (), 1, str(broken), False, 600.0)  # fmt: skip
     row = fly_flight(FlightJob(flight, str(tmp_path / "flights"), timeout_s=120.0, silent_s=60.0))

@@ -5,17 +5,8 @@ from __future__ import annotations
 import subprocess
 import sys
 
+from tests.support.configs import link, vehicle_config
 from tests.support.vehicle import REPO
-
-CONFIG = """
-[vehicle]
-name = "p"
-state_dir = "{state}"
-[[plugins]]
-name = "link"
-plugin = "link.mavlink"
-settings = {{ endpoints = ["udpout://127.0.0.1:14999"] }}
-"""
 
 
 def companion(*args: str) -> subprocess.CompletedProcess[str]:
@@ -25,7 +16,9 @@ def companion(*args: str) -> subprocess.CompletedProcess[str]:
 
 def test_save_edit_load_round_trip_and_a_bad_file_is_refused(tmp_path):
     config = tmp_path / "v.toml"
-    config.write_text(CONFIG.format(state=tmp_path / "state"))
+    config.write_text(
+        vehicle_config("p", link("udpout://127.0.0.1:14999"), state_dir=tmp_path / "state")
+    )
     saved = tmp_path / "v.params"
     assert companion("params", "save", str(saved), "-c", str(config)).returncode == 0
     text = saved.read_text()

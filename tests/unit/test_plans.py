@@ -12,6 +12,7 @@ import pytest
 from companion.control.mission.items import check_mission
 from companion.control.mission.plan import PlanError, load_plan, save_plan
 from mavlink_dialect import companion as d
+from tests.support.configs import vehicle_config
 from tests.support.vehicle import REPO
 
 PLANS = sorted((REPO / "qgc_plans").glob("*.plan"))
@@ -62,7 +63,7 @@ def test_bad_plans_are_refused_with_the_reason(tmp_path):
 
 def test_cli_load_and_save(tmp_path):
     config = tmp_path / "v.toml"
-    config.write_text(f'[vehicle]\nname = "m"\nstate_dir = "{tmp_path / "state"}"\n')
+    config.write_text(vehicle_config("m", state_dir=tmp_path / "state"))
     run = [sys.executable, "-m", "companion", "mission"]
     done = subprocess.run(
         [*run, "load", str(PLANS[0]), "-c", str(config)],
