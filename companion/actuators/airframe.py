@@ -1,7 +1,8 @@
 """An airframe file: which servo moves which surface, with trim, travel and reversal.
 
 The same file drives the Mini SSC plug-in (surface command → servo position) and the
-simulator bridge (servo position → JSBSim control), so the two cannot disagree.
+simulator bridge (servo position → JSBSim control); the bridge reads it with its own code,
+so a mistake here shows as a surface that moves the wrong way in simulation.
 
 ```toml
 [airframe]
