@@ -7,6 +7,7 @@ import math
 import time
 
 from companion.messages import PluginState
+from tests.support.configs import plugin, vehicle_config
 from tests.support.hostile_sentences import compass_valid, hostile_stream, imu_valid, nmea_valid
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
@@ -20,13 +21,8 @@ DEVICES = {  # plug-in name: (plug-in kind, valid sentence, bus channels it publ
 
 
 def sensors_vehicle(ptys: dict[str, Pty]) -> str:
-    text = '[vehicle]\nname = "devices"\n'
-    for name, (kind, _, _) in DEVICES.items():
-        text += (
-            f'\n[[plugins]]\nname = "{name}"\nplugin = "{kind}"\n'
-            f'settings = {{ device = "{ptys[name].link}" }}\n'
-        )
-    return text
+    sensors = (plugin(name, kind, device=ptys[name].link) for name, (kind, _, _) in DEVICES.items())
+    return vehicle_config("devices", *sensors)
 
 
 def no_infinities(sample) -> bool:

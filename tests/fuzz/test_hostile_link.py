@@ -10,7 +10,8 @@ from pathlib import Path
 
 from companion.messages import PluginState
 from mavlink_dialect import companion as d
-from tests.protocol.mav_client import GroundStation, client_vehicle, free_udp_port, upload_mission
+from tests.protocol.mav_client import GroundStation, free_udp_port, upload_mission
+from tests.support.configs import client_vehicle
 from tests.support.hostile import HostileStream
 from tests.support.vehicle import wait_for
 
