@@ -7,7 +7,9 @@
   specific force as on the ground.
 - Heading: the magnetometer levelled with that tilt, else the compass, else (in the air only,
   above 5 m/s) the GPS course, which ignores the wind's crab angle: it starts with a
-  larger uncertainty and the heading updates correct it.
+  larger uncertainty and the heading updates correct it. In the air, a magnetometer heading
+  far from the course (more than a crab angle) is a disturbed magnetometer: the course wins
+  and the magnetometer starts out distrusted.
 """
 
 from __future__ import annotations
@@ -18,7 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from companion.navigation.rotations import tilt_compensated_heading
+from companion.navigation.earth_field import EarthField
+from companion.navigation.ins_mag import MagMonitor, mag_heading
 
 STILL_SPEED_M_S = 2.0
 COURSE_MIN_SPEED_M_S = 5.0
@@ -72,19 +75,21 @@ class Aligner:
         vel_ned: np.ndarray,
         compass_heading: float | None,
         mag_body: np.ndarray | None,
-        declination: float,
+        field: EarthField,
+        monitor: MagMonitor,
     ) -> Alignment | None:
         """The alignment, or None while a heading source is still missing."""
         if not self.ready():
             return None
         speed = math.hypot(vel_ned[0], vel_ned[1]) if np.all(np.isfinite(vel_ned[:2])) else 0.0
         roll, pitch, tilt_std = self.tilt(speed)
+        course = math.atan2(vel_ned[1], vel_ned[0]) if speed > COURSE_MIN_SPEED_M_S else None
         if mag_body is not None:
-            yaw = tilt_compensated_heading(mag_body, roll, pitch) + declination
-            return Alignment(roll, pitch, yaw, tilt_std, 3 * tilt_std)
-        if compass_heading is not None:
+            mag = mag_heading(mag_body, roll, pitch, field, 0.0, tilt_std)
+            if monitor.heading_for_alignment(mag, course) and mag is not None:
+                return Alignment(roll, pitch, mag.heading, tilt_std, max(mag.std, 3 * tilt_std))
+        elif compass_heading is not None:
             return Alignment(roll, pitch, compass_heading, tilt_std, math.radians(15.0))
-        if speed > COURSE_MIN_SPEED_M_S:
-            course = math.atan2(vel_ned[1], vel_ned[0])
+        if course is not None:
             return Alignment(roll, pitch, course, tilt_std, math.radians(20.0))
         return None

@@ -1,0 +1,55 @@
+"""The Earth's magnetic field where the vehicle is, from the World Magnetic Model (pygeomag).
+
+The navigator needs the declination to turn a magnetic heading into a true one, and the
+field's inclination and strength to tell a clean magnetometer reading from a disturbed one
+(motor currents, steel, a poor hard-iron calibration): a disturbance that bends the heading
+also bends the inclination or changes the strength, which the model lets us see.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+# The secular variation is a fraction of a degree per year; the model's own epoch is as
+# good a guess as any for a log of unknown date.
+MODEL_EPOCH = 2025.0
+NT_PER_GAUSS = 1e5
+
+
+@dataclass(frozen=True)
+class EarthField:
+    """The main field at a place: angles in radians, strength in gauss."""
+
+    declination: float
+    inclination: float
+    intensity_gauss: float
+
+    def ned(self) -> np.ndarray:
+        """The field vector, NED, gauss."""
+        d, i, f = self.declination, self.inclination, self.intensity_gauss
+        return f * np.array([math.cos(i) * math.cos(d), math.cos(i) * math.sin(d), math.sin(i)])
+
+    @property
+    def horizontal_gauss(self) -> float:
+        """The horizontal intensity: what a heading is measured against."""
+        return self.intensity_gauss * math.cos(self.inclination)
+
+
+@functools.lru_cache(maxsize=1)
+def _model():  # type: ignore[no-untyped-def]
+    from pygeomag import GeoMag
+
+    return GeoMag()
+
+
+def wmm_field(lat_deg: float, lon_deg: float, alt_m: float = 0.0) -> EarthField:
+    """The World Magnetic Model's field at a place (at the model's epoch)."""
+    result = _model().calculate(
+        glat=lat_deg, glon=lon_deg, alt=alt_m / 1000.0, time=MODEL_EPOCH,
+        allow_date_outside_lifespan=True,
+    )  # fmt: skip
+    return EarthField(math.radians(result.d), math.radians(result.i), result.f / NT_PER_GAUSS)

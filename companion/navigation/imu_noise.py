@@ -1,0 +1,42 @@
+"""How noisy the IMU's samples really are, measured from the samples themselves.
+
+A datasheet's noise density holds for an averaged, well-mounted sensor. A logged IMU is
+often a point sample at 10-25 Hz of a vibrating airframe: vibration aliases into it, and
+between two samples the motion itself changes more than the filter, which holds each sample
+over the interval, can follow. Half the mean square of the difference between consecutive
+samples measures both; as a density (σ²·dt) it is the process noise the filter must allow.
+"""
+
+from __future__ import annotations
+
+import math
+
+
+class ImuNoise:
+    """Running sample-to-sample noise of the accelerometer and the gyro, as densities."""
+
+    def __init__(self, window_s: float, accel_floor: float, gyro_floor: float) -> None:
+        self.window_s = window_s
+        self.accel_floor, self.gyro_floor = accel_floor, gyro_floor
+        self.accel_var = self.gyro_var = 0.0  # per sample, per axis
+        self.dt = 0.0
+        self.last: tuple[float, ...] | None = None
+
+    def add(self, values: tuple[float, ...], dt: float) -> None:
+        """One sample (ax, ay, az, gx, gy, gz), ``dt`` after the previous one."""
+        last, self.last = self.last, values
+        if last is None or dt <= 0.0:
+            return
+        a = sum((values[i] - last[i]) ** 2 for i in range(3)) / 6.0
+        g = sum((values[i] - last[i]) ** 2 for i in range(3, 6)) / 6.0
+        w = min(1.0, dt / self.window_s)
+        self.accel_var += w * (a - self.accel_var)
+        self.gyro_var += w * (g - self.gyro_var)
+        self.dt += w * (dt - self.dt)
+
+    def densities(self) -> tuple[float, float]:
+        """(accelerometer, gyro) noise densities: measured, never below the floors."""
+        return (
+            max(self.accel_floor, math.sqrt(self.accel_var * self.dt)),
+            max(self.gyro_floor, math.sqrt(self.gyro_var * self.dt)),
+        )
