@@ -14,10 +14,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# The secular variation is a fraction of a degree per year; the model's own epoch is as
-# good a guess as any for a log of unknown date.
-MODEL_EPOCH = 2025.0
+# The field drifts by a fraction of a degree per year. Without a date (a replayed log)
+# the middle of the years most logs come from is the best guess: ~1° off at worst.
+DEFAULT_YEAR = 2020.0
 NT_PER_GAUSS = 1e5
+# Each model's coefficients hold for five years from its epoch.
+_MODELS = ((2020.0, "wmm/WMM_2015v2.COF"), (2025.0, "wmm/WMM_2020.COF"), (math.inf, "wmm/WMM.COF"))
 
 
 @dataclass(frozen=True)
@@ -39,17 +41,20 @@ class EarthField:
         return self.intensity_gauss * math.cos(self.inclination)
 
 
-@functools.lru_cache(maxsize=1)
-def _model():  # type: ignore[no-untyped-def]
+@functools.lru_cache(maxsize=3)
+def _model(coefficients: str):  # type: ignore[no-untyped-def]
     from pygeomag import GeoMag
 
-    return GeoMag()
+    return GeoMag(coefficients_file=coefficients)
 
 
-def wmm_field(lat_deg: float, lon_deg: float, alt_m: float = 0.0) -> EarthField:
-    """The World Magnetic Model's field at a place (at the model's epoch)."""
-    result = _model().calculate(
-        glat=lat_deg, glon=lon_deg, alt=alt_m / 1000.0, time=MODEL_EPOCH,
+def wmm_field(
+    lat_deg: float, lon_deg: float, alt_m: float = 0.0, year: float = DEFAULT_YEAR
+) -> EarthField:
+    """The World Magnetic Model's field at a place and time (decimal year)."""
+    coefficients = next(name for until, name in _MODELS if year < until)
+    result = _model(coefficients).calculate(
+        glat=lat_deg, glon=lon_deg, alt=alt_m / 1000.0, time=year,
         allow_date_outside_lifespan=True,
     )  # fmt: skip
     return EarthField(math.radians(result.d), math.radians(result.i), result.f / NT_PER_GAUSS)

@@ -25,6 +25,7 @@ from companion.navigation.ins_mag import MagMonitor, mag_heading
 
 STILL_SPEED_M_S = 2.0
 COURSE_MIN_SPEED_M_S = 5.0
+INTERFERED_STD = math.radians(30.0)
 
 
 @dataclass(frozen=True)
@@ -87,7 +88,8 @@ class Aligner:
         if mag_body is not None:
             mag = mag_heading(mag_body, roll, pitch, field, 0.0, tilt_std)
             if monitor.heading_for_alignment(mag, course) and mag is not None:
-                return Alignment(roll, pitch, mag.heading, tilt_std, max(mag.std, 3 * tilt_std))
+                std = max(mag.std, 3 * tilt_std, INTERFERED_STD if mag.interfered else 0.0)
+                return Alignment(roll, pitch, mag.heading, tilt_std, std)
         elif compass_heading is not None:
             return Alignment(roll, pitch, compass_heading, tilt_std, math.radians(15.0))
         if course is not None:

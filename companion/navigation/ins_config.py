@@ -35,6 +35,7 @@ class InsEkfConfig:
     mag_window_s: float = 5.0  # the magnetometer's consistency is judged over this
     mag_max_nis: float = 4.0  # mean normalised innovation² above which it is not fused
     declination_deg: float | None = None
+    field_year: float = 2020.0  # decimal year for the World Magnetic Model
     gps_delay_s: float | None = None
     gps_lag_window_s: float = 60.0
     gps_timeout_s: float = 2.0

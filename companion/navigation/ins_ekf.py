@@ -105,7 +105,7 @@ class InsEkf(InsCore):
         self._gps_update(fix)
 
     def _earth_field(self, lat: float, lon: float, alt: float) -> EarthField:
-        field = wmm_field(lat, lon, alt)
+        field = wmm_field(lat, lon, alt, self.cfg.field_year)
         if self.cfg.declination_deg is None:
             return field
         return EarthField(math.radians(self.cfg.declination_deg), field.inclination,
@@ -165,13 +165,15 @@ class InsEkf(InsCore):
         self.next_heading_us = reading.t_us + round(self.cfg.heading_interval_s * 1e6)
         measured = self._mag_heading(self.last_mag)
         yj = yaw_jacobian(self.q)
-        if measured is None or yj is None:
+        if measured is None or yj is None or measured.interfered:
             return
         yaw, h_th = yj
         h = np.zeros(15)
         h[TH] = h_th
         y = math.remainder(measured.heading - yaw, math.tau)
-        s = self._innovation_var(h, measured.std**2)
+        # Judged against the clean magnetometer's noise, not the disturbance allowance: a
+        # heading that is consistently 20° off is not made consistent by doubting it.
+        s = self._innovation_var(h, self.cfg.mag_heading_std**2)
         if not self.mag_monitor.observe(reading.t_us, y, s):
             return
         self._heading_update(measured.heading, measured.std)

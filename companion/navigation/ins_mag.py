@@ -37,6 +37,9 @@ STRENGTH_TOLERANCE = 0.15  # relative; calibration scale errors of this size are
 # inclination and leaves a level heading alone: only the excess over this counts.
 INCLINATION_TOLERANCE = math.radians(10.0)
 MAX_DISTURBANCE_RAD = math.radians(90.0)
+# A field this far from the model's strength is mostly local interference (a motor, steel,
+# a current loop): its direction says little about north, and it is not fused at all.
+STRENGTH_LIMITS = (0.65, 1.35)
 
 
 @dataclass(frozen=True)
@@ -46,6 +49,7 @@ class MagHeading:
     heading: float
     std: float
     disturbance: float  # the heading error the field checks allow for, radians
+    interfered: bool  # the strength is far from the model's: not to be fused
 
 
 def mag_heading(
@@ -81,7 +85,9 @@ def mag_heading(
     from_tilt = abs(math.tan(field.inclination)) * tilt_std
     std = math.sqrt(base_std**2 + disturbance**2 + from_tilt**2)
     heading = math.atan2(-east, north) + field.declination
-    return MagHeading(heading, std, disturbance)
+    ratio = strength / field.intensity_gauss
+    interfered = not STRENGTH_LIMITS[0] <= ratio <= STRENGTH_LIMITS[1]
+    return MagHeading(heading, std, disturbance, interfered)
 
 
 class MagMonitor:
@@ -115,7 +121,7 @@ class MagMonitor:
         if mag is None:
             return False
         if course is None:
-            return True
+            return True  # nothing better (interfered or not: the INS then holds it)
         agrees = abs(math.remainder(mag.heading - course, math.tau)) < ALIGN_AGREE_RAD
         if not agrees:
             self.trusted = False

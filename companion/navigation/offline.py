@@ -25,7 +25,9 @@ class Navigator(Protocol):
 class InsEkfRunner:
     """``nav.ins_ekf``'s navigator."""
 
-    def __init__(self, declination_deg: float = 0.0, config: InsEkfConfig | None = None) -> None:
+    def __init__(
+        self, declination_deg: float | None = None, config: InsEkfConfig | None = None
+    ) -> None:
         self.nav = InsEkf(config or InsEkfConfig(declination_deg=declination_deg))
         self._feed: dict[type, Callable[[Message], None]] = {
             Imu: self.nav.on_imu,  # type: ignore[dict-item]
@@ -49,7 +51,7 @@ class InsEkfRunner:
 class GpsCompassRunner:
     """``nav.gps_compass``'s navigator."""
 
-    def __init__(self, declination_deg: float = 0.0) -> None:
+    def __init__(self, declination_deg: float | None = None) -> None:
         # Imported here: filterpy brings scipy.stats (~2.5 s of CPU), which the ins_ekf
         # plug-in, importing this module for its own runner, must not pay at every start.
         from companion.navigation.gps_compass import GpsCompassNavigator
@@ -68,15 +70,16 @@ class GpsCompassRunner:
         return self.nav.state(t_us)
 
 
-NAVIGATORS: dict[str, Callable[[float], Navigator]] = {
+NAVIGATORS: dict[str, Callable[[float | None], Navigator]] = {
     "ins_ekf": InsEkfRunner,
     "gps_compass": GpsCompassRunner,
 }
 
 
-def true_headings(samples: Iterable[Message], declination_deg: float) -> Iterator[Message]:
-    """Compass headings made true (logs keep them magnetic, as the compass reports them)."""
-    offset = math.radians(declination_deg)
+def true_headings(samples: Iterable[Message], declination_deg: float | None) -> Iterator[Message]:
+    """Compass headings made true (logs keep them magnetic, as the compass reports them).
+    None: left magnetic (the INS applies the World Magnetic Model's declination itself)."""
+    offset = math.radians(declination_deg or 0.0)
     for sample in samples:
         if offset and isinstance(sample, Compass):
             sample.heading_rad = (sample.heading_rad + offset) % math.tau

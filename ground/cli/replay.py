@@ -36,8 +36,12 @@ def replay(
     truth: Annotated[Path | None, typer.Option(help="truth CSV to draw beside it")] = None,
     rate: Annotated[float, typer.Option(help="estimate rows per second of log time")] = 50.0,
     declination: Annotated[
-        float, typer.Option(help="magnetic declination, degrees east (compass, magnetometer)")
-    ] = 0.0,
+        float | None,
+        typer.Option(
+            help="magnetic declination, degrees east (compass, magnetometer); "
+            "default: the World Magnetic Model's at the first fix"
+        ),
+    ] = None,
     address: Annotated[
         str | None, typer.Option(help="many logs: Ray cluster address (default: local)")
     ] = None,
@@ -66,7 +70,7 @@ def replay(
 
 def _replay_one(
     log: Path, out_path: Path, navigator: str, plot: Path | None, truth: Path | None,
-    rate: float, declination: float,
+    rate: float, declination: float | None,
 ) -> None:  # fmt: skip
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
@@ -100,7 +104,7 @@ def _replay_one(
 
 def _replay_batch(
     args: list[str], out_dir: Path, navigator: str, plot: Path | None, rate: float,
-    declination: float, address: str | None, cpus: int | None,
+    declination: float | None, address: str | None, cpus: int | None,
 ) -> None:  # fmt: skip
     from ground.replay.batch import (
         SUMMARY_NAME,

@@ -91,7 +91,7 @@ class ReplayJob:
     out: Path
     navigator: str
     rate_hz: float = 50.0
-    declination_deg: float = 0.0
+    declination_deg: float | None = None
     plot: Path | None = None
 
 
@@ -127,7 +127,7 @@ def replay_logs(
     out_dir: Path,
     navigator: str,
     rate_hz: float = 50.0,
-    declination_deg: float = 0.0,
+    declination_deg: float | None = None,
     plot_dir: Path | None = None,
     address: str | None = None,
     cpus: int | None = None,

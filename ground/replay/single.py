@@ -86,7 +86,7 @@ def replay_log(
     navigator: str,
     out: Path,
     rate_hz: float = 50.0,
-    declination_deg: float = 0.0,
+    declination_deg: float | None = None,
     progress: Callable[[int], None] | None = None,
     fixes: list[GpsFix] | None = None,
 ) -> tuple[ReplaySummary, list[NavState]]:

@@ -9,6 +9,7 @@ them in time order to ``companion.navigation.ins_ekf.InsEkf`` (the navigator
 from __future__ import annotations
 
 import dataclasses
+import math
 
 from companion.messages import Imu
 from companion.navigation.ins_ekf import InsEkfConfig
@@ -26,9 +27,19 @@ class InsEkfPlugin(Plugin):
     settings = {
         "publish_hz": Setting(float, 50.0, "nav/state rate, in vehicle time", min=1.0, max=400),
         "declination_deg": Setting(
-            float, 0.0, "magnetic declination (east +) for magnetometer headings", min=-180, max=180
+            float,
+            math.nan,
+            "magnetic declination (east +); nan: the World Magnetic Model's",
+            min=-180,
+            max=180,
         ),
-        "gps_delay_s": Setting(float, 0.0, "how much the GPS's fixes lag the IMU", min=0, max=1),
+        "gps_delay_s": Setting(
+            float,
+            math.nan,
+            "how much the GPS's fixes lag the IMU; nan: measured in flight",
+            min=0,
+            max=1,
+        ),
         "accel_noise": Setting(
             float, _DEFAULTS.accel_noise, "accelerometer noise density, m/s²/√Hz", min=1e-5
         ),
@@ -45,8 +56,8 @@ class InsEkfPlugin(Plugin):
         s = ctx.settings
         config = dataclasses.replace(
             _DEFAULTS,
-            declination_deg=s["declination_deg"],
-            gps_delay_s=s["gps_delay_s"],
+            declination_deg=_given(s["declination_deg"]),
+            gps_delay_s=_given(s["gps_delay_s"]),
             accel_noise=s["accel_noise"],
             gyro_noise=s["gyro_noise"],
         )
@@ -77,3 +88,7 @@ class InsEkfPlugin(Plugin):
 
     def close(self) -> None:
         self.waiter.close()
+
+
+def _given(value: float) -> float | None:
+    return None if math.isnan(value) else value
