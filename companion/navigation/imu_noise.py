@@ -4,7 +4,10 @@ A datasheet's noise density holds for an averaged, well-mounted sensor. A logged
 often a point sample at 10-25 Hz of a vibrating airframe: vibration aliases into it, and
 between two samples the motion itself changes more than the filter, which holds each sample
 over the interval, can follow. Half the mean square of the difference between consecutive
-samples measures both; as a density (σ²·dt) it is the process noise the filter must allow.
+samples measures both; as a density (σ²·dt) it is the process noise the filter must allow
+on velocity. The gyro is left at its configured density: its sample differences are mostly
+the airframe's real angular acceleration, which the attitude integration follows well, and
+counting them as noise would let every heading reading shake the yaw.
 """
 
 from __future__ import annotations
@@ -13,12 +16,12 @@ import math
 
 
 class ImuNoise:
-    """Running sample-to-sample noise of the accelerometer and the gyro, as densities."""
+    """Running sample-to-sample noise of the accelerometer, as a density."""
 
     def __init__(self, window_s: float, accel_floor: float, gyro_floor: float) -> None:
         self.window_s = window_s
         self.accel_floor, self.gyro_floor = accel_floor, gyro_floor
-        self.accel_var = self.gyro_var = 0.0  # per sample, per axis
+        self.accel_var = 0.0  # per sample, per axis
         self.dt = 0.0
         self.last: tuple[float, ...] | None = None
 
@@ -28,15 +31,14 @@ class ImuNoise:
         if last is None or dt <= 0.0:
             return
         a = sum((values[i] - last[i]) ** 2 for i in range(3)) / 6.0
-        g = sum((values[i] - last[i]) ** 2 for i in range(3, 6)) / 6.0
         w = min(1.0, dt / self.window_s)
         self.accel_var += w * (a - self.accel_var)
-        self.gyro_var += w * (g - self.gyro_var)
         self.dt += w * (dt - self.dt)
 
     def densities(self) -> tuple[float, float]:
-        """(accelerometer, gyro) noise densities: measured, never below the floors."""
+        """(accelerometer, gyro) noise densities: the accelerometer's measured, never below
+        its floor; the gyro's as configured."""
         return (
             max(self.accel_floor, math.sqrt(self.accel_var * self.dt)),
-            max(self.gyro_floor, math.sqrt(self.gyro_var * self.dt)),
+            self.gyro_floor,
         )

@@ -55,6 +55,9 @@ class FlightSpec:
     legs: tuple[Leg, ...] = CIRCUIT
     home: tuple[float, float, float] = (-37.9105, 145.1340, 380.0)
     heading_deg: float = 30.0
+    # Already turning at the log's start (a log cut out of a flight): the bank follows from
+    # it; a first leg that turns the other way rolls the aircraft at once.
+    start_turn_deg_s: float = 0.0
     imu_hz: float = 100.0
     gps_hz: float = 5.0
     gps_jitter: float = 0.3  # fraction of the period by which fix times wander
@@ -77,7 +80,7 @@ class _Kinematics:
 
     def __init__(self, spec: FlightSpec) -> None:
         first = spec.legs[0]
-        self.v, self.turn, self.climb = first.speed_m_s, 0.0, 0.0
+        self.v, self.turn, self.climb = first.speed_m_s, math.radians(spec.start_turn_deg_s), 0.0
         self.yaw = math.radians(spec.heading_deg)
         self.g = normal_gravity(spec.home[0], spec.home[2])
         self.rates = (0.0, 0.0, 0.0)  # dv/dt, turn-rate rate, climb-rate rate
