@@ -1,6 +1,8 @@
-"""Navigator accuracy on synthetic flights (and on simulator truth when given).
+"""Navigator accuracy on synthetic flights and on real flight logs (and on simulator truth
+when given).
 
 Usage: uv run python benchmarks/nav_accuracy.py [--seeds 4] [--sim-log S.csv --sim-truth T.csv]
+       [--navlogs ../shared/navlogs]
 
 Each seed flies the six-minute circuit of ``ground.simulation.synthetic_flight`` with a
 VN-100-class IMU (noise, turn-on biases, drift), a magnetometer, an OS-3000 that levels
@@ -10,6 +12,9 @@ and pitch), yaw, horizontal position and velocity error (position and velocity w
 is available), and the horizontal error at the end of the outage. Targets for ins_ekf:
 tilt ≤ 0.5°, yaw ≤ 2°, position ≤ 2 m RMS, ≤ 30 m after the outage. For scale, the GPS
 alone is printed too.
+
+Then the real flight logs of ``--navlogs`` (five fixed-wing, four multicopter), scored
+against the autopilot's own estimate beside a complementary filter: ``nav_real_logs.py``.
 """
 
 from __future__ import annotations
@@ -22,6 +27,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from nav_real_logs import NAVLOGS, real_log_table  # beside this script
 
 from companion.messages import GpsFix
 from companion.navigation.estimate_csv import read_estimate
@@ -63,6 +70,7 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=4)
     parser.add_argument("--sim-estimate", type=Path, help="an estimate CSV from the simulator")
     parser.add_argument("--sim-truth", type=Path, help="the simulator's truth CSV for it")
+    parser.add_argument("--navlogs", type=Path, default=NAVLOGS, help="the real-log set")
     args = parser.parse_args()
     rows: dict[str, list[Errors]] = {"ins_ekf": [], "gps_compass": []}
     gps = []
@@ -79,6 +87,8 @@ def main() -> None:
 
         errors = score(read_estimate(args.sim_estimate), read_estimate(args.sim_truth))
         table("simulator run", {"estimate": [errors]})
+    print("\nreal flight logs (reference: the autopilot's own estimate; first 10 s skipped)")
+    print("\n".join(real_log_table(args.navlogs)))
 
 
 if __name__ == "__main__":

@@ -27,6 +27,7 @@ MAX_LAG_S = 0.5
 # is believed: straight and level, every candidate fits as well as any other.
 MIN_EXCITATION_M_S = 20.0
 MIN_FIXES = 20
+SWITCH_MARGIN = 0.05
 
 
 class StateHistory:
@@ -94,5 +95,11 @@ class GpsLag:
         self.cost = self.cost * forget + err
         self.fixes += 1
         self.last = (t_us, v_gps[:2].copy())
-        if self.fixes >= MIN_FIXES and self.excitation >= MIN_EXCITATION_M_S:
-            self.lag_s = float(self.lags[int(np.argmin(self.cost))])
+        if self.fixes < MIN_FIXES or self.excitation < MIN_EXCITATION_M_S:
+            return
+        best = int(np.argmin(self.cost))
+        current = int(np.argmin(np.abs(self.lags - self.lag_s)))
+        # Only a clearly better fit moves the lag: GPS noise alone makes neighbouring
+        # candidates differ by a percent or two, and a wandering lag costs accuracy.
+        if self.cost[best] < (1.0 - SWITCH_MARGIN) * self.cost[current]:
+            self.lag_s = float(self.lags[best])

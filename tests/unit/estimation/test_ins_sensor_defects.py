@@ -9,12 +9,12 @@ import math
 
 import numpy as np
 
-from companion.estimation.ins_ekf import InsEkfConfig
-from companion.estimation.offline import InsEkfRunner
+from companion.navigation.ins_ekf import InsEkfConfig
+from companion.navigation.offline import InsEkfRunner
 from companion.messages import Magnetometer, NavState
-from companion.simulation import evaluation
-from companion.simulation.synthetic_flight import FlightSpec, Leg
-from companion.simulation.synthetic_log import SyntheticFlight, synthesize
+from ground.simulation import evaluation
+from ground.simulation.synthetic_flight import FlightSpec, Leg
+from ground.simulation.synthetic_log import SyntheticFlight, synthesize
 from tests.unit.estimation.flights import DECLINATION, OUTAGE, SHORT, flight, fly
 
 # Banked 45° and already turning at the first sample, then rolled hard the other way.
