@@ -14,6 +14,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import deque
 from dataclasses import dataclass
@@ -26,6 +27,9 @@ from companion.navigation.ins_mag import MagMonitor, mag_heading
 STILL_SPEED_M_S = 2.0
 COURSE_MIN_SPEED_M_S = 5.0
 INTERFERED_STD = math.radians(30.0)
+# In the air the turn-rate roll assumes a level, coordinated turn; a pull-up or a slip
+# breaks it by tens of degrees, and the filter must be free to move that far.
+AIR_TILT_STD = math.radians(15.0)
 
 
 @dataclass(frozen=True)
@@ -69,7 +73,19 @@ class Aligner:
         for _ in range(3):  # ψ̇ = (q sin φ + r cos φ) / cos θ, φ = atan(V ψ̇ / g)
             yaw_rate = (q * math.sin(roll) + r * math.cos(roll)) / math.cos(pitch)
             roll = math.atan(ground_speed * yaw_rate / self.g)
-        return roll, pitch, math.radians(5.0)
+        # That is the roll of the window's middle; a rolling aircraft (real logs start
+        # rolling at 2 rad/s) has rolled on since: the gyro says how far.
+        rolled = self._rolled_since_middle()
+        std = math.hypot(AIR_TILT_STD, 0.5 * rolled)
+        return math.remainder(roll + rolled, math.tau), pitch, std
+
+    def _rolled_since_middle(self) -> float:
+        middle = 0.5 * (self.samples[0][0] + self.samples[-1][0])
+        rolled = 0.0
+        for (t0, _, g0), (t1, _, _) in itertools.pairwise(self.samples):
+            if t0 >= middle:
+                rolled += g0[0] * (t1 - t0) / 1e6
+        return rolled
 
     def align(
         self,

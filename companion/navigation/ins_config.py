@@ -44,4 +44,5 @@ class InsEkfConfig:
     heading_interval_s: float = 0.2  # magnetometer heading updates at most this often
     covariance_interval_s: float = 0.04
     align_window_s: float = 0.5
+    settle_s: float = 5.0  # GPS is not gated for this long after the alignment
     noise_window_s: float = 10.0  # the IMU's sample noise is measured over this

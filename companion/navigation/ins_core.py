@@ -98,14 +98,16 @@ class InsCore:
         self.cov_dt = 0.0
 
     # -- updates --------------------------------------------------------------------
-    def _update(self, y: np.ndarray, h: np.ndarray, r: np.ndarray, k_mask=None) -> bool:  # type: ignore[no-untyped-def]
-        """Gate, then correct; False when the innovation was rejected. ``k_mask`` (15
-        booleans) limits which error states this measurement may correct."""
+    def _update(  # type: ignore[no-untyped-def]
+        self, y: np.ndarray, h: np.ndarray, r: np.ndarray, k_mask=None, gate: bool = True
+    ) -> bool:
+        """Gate (unless told not to), then correct; False when the innovation was rejected.
+        ``k_mask`` (15 booleans) limits which error states this measurement may correct."""
         self._flush_covariance()
         ph = self.P @ h.T
         s = h @ ph + r
         s_inv = np.linalg.inv(s)
-        if float(y @ s_inv @ y) > CHI2_9999[len(y)]:
+        if gate and float(y @ s_inv @ y) > CHI2_9999[len(y)]:
             return False
         k = ph @ s_inv
         if k_mask is not None:

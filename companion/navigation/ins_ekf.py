@@ -58,6 +58,7 @@ class InsEkf(InsCore):
         self.pending_fix: GpsFix | None = None
         self.gps_reject_run = self.baro_reject_run = 0
         self.resets = 0
+        self.aligned_us = 0
         self.next_heading_us = 0
         self.baro = BaroDatum(c.baro_interval_s, c.baro_timeout_s, c.baro_offset_tau_s)
         self.lag = GpsLag(c.gps_lag_window_s, c.gps_delay_s or 0.0)
@@ -212,7 +213,7 @@ class InsEkf(InsCore):
         diag += [c.accel_bias_std] * 3 + [c.gyro_bias_std] * 3
         self.P = np.diag(np.square(diag))
         self.aligned = True
-        self.last_gps_us = fix.t_us
+        self.aligned_us = self.last_gps_us = fix.t_us
 
     # -- updates --------------------------------------------------------------------
     def _fix_position(self, fix: GpsFix) -> np.ndarray:
@@ -239,7 +240,11 @@ class InsEkf(InsCore):
         c = self.cfg
         vd_std = fix.vd_std_m_s if fix.vd_std_m_s > 0 else c.gps_vel_std  # NaN > 0 is False
         sig = np.array([std, std, vstd, c.gps_vel_std, c.gps_vel_std, vd_std])
-        ok = self._update(y_all[rows], _I15[rows], np.diag(np.square(sig[rows])))
+        # Just after an alignment in the air the attitude can be tens of degrees off (a
+        # start in a pull-up or a roll): GPS is then the truth to converge to, not an
+        # outlier to refuse.
+        settling = fix.t_us - self.aligned_us < self.cfg.settle_s * 1e6
+        ok = self._update(y_all[rows], _I15[rows], np.diag(np.square(sig[rows])), gate=not settling)
         self.last_gps_ok = ok
         if ok:
             self.gps_reject_run = 0

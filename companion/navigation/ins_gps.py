@@ -28,6 +28,7 @@ MAX_LAG_S = 0.5
 MIN_EXCITATION_M_S = 20.0
 MIN_FIXES = 20
 SWITCH_MARGIN = 0.05
+MIN_CONTRAST = 1.5  # worst candidate's cost over the best's
 
 
 class StateHistory:
@@ -96,6 +97,9 @@ class GpsLag:
         self.fixes += 1
         self.last = (t_us, v_gps[:2].copy())
         if self.fixes < MIN_FIXES or self.excitation < MIN_EXCITATION_M_S:
+            return
+        # The candidates must have been told apart: noise alone leaves the cost flat.
+        if self.cost.max() < MIN_CONTRAST * self.cost.min():
             return
         best = int(np.argmin(self.cost))
         current = int(np.argmin(np.abs(self.lags - self.lag_s)))
