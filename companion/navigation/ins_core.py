@@ -10,12 +10,12 @@ import math
 
 import numpy as np
 
+from companion.messages import NavFlags, NavState
 from companion.navigation import rotations as rot
 from companion.navigation.imu_noise import ImuNoise
 from companion.navigation.ins_config import InsEkfConfig
 from companion.navigation.ins_gps import StateHistory
 from companion.navigation.local_frame import LocalFrame
-from companion.messages import NavFlags, NavState
 
 CHI2_9999 = {1: 15.14, 2: 18.42, 3: 21.11, 4: 23.51, 5: 25.74, 6: 27.86}
 P, V, TH, BA, BG = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12), slice(12, 15)

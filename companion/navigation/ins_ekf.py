@@ -26,6 +26,7 @@ import math
 
 import numpy as np
 
+from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
 from companion.navigation import rotations as rot
 from companion.navigation.baro_datum import BaroDatum
 from companion.navigation.earth_field import EarthField, wmm_field
@@ -35,7 +36,6 @@ from companion.navigation.ins_core import TH, InsCore
 from companion.navigation.ins_gps import GpsLag
 from companion.navigation.ins_mag import MagHeading, MagMonitor, mag_heading, yaw_jacobian
 from companion.navigation.local_frame import LocalFrame, normal_gravity
-from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
 
 MAX_IMU_GAP_S = 0.5
 COMPASS_TILT_TO_HEADING = 3.0

@@ -16,10 +16,10 @@ from pathlib import Path
 
 import pytest
 
-from companion.estimation.local_frame import LocalFrame
-from companion.estimation.offline import InsEkfRunner, run_navigator
 from companion.messages import NavFlags
-from companion.sensorlog import read_sensor_log
+from companion.navigation.local_frame import LocalFrame
+from companion.navigation.offline import InsEkfRunner, run_navigator
+from companion.sensors.sensorlog import read_sensor_log
 
 NAVLOGS = Path(__file__).resolve().parents[4] / "shared" / "navlogs" / "data"
 GOLDEN = Path(__file__).with_name("golden")

@@ -9,9 +9,9 @@ import math
 
 import numpy as np
 
+from companion.messages import Magnetometer, NavState
 from companion.navigation.ins_ekf import InsEkfConfig
 from companion.navigation.offline import InsEkfRunner
-from companion.messages import Magnetometer, NavState
 from ground.simulation import evaluation
 from ground.simulation.synthetic_flight import FlightSpec, Leg
 from ground.simulation.synthetic_log import SyntheticFlight, synthesize
