@@ -39,6 +39,7 @@ from companion.navigation.local_frame import LocalFrame, normal_gravity
 
 MAX_IMU_GAP_S = 0.5
 COMPASS_TILT_TO_HEADING = 3.0
+LAG_MAX_WANDER = 0.5
 _I15 = np.eye(15)
 _YAW_ONLY = np.array([True] * 6 + [False, False, True] + [False] * 3 + [True] * 3)
 __all__ = ["InsEkf", "InsEkfConfig"]
@@ -224,7 +225,7 @@ class InsEkf(InsCore):
     def _gps_update(self, fix: GpsFix) -> None:
         z_p = self._fix_position(fix)
         z_v = np.array((fix.vn_m_s, fix.ve_m_s, fix.vd_m_s))
-        if self.cfg.gps_delay_s is None:
+        if self.cfg.gps_delay_s is None and self._lag_observable(fix.t_us):
             self.lag.observe(fix.t_us, z_v, self.history)
         then = self.history.at(fix.t_us - self.lag.lag_s * 1e6)
         p_then, v_then = then if then is not None else (np.array(self.p), np.array(self.v))
@@ -254,6 +255,16 @@ class InsEkf(InsCore):
         self.gps_reject_run += 1
         if self.gps_reject_run >= self.cfg.reset_after:
             self._reset_to_gps(z_p, z_v, std)
+
+    def _lag_observable(self, t_us: int) -> bool:
+        """Is the INS velocity between fixes clean enough to time the GPS by? A vibrating
+        IMU's velocity wanders between fixes by more than GPS velocity's own noise, and is
+        cleanest just after each update: the fit would then favour lags of a fix period."""
+        if self.last_gps_us is None:
+            return False
+        accel_density, _ = self.noise.densities()
+        wander = accel_density * math.sqrt(max(t_us - self.last_gps_us, 0) / 1e6)
+        return wander < LAG_MAX_WANDER * self.cfg.gps_vel_std
 
     def _reset_to_gps(self, z_p: np.ndarray, z_v: np.ndarray, std: float) -> None:
         """The INS has disagreed with GPS for too long: believe GPS, and say so."""

@@ -36,6 +36,15 @@ class NoiseModel:
     gps_correlation_s: float = 60.0
     gps_white_m: float = 0.3
     gps_velocity_m_s: float = 0.1
+    # What a real airframe adds (all off by default: the VN-100 on a quiet mount).
+    # Magnetometer: a body-fixed offset (hard iron, a poor calibration or a steel part)
+    # and per-axis gains (soft iron); real logs show ±30-70° of heading error from these.
+    mag_hard_iron_gauss: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    mag_soft_iron: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    # Vibration (a propeller's, at vibration_hz): a point-sampled IMU at 10-25 Hz aliases it.
+    accel_vibration_m_s2: float = 0.0
+    gyro_vibration_rad_s: float = 0.0
+    vibration_hz: float = 87.0
 
 
 @dataclass(frozen=True)
@@ -99,6 +108,7 @@ class SensorErrors:
         self.gyro_bias = self.rng.normal(0.0, model.gyro_bias_rad_s * k, 3)
         self.gps_error = self.rng.normal(0.0, 1.0, 3) * self._gps_sigma()
         self.field_ned = field.ned()
+        self.vibration_phase = np.array([0.0, 2.1, 4.2])  # the axes shake out of step
 
     def _gps_sigma(self) -> np.ndarray:
         k = self.m.scale
@@ -116,7 +126,12 @@ class SensorErrors:
         self.gyro_bias += z[3:6] * (m.gyro_walk_rad_s_rt_s * root)
         accel = np.array(s.f_body) + self.accel_bias + z[6:9] * m.accel_noise_m_s2
         gyro = np.array((s.p, s.q, s.r)) + self.gyro_bias + z[9:12] * m.gyro_noise_rad_s
+        if m.accel_vibration_m_s2 or m.gyro_vibration_rad_s:
+            shake = np.sin(math.tau * m.vibration_hz * s.t_s + self.vibration_phase)
+            accel += shake * m.accel_vibration_m_s2 * m.scale
+            gyro += shake * m.gyro_vibration_rad_s * m.scale
         mag = body_from_ned(s.roll, s.pitch, s.yaw) @ self.field_ned
+        mag = mag * np.array(m.mag_soft_iron) + np.array(m.mag_hard_iron_gauss)
         mag = mag + z[12:15] * m.mag_noise_gauss
         pressure_kpa += z[15] * m.baro_noise_pa / 1000.0
         return ImuSample(accel, gyro, mag, 25.0, pressure_kpa)
