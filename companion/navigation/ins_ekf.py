@@ -40,6 +40,8 @@ from companion.navigation.local_frame import LocalFrame, normal_gravity
 MAX_IMU_GAP_S = 0.5
 COMPASS_TILT_TO_HEADING = 3.0
 LAG_MAX_WANDER = 0.5
+LOST_TILT_STD = math.radians(5.0)
+LOST_YAW_STD = math.radians(30.0)
 _I15 = np.eye(15)
 _YAW_ONLY = np.array([True] * 6 + [False, False, True] + [False] * 3 + [True] * 3)
 __all__ = ["InsEkf", "InsEkfConfig"]
@@ -273,6 +275,13 @@ class InsEkf(InsCore):
         self._reset_block(slice(0, 6), [std] * 3 + [self.cfg.gps_vel_std * 2] * 3)
         self.gps_reject_run = 0
         self.resets += 1
+        # An INS that has disagreed with GPS for a second or more has most likely lost its
+        # attitude (a heading from a bad magnetometer, a tilt from a wild start): let GPS
+        # teach it again (in flight the turns make heading observable), ungated for a while.
+        att = np.sqrt(np.maximum(np.diag(self.P)[6:9], 0.0))
+        relearn = np.maximum(att, [LOST_TILT_STD, LOST_TILT_STD, LOST_YAW_STD]).tolist()
+        self._reset_block([6, 7, 8], relearn)
+        self.aligned_us = self.t_us or 0
 
     def _heading_update(self, heading: float, std: float) -> None:
         """A yaw-only update: a heading must never tilt the attitude."""

@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from companion.messages import Magnetometer, NavState
+from companion.navigation import rotations
 from companion.navigation.ins_ekf import InsEkfConfig
 from companion.navigation.offline import InsEkfRunner
 from ground.simulation import evaluation
@@ -129,3 +130,25 @@ def test_without_a_declination_the_world_magnetic_model_gives_true_headings():
     errors, _ = fly(untold, flight(), drop={"compass"})
     assert abs(math.degrees(untold.nav.field.declination) - DECLINATION) < 1.0
     assert errors.yaw_rms_deg <= 1.5
+
+
+def test_a_navigator_that_has_lost_its_heading_finds_it_again():
+    runner = InsEkfRunner(DECLINATION)
+    original = runner.feed
+    done = False
+
+    def feed(sample):
+        nonlocal done
+        nav = runner.nav
+        if not done and nav.aligned and sample.t_us > 40e6:
+            # As if it had converged on a heading 90° wrong, and were sure of it.
+            _, _, yaw = rotations.quaternion_to_euler(nav.q)
+            nav._set_yaw(yaw + math.pi / 2, math.radians(1.0))
+            done = True
+        original(sample)
+
+    runner.feed = feed  # type: ignore[method-assign]
+    _, states = fly(runner, flight(), drop={"compass"})
+    t, yaw_err = yaw_errors_deg(states, flight())
+    assert done and yaw_err[(t > 40.0) & (t < 41.0)].min() > 60.0
+    assert yaw_err[t > 70.0].max() < 10.0
