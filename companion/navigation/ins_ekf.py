@@ -277,11 +277,12 @@ class InsEkf(InsCore):
         self.resets += 1
         # An INS that has disagreed with GPS for a second or more has most likely lost its
         # attitude (a heading from a bad magnetometer, a tilt from a wild start): let GPS
-        # teach it again (in flight the turns make heading observable), ungated for a while.
+        # teach it again (in flight the turns make heading observable). The gate stays: a
+        # reset can also follow a run of outliers (multipath), and the next fixes must not
+        # be swallowed whole.
         att = np.sqrt(np.maximum(np.diag(self.P)[6:9], 0.0))
         relearn = np.maximum(att, [LOST_TILT_STD, LOST_TILT_STD, LOST_YAW_STD]).tolist()
         self._reset_block([6, 7, 8], relearn)
-        self.aligned_us = self.t_us or 0
 
     def _heading_update(self, heading: float, std: float) -> None:
         """A yaw-only update: a heading must never tilt the attitude."""
