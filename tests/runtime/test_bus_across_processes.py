@@ -27,7 +27,13 @@ WRITER = textwrap.dedent(
         for i in range(count):
             imu.publish(Imu(t_us=i, ax_m_s2=i * 0.5))
             nav.publish(NavState(t_us=i, yaw_rad=i * 0.001))
-        ready.wait(10.0)          # keep the writer alive until the test has read
+        # Stay alive (a Latest value goes with its writer) until the test has read: it
+        # says so with clock 2. wait() returns at once while clock 1 is still the newest.
+        deadline = time.monotonic() + 10.0
+        while time.monotonic() < deadline:
+            clock = ready.wait(0.1)
+            if clock is not None and clock.t_us == 2:
+                break
     """
 )
 
