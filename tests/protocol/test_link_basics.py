@@ -153,3 +153,18 @@ def test_plugin_health_and_nav_status(link):
     assert names == {"link", "nav", "imu", "relay_in_flight"}
     nav = gcs.recv("NAV_STATUS")
     assert nav.flags & 8  # POSITION_VALID, from the bus
+
+
+def test_reboot_is_acknowledged_and_every_plug_in_comes_back(link):
+    vehicle, gcs, _ = link
+    before = {row.name.decode(): row.restarts for row in vehicle.health().rows()}
+    gcs.command(m.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, 1)
+    assert gcs.ack(m.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN).result == m.MAV_RESULT_ACCEPTED
+
+    def restarted() -> bool:
+        rows = {row.name.decode(): row for row in vehicle.health().rows()}
+        core = [n for n, r in rows.items() if r.group.decode() == "core"]
+        return all(rows[n].restarts == before[n] + 1 and rows[n].pid for n in core)
+
+    wait_for(restarted, 60, "every core plug-in restarted once")
+    gcs.connect(timeout_s=60)  # the link is back and answers

@@ -36,7 +36,11 @@ class ArmingCommands:
     def reboot(self, args: CommandArgs) -> Outcome:
         if round(args.params[0]) != 1:  # only "reboot the autopilot" is meaningful here
             return Outcome(d.MAV_RESULT_UNSUPPORTED)
-        return Outcome(defer_seq=self.port.publish_command(CommandId.RESTART_PLUGINS))
+        # Acknowledged now, as ArduPilot and PX4 do before they reboot: the restart takes
+        # this link down too, so an answer deferred to the bus would never go out.
+        self.port.statustext("Rebooting: restarting every plug-in", d.MAV_SEVERITY_NOTICE)
+        self.port.publish_command(CommandId.RESTART_PLUGINS)
+        return Outcome(d.MAV_RESULT_ACCEPTED)
 
     def inject_failure(self, args: CommandArgs) -> Outcome:
         """As PX4: off unless SYS_FAILURE_EN is 1; the simulator bridge applies it to its
