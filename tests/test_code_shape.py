@@ -1,10 +1,12 @@
-"""The tools that keep the code's shape honest: ruff and the import-linter contracts."""
+"""What keeps the code's shape honest: ruff, the import-linter contracts, and sizes."""
 
 from __future__ import annotations
 
+import ast
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 from tests.support.vehicle import REPO
 
@@ -23,3 +25,31 @@ def test_import_contracts_hold():
     assert exe, "import-linter is a dev dependency"
     done = run(exe)
     assert done.returncode == 0, done.stdout + done.stderr
+
+
+def _program_files() -> list[Path]:
+    return sorted(p for room in ("companion", "ground") for p in (REPO / room).rglob("*.py"))
+
+
+def _body_lines(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    """Lines of a function's body, its signature and docstring left out (a typer command's
+    options are its signature)."""
+    body = node.body
+    if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+        body = body[1:]
+    return 0 if not body else body[-1].end_lineno - body[0].lineno + 1  # type: ignore[operator]
+
+
+def test_program_files_stay_under_400_lines_and_functions_under_50():
+    long_files = [
+        f"{p.relative_to(REPO)}: {n}"
+        for p in _program_files()
+        if (n := p.read_text().count("\n")) > 400
+    ]
+    long_functions = [
+        f"{p.relative_to(REPO)}:{node.name}: {_body_lines(node)}"
+        for p in _program_files()
+        for node in ast.walk(ast.parse(p.read_text()))
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef) and _body_lines(node) > 50
+    ]
+    assert long_files == [] and long_functions == []
