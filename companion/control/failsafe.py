@@ -5,10 +5,14 @@ changes and operator messages out (the ``vehicle.commander`` plug-in applies the
 As ArduPlane and PX4 do it:
 - no ground-station heartbeat for ``FS_GCS_TIMEOUT`` while flying → Return; when the
   link comes back the mission is resumed if it was flying one and ``FS_GCS_RESUME`` is 1;
-- GPS lost (the navigator dead-reckons) → the controller holds heading and height; when
-  GPS is back the aircraft loiters where it is;
+- GPS lost (the navigator has had no usable fix for ``FS_GPS_LOST_S`` of its own sensor
+  time) → the controller holds heading and height; when GPS has been steady again for
+  ``FS_GPS_BACK_S`` the aircraft loiters where it is;
 - outside the fence (or inside an exclusion zone) while flying → Return.
-Each is announced once when it triggers and once when it clears.
+Each is announced once when it triggers and once when it clears. The GPS is judged by
+the navigator's time stamps with hysteresis (``Hysteresis``), never by one flag on one
+sample nor by how late a process ran, so it cannot flap; a failsafe never fires on the
+ground or during a take-off roll (``flying`` is false there).
 """
 
 from __future__ import annotations
@@ -23,6 +27,8 @@ FAILSAFE_PARAMS = (
     ParamDecl("FS_GCS_ENABLE", 1.0, 0.0, 1.0, "", "return home when the ground station is lost"),
     ParamDecl("FS_GCS_TIMEOUT", 5.0, 1.0, 300.0, "s", "ground-station silence that counts as lost"),
     ParamDecl("FS_GCS_RESUME", 1.0, 0.0, 1.0, "", "resume the mission when the link returns"),
+    ParamDecl("FS_GPS_LOST_S", 1.0, 0.0, 60.0, "s", "no usable fix this long: GPS lost"),
+    ParamDecl("FS_GPS_BACK_S", 3.0, 0.0, 60.0, "s", "good fixes this long: GPS back"),
     ParamDecl("FENCE_ENABLE", 1.0, 0.0, 1.0, "", "return home when the fence is breached"),
 )
 
@@ -36,6 +42,48 @@ class Action:
     severity: int = d.MAV_SEVERITY_CRITICAL
 
 
+class Hysteresis:
+    """A bad/good condition judged over sensor time: bad only after ``lost_s`` with no good
+    sample, good again only after ``back_s`` with no bad one.
+
+    Samples are taken with their own time stamps; a sample older than the newest seen
+    (a late process) says nothing new and is ignored. Whatever the flags do, the state
+    can change at most once per hold time in each direction.
+    """
+
+    def __init__(self, lost_s: float, back_s: float) -> None:
+        self.lost_us, self.back_us = round(lost_s * 1e6), round(back_s * 1e6)
+        self.bad = False
+        self.t_us: int | None = None  # the newest sample's time
+        self.last_good_us: int | None = None
+        self.good_since_us: int | None = None
+
+    def update(self, t_us: int, good: bool) -> bool | None:
+        """Take one sample; True when the condition just went bad, False when it just
+        cleared, None when nothing changed."""
+        if self.t_us is not None and t_us <= self.t_us:
+            return None
+        self.t_us = t_us
+        if self.last_good_us is None:
+            self.last_good_us = t_us  # the watch starts now: a hold time from here
+        if not self.bad:
+            if good:
+                self.last_good_us = t_us
+            elif t_us - self.last_good_us >= self.lost_us:
+                self.bad, self.good_since_us = True, None
+                return True
+            return None
+        if not good:
+            self.good_since_us = None
+            return None
+        if self.good_since_us is None:
+            self.good_since_us = t_us
+        if t_us - self.good_since_us >= self.back_us:
+            self.bad, self.last_good_us = False, t_us
+            return False
+        return None
+
+
 @dataclass
 class Situation:
     """What the failsafes look at, once per step."""
@@ -46,6 +94,7 @@ class Situation:
     gcs_silence_s: float  # since the last ground-station heartbeat; NaN: none heard yet
     nav_flags: int
     fence_breach: str | None
+    nav_t_us: int | None = None  # the navigation solution's own time stamp
 
 
 class Failsafes:
@@ -55,6 +104,7 @@ class Failsafes:
         self.params = params
         self.gcs_lost = self.gps_lost = self.fence_breached = False
         self.mode_before_gcs: FlightMode | None = None
+        self.gps = Hysteresis(params["FS_GPS_LOST_S"], params["FS_GPS_BACK_S"])
 
     def step(self, s: Situation) -> list[Action]:
         """The actions this situation calls for (usually none)."""
@@ -75,15 +125,23 @@ class Failsafes:
         return []
 
     def _gps(self, s: Situation) -> list[Action]:
-        dead_reckoning = bool(s.nav_flags & NavFlags.DEAD_RECKONING)
-        if not self.gps_lost and dead_reckoning and s.flying:
+        gps = self.gps
+        gps.lost_us = round(self.params["FS_GPS_LOST_S"] * 1e6)
+        gps.back_us = round(self.params["FS_GPS_BACK_S"] * 1e6)
+        if s.nav_t_us is None:
+            return []
+        usable = not s.nav_flags & NavFlags.DEAD_RECKONING and s.nav_flags & NavFlags.POSITION_VALID
+        gps.update(s.nav_t_us, bool(usable))
+        # Lost while on the ground is said once airborne (arming checks should prevent it).
+        if gps.bad and not self.gps_lost and s.flying:
             self.gps_lost = True
             return [Action(None, "Failsafe: GPS lost, holding heading and height")]
-        if self.gps_lost and not dead_reckoning:
+        if not gps.bad and self.gps_lost:
             self.gps_lost = False
+            notice = d.MAV_SEVERITY_NOTICE
             if s.flying:
-                notice = d.MAV_SEVERITY_NOTICE
                 return [Action(FlightMode.LOITER, "GPS back: loitering here", notice)]
+            return [Action(None, "GPS back", notice)]
         return []
 
     def _fence(self, s: Situation) -> list[Action]:

@@ -48,7 +48,8 @@ class InsCore:
         self.rate: tuple[float, ...] = (0.0, 0.0, 0.0)
         self.history = StateHistory()
         self.noise = ImuNoise(c.noise_window_s, c.accel_noise, c.gyro_noise)
-        self.last_gps_us: int | None = None
+        self.last_gps_us: int | None = None  # the newest fix the filter accepted
+        self.last_fix_us: int | None = None  # the newest usable fix received
         self.gps_rejected = self.heading_rejected = 0
         self.last_gps_ok = self.last_heading_ok = True
         self.cov_dt = 0.0
@@ -169,7 +170,9 @@ class InsCore:
     def _flags(self) -> int:
         flags = _SOLUTION_VALID
         t = self.t_us or 0
-        if self.last_gps_us is None or (t - self.last_gps_us) / 1e6 > self.cfg.gps_timeout_s:
+        # Dead reckoning means no fix is coming; fixes that come but are rejected say so
+        # in GPS_REJECTED (and reset the filter to GPS after ``reset_after`` of them).
+        if self.last_fix_us is None or (t - self.last_fix_us) / 1e6 > self.cfg.gps_timeout_s:
             flags |= _DEAD_RECKONING
         if not self.last_gps_ok:
             flags |= _GPS_REJECTED

@@ -98,6 +98,7 @@ class InsEkf(InsCore):
         """Position and velocity update (or the first fix, which anchors the frame)."""
         if fix.fix_type < 2 or not (math.isfinite(fix.lat_deg) and math.isfinite(fix.lon_deg)):
             return
+        self.last_fix_us = fix.t_us if self.last_fix_us is None else max(self.last_fix_us, fix.t_us)
         if self.frame is None:
             alt = fix.alt_msl_m if math.isfinite(fix.alt_msl_m) else 0.0
             self.frame = LocalFrame(fix.lat_deg, fix.lon_deg, alt)

@@ -241,7 +241,9 @@ def nav_grid_hz(config: Path) -> float:
 
 def run_sim(req: SimRequest, opts: BridgeOptions, log_level: str = "INFO") -> int:
     """Start the bridge, then the vehicle on its ptys; return when both have stopped."""
-    sync_hz = nav_grid_hz(req.config) if opts.exact and opts.speed is None else 0.0
+    # Lockstep, fast or exact, keeps in step with the navigator's grid (fast: a period
+    # behind at most, so a late vehicle process holds the simulation instead of losing data).
+    sync_hz = nav_grid_hz(req.config) if opts.speed is None else 0.0
     if opts.exact and not sync_hz:
         log.warning("--exact: only lockstep (--speed max) with nav.ins_ekf can follow control")
     opts = dataclasses.replace(opts, hold=True, sync_hz=sync_hz)

@@ -112,6 +112,7 @@ class CommanderPlugin(Plugin):
             flying=bool(flying),
             gcs_silence_s=link.gcs_silence_s if link is not None else math.nan,
             nav_flags=nav.flags if nav is not None else 0,
+            nav_t_us=int(nav.t_us) if nav is not None else None,
             fence_breach=self._fence(now).breach(nav.lat_deg, nav.lon_deg) if valid else None,
         )
         changed = False

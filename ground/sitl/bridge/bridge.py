@@ -40,6 +40,7 @@ DEVICE_CHANNELS = {
     "gps": ("sensors/gps",),
 }
 STANDARD_PRESSURE_KPA = 101.325
+FAST_LAG_PERIODS = 1  # fast lockstep: how many nav/state periods the vehicle may trail
 
 
 def pressure_kpa(alt_msl_m: float) -> float:
@@ -70,7 +71,8 @@ class SimBridge:
         self.order = 0
         self.servo_card = MiniSscReader()
         self.pacer = RealTime(opts.speed) if opts.speed else None
-        exact = self.pacer is None and opts.sync_hz > 0
+        lockstep = self.pacer is None and opts.sync_hz > 0
+        exact = lockstep and opts.exact
         stall_s = EXACT_STALL_S if exact else STALL_S
         self.lockstep = Lockstep([self.ports[n] for n in SENSORS], stall_s)
         self.truth = TruthLog(opts.truth_path) if opts.truth_path else None
@@ -78,11 +80,19 @@ class SimBridge:
         self.clock = self.bus.writer("sim/clock")
         self.truth_out = self.bus.writer("sim/truth")
         self.sync: FlightSync | None = None
+        self.nav_sync: FlightSync | None = None
         self.samples: SampleSync | None = None
-        if exact:
+        if lockstep:
             period_us = round(1e6 / opts.sync_hz)
+            # Fast lockstep lets the vehicle trail by a period (it runs beside the physics)
+            # but never further: a late process holds the simulation, whatever the load.
+            lag = 0 if exact else FAST_LAG_PERIODS
             answers = self.bus.latest_reader("actuators/servos")
-            self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]))
+            self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]), lag)
+            nav = self.bus.latest_reader("nav/state")
+            waiter = self.bus.waiter([nav])
+            self.nav_sync = FlightSync(period_us, nav, waiter, lag, "t_us", always=True)
+        if exact:
             readers = {
                 device: {c: self.bus.queue_reader(c) for c in channels}
                 for device, channels in DEVICE_CHANNELS.items()
@@ -114,21 +124,22 @@ class SimBridge:
             wall,
             self.flight.t_s / wall if wall else 0.0,
             self.lockstep.stalls,
-            "-" if sync is None else self._exact_summary(),
+            "-" if sync is None else self._sync_summary(),
         )
 
-    def _exact_summary(self) -> str:
-        sync, samples = self.sync, self.samples
-        assert sync is not None and samples is not None
-        return (
-            f"{sync.stalls} (waited {sync.wait_s:.1f} s); late samples {samples.late}"
-            f" (waited {samples.wait_s:.1f} s)"
-        )
+    def _sync_summary(self) -> str:
+        sync, nav, samples = self.sync, self.nav_sync, self.samples
+        assert sync is not None and nav is not None
+        text = f"{sync.stalls} (waited {sync.wait_s:.1f} s); nav stalls {nav.stalls}"
+        text += f" (waited {nav.wait_s:.1f} s)"
+        if samples is not None:
+            text += f"; late samples {samples.late} (waited {samples.wait_s:.1f} s)"
+        return text
 
     def stop(self) -> None:
         """Ask the loop to end after the current frame (also ends any wait for the vehicle)."""
         self.stopping = True
-        for waiting in (self.sync, self.samples):
+        for waiting in (self.sync, self.nav_sync, self.samples):
             if waiting is not None:
                 waiting.cancelled = True
 
@@ -162,6 +173,8 @@ class SimBridge:
         else:
             self.lockstep.wait()
         self.commands.serve(t_us)
+        if self.nav_sync is not None:
+            self.nav_sync.wait(t_us)
         if self.sync is not None:
             self.sync.wait(t_us)
         self._apply_servos()

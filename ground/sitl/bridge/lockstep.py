@@ -13,11 +13,10 @@ from ground.sitl.bridge.ptys import PtyPort
 if TYPE_CHECKING:
     from companion.bus.channels import LatestReader, Reader
     from companion.bus.node import Waiter
-    from companion.messages import ServoOutput
 
 log = logging.getLogger(__name__)
 
-STALL_S = 0.5  # a driver that reads nothing for this long is not waited for
+STALL_S = 2.0  # a driver that reads nothing for this long is not waited for
 EXACT_STALL_S = 10.0  # the same, when every frame must be the same run after run
 EVENT_WAIT_S = 0.05  # exact: longest sleep on a bus event before looking again
 SAMPLE_GRACE_S = 2.0  # exact: a driver's sample is waited for this long after its bytes
@@ -112,7 +111,7 @@ class _BusWait:
 
 
 class FlightSync(_BusWait):
-    """Lockstep with the control loop, so the same seed flies the same flight.
+    """Lockstep with a vehicle process that answers a fixed grid of vehicle time.
 
     The vehicle's navigator publishes on a fixed grid of vehicle time (``period_us``), the
     controller answers each state, and the servo plug-in says which command its bytes
@@ -121,12 +120,29 @@ class FlightSync(_BusWait):
     whatever the scheduler did. Only while the flight plug-ins run (from the START ack to
     STOP); a flight plug-in that does not answer is waited for ``stall_s`` once, then not
     until it catches up again.
+
+    ``lag_periods`` > 0 (fast lockstep) lets the answer trail by that many grid periods,
+    so the vehicle's processes run beside the physics instead of after it, while a late
+    process still holds the simulation: sim time never runs ahead of what the vehicle has
+    consumed (its queues would overflow and it would navigate and fly on a gap).
+    ``stamp`` names the answer's time field; ``always`` waits whether or not the flight
+    plug-ins run (for the navigator), from its first answer on.
     """
 
-    def __init__(self, period_us: int, answers: LatestReader[ServoOutput], waiter: Waiter) -> None:
+    def __init__(
+        self,
+        period_us: int,
+        answers: LatestReader[Any],
+        waiter: Waiter,
+        lag_periods: int = 0,
+        stamp: str = "command_t_us",
+        always: bool = False,
+    ) -> None:
         super().__init__(waiter)
         self.period_us = period_us
         self.answers = answers
+        self.lag_us = lag_periods * period_us
+        self.stamp, self.always = stamp, always
         self.flying = False  # the flight plug-ins were started
         self.synced = False  # they have answered in step since
         self.lagging = False  # they stopped answering: not waited for until they catch up
@@ -139,15 +155,19 @@ class FlightSync(_BusWait):
 
     def wait(self, t_us: int) -> None:
         """Return once the answer to the newest grid state at or before ``t_us`` is in."""
-        if not self.flying:
+        if self.always:
+            self._answered(0)
+            if self.answered_us < 0:
+                return  # not started yet: nothing to keep in step with
+        elif not self.flying:
             return
-        grid = t_us // self.period_us * self.period_us
+        grid = (t_us - self.lag_us) // self.period_us * self.period_us
         if self._answered(grid) or self.lagging:
             return
-        limit = STALL_FLIGHT_S if self.synced else START_FLIGHT_S
+        limit = STALL_FLIGHT_S if self.synced or self.always else START_FLIGHT_S
         if not self._until(lambda: self._answered(grid), limit):
             log.warning(
-                "lockstep: no servo answer to the state at %.2f s for %.0f s (newest"
+                "lockstep: no answer to the state at %.2f s for %.0f s (newest"
                 " answer: %.2f s); not waiting for it",
                 grid / 1e6,
                 limit,
@@ -158,8 +178,8 @@ class FlightSync(_BusWait):
 
     def _answered(self, grid: int) -> bool:
         answer = self.answers.get()
-        if answer is not None and answer.command_t_us > self.answered_us:
-            self.answered_us = int(answer.command_t_us)
+        if answer is not None and getattr(answer, self.stamp) > self.answered_us:
+            self.answered_us = int(getattr(answer, self.stamp))
         if self.answered_us < grid:
             return False
         self.synced, self.lagging = True, False

@@ -1,0 +1,97 @@
+"""The failsafe state machine judged by sensor time: no flapping, each change said once."""
+
+from __future__ import annotations
+
+import pytest
+
+from companion.failsafe import FAILSAFE_PARAMS, Failsafes, Hysteresis, Situation
+from companion.messages import FlightMode, NavFlags
+
+GOOD = int(NavFlags.POSITION_VALID | NavFlags.ATTITUDE_VALID)
+DEAD = GOOD | int(NavFlags.DEAD_RECKONING)
+
+
+def _failsafes(**overrides: float) -> Failsafes:
+    params = {p.name: p.default for p in FAILSAFE_PARAMS}
+    params.update(overrides)
+    return Failsafes(params)
+
+
+def _situation(t_us: int, flags: int, flying: bool = True) -> Situation:
+    return Situation(
+        now_us=t_us, mode=FlightMode.MISSION, flying=flying, gcs_silence_s=0.0,
+        nav_flags=flags, fence_breach=None, nav_t_us=t_us,
+    )  # fmt: skip
+
+
+def _texts(fs: Failsafes, samples) -> list[str]:
+    return [a.text for t, flags, flying in samples for a in fs.step(_situation(t, flags, flying))]
+
+
+@pytest.mark.parametrize("rate_hz", [10, 25, 50, 100])
+@pytest.mark.parametrize("pattern", [(True, False), (False, True), (True, True, False)])
+def test_alternating_gps_flags_change_the_state_at_most_once_each_way_per_hold(rate_hz, pattern):
+    lost_s, back_s = 1.0, 3.0
+    hyst = Hysteresis(lost_s, back_s)
+    period = round(1e6 / rate_hz)
+    changes: list[tuple[int, bool]] = []
+    for i in range(rate_hz * 120):
+        change = hyst.update(i * period, pattern[i % len(pattern)])
+        if change is not None:
+            changes.append((i * period, change))
+    # Good at least every third sample: the GPS never counts as lost at all.
+    assert changes == []
+
+
+@pytest.mark.parametrize("rate_hz", [10, 100])
+def test_bursts_of_outage_and_fix_cannot_make_the_state_flap(rate_hz):
+    # Outages just longer than the hold, fixes just shorter than the return hold: the GPS
+    # goes lost once and stays lost (no return without a steady stretch of fixes).
+    hyst = Hysteresis(1.0, 3.0)
+    period = round(1e6 / rate_hz)
+    changes, t = [], 0
+    for _ in range(30):
+        for good, seconds in ((False, 1.5), (True, 2.5)):
+            for _ in range(round(seconds * rate_hz)):
+                t += period
+                if (c := hyst.update(t, good)) is not None:
+                    changes.append((t, c))
+    assert [c for _, c in changes] == [True]
+
+
+def test_an_outage_is_announced_once_and_the_return_once_with_loiter():
+    fs = _failsafes(FS_GPS_LOST_S=1.0, FS_GPS_BACK_S=3.0)
+    period = 20_000  # 50 Hz navigation solutions
+    samples = [(i * period, GOOD, True) for i in range(100)]  # 2 s good
+    samples += [(i * period, DEAD, True) for i in range(100, 400)]  # 6 s dead reckoning
+    samples += [(i * period, GOOD, True) for i in range(400, 800)]  # 8 s good
+    actions = [a for t, flags, flying in samples for a in fs.step(_situation(t, flags, flying))]
+    assert [a.text for a in actions] == [
+        "Failsafe: GPS lost, holding heading and height",
+        "GPS back: loitering here",
+    ]
+    assert actions[1].mode == FlightMode.LOITER
+
+
+def test_a_transient_shorter_than_the_hold_does_not_undo_the_mission():
+    fs = _failsafes(FS_GPS_LOST_S=1.0)
+    period = 10_000
+    samples = [(i * period, DEAD if 100 <= i < 180 else GOOD, True) for i in range(400)]
+    assert _texts(fs, samples) == []
+
+
+def test_no_gps_failsafe_on_the_ground_or_in_the_take_off_roll():
+    fs = _failsafes()
+    period = 20_000
+    samples = [(i * period, DEAD if i % 300 > 100 else GOOD, False) for i in range(3000)]
+    assert _texts(fs, samples) == []
+
+
+def test_late_and_repeated_samples_say_nothing_new():
+    hyst = Hysteresis(1.0, 3.0)
+    assert hyst.update(5_000_000, True) is None
+    # An old sample arriving late, however bad, is ignored.
+    assert hyst.update(1_000_000, False) is None
+    assert hyst.update(5_000_000, False) is None
+    assert hyst.update(5_500_000, False) is None
+    assert hyst.update(6_000_000, False) is True
