@@ -1,13 +1,48 @@
-"""Shared fixtures: a real vehicle per test, each on its own bus namespace."""
+"""Shared fixtures: a real vehicle per test, each on its own bus namespace.
+
+``COMPANION_TEST_STRESS=1`` runs the whole session on a busy machine: one CPU-bound
+Python process per core for as long as the tests run (a real companion computer is never
+idle, and the vehicle must fly the same whatever the scheduler does).
+"""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 
 from tests.support.vehicle import Vehicle
+
+STRESS_ENV = "COMPANION_TEST_STRESS"
+_HOG = "while True:\n    pass\n"
+_hogs: list[subprocess.Popen[bytes]] = []
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """Start the CPU hogs when asked for a busy machine."""
+    if os.environ.get(STRESS_ENV, "") not in ("", "0"):
+        for _ in range(os.cpu_count() or 2):
+            _hogs.append(subprocess.Popen([sys.executable, "-c", _HOG]))
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    """End the hogs this session started (by their own pids)."""
+    for hog in _hogs:
+        hog.kill()
+    for hog in _hogs:
+        hog.wait()
+    _hogs.clear()
+
+
+def pytest_report_header(config: pytest.Config) -> str | None:
+    """Say when the session runs under stress."""
+    if os.environ.get(STRESS_ENV, "") not in ("", "0"):
+        return f"{STRESS_ENV}: one CPU hog per core ({os.cpu_count()}) for the session"
+    return None
 
 
 @pytest.fixture
