@@ -65,7 +65,10 @@ _VEHICLE_KEYS: dict[str, Setting] = {
     "namespace": Setting(str, "", "bus namespace (default: $COMPANION_BUS or 'companion')"),
     "clock": Setting(str, "monotonic", "vehicle time base", choices=CLOCKS),
     "state_dir": Setting(
-        str, "", "where parameters and missions persist (default ~/.local/state/companion/NAME)"
+        str,
+        "",
+        "where parameters and missions persist"
+        " (default ~/.local/state/companion/NAME/NAMESPACE: one vehicle's, never shared)",
     ),
 }
 # `companion sim` flies this many copies of the vehicle; `companion run` ignores the table.
@@ -156,20 +159,28 @@ def _table(check: _Checker, data: dict[str, Any], name: str, decl: dict[str, Set
     return check.values(table, decl, (name,))
 
 
-def _vehicle_and_fleet(check: _Checker, data: dict[str, Any]) -> tuple[dict, dict]:
+def _vehicle_and_fleet(
+    check: _Checker, data: dict[str, Any], namespace: str | None = None
+) -> tuple[dict, dict]:
     vehicle = _table(check, data, "vehicle", _VEHICLE_KEYS)
     if not vehicle["state_dir"]:
-        vehicle["state_dir"] = str(Path("~/.local/state/companion").expanduser() / vehicle["name"])
+        # Each bus namespace is one vehicle: two vehicles of one config on one machine
+        # must never read each other's mission or parameters.
+        ns = namespace or vehicle["namespace"] or default_namespace()
+        base = Path("~/.local/state/companion").expanduser()
+        vehicle["state_dir"] = str(base / vehicle["name"] / ns)
     return vehicle, _table(check, data, "fleet", _FLEET_KEYS)
 
 
-def load_sections(path: str | Path) -> tuple[dict[str, Any], dict[str, Any]]:
+def load_sections(
+    path: str | Path, namespace: str | None = None
+) -> tuple[dict[str, Any], dict[str, Any]]:
     """The checked ``[vehicle]`` and ``[fleet]`` tables, defaults filled in.
 
     ``companion sim`` needs them before the simulator exists, when the plug-ins' ``sim://``
     settings cannot be resolved yet; the rest of the file is checked when each vehicle starts.
     """
-    return _vehicle_and_fleet(*_parse(Path(path)))
+    return _vehicle_and_fleet(*_parse(Path(path)), namespace)
 
 
 def load_config(
@@ -183,7 +194,7 @@ def load_config(
     path = Path(path)
     check, data = _parse(path)
     check.sim_refs = sim_refs
-    vehicle, fleet = _vehicle_and_fleet(check, data)
+    vehicle, fleet = _vehicle_and_fleet(check, data, namespace)
     ns = namespace or vehicle["namespace"] or None
     if ns is not None:
         try:

@@ -22,7 +22,7 @@ from companion.messages.control import (
     VehicleCommand,
     VehicleStatus,
 )
-from companion.messages.link import LinkStatus, StatusText
+from companion.messages.link import LinkStatus, MissionChanged, StatusText
 from companion.messages.navigation import NavFlags, NavState
 from companion.messages.sensors import Baro, Compass, GpsFix, GpsFixType, Imu, Magnetometer
 from companion.messages.simulation import SimClock, SimTruth
@@ -54,6 +54,7 @@ __all__ = [
     "LinkStatus",
     "Magnetometer",
     "Message",
+    "MissionChanged",
     "MissionState",
     "NavFlags",
     "NavState",

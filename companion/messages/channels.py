@@ -8,7 +8,7 @@ from typing import Literal
 from companion.messages.actuators import ActuatorCommand, ServoOutput
 from companion.messages.base import Message
 from companion.messages.control import CommandAck, ControlStatus, VehicleCommand, VehicleStatus
-from companion.messages.link import LinkStatus, StatusText
+from companion.messages.link import LinkStatus, MissionChanged, StatusText
 from companion.messages.navigation import NavState
 from companion.messages.sensors import Baro, Compass, GpsFix, Imu, Magnetometer
 from companion.messages.simulation import SimClock, SimTruth
@@ -50,6 +50,7 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("system/health", SystemHealth, "latest", doc="the health table"),
     Channel("params/changes", ParamChange, "queue", 32, "parameters set from the ground"),
     Channel("link/status", LinkStatus, "latest", doc="ground-station heartbeats heard"),
+    Channel("mission/changed", MissionChanged, "latest", doc="stored mission lists changed"),
     Channel("vehicle/statustext", StatusText, "queue", 16, "messages for the operator", True),
 )
 

@@ -19,6 +19,26 @@ class LinkStatus(Message):
     ]
 
 
+class MissionChanged(Message):
+    """The stored mission, fence and rally points changed (or the link started).
+
+    Producer: link (after a complete, valid upload or a clear). Consumers: vehicle.commander,
+    control.fixed_wing, which reload the store when a checksum differs from theirs.
+    ``mission_type``, ``count`` and ``checksum`` describe the change; ``counts`` and
+    ``checksums`` every type (index = MAV_MISSION_TYPE), so a reader that only sees the
+    newest value misses none. The checksum is the CRC-32 of the stored list.
+    """
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("mission_type", ctypes.c_uint8),
+        ("count", ctypes.c_uint32),
+        ("checksum", ctypes.c_uint32),
+        ("counts", ctypes.c_uint32 * 3),
+        ("checksums", ctypes.c_uint32 * 3),
+    ]
+
+
 class StatusText(Message):
     """A line for the ground station's message list (STATUSTEXT). Producers: any plug-in."""
 

@@ -78,11 +78,11 @@ def _single_links(link: list[str] | None, api_port_base: int | None) -> list[str
     return links
 
 
-def _fleet_settings(config: Path) -> tuple[dict, dict]:
+def _fleet_settings(config: Path, namespace: str) -> tuple[dict, dict]:
     from companion.exec_control.config import ConfigError, load_sections
 
     try:
-        return load_sections(config)
+        return load_sections(config, namespace)
     except ConfigError as exc:
         err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
         raise typer.Exit(EXIT_CONFIG) from None
@@ -168,7 +168,7 @@ def sim(
 
     setup_logging(log_level)
     lists = plan_or_exit(plan) if plan is not None else None
-    vehicle, fleet = _fleet_settings(config)
+    vehicle, fleet = _fleet_settings(config, namespace or default_namespace())
     try:
         opts = BridgeOptions(
             airframe=aircraft, home=_home(home), airborne=airborne, speed=_speed(speed),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from companion.failsafe import FAILSAFE_PARAMS, Failsafes, Hysteresis, Situation
+from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Hysteresis, Situation
 from companion.messages import FlightMode, NavFlags
 
 GOOD = int(NavFlags.POSITION_VALID | NavFlags.ATTITUDE_VALID)

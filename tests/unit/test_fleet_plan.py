@@ -81,8 +81,8 @@ def test_the_vehicle_command_line_means_what_the_fleet_planned(tmp_path, monkeyp
 
 
 def test_the_fleet_table_is_checked_and_ignored_by_run(tmp_path):
-    vehicle, fleet = load_sections(SIM_TOML)
-    assert vehicle["sysid"] == 1 and vehicle["state_dir"].endswith("companion/sim")
+    vehicle, fleet = load_sections(SIM_TOML, "fl")
+    assert vehicle["sysid"] == 1 and vehicle["state_dir"].endswith("companion/sim/fl")
     assert fleet == {"count": 1, "spacing_m": 50.0, "api_port_base": 14540}
     config = tmp_path / "v.toml"
     config.write_text('[vehicle]\nname = "v"\n\n[fleet]\ncount = 2\ncuont = 3\n')
@@ -103,3 +103,12 @@ def test_sim_refuses_a_misspelt_fleet_key_before_starting_anything(tmp_path):
     result = CliRunner().invoke(app, ["sim", "--config", str(config)])
     assert result.exit_code == 2
     assert "fleet.spaceing_m" in result.output and "did you mean 'spacing_m'" in result.output
+
+
+def test_two_vehicles_of_one_config_never_share_a_default_state_dir():
+    one, _ = load_sections(SIM_TOML, "alpha")
+    two, _ = load_sections(SIM_TOML, "bravo")
+    assert one["state_dir"] != two["state_dir"]
+    refs = {name: "/dev/null" for name in ("gps", "compass", "imu", "servos")}
+    config = load_config(SIM_TOML, "bravo", sim_refs={**refs, "airframe": "c172p"})
+    assert config.vehicle["state_dir"] == two["state_dir"]

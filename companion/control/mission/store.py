@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import json
 import logging
+import zlib
 from pathlib import Path
 
 from companion.control.mission.items import MISSION_TYPES, MissionItem
+from companion.messages import MissionChanged
 from companion.params.atomic import atomic_write_text
 
 log = logging.getLogger(__name__)
@@ -28,14 +30,10 @@ class MissionStore:
                 self.items[mission_type] = self._load(self.directory / FILES[mission_type])
         return self
 
-    def stamp(self, mission_type: int) -> int:
-        """The stored list's modification time (ns; 0 when none): a change means reload."""
-        if self.directory is None:
-            return 0
-        try:
-            return (self.directory / FILES[mission_type]).stat().st_mtime_ns
-        except FileNotFoundError:
-            return 0
+    def checksum(self, mission_type: int) -> int:
+        """CRC-32 of the list as it is held (the same list always gives the same number)."""
+        text = json.dumps([item.as_dict() for item in self.items[mission_type]], sort_keys=True)
+        return zlib.crc32(text.encode())
 
     def _load(self, path: Path) -> list[MissionItem]:
         try:
@@ -53,3 +51,31 @@ class MissionStore:
             text = json.dumps([item.as_dict() for item in items], indent=1)
             atomic_write_text(self.directory / FILES[mission_type], text)
         self.items[mission_type] = list(items)
+
+    def changed(self, mission_type: int, t_us: int) -> MissionChanged:
+        """What ``mission/changed`` says after ``mission_type`` was stored."""
+        msg = MissionChanged(t_us=t_us, mission_type=mission_type)
+        for t in MISSION_TYPES:
+            msg.counts[t], msg.checksums[t] = len(self.items[t]), self.checksum(t)
+        msg.count, msg.checksum = msg.counts[mission_type], msg.checksums[mission_type]
+        return msg
+
+
+class StoreFollower:
+    """Keeps a process's copy of the store in step with ``mission/changed``.
+
+    The lists are read again only when the link says a checksum differs from the one held
+    here: storing an identical mission again changes nothing (a running mission goes on).
+    """
+
+    def __init__(self, store: MissionStore) -> None:
+        self.store = store
+        self.sums = {t: store.checksum(t) for t in MISSION_TYPES}
+
+    def follow(self, msg: MissionChanged | None) -> set[int]:
+        """The mission types whose lists changed (reloaded from disk)."""
+        if msg is None or all(msg.checksums[t] == self.sums[t] for t in MISSION_TYPES):
+            return set()
+        self.store.reload()
+        before, self.sums = self.sums, {t: self.store.checksum(t) for t in MISSION_TYPES}
+        return {t for t in MISSION_TYPES if self.sums[t] != before[t]}

@@ -17,7 +17,7 @@ from typing import Any
 from companion.actuators.airframe import AirframeError, load_airframe
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.params import control_params, flight_config
-from companion.control.mission.store import MissionStore
+from companion.control.mission.store import MissionStore, StoreFollower
 from companion.messages import (
     ActuatorCommand,
     ControlStatus,
@@ -32,7 +32,6 @@ from mavlink_dialect import companion as d
 
 WAIT_S = 0.5
 STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item is reached)
-MISSION_CHECK_US = 1_000_000
 
 
 class FixedWingPlugin(Plugin):
@@ -42,7 +41,7 @@ class FixedWingPlugin(Plugin):
         "airframe": Setting(str, "c172p", "airframe name (companion/airframes) or TOML path"),
     }
     inputs = ("nav/state",)
-    optional_inputs = ("vehicle/status", "params/changes")
+    optional_inputs = ("vehicle/status", "params/changes", "mission/changed")
     outputs = ("control/actuators", "control/status")
 
     @classmethod
@@ -63,31 +62,28 @@ class FixedWingPlugin(Plugin):
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
         self.params = LiveParams(ctx.bus, decls, state_dir)
         self.missions = MissionStore(state_dir / "missions")
-        self.mission_stamp = self.missions.stamp(d.MAV_MISSION_TYPE_MISSION)
+        self.follower = StoreFollower(self.missions)
         self.controller = FlightController(
             flight_config(self.params.values), self.missions.items[0]
         )
         bus = ctx.bus
         self.nav = bus.latest_reader("nav/state")
         self.status_in = bus.latest_reader("vehicle/status")
+        self.mission_changes = bus.latest_reader("mission/changed")
         self.surfaces = bus.writer("control/actuators")
         self.status_out = bus.writer("control/status")
         self.reached_count = 0
         self.last_reached = -1
         self.next_status_us = 0
-        self.next_mission_check_us = 0
         self.default_status = VehicleStatus(mode=int(FlightMode.LOITER), armed=1)
 
     def _follow_changes(self, now_us: int) -> None:
         if self.params.poll():
             self.controller.set_config(flight_config(self.params.values))
-        if now_us >= self.next_mission_check_us:
-            self.next_mission_check_us = now_us + MISSION_CHECK_US
-            stamp = self.missions.stamp(d.MAV_MISSION_TYPE_MISSION)
-            if stamp != self.mission_stamp:
-                self.mission_stamp = stamp
-                self.controller.set_mission(self.missions.reload().items[0])
-                self.ctx.log.info("new mission: %d items", len(self.missions.items[0]))
+        # Only a different mission restarts it: the same list stored again changes nothing.
+        if d.MAV_MISSION_TYPE_MISSION in self.follower.follow(self.mission_changes.get()):
+            self.controller.set_mission(self.missions.items[d.MAV_MISSION_TYPE_MISSION])
+            self.ctx.log.info("new mission: %d items", len(self.missions.items[0]))
 
     def step(self) -> None:
         nav = self.nav.wait(WAIT_S)

@@ -95,7 +95,7 @@ class MavlinkLink(Plugin):
         "control/status",
         "vehicle/statustext",
     )
-    outputs = ("link/commands", "params/changes", "link/status")
+    outputs = ("link/commands", "params/changes", "link/status", "mission/changed")
 
     @classmethod
     def validate(cls, settings: Mapping[str, Any]) -> list[str]:
@@ -156,10 +156,18 @@ class MavlinkLink(Plugin):
         store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
         self.missions = MissionService(self.mav, store, sysid, ctx.settings["compid"])
         self.router.add_service(self.missions)
+        # The other plug-ins follow the stored lists through this, not the files' times.
+        self.mission_changes = bus.writer("mission/changed")
+        self.missions.on_change = self._mission_changed
+        self._mission_changed(0)
         register_commands(self.commands, self, self.identity, self.router)
         self.commands.on_refusal = self.refusal_text
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         self._seq = 0
+
+    def _mission_changed(self, mission_type: int) -> None:
+        now = self.ctx.clock.now_us()
+        self.mission_changes.publish(self.missions.store.changed(mission_type, now))
 
     def _serve_params(self, ctx: PluginContext, sysid: int) -> None:
         path = Path(ctx.vehicle.get("state_dir", ".")) / "params.json"

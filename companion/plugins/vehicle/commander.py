@@ -16,7 +16,7 @@ from typing import Any
 from companion.control.commander import MODE_COMMANDS, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.control.mission.fence import Fence
-from companion.control.mission.store import MissionStore
+from companion.control.mission.store import MissionStore, StoreFollower
 from companion.messages import NAME_LEN, CommandAck, FlightMode, NavFlags, StatusText
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
@@ -24,7 +24,6 @@ from mavlink_dialect import companion as d
 
 WAIT_S = 0.05
 STATUS_PERIOD_US = 250_000  # 4 Hz: the link and the controller follow it
-FENCE_CHECK_US = 1_000_000
 FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) second
 
 
@@ -33,17 +32,23 @@ class CommanderPlugin(Plugin):
 
     params = FAILSAFE_PARAMS
     inputs = ("link/commands",)
-    optional_inputs = ("nav/state", "system/health", "control/status", "link/status")
+    optional_inputs = (
+        "nav/state",
+        "system/health",
+        "control/status",
+        "link/status",
+        "mission/changed",
+    )
     outputs = ("vehicle/status", "link/command_acks", "vehicle/statustext")
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
         self.store = MissionStore(state_dir / "missions")
-        self.fence_stamp: int | None = None
-        self.fence = Fence.from_items([])
-        # The link writes missions in its own process: read the stored file each time.
-        self.commander = Commander(lambda: len(self.store.reload().items[0]))
+        self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
+        # The link stores missions in its own process and says so on mission/changed.
+        self.follower = StoreFollower(self.store)
+        self.commander = Commander(lambda: len(self.store.items[d.MAV_MISSION_TYPE_MISSION]))
         self.live = LiveParams(ctx.bus, self.params, state_dir)
         self.failsafes = Failsafes(self.live.values)
         bus = ctx.bus
@@ -52,6 +57,7 @@ class CommanderPlugin(Plugin):
         self.health = bus.latest_reader("system/health")
         self.control = bus.latest_reader("control/status")
         self.link = bus.latest_reader("link/status")
+        self.mission_changes = bus.latest_reader("mission/changed")
         # Commands wake it at once; the rest (navigation at 100 Hz and more) is read when
         # it wakes on its own, 20 times a wall second: waking for every navigation sample
         # cost a lockstep simulation a tenth of its speed.
@@ -60,7 +66,6 @@ class CommanderPlugin(Plugin):
         self.out = bus.writer("vehicle/status")
         self.texts = bus.writer("vehicle/statustext")
         self.next_status_us = 0
-        self.next_fence_us = 0
         self.next_failsafe_us = 0
 
     def step(self) -> None:
@@ -73,6 +78,8 @@ class CommanderPlugin(Plugin):
         if (health := self.health.get()) is not None:
             c.on_armed(bool(health.flight_running))
         self.live.poll()
+        if d.MAV_MISSION_TYPE_FENCE in self.follower.follow(self.mission_changes.get()):
+            self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
         changed = self._commands()
         if now >= self.next_failsafe_us or now < self.next_failsafe_us - FAILSAFE_PERIOD_US:
             self.next_failsafe_us = now + FAILSAFE_PERIOD_US
@@ -113,7 +120,7 @@ class CommanderPlugin(Plugin):
             gcs_silence_s=link.gcs_silence_s if link is not None else math.nan,
             nav_flags=nav.flags if nav is not None else 0,
             nav_t_us=int(nav.t_us) if nav is not None else None,
-            fence_breach=self._fence(now).breach(nav.lat_deg, nav.lon_deg) if valid else None,
+            fence_breach=self.fence.breach(nav.lat_deg, nav.lon_deg) if valid else None,
         )
         changed = False
         for action in self.failsafes.step(situation):
@@ -124,15 +131,6 @@ class CommanderPlugin(Plugin):
             if action.mode is not None and action.mode != c.mode:
                 changed |= c.failsafe(FlightMode(action.mode)).result == 0
         return changed
-
-    def _fence(self, now: int) -> Fence:
-        if now >= self.next_fence_us or now < self.next_fence_us - FENCE_CHECK_US:
-            self.next_fence_us = now + FENCE_CHECK_US
-            stamp = self.store.stamp(d.MAV_MISSION_TYPE_FENCE)
-            if stamp != self.fence_stamp:
-                self.fence_stamp = stamp
-                self.fence = Fence.from_items(self.store.reload().items[1])
-        return self.fence
 
     def close(self) -> None:
         self.waiter.close()
