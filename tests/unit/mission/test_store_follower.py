@@ -25,5 +25,7 @@ def test_a_new_mission_is_followed_and_the_same_one_stored_again_is_not(tmp_path
 
     link.replace(0, short)
     assert follower.follow(link.changed(0, 4)) == {0}
-    assert follower.store.items[0] == short
+    assert [(i.command, i.x, i.y) for i in follower.store.items[0]] == [
+        (i.command, i.x, i.y) for i in short
+    ]
     assert follower.follow(None) == set()
