@@ -110,6 +110,12 @@ class Plugin(ABC):
         """Problems with the settings taken together (checked before anything starts)."""
         return []
 
+    @classmethod
+    def prearm(cls, settings: Mapping[str, Any]) -> list[str]:
+        """Why this ``flight`` plug-in could not fly now (its device missing...), checked by
+        the supervisor before arming; each reason follows ``PreArm: ``."""
+        return []
+
     def init(self, ctx: PluginContext) -> None:
         """Open the device and the bus ports. Raising here counts as a crash."""
         self.ctx = ctx

@@ -16,6 +16,7 @@ from dataclasses import asdict
 from companion.bus import BusNode, MonotonicClock, Reader, cleanup_namespace
 from companion.exec_control.child import FIRST_BACKOFF_S, Child
 from companion.exec_control.config import VehicleConfig
+from companion.exec_control.registry import load
 from companion.messages import (
     NAME_LEN,
     CommandAck,
@@ -47,6 +48,7 @@ class Supervisor:
         }
         self.children = [Child(spec, base) for spec in cfg.plugins]
         self.flight_running = False
+        self.reason = ""  # why the last command was refused, for its ack
         self.stopping = False
         self.clock = MonotonicClock()
         self.until: float | None = None
@@ -77,10 +79,23 @@ class Supervisor:
                 child.kill()
                 child.wait_stopped(time.monotonic() + 0.5)
 
+    def prearm_problem(self) -> str:
+        """The first reason a flight plug-in gives for not arming ("" when none)."""
+        for child in self.group("flight"):
+            for reason in load(child.spec.kind).prearm(child.spec.settings):
+                return f"PreArm: {reason}"
+        return ""
+
     def handle_command(self, cmd: VehicleCommand) -> CommandResult | None:
         """Act on the commands that belong to execution control; None for the others."""
         kind = cmd.command
+        self.reason = ""
         if kind == CommandId.START:
+            if cmd.param[1] >= 0.5 and not self.flight_running:  # the link asks for checks
+                self.reason = self.prearm_problem()
+                if self.reason:
+                    log.warning("arming refused: %s", self.reason)
+                    return CommandResult.DENIED
             self.start_group("flight")
             self.flight_running = True
         elif kind == CommandId.STOP:
@@ -176,4 +191,5 @@ class Supervisor:
         ack = CommandAck(t_us=self.clock.now_us(), seq=cmd.seq, command=cmd.command)
         ack.result = int(result)
         ack.source = b"exec_control"[: NAME_LEN - 1]
+        ack.reason = self.reason.encode()[:47]
         return ack

@@ -44,6 +44,7 @@ class Snapshot:
     mission_total: int = 0
     home: tuple[float, float, float] | None = None  # lat_deg, lon_deg, alt_msl_m
     health_cursor: int = 0  # PLUGIN_HEALTH sends one row at a time, round the table
+    prearm_ok: bool | None = None  # the pre-arm checks pass (None: not judged yet)
 
 
 Builder = Callable[[Any, Snapshot], Any]
@@ -180,6 +181,10 @@ def sensor_bits(s: Snapshot) -> tuple[int, int]:
         present |= bits
         if s.nav.flags & NavFlags.ATTITUDE_VALID:
             healthy |= bits
+    if s.prearm_ok is not None:  # as ArduPilot: QGroundControl shows "Ready To Fly" on it
+        present |= d.MAV_SYS_STATUS_PREARM_CHECK
+        if s.prearm_ok:
+            healthy |= d.MAV_SYS_STATUS_PREARM_CHECK
     return present, healthy
 
 

@@ -43,6 +43,16 @@ def split_device(url: str, baud: int) -> tuple[str, int]:
     return path, baud
 
 
+def open_problem(url: str, baud: int) -> str | None:
+    """Why the device cannot be opened now (None: it can); it is closed again at once."""
+    path, rate = split_device(url, baud)
+    try:
+        serial.serial_for_url(path, baudrate=rate, timeout=0).close()
+    except _PORT_ERRORS as exc:
+        return str(getattr(exc, "strerror", None) or exc)
+    return None
+
+
 class ReopeningSerial:
     """A port that is opened on first use and reopened, with back-off, whenever it fails."""
 

@@ -66,7 +66,11 @@ def test_unknown_commands_are_unsupported_at_once(link):
 
 def test_arm_starts_the_flight_group_and_disarm_stops_it(link):
     vehicle, gcs, _ = link
+    # This vehicle has no GPS: arming is refused until forced (param2 21196).
     gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 1)
+    assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_DENIED
+    assert gcs.recv("STATUSTEXT", 3).text.startswith("PreArm: GPS")
+    gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 1, 21196)
     assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_ACCEPTED
     wait_for(lambda: vehicle.row("relay_in_flight").pid, 5, "flight group running")
     gcs.recv(
@@ -74,7 +78,7 @@ def test_arm_starts_the_flight_group_and_disarm_stops_it(link):
     )
     # A retransmission of the same command is answered, not executed again.
     restarts = vehicle.row("relay_in_flight").restarts
-    gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 1, confirmation=1)
+    gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 1, 21196, confirmation=1)
     assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_ACCEPTED
     gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 0)
     assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_ACCEPTED

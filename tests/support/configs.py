@@ -20,6 +20,7 @@ TICKER = "tests.support.plugins:Ticker"
 RELAY = "tests.support.plugins:Relay"
 WAITING = "tests.support.plugins:Waiting"
 FAKE_NAV = "tests.support.plugins:FakeNav"
+FAKE_GPS = "tests.support.plugins:FakeGps"
 CRASH_AFTER = "tests.support.plugins:CrashAfter"
 PUBLISH_ONCE = "tests.support.plugins:PublishOnce"
 
@@ -117,6 +118,7 @@ def client_vehicle(
         name,
         link(endpoint),
         plugin("nav", FAKE_NAV),
+        plugin("gps", FAKE_GPS),  # a 3-D fix: the pre-arm checks pass
         *extra,
         plugin("commander", "vehicle.commander"),
         flight or flight_group(),

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import threading
 
-from companion.messages import Imu, NavFlags, NavState
+from companion.messages import GpsFix, Imu, NavFlags, NavState
 from companion.plugin import Plugin, PluginContext, Setting
 
 
@@ -82,6 +82,7 @@ class CrashAfter(Plugin):
 class FakeNav(Plugin):
     """A navigator stand-in: a known, valid solution on nav/state at 20 Hz."""
 
+    settings = {"aligning": Setting(bool, False, "say ALIGNING, as a navigator starting up")}
     outputs = ("nav/state",)
     ROLL, PITCH, YAW = 0.1, -0.05, 1.2
     LAT, LON, ALT = -37.9105, 145.1340, 120.0
@@ -105,7 +106,30 @@ class FakeNav(Plugin):
             | NavFlags.POSITION_VALID
             | NavFlags.VELOCITY_VALID
         )
+        if self.ctx.settings["aligning"]:
+            msg.flags = int(NavFlags.ALIGNING)
         self.nav.publish(msg)
+
+
+class FakeGps(Plugin):
+    """A GPS stand-in: a fix at FakeNav's position five times a second (``fix_type`` 3: 3-D)."""
+
+    settings = {"fix_type": Setting(int, 3, "GPS_FIX_TYPE of every fix", min=0, max=6)}
+    outputs = ("sensors/gps",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.gps = ctx.bus.writer("sensors/gps")
+        self._pace = threading.Event()
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:
+            self._pace.wait(0.2)
+        fix = GpsFix(t_us=self.ctx.clock.now_us(), fix_type=self.ctx.settings["fix_type"])
+        fix.lat_deg, fix.lon_deg, fix.alt_msl_m = FakeNav.LAT, FakeNav.LON, FakeNav.ALT
+        fix.eph_m, fix.epv_m, fix.satellites = 1.2, 2.0, 9
+        self.gps.publish(fix)
+        self.ctx.health.ok()
 
 
 class PublishOnce(Plugin):

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from companion.control.prearm import FORCE_ARM, PREFIX
 from companion.link.codec import dialect as d
 from companion.link.command_rules import whole_or
 from companion.link.command_service import CommandArgs, CommandService, Outcome
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
 from companion.messages import CommandId
 
-FORCE_DISARM = 21196  # param2 of COMPONENT_ARM_DISARM that means "even in the air"
+FORCE_DISARM = FORCE_ARM  # param2 of COMPONENT_ARM_DISARM that means "even in the air"
+MAX_PREARM_TEXTS = 3
 
 
 class ArmingCommands:
@@ -31,7 +33,18 @@ class ArmingCommands:
             # aircraft, so it takes the magic number to mean it.
             self.port.statustext("Disarm refused: flying (param2 21196 forces it)")
             return Outcome(d.MAV_RESULT_DENIED)
-        return Outcome(defer_seq=self.port.publish_command(command), timeout_s=BUS_ACK_TIMEOUT_S)
+        forced = whole_or(args.params[1], 0) == FORCE_ARM
+        checked = (
+            command == CommandId.START and not forced and self.port.param("ARMING_CHECK") >= 0.5
+        )
+        if checked and (found := self.port.prearm_failures()):
+            for reason in found[:MAX_PREARM_TEXTS]:  # as ArduPilot: one line per reason
+                self.port.statustext(PREFIX + reason, d.MAV_SEVERITY_CRITICAL)
+            return Outcome(d.MAV_RESULT_DENIED)
+        # The supervisor checks the flight plug-ins' devices when param[1] asks it to.
+        params = (1.0, 1.0 if checked else 0.0) if command == CommandId.START else ()
+        seq = self.port.publish_command(command, params)
+        return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)
 
     def reboot(self, args: CommandArgs) -> Outcome:
         if round(args.params[0]) != 1:  # only "reboot the autopilot" is meaningful here

@@ -7,7 +7,9 @@ from typing import Protocol
 from companion.link.codec import dialect as d
 from companion.link.telemetry import Snapshot
 
-BUS_ACK_TIMEOUT_S = 3.0  # how long a command handed to another plug-in waits for its answer
+# How long a command handed to another plug-in waits for its answer: a busy machine may
+# take seconds to start the flight group.
+BUS_ACK_TIMEOUT_S = 10.0
 
 
 class VehiclePort(Protocol):
@@ -29,6 +31,10 @@ class VehiclePort(Protocol):
 
     def param(self, name: str) -> float:
         """The current value of one of the link's own parameters."""
+        ...
+
+    def prearm_failures(self) -> list[str]:
+        """Why arming would be refused now (companion.control.prearm; empty: ready)."""
         ...
 
     @property

@@ -15,7 +15,7 @@ from companion.actuators import minissc
 from companion.actuators.airframe import Airframe, AirframeError, load_airframe
 from companion.messages import ActuatorCommand, ServoOutput
 from companion.plugin import Plugin, PluginContext, Setting
-from companion.sensors.serial_port import ReopeningSerial
+from companion.sensors.serial_port import ReopeningSerial, open_problem
 
 WAIT_S = 0.1  # also the refresh cadence when no command arrives
 CYCLE_MIN_S, CYCLE_MAX_S = 0.01, 0.1
@@ -51,6 +51,11 @@ class MiniSscOutput(Plugin):
         except AirframeError as exc:
             return [f"airframe: {exc}"]
         return []
+
+    @classmethod
+    def prearm(cls, settings: Mapping[str, Any]) -> list[str]:
+        problem = open_problem(settings["device"], settings["baud"])
+        return [] if problem is None else [f"servo device: {problem}"[:38]]
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)

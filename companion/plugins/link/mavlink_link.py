@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from companion.control.mission.store import MissionStore
+from companion.control.prearm import PREARM_PARAMS, Readiness, failures
 from companion.link.codec import dialect as d
 from companion.link.codec import new_encoder
 from companion.link.command_service import CommandService
@@ -39,11 +40,12 @@ from companion.link.signing import key_from
 from companion.link.statustext import StatusTexts
 from companion.link.telemetry import Snapshot
 from companion.link.timesync import TimesyncService
-from companion.messages import ControlStatus, LinkStatus, ParamChange, VehicleCommand
+from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChange, VehicleCommand
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 
 MAX_WAIT_S = 0.02
+PREARM_PERIOD_S = 1.0  # SYS_STATUS's ready-to-arm bit is judged once a second
 LINK_STATUS_PERIOD_S = 0.2  # link/status (ground-station silence) five times a second
 COMMANDER = "vehicle.commander"
 STREAM_PARAMS = {
@@ -83,6 +85,7 @@ class MavlinkLink(Plugin):
         ParamDecl("SR_POSITION", 5.0, 0.0, 50.0, "Hz", "GLOBAL_POSITION_INT and VFR_HUD rate"),
         ParamDecl("SR_GPS", 2.0, 0.0, 10.0, "Hz", "GPS_RAW_INT rate"),
         ParamDecl("SYS_FAILURE_EN", 0.0, 0.0, 1.0, "", "accept MAV_CMD_INJECT_FAILURE (simulator)"),
+        *PREARM_PARAMS,
     )
     optional_inputs = (
         "nav/state",
@@ -142,6 +145,7 @@ class MavlinkLink(Plugin):
         self.link_status = bus.writer("link/status")
         self.texts = bus.queue_reader("vehicle/statustext")
         self.next_link_status_s = 0.0
+        self.next_prearm_s = 0.0
         self.reached_count = 0
         timesync = TimesyncService(self.mav, lambda: ctx.clock.now_us() * 1000)
         services = [self.identity, self.commands, timesync]
@@ -215,6 +219,11 @@ class MavlinkLink(Plugin):
         if s.status is not None and s.status.home_valid:  # home is the commander's alone
             s.home = (s.status.home_lat_deg, s.status.home_lon_deg, s.status.home_alt_msl_m)
             s.home_alt_m = s.status.home_alt_msl_m
+        if time.monotonic() >= self.next_prearm_s:  # for SYS_STATUS: a second is often enough
+            self.next_prearm_s = time.monotonic() + PREARM_PERIOD_S
+            armed = s.health is not None and bool(s.health.flight_running)
+            checks = self.param("ARMING_CHECK") >= 0.5
+            s.prearm_ok = armed or not checks or not self.prearm_failures()
         s.mission_seq = self.missions.current
         s.mission_total = len(self.missions.store.items[0])
         s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
@@ -296,6 +305,19 @@ class MavlinkLink(Plugin):
     def param(self, name: str) -> float:
         """One of the link's own parameters (VehiclePort)."""
         return self.store.get(name)
+
+    def prearm_failures(self) -> list[str]:
+        """Why arming would be refused now, from what the link sees (VehiclePort)."""
+        snap = self.snapshot
+        mode = FlightMode.LOITER
+        if snap.status is not None and snap.status.mode in FlightMode._value2member_map_:
+            mode = FlightMode(snap.status.mode)
+        items = self.missions.store.items
+        r = Readiness(
+            now_us=self.ctx.clock.now_us(), nav=snap.nav, gps=snap.gps, imu=snap.imu, mode=mode,
+            mission=items[d.MAV_MISSION_TYPE_MISSION], fence=items[d.MAV_MISSION_TYPE_FENCE],
+        )  # fmt: skip
+        return failures(r, self.store.values)
 
     @property
     def simulated(self) -> bool:

@@ -1,0 +1,96 @@
+"""Pre-arm checks: what must hold before the aircraft may be armed, as ArduPilot and PX4 ask.
+
+Pure: the newest navigation solution, GPS fix and IMU sample (with their own time stamps),
+the vehicle time, the mode and the stored lists in; the reasons arming is refused out,
+each worded for a ``PreArm: ...`` STATUSTEXT. The link refuses the arm command with them
+(MAV_RESULT_DENIED) and shows the result in SYS_STATUS; the supervisor adds the checks that
+need the flight plug-ins' devices (``Plugin.prearm``). ``ARMING_CHECK`` 0 turns them off for
+the bench, and force arming (param2 21196) skips them, as in ArduPilot and PX4.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from companion.control.mission.fence import Fence
+from companion.control.mission.items import MissionItem, check_mission
+from companion.messages import FlightMode, GpsFix, Imu, NavFlags, NavState
+from companion.params import ParamDecl
+from mavlink_dialect import companion as d
+
+FORCE_ARM = 21196  # param2 of COMPONENT_ARM_DISARM that skips the checks
+PREFIX = "PreArm: "
+PREARM_PARAMS = (
+    ParamDecl("ARMING_CHECK", 1.0, 0.0, 1.0, "", "pre-arm checks (0: none, for the bench)"),
+    ParamDecl("ARMING_GPS_EPH", 5.0, 0.5, 100.0, "m", "worst GPS horizontal accuracy to arm"),
+    ParamDecl("ARMING_STALE_S", 1.0, 0.1, 10.0, "s", "a sensor older than this is not fresh"),
+)
+_NAV_OK = int(NavFlags.ATTITUDE_VALID | NavFlags.POSITION_VALID | NavFlags.VELOCITY_VALID)
+
+
+@dataclass
+class Readiness:
+    """What the checks look at: the newest samples as the bus has them."""
+
+    now_us: int
+    nav: NavState | None = None
+    gps: GpsFix | None = None
+    imu: Imu | None = None
+    mode: FlightMode = FlightMode.LOITER
+    mission: list[MissionItem] = field(default_factory=list)
+    fence: list[MissionItem] = field(default_factory=list)
+
+
+def failures(r: Readiness, params: dict[str, float]) -> list[str]:
+    """Every reason arming is refused now (empty: ready), each without the prefix."""
+    return [*_navigation(r), *_gps(r, params), *_fresh(r, params), *_plans(r)]
+
+
+def _navigation(r: Readiness) -> list[str]:
+    nav = r.nav
+    if nav is None:
+        return ["navigation not running"]
+    if nav.flags & NavFlags.ALIGNING:
+        return ["navigation still aligning"]
+    if nav.flags & _NAV_OK != _NAV_OK or nav.flags & NavFlags.DEAD_RECKONING:
+        return ["navigation unhealthy"]
+    return []
+
+
+def _gps(r: Readiness, params: dict[str, float]) -> list[str]:
+    gps = r.gps
+    if gps is None or gps.fix_type < 3:
+        return ["GPS: no 3D fix"]
+    eph, limit = gps.eph_m, params["ARMING_GPS_EPH"]
+    if math.isfinite(eph) and eph > limit:
+        return [f"GPS: accuracy {eph:.1f} m, need {limit:g} m"]
+    return []
+
+
+def _fresh(r: Readiness, params: dict[str, float]) -> list[str]:
+    stale_us = params["ARMING_STALE_S"] * 1e6
+    found = []
+    for name, sample in (("navigation", r.nav), ("GPS", r.gps), ("IMU", r.imu)):
+        if sample is not None and r.now_us - int(sample.t_us) > stale_us:
+            found.append(f"{name} not fresh")
+    return found
+
+
+def _plans(r: Readiness) -> list[str]:
+    found = []
+    if r.mode == FlightMode.MISSION:
+        if not r.mission:
+            found.append("Mission: none stored")
+        elif check_mission(r.mission) != d.MAV_MISSION_ACCEPTED:
+            found.append("Mission: not valid")
+    if r.fence:
+        fence = Fence.from_items(r.fence)
+        zones = [*fence.inclusions, *fence.exclusions]
+        if fence.empty or not all(z.is_valid and z.area > 0 for z in zones):
+            found.append("Fence: not valid")
+        elif r.nav is not None and r.nav.flags & NavFlags.POSITION_VALID:
+            breach = fence.breach(r.nav.lat_deg, r.nav.lon_deg)
+            if breach is not None:
+                found.append(f"Fence: {breach}")
+    return found
