@@ -149,10 +149,17 @@ class FlightController:
         agl = nav.alt_msl_m - self.home_alt
         if self.landed is None:  # first solution: started on the runway or in the air?
             self.landed = agl < AIRBORNE_AGL_M and airspeed < self.config["AIRSPEED_MIN"] * 0.7
-        elif self.landed and agl > AIRBORNE_AGL_M:
+        elif self.landed and agl > AIRBORNE_AGL_M and self._moving(nav, airspeed):
+            # Height alone is not flight: a drifting navigator can say 30 m while the
+            # aircraft stands on the runway, and leaving "landed" opens the throttle.
             self.landed = False
         elif not self.landed and agl < 2.0 and math.hypot(nav.vn_m_s, nav.ve_m_s) < LANDED_SPEED:
             self.landed = True
+
+    @staticmethod
+    def _moving(nav: NavState, airspeed: float) -> bool:
+        ground = math.hypot(nav.vn_m_s, nav.ve_m_s)
+        return max(ground, airspeed if math.isfinite(airspeed) else 0.0) >= LANDED_SPEED
 
     def _taking_off(self, nav: NavState) -> bool:
         return self.takeoff is not None and self.takeoff.phase != Phase.CLIMB_OUT

@@ -1,0 +1,81 @@
+"""On the ground only a take-off opens the throttle: every other mode holds idle and trim."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from companion.actuators.airframe import load_airframe
+from companion.flight.controller import FlightController
+from companion.flight.params import control_params, flight_config
+from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
+from companion.mission.plan import load_plan
+from tests.support.vehicle import REPO
+
+HOME = (-37.9105, 145.134, 81.3)
+VALID = int(NavFlags.ATTITUDE_VALID | NavFlags.POSITION_VALID | NavFlags.VELOCITY_VALID)
+
+
+def _controller(items=None) -> FlightController:
+    decls = control_params(load_airframe("c172p").control)
+    return FlightController(flight_config({p.name: p.default for p in decls}), items)
+
+
+def _on_runway(t_s: float, flags: int = VALID) -> NavState:
+    nav = NavState(t_us=round(t_s * 1e6), flags=flags)
+    nav.lat_deg, nav.lon_deg, nav.alt_msl_m = HOME
+    nav.yaw_rad = math.pi / 2
+    nav.q[0] = 1.0
+    return nav
+
+
+def _status(mode: FlightMode) -> VehicleStatus:
+    s = VehicleStatus(mode=int(mode), armed=1, home_valid=1)
+    s.home_lat_deg, s.home_lon_deg, s.home_alt_msl_m = HOME
+    s.target_lat_deg, s.target_lon_deg, s.target_alt_msl_m = HOME[0] + 0.01, HOME[1], 200.0
+    return s
+
+
+def _outputs(controller: FlightController, mode: FlightMode, flags: int = VALID):
+    return [
+        controller.step(_on_runway(i * 0.02, flags), _status(mode), i * 0.02) for i in range(200)
+    ]
+
+
+@pytest.mark.parametrize(
+    "mode",
+    [
+        FlightMode.LOITER,
+        FlightMode.RTL,
+        FlightMode.GUIDED,
+        FlightMode.STABILIZED,
+        FlightMode.MANUAL,
+    ],
+)
+@pytest.mark.parametrize("flags", [VALID, VALID | int(NavFlags.DEAD_RECKONING)])
+def test_no_mode_but_take_off_opens_the_throttle_on_the_ground(mode, flags):
+    for out in _outputs(_controller(), mode, flags):
+        assert out.throttle == 0.0
+        assert (out.aileron, out.elevator, out.rudder) == (0.0, 0.0, 0.0)  # trim
+
+
+def test_a_mission_opens_the_throttle_only_with_its_take_off_item():
+    square = load_plan(REPO / "qgc_plans" / "square.plan")[0]
+    assert max(o.throttle for o in _outputs(_controller(square), FlightMode.MISSION)) > 0.5
+    no_takeoff = square[1:]
+    assert max(o.throttle for o in _outputs(_controller(no_takeoff), FlightMode.MISSION)) == 0.0
+
+
+def test_take_off_opens_the_throttle():
+    assert max(o.throttle for o in _outputs(_controller(), FlightMode.TAKEOFF)) > 0.5
+
+
+def test_a_navigator_drifting_upwards_on_the_runway_does_not_make_it_fly():
+    controller = _controller()
+    outs = []
+    for i in range(300):
+        nav = _on_runway(i * 0.02)
+        nav.alt_msl_m += 0.2 * i  # 60 m of drift while standing still
+        outs.append(controller.step(nav, _status(FlightMode.LOITER), i * 0.02))
+    assert all(o.throttle == 0.0 and o.landed for o in outs)
