@@ -168,7 +168,7 @@ def _sim_command(flight: Flight, folder: Path, port: int, namespace: str) -> lis
     if flight.airborne:
         cmd.append("--airborne")
     if flight.start_at_s is not None:
-        cmd += ["--exact", "--start-at", f"{flight.start_at_s:g}"]
+        cmd += ["--start-at", f"{flight.start_at_s:g}", "--fast" if flight.fast else "--exact"]
     return cmd
 
 

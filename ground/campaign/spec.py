@@ -79,6 +79,7 @@ class Flight:
     airborne: bool
     max_sim_s: float
     start_at_s: float | None = None  # exact lockstep, armed and started by the simulator then
+    fast: bool = False  # with start_at_s: fast lockstep instead of exact (to compare the two)
 
     @property
     def condition(self) -> str:
@@ -104,7 +105,8 @@ class Flight:
     def _key(self) -> tuple:
         plan, config = Path(self.plan).name, Path(self.config).name
         return (plan, self.airframe, self.wind_ned, self.turbulence, self.outages, self.seed,
-                config, self.airborne, self.max_sim_s, self.start_at_s)  # fmt: skip
+                config, self.airborne, self.max_sim_s, self.start_at_s,
+                *(("fast",) if self.fast else ()))  # fmt: skip
 
 
 @dataclass(frozen=True)
