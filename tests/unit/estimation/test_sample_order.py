@@ -36,3 +36,36 @@ def test_aiding_flows_on_when_the_imu_goes_quiet():
     assert order.push([GpsFix(t_us=100_000)]) == []
     ready = order.push([GpsFix(t_us=300_000)])  # 0.2 s newer: the first is let go
     assert _kinds(ready) == [("GpsFix", 100_000)]
+
+
+def test_fixes_that_arrive_late_are_still_used_and_never_look_like_an_outage():
+    # The GPS driver's process runs late: each fix reaches the navigator 0.6 s after its
+    # time stamp, behind 60 IMU samples. The navigator still uses every fix (against its
+    # state of that time) and never says dead reckoning outside the real outage.
+    from companion.estimation.offline import InsEkfRunner, true_headings
+    from companion.messages import NavFlags
+    from companion.simulation import evaluation
+    from tests.unit.estimation.flights import DECLINATION, OUTAGE, flight
+
+    samples = list(true_headings(evaluation.messages(flight()), DECLINATION))
+    late_us = 600_000
+    arrivals = sorted(
+        ((s.t_us + (late_us if isinstance(s, GpsFix) else 0), i, s) for i, s in enumerate(samples)),
+        key=lambda a: (a[0], a[1]),
+    )
+    runner, order = InsEkfRunner(DECLINATION), SampleOrder()
+    fixes = accepted = 0
+    dead_reckoning_outside_outage = 0
+    start, end = OUTAGE[0] * 1e6, (OUTAGE[0] + OUTAGE[1] + 3) * 1e6
+    for _, _, sample in arrivals:
+        for ready in order.push([sample]):
+            before = runner.nav.last_gps_us
+            runner.feed(ready)
+            if isinstance(ready, GpsFix) and ready.fix_type >= 3 and runner.nav.aligned:
+                fixes += 1
+                accepted += runner.nav.last_gps_us != before
+            if isinstance(ready, Imu) and runner.nav.aligned and not start <= ready.t_us <= end:
+                state = runner.nav.state()
+                dead_reckoning_outside_outage += bool(state.flags & NavFlags.DEAD_RECKONING)
+    assert fixes > 500 and accepted >= 0.98 * fixes
+    assert dead_reckoning_outside_outage == 0
