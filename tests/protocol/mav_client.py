@@ -36,7 +36,7 @@ class GroundStation:
     def heartbeat(self) -> None:
         self.mav.heartbeat_send(6, 8, 192, 0, 4)  # GCS, INVALID autopilot, as QGC sends
 
-    def connect(self, timeout_s: float = 15.0) -> Any:
+    def connect(self, timeout_s: float = 60.0) -> Any:
         """Send heartbeats until the vehicle's heartbeat comes back."""
         deadline = time.monotonic() + timeout_s
         while time.monotonic() < deadline:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import time
 
 import pytest
@@ -68,8 +69,9 @@ def test_arm_starts_the_flight_group_and_disarm_stops_it(link):
     vehicle, gcs, _ = link
     # This vehicle has no GPS: arming is refused until forced (param2 21196).
     gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 1)
+    said = gcs.recv("STATUSTEXT", 5)  # as ArduPilot, the reason comes first, then the ack
+    assert said.text.startswith("PreArm: GPS"), said.text
     assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_DENIED
-    assert gcs.recv("STATUSTEXT", 3).text.startswith("PreArm: GPS")
     gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 1, 21196)
     assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_ACCEPTED
     wait_for(lambda: vehicle.row("relay_in_flight").pid, 5, "flight group running")
@@ -102,11 +104,13 @@ def test_telemetry_reflects_the_bus_and_rates_can_be_changed(link):
     assert gcs.ack(m.MAV_CMD_SET_MESSAGE_INTERVAL).result == m.MAV_RESULT_ACCEPTED
     gcs.command(m.MAV_CMD_GET_MESSAGE_INTERVAL, m.MAVLINK_MSG_ID_ATTITUDE)
     assert gcs.recv("MESSAGE_INTERVAL", message_id=m.MAVLINK_MSG_ID_ATTITUDE).interval_us == 20000
-    count, t0 = 0, time.monotonic()
-    while time.monotonic() - t0 < 2.0:
-        if gcs.conn.recv_match(type="ATTITUDE", blocking=True, timeout=0.1):
-            count += 1
-    assert count >= 60, f"only {count} ATTITUDE in 2 s at a requested 50 Hz"
+    # Judged by the vehicle's own time stamps, not by how many came in a wall-clock
+    # window: a busy machine may hold the link back now and then, not change its rate.
+    stamps: list[int] = []
+    while len(stamps) < 100:
+        stamps.append(gcs.recv("ATTITUDE", 10).time_boot_ms)
+    gaps = sorted(b - a for a, b in itertools.pairwise(stamps))
+    assert 15 <= gaps[len(gaps) // 2] <= 25, f"median ATTITUDE interval {gaps[len(gaps) // 2]} ms"
 
 
 def test_garbage_and_bad_crc_are_counted_and_the_link_survives(link):

@@ -62,7 +62,7 @@ def _vehicle(vehicle_factory, tmp_path, servo: str, aligning=False, fix_type=3, 
     )
     vehicle = vehicle_factory(text)
     gcs = GroundStation(port)
-    gcs.connect(timeout_s=60)  # a busy machine starts the vehicle slowly
+    gcs.connect()
     wait_for(lambda: vehicle.row("gps").pid and vehicle.row("nav").pid, 10, "sensors running")
     return vehicle, gcs
 
