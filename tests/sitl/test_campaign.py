@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 import psutil
+import pytest
 
 from ground.campaign.flight_run import FlightJob, fly_flight
 from ground.campaign.spec import Flight
@@ -61,6 +62,7 @@ def rows(out: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(f))
 
 
+@pytest.mark.timeout(900)  # five lockstep flights on two cores: minutes on a busy machine
 def test_a_small_campaign_scores_each_flight_and_survives_hung_ones(tmp_path):
     spec = tmp_path / "small.toml"
     spec.write_text(SPEC)

@@ -85,7 +85,7 @@ class Vehicle:
             return None
         return next((r for r in health.rows() if r.name.decode() == name), None)
 
-    def wait_running(self, name: str, timeout_s: float = 10.0) -> int:
+    def wait_running(self, name: str, timeout_s: float = 60.0) -> int:
         """Wait until the plug-in reports a pid in a fresh health table; return it."""
         return wait_for(lambda: (r := self.row(name)) is not None and r.pid, timeout_s, name)
 
