@@ -42,9 +42,9 @@ def test_fixes_that_arrive_late_are_still_used_and_never_look_like_an_outage():
     # The GPS driver's process runs late: each fix reaches the navigator 0.6 s after its
     # time stamp, behind 60 IMU samples. The navigator still uses every fix (against its
     # state of that time) and never says dead reckoning outside the real outage.
-    from companion.estimation.offline import InsEkfRunner, true_headings
     from companion.messages import NavFlags
-    from companion.simulation import evaluation
+    from companion.navigation.offline import InsEkfRunner, true_headings
+    from ground.simulation import evaluation
     from tests.unit.estimation.flights import DECLINATION, OUTAGE, flight
 
     samples = list(true_headings(evaluation.messages(flight()), DECLINATION))

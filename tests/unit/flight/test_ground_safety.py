@@ -7,10 +7,10 @@ import math
 import pytest
 
 from companion.actuators.airframe import load_airframe
-from companion.flight.controller import FlightController
-from companion.flight.params import control_params, flight_config
+from companion.control.flight.controller import FlightController
+from companion.control.flight.params import control_params, flight_config
+from companion.control.mission.plan import load_plan
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
-from companion.mission.plan import load_plan
 from tests.support.vehicle import REPO
 
 HOME = (-37.9105, 145.134, 81.3)
