@@ -35,7 +35,11 @@ MISSION_MODES = {m.px4 for m in MODES if m.mode == FlightMode.MISSION} | {
 def legacy_vehicle(
     state: Path, log: Path, bridge_port: int, gcs_port: int, *more: PluginEntry
 ) -> str:
-    """A replayed flight, the GPS-compass navigator, the commander, and a link for each side."""
+    """A replayed flight, the GPS-compass navigator, the commander, and a link for each side.
+
+    Its pre-arm checks are off, as on a bench: the replayed samples keep the log's time
+    stamps, which are not the vehicle clock's, so none would ever look fresh."""
+    (state / "params.json").write_text('{"ARMING_CHECK": 0}')
     return vehicle_config(
         "legacy",
         link(f"udpin://127.0.0.1:{bridge_port}", f"udpin://127.0.0.1:{gcs_port}"),
