@@ -157,17 +157,20 @@ class MavlinkLink(Plugin):
         self.gcs = GcsWatch()
         self.router.add_service(self.gcs)
         self._serve_params(ctx, sysid)
-        store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
-        self.missions = MissionService(self.mav, store, sysid, ctx.settings["compid"])
-        self.router.add_service(self.missions)
-        # The other plug-ins follow the stored lists through this, not the files' times.
-        self.mission_changes = bus.writer("mission/changed")
-        self.missions.on_change = self._mission_changed
-        self._mission_changed(0)
+        self._serve_missions(ctx, sysid)
         register_commands(self.commands, self, self.identity, self.router)
         self.commands.on_refusal = self.refusal_text
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         self._seq = 0
+
+    def _serve_missions(self, ctx: PluginContext, sysid: int) -> None:
+        store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
+        self.missions = MissionService(self.mav, store, sysid, ctx.settings["compid"])
+        self.router.add_service(self.missions)
+        # The other plug-ins follow the stored lists through this, not the files' times.
+        self.mission_changes = ctx.bus.writer("mission/changed")
+        self.missions.on_change = self._mission_changed
+        self._mission_changed(0)
 
     def _mission_changed(self, mission_type: int) -> None:
         now = self.ctx.clock.now_us()

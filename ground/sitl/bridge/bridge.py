@@ -83,15 +83,21 @@ class SimBridge:
         self.nav_sync: FlightSync | None = None
         self.samples: SampleSync | None = None
         if lockstep:
-            period_us = round(1e6 / opts.sync_hz)
-            # Fast lockstep lets the vehicle trail by a period (it runs beside the physics)
-            # but never further: a late process holds the simulation, whatever the load.
-            lag = 0 if exact else FAST_LAG_PERIODS
-            answers = self.bus.latest_reader("actuators/servos")
-            self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]), lag)
-            nav = self.bus.latest_reader("nav/state")
-            waiter = self.bus.waiter([nav])
-            self.nav_sync = FlightSync(period_us, nav, waiter, lag, "t_us", always=True)
+            self._keep_in_step(round(1e6 / opts.sync_hz), exact)
+        self.commands = VehicleCommands(self.bus, self.failures, self.sync, opts.start_at_s)
+        self.frames = 0
+        self.stopping = False
+        self.clock.publish(SimClock(t_us=0, frame=0))
+
+    def _keep_in_step(self, period_us: int, exact: bool) -> None:
+        """Lockstep with the vehicle's navigator and control loop (and, exact, its samples)."""
+        # Fast lockstep lets the vehicle trail by a period (it runs beside the physics)
+        # but never further: a late process holds the simulation, whatever the load.
+        lag = 0 if exact else FAST_LAG_PERIODS
+        answers = self.bus.latest_reader("actuators/servos")
+        self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]), lag)
+        nav = self.bus.latest_reader("nav/state")
+        self.nav_sync = FlightSync(period_us, nav, self.bus.waiter([nav]), lag, "t_us", True)
         if exact:
             readers = {
                 device: {c: self.bus.queue_reader(c) for c in channels}
@@ -99,10 +105,6 @@ class SimBridge:
             }
             every = [r for by_channel in readers.values() for r in by_channel.values()]
             self.samples = SampleSync(readers, self.bus.waiter(every))
-        self.commands = VehicleCommands(self.bus, self.failures, self.sync, opts.start_at_s)
-        self.frames = 0
-        self.stopping = False
-        self.clock.publish(SimClock(t_us=0, frame=0))
 
     def device_paths(self) -> dict[str, str]:
         """Device name → the pty path the vehicle's driver opens."""
