@@ -1,0 +1,62 @@
+"""The directory of flight logs: numbered files, the oldest removed past a disk budget."""
+
+from __future__ import annotations
+
+import logging
+import re
+from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+_NAME = re.compile(r"^(\d{4,})_[A-Za-z0-9_-]*\.ulg$")
+
+
+class LogDirectory:
+    """``NNNN_label.ulg`` files in one directory, numbered in the order they were started."""
+
+    def __init__(self, path: Path, budget_bytes: int) -> None:
+        self.path = path
+        self.budget_bytes = budget_bytes
+
+    def files(self) -> list[Path]:
+        """The logs, oldest first."""
+        if not self.path.is_dir():
+            return []
+        found = [(int(m.group(1)), p) for p in self.path.iterdir() if (m := _NAME.match(p.name))]
+        return [p for _, p in sorted(found)]
+
+    def new_path(self, label: str) -> Path:
+        """The path of the next log (the directory is made if needed)."""
+        self.path.mkdir(parents=True, exist_ok=True)
+        existing = self.files()
+        number = int(_NAME.match(existing[-1].name).group(1)) + 1 if existing else 1  # type: ignore[union-attr]
+        safe = re.sub(r"[^A-Za-z0-9_-]", "_", label)
+        return self.path / f"{number:04d}_{safe}.ulg"
+
+    def prune(self, keep: Path | None = None) -> list[Path]:
+        """Remove the oldest logs (never ``keep``, the one being written) while the directory
+        is over its budget; the removed paths."""
+        files = self.files()
+        sizes = {p: _size(p) for p in files}
+        total = sum(sizes.values())
+        removed: list[Path] = []
+        for path in files:
+            if total <= self.budget_bytes:
+                break
+            if path == keep:
+                continue
+            try:
+                path.unlink()
+            except OSError as exc:
+                log.warning("cannot remove old log %s: %s", path, exc)
+                continue
+            total -= sizes[path]
+            removed.append(path)
+        return removed
+
+
+def _size(path: Path) -> int:
+    try:
+        return path.stat().st_size
+    except OSError:
+        return 0
