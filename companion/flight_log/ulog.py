@@ -151,8 +151,9 @@ class ULogWriter:
     ) -> None:
         self.stream = stream
         self.bytes_written = 0
+        self.start_us = max(start_us, 0)
         self._ids: dict[str, tuple[bytes, tuple[tuple[int, int], ...]]] = {}
-        head = [MAGIC + bytes([VERSION]) + struct.pack("<Q", max(start_us, 0))]
+        head = [MAGIC + bytes([VERSION]) + struct.pack("<Q", self.start_us)]
         head.append(_message("B", bytes(8 + 8 + 3 * 8)))  # no compat/incompat flags set
         head += [_info(k, v) for k, v in (info or {}).items()]
         head += [_param(k, v) for k, v in (params or {}).items()]

@@ -1,0 +1,1 @@
+"""System plug-ins: the on-board flight logger."""

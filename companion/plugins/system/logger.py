@@ -1,0 +1,185 @@
+"""``system.logger``: the on-board flight log (group ``core``).
+
+Records the configured bus channels, with their ``t_us``, in PX4's ULog format
+(``companion.flight_log``): one file per arming in ``<state_dir>/logs/`` (and, with
+``from_boot``, one from start-up to the first arming and between flights). It is just
+another reader: producers never wait for it, and what a full queue made it lose is counted
+in its ``dropped`` health counter and as a logged warning. The file is flushed and fsynced
+at least once a (wall) second, so a power cut loses at most that much and leaves a file
+pyulog reads up to its last complete message. Past ``budget_mb`` the oldest logs go.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections import deque
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, BinaryIO
+
+from companion import __version__
+from companion.flight_log import LogDirectory, ULogWriter, topic_name
+from companion.messages.channels import CHANNELS
+from companion.params.store import ParamStore
+from companion.plugin import Plugin, PluginContext, Ports, Setting
+
+DEFAULT_CHANNELS = [
+    "sensors/imu",
+    "sensors/mag",
+    "sensors/gps",
+    "sensors/compass",
+    "sensors/baro",
+    "nav/state",
+    "control/actuators",
+    "control/status",
+    "actuators/servos",
+    "vehicle/status",
+    "link/commands",
+    "link/command_acks",
+    "params/changes",
+    "vehicle/statustext",
+    "system/health",
+]
+# The channels that wake the logger at once (rare, and worth their exact order); the rest
+# is drained when it wakes on its own: waking for every 100 Hz sample would cost more CPU
+# than writing them.
+_WAKERS = ("system/health", "vehicle/statustext", "link/commands", "params/changes")
+
+
+class LoggerPlugin(Plugin):
+    """Writes the flight log."""
+
+    settings = {
+        "channels": Setting(list, DEFAULT_CHANNELS, "bus channels to record"),
+        "from_boot": Setting(bool, False, "also log while disarmed (from start-up)"),
+        "budget_mb": Setting(float, 1000.0, "disk space for logs; oldest removed", min=0.01),
+        "flush_s": Setting(float, 1.0, "wall seconds between fsyncs", min=0.05, max=1.0),
+        "period_s": Setting(float, 0.02, "wall seconds between reads of the queues", min=0.001),
+        "prearm_samples": Setting(
+            int, 1000, "samples before arming kept for the flight's log", min=0, max=100_000
+        ),
+        "airframe": Setting(str, "", "airframe name for the log's INFO (default: vehicle's)"),
+    }
+
+    @classmethod
+    def ports(cls, settings: Mapping[str, Any]) -> Ports:
+        return Ports(optional_inputs=tuple(dict.fromkeys([*settings["channels"], "system/health"])))
+
+    @classmethod
+    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
+        return [
+            f"channels: unknown bus channel {name!r}"
+            for name in settings["channels"]
+            if not isinstance(name, str) or name not in CHANNELS
+        ]
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        s = ctx.settings
+        state_dir = Path(ctx.vehicle.get("state_dir", "."))
+        self.logs = LogDirectory(state_dir / "logs", int(s["budget_mb"] * 1e6))
+        self.params = ParamStore(ctx.param_decls, state_dir / "params.json").values
+        names = list(dict.fromkeys(s["channels"]))
+        self.readers = {name: ctx.bus.reader(name) for name in names}
+        # Its own reader: the one in ``readers`` hands every table to the log.
+        self.health = ctx.bus.latest_reader("system/health")
+        self.waiter = ctx.bus.waiter([r for n, r in self.readers.items() if n in _WAKERS])
+        self.topics = [(name, topic_name(name), CHANNELS[name].type) for name in names]
+        self.info = {
+            "sys_name": "companion",
+            "ver_sw": __version__,
+            "vehicle_name": str(ctx.vehicle.get("name", "")),
+            "airframe": s["airframe"] or str(ctx.vehicle.get("airframe", "")),
+            "sys_id": int(ctx.vehicle.get("sysid", 1)),
+        }
+        self.armed = False
+        self.file: BinaryIO | None = None
+        self.writer: ULogWriter | None = None
+        self.path: Path | None = None
+        self.lost = 0
+        # What came before the arming was seen (the health table lags the first samples).
+        self.recent: deque[tuple[str, Any]] = deque(maxlen=s["prearm_samples"])
+        self.next_flush = 0.0
+        if s["from_boot"]:
+            self._open("boot")
+
+    def step(self) -> None:
+        self.waiter.wait(self.ctx.settings["period_s"])
+        self._follow_arming()
+        for name, reader in self.readers.items():
+            for msg in reader.drain():
+                self._record(name, msg)
+        self._count_losses()
+        if self.file is not None and time.monotonic() >= self.next_flush:
+            self._flush()
+
+    def _follow_arming(self) -> None:
+        health = self.health.get()
+        armed = bool(health is not None and health.flight_running)
+        if armed == self.armed:
+            return
+        self.armed = armed
+        self._close()
+        if armed:
+            self._open("armed")
+        elif self.ctx.settings["from_boot"]:
+            self._open("disarmed")
+
+    def _record(self, name: str, msg: Any) -> None:
+        if name == "params/changes":
+            value = float(msg.value)
+            key = msg.name.decode(errors="replace")
+            if key in self.params:
+                self.params[key] = value
+                if self.writer is not None:
+                    self.writer.parameter(key, value)
+        if self.writer is None:
+            self.recent.append((name, msg))
+            return
+        self.writer.data(topic_name(name), msg)
+        if name == "vehicle/statustext":
+            self.writer.log_string(msg.t_us, msg.severity, msg.text.decode(errors="replace"))
+        self.ctx.health.ok()
+
+    def _count_losses(self) -> None:
+        lost = self.ctx.bus.total_lost()
+        if lost > self.lost:
+            self.ctx.health.dropped += lost - self.lost
+            if self.writer is not None:
+                text = f"logger lost {lost - self.lost} samples (reader fell behind)"
+                self.writer.log_string(self.ctx.clock.now_us(), 4, text)
+            self.lost = lost
+
+    def _open(self, label: str) -> None:
+        self.path = self.logs.new_path(label)
+        self.file = open(self.path, "wb", buffering=256 * 1024)  # noqa: SIM115 - kept open
+        topics = [(topic, kind) for _, topic, kind in self.topics]
+        self.writer = ULogWriter(self.file, self.ctx.clock.now_us(), topics, self.info, self.params)
+        self._flush()  # the definitions are on disk before any data
+        for name, msg in self.recent:
+            self._record(name, msg)
+        self.recent.clear()
+        for path in self.logs.prune(keep=self.path):
+            self.ctx.log.info("removed old log %s (over the disk budget)", path.name)
+        self.ctx.log.info("logging to %s", self.path)
+
+    def _flush(self) -> None:
+        assert self.file is not None and self.writer is not None
+        self.writer.sync()
+        self.file.flush()
+        os.fsync(self.file.fileno())
+        self.next_flush = time.monotonic() + self.ctx.settings["flush_s"]
+
+    def _close(self) -> None:
+        if self.file is None:
+            return
+        self._flush()
+        self.file.close()
+        self.ctx.log.info("closed %s", self.path)
+        self.file = self.writer = None
+        if self.path is not None:
+            self.logs.prune(keep=self.path)
+
+    def close(self) -> None:
+        self._close()

@@ -1,0 +1,114 @@
+"""system.logger records a real vehicle's bus to a ULog file that survives kill -9."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+from pathlib import Path
+
+from pyulog import ULog
+
+from companion.messages import CommandId, VehicleCommand
+from tests.support.configs import plugin, vehicle_config
+from tests.support.vehicle import Vehicle, wait_for
+
+ROWS = 200
+
+
+def make_sensor_log(path: Path) -> None:
+    """IMU samples numbered by their ax, 50 Hz, a GPS fix every tenth sample."""
+    lines = ["t,kind,ax,ay,az,gx,gy,gz,lat,lon,alt_m,vn,ve,vd,fix,hdop,mx,my,mz,baro_alt_m"]
+    for i in range(ROWS):
+        lines.append(f"{i * 0.02:.3f},imu,{i},0,-9.81,0,0,0,,,,,,,,,,,,")
+        if i % 10 == 0:
+            lines.append(
+                f"{i * 0.02:.3f},gps,,,,,,,-37.91,{145.134 + i * 1e-5:.5f},100,1,2,,3,1,,,,"
+            )
+    path.write_text("\n".join(lines) + "\n")
+
+
+def read_log(logs: Path) -> ULog | None:
+    """The newest log as pyulog reads it (None while there is none with IMU samples)."""
+    files = sorted(logs.glob("*.ulg"))
+    if not files:
+        return None
+    try:
+        ulog = ULog(str(files[-1]))
+        ulog.get_dataset("sensors_imu")
+    except (IndexError, ValueError, KeyError):
+        return None
+    return ulog
+
+
+def imu_ax(ulog: ULog | None) -> list[float]:
+    if ulog is None:
+        return []
+    return [float(x) for x in ulog.get_dataset("sensors_imu").data["ax_m_s2"]]
+
+
+def kill_everything(vehicle: Vehicle) -> None:
+    """A power cut: every process of the vehicle at once, no chance to close a file."""
+    for pid in vehicle.all_pids():
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+    assert vehicle.proc is not None
+    vehicle.proc.wait(timeout=10)
+
+
+def test_an_armed_flight_is_logged_and_readable_after_kill_9(vehicle_factory, tmp_path):
+    sensor_log = tmp_path / "flight.csv"
+    make_sensor_log(sensor_log)
+    state = tmp_path / "state"
+    vehicle = vehicle_factory(
+        vehicle_config(
+            "logged",
+            plugin("logger", "system.logger", flush_s=0.2, airframe="x8"),
+            # In the flight group: it plays (in a loop) once armed, as sensors would fly.
+            plugin("replay", "sensors.replay", group="flight", file=sensor_log, loop=True),
+            state_dir=state,
+        )
+    )
+    wait_for(lambda: vehicle.row("logger") is not None and vehicle.row("logger").pid, 20, "logger")
+    vehicle.bus.writer("link/commands").publish(
+        VehicleCommand(t_us=0, seq=1, command=int(CommandId.START))
+    )
+    logs = state / "logs"
+    # The samples reach the disk while the vehicle runs: more than one pass of the log.
+    wait_for(lambda: len(imu_ax(read_log(logs))) > ROWS + 10, 30, "a log on disk")
+    kill_everything(vehicle)
+
+    files = sorted(logs.glob("*.ulg"))
+    assert [p.name for p in files] == ["0001_armed.ulg"]  # no boot log unless asked
+    ulog = read_log(logs)
+    ax = imu_ax(ulog)
+    assert len(ax) > ROWS + 10
+    assert ax == [float(i % ROWS) for i in range(len(ax))]  # in order, none lost or repeated
+    assert ulog is not None
+    assert ulog.msg_info_dict["vehicle_name"] == "logged"
+    assert ulog.msg_info_dict["sys_name"] == "companion"
+    gps = ulog.get_dataset("sensors_gps").data
+    assert len(gps["timestamp"]) >= ROWS // 10
+    assert [round(float(x), 5) for x in gps["lon_deg"][:3]] == [145.134, 145.1341, 145.1342]
+    health = ulog.get_dataset("system_health").data
+    assert max(health["flight_running"]) == 1
+
+
+def test_from_boot_logs_while_disarmed(vehicle_factory, tmp_path):
+    state = tmp_path / "state"
+    vehicle = vehicle_factory(
+        vehicle_config(
+            "boot",
+            plugin("logger", "system.logger", from_boot=True, flush_s=0.2),
+            plugin("imu", "tests.support.plugins:Ticker", rate_hz=100.0),
+            state_dir=state,
+        )
+    )
+    logs = state / "logs"
+    wait_for(lambda: len(imu_ax(read_log(logs))) >= 50, 30, "a boot log on disk")
+    vehicle.stop()
+    ulog = read_log(logs)
+    assert [p.name for p in sorted(logs.glob("*.ulg"))] == ["0001_boot.ulg"]
+    ax = imu_ax(ulog)
+    # A clean stop writes everything: the Ticker numbers its samples from 1.
+    assert ax[:50] == [float(i) for i in range(1, 51)]
