@@ -41,6 +41,7 @@ DEFAULT_CHANNELS = [
     "vehicle/statustext",
     "system/health",
 ]
+MIN_PERIOD_S = 0.001
 # The channels that wake the logger at once (rare, and worth their exact order); the rest
 # is drained when it wakes on its own: waking for every 100 Hz sample would cost more CPU
 # than writing them.
@@ -59,7 +60,7 @@ class LoggerPlugin(Plugin):
         "prearm_samples": Setting(
             int, 1000, "samples before arming kept for the flight's log", min=0, max=100_000
         ),
-        "airframe": Setting(str, "", "airframe name for the log's INFO (default: vehicle's)"),
+        "airframe": Setting(str, "", "airframe name or file, for the log's INFO"),
     }
 
     @classmethod
@@ -85,12 +86,15 @@ class LoggerPlugin(Plugin):
         # Its own reader: the one in ``readers`` hands every table to the log.
         self.health = ctx.bus.latest_reader("system/health")
         self.waiter = ctx.bus.waiter([r for n, r in self.readers.items() if n in _WAKERS])
+        self.depths = {n: CHANNELS[n].depth for n in names}
+        self.period_s = s["period_s"]
         self.topics = [(name, topic_name(name), CHANNELS[name].type) for name in names]
         self.info = {
             "sys_name": "companion",
             "ver_sw": __version__,
             "vehicle_name": str(ctx.vehicle.get("name", "")),
-            "airframe": s["airframe"] or str(ctx.vehicle.get("airframe", "")),
+            # The airframe's name: a file (as ``companion sim`` gives) by its stem.
+            "airframe": Path(s["airframe"]).stem if s["airframe"] else "",
             "sys_id": int(ctx.vehicle.get("sysid", 1)),
         }
         self.armed = False
@@ -105,14 +109,27 @@ class LoggerPlugin(Plugin):
             self._open("boot")
 
     def step(self) -> None:
-        self.waiter.wait(self.ctx.settings["period_s"])
+        self.waiter.wait(self.period_s)
         self._follow_arming()
+        fill = 0.0
         for name, reader in self.readers.items():
+            count = 0
             for msg in reader.drain():
                 self._record(name, msg)
+                count += 1
+            fill = max(fill, count / self.depths[name])
+        self._adapt(fill)
         self._count_losses()
         if self.file is not None and time.monotonic() >= self.next_flush:
             self._flush()
+
+    def _adapt(self, fill: float) -> None:
+        """Read more often while a queue comes back over half full (a lockstep simulation
+        runs its sensors many times faster than real time), less often again when calm."""
+        if fill > 0.5:
+            self.period_s = max(self.period_s / 2, MIN_PERIOD_S)
+        elif fill < 0.25:
+            self.period_s = min(self.period_s * 1.25, self.ctx.settings["period_s"])
 
     def _follow_arming(self) -> None:
         health = self.health.get()
