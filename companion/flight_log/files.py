@@ -28,8 +28,8 @@ class LogDirectory:
     def new_path(self, label: str) -> Path:
         """The path of the next log (the directory is made if needed)."""
         self.path.mkdir(parents=True, exist_ok=True)
-        existing = self.files()
-        number = int(_NAME.match(existing[-1].name).group(1)) + 1 if existing else 1  # type: ignore[union-attr]
+        numbers = [int(m.group(1)) for p in self.files() if (m := _NAME.match(p.name))]
+        number = max(numbers, default=0) + 1
         safe = re.sub(r"[^A-Za-z0-9_-]", "_", label)
         return self.path / f"{number:04d}_{safe}.ulg"
 

@@ -11,6 +11,7 @@ pyulog reads up to its last complete message. Past ``budget_mb`` the oldest logs
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from collections import deque
@@ -110,6 +111,22 @@ class LoggerPlugin(Plugin):
 
     def step(self) -> None:
         self.waiter.wait(self.period_s)
+        try:
+            self._work()
+        except OSError as exc:
+            # A full or failing card: stop this file (what reached it stays readable) and
+            # carry on reading, so nothing upstream notices; the next arming tries again.
+            self.ctx.log.error("flight log %s: %s; logging stopped", self.path, exc)
+            self.ctx.health.bad()
+            self._abandon()
+
+    def _abandon(self) -> None:
+        if self.file is not None:
+            with contextlib.suppress(OSError):
+                self.file.close()
+        self.file = self.writer = None
+
+    def _work(self) -> None:
         self._follow_arming()
         fill = 0.0
         for name, reader in self.readers.items():
