@@ -24,6 +24,7 @@ from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 
 AIRBORNE_AGL_M = 10.0
 LANDED_SPEED = 8.0  # m/s: slower than this near the ground is "on the ground"
+MAX_TURN_WIND = 15.0  # m/s: a wind estimate beyond this is not trusted to size turns
 
 
 @dataclass
@@ -64,6 +65,8 @@ class FlightController:
         self._mode_key: tuple[int, int] | None = None
         self._mode_setpoint: Setpoint | None = None
         self._hold_course: Setpoint | None = None
+        self._line: tuple[tuple[float, float], tuple[float, float]] | None = None
+        self._corner_from: tuple[float, float] | None = None
         self.attitude = AttitudeController(config.attitude)
         self.tecs = Tecs(config.tecs)
         self.l1 = L1Guidance(
@@ -322,12 +325,14 @@ class FlightController:
         return out
 
     def _turn_radius(self) -> float:
-        """The radius of a turn at cruise speed and 80 % of the bank limit.
+        """The radius of a turn at 80 % of the bank limit at the fastest ground speed of the
+        turn (cruise airspeed with the wind behind).
 
-        From the planned speed, not the measured one: a circle whose radius followed every
-        gust would never be flown round.
+        From the planned speed and the slowly changing wind estimate, not the measured
+        speed: a circle whose radius followed every gust would never be flown round.
         """
-        v = self.config["AIRSPEED_CRUISE"]
+        wind = min(math.hypot(*self.wind.wind_ne), MAX_TURN_WIND)
+        v = self.config["AIRSPEED_CRUISE"] + wind
         return v * v / (G * math.tan(self.config.roll_limit * 0.8))
 
     def _lateral(
@@ -337,4 +342,9 @@ class FlightController:
             # A circle tighter than the bank limit allows is flown at the tightest it can.
             radius = max(sp.radius, self._turn_radius())
             return self.l1.circle(pos, vel, sp.b, radius, sp.clockwise)
-        return self.l1.line(pos, vel, sp.a, sp.b, dt)
+        line = (sp.a, sp.b)
+        if line != self._line:
+            # A leg that starts where the last one ended: its corner is flown as an arc.
+            self._corner_from = self._line[0] if self._line and self._line[1] == sp.a else None
+            self._line = line
+        return self.l1.line(pos, vel, sp.a, sp.b, dt, self._corner_from, self._turn_radius())

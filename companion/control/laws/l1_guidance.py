@@ -13,12 +13,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from companion.control.laws.fillet import Fillet, fillet, on_arc
 from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import wrap_pi
 
 MIN_SPEED = 1.0  # below this the ground course is meaningless
 XTRACK_I_CAPTURE_RAD = math.radians(5.0)
 XTRACK_I_MAX_RAD = 0.1
+# The wings take about this long to level: leave the arc that much before its end.
+ROLL_OUT_S = 0.6
 
 
 @dataclass(frozen=True)
@@ -54,6 +57,8 @@ class L1Guidance:
         self.xtrack_i = xtrack_i
         self.integ = 0.0
         self._line: tuple[tuple[float, float], tuple[float, float]] | None = None
+        self._fillet: Fillet | None = None
+        self._arc_state = 0  # 0 before the arc, 1 on it, 2 past it
 
     def l1_distance(self, speed: float) -> float:
         """How far ahead the reference point is, m."""
@@ -66,16 +71,48 @@ class L1Guidance:
         a: tuple[float, float],
         b: tuple[float, float],
         dt: float = 0.0,
+        prev: tuple[float, float] | None = None,
+        turn_radius: float = 0.0,
     ) -> LateralDemand:
-        """Follow the line from ``a`` through ``b`` (north/east metres)."""
+        """Follow the line from ``a`` through ``b`` (north/east metres).
+
+        With ``prev``, the start of the leg that ended at ``a``, the corner at ``a`` is
+        flown as an arc of ``turn_radius`` tangent to both legs (see ``fillet``).
+        """
         if self._line != (a, b):
             self._line, self.integ = (a, b), 0.0
+            self._fillet = fillet(prev, a, b, turn_radius) if prev is not None else None
+            self._arc_state = 0
+        f = self._fillet
+        if f is not None and self._arc_state < 2:
+            speed = max(math.hypot(*vel), MIN_SPEED)
+            if on_arc(f, pos, speed * ROLL_OUT_S):
+                self._arc_state = 1
+                arc = self.circle(pos, vel, f.centre, f.radius, f.clockwise)
+                to_b = (b[0] - pos[0], b[1] - pos[1])
+                bearing = math.atan2(to_b[1], to_b[0])
+                return LateralDemand(arc.lat_acc, bearing, arc.xtrack, math.hypot(*to_b))
+            if self._arc_state == 0:  # not yet at the arc: still on the leg into it
+                assert prev is not None
+                return self._line_law(pos, vel, prev, a, b, 0.0)
+            self._arc_state = 2
+        return self._line_law(pos, vel, a, b, b, dt)
+
+    def _line_law(
+        self,
+        pos: tuple[float, float],
+        vel: tuple[float, float],
+        a: tuple[float, float],
+        b: tuple[float, float],
+        target: tuple[float, float],
+        dt: float,
+    ) -> LateralDemand:
         speed = max(math.hypot(*vel), MIN_SPEED)
         vel = vel if math.hypot(*vel) >= MIN_SPEED else (speed, 0.0)
         l1 = self.l1_distance(speed)
         ab = (b[0] - a[0], b[1] - a[1])
         length = math.hypot(*ab)
-        to_b = (b[0] - pos[0], b[1] - pos[1])
+        to_b = (target[0] - pos[0], target[1] - pos[1])
         bearing_b = math.atan2(to_b[1], to_b[0])
         if length < 0.1:
             return self._towards(vel, speed, l1, to_b, 0.0)

@@ -205,7 +205,7 @@ class MissionExecutor:
             return 0.0
         leg_in = math.atan2(b[1] - a[1], b[0] - a[0])
         leg_out = math.atan2(nxt[1] - b[1], nxt[0] - b[0])
-        turn = min(abs(wrap_pi(leg_out - leg_in)), math.radians(120.0))
+        turn = min(abs(wrap_pi(leg_out - leg_in)), math.radians(150.0))
         lead = self._turn_radius * math.tan(turn / 2.0)
         return min(lead, 0.5 * _distance(a, b), 0.5 * _distance(b, nxt))
 

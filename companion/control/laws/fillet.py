@@ -1,0 +1,63 @@
+"""The arc that joins one straight leg to the next: where a turn starts, ends and circles.
+
+A waypoint corner is flown as a circular arc of the turn radius tangent to both legs, as
+an aircraft must fly it anyway: it starts turning ``R·tan(θ/2)`` before the corner (θ
+the change of course) and ends on the new leg as far past it, with the wings levelling
+as it gets there. Guided only by the new line, L1 begins the turn when the aircraft is
+one L1 distance from that line, which for a turn radius longer than L1 overshoots the
+new leg by tens of metres.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+MIN_TURN_RAD = math.radians(3.0)  # below this a corner is flown as a straight line
+
+
+@dataclass(frozen=True)
+class Fillet:
+    """Geometry of one corner (north/east metres)."""
+
+    corner: tuple[float, float]
+    u_in: tuple[float, float]  # unit vector along the leg flown into the corner
+    u_out: tuple[float, float]  # and along the leg flown out of it
+    lead: float  # distance from the corner to either tangent point
+    centre: tuple[float, float]
+    radius: float
+    clockwise: bool  # a right turn
+
+
+def fillet(
+    prev: tuple[float, float], corner: tuple[float, float], nxt: tuple[float, float], radius: float
+) -> Fillet | None:
+    """The arc of ``radius`` from leg prev→corner onto leg corner→nxt (None: no turn)."""
+    d_in = (corner[0] - prev[0], corner[1] - prev[1])
+    d_out = (nxt[0] - corner[0], nxt[1] - corner[1])
+    l_in, l_out = math.hypot(*d_in), math.hypot(*d_out)
+    if l_in < 1.0 or l_out < 1.0 or radius <= 0.0:
+        return None
+    u_in = (d_in[0] / l_in, d_in[1] / l_in)
+    u_out = (d_out[0] / l_out, d_out[1] / l_out)
+    turn = math.atan2(
+        u_in[0] * u_out[1] - u_in[1] * u_out[0], u_in[0] * u_out[0] + u_in[1] * u_out[1]
+    )
+    if abs(turn) < MIN_TURN_RAD or abs(turn) > math.radians(175.0):
+        return None
+    # Short legs leave no room for the whole arc: a tighter one, flown at the bank limit.
+    lead = min(radius * math.tan(abs(turn) / 2.0), 0.5 * l_in, 0.5 * l_out)
+    radius = lead / math.tan(abs(turn) / 2.0)
+    sign = 1.0 if turn > 0 else -1.0
+    right = (-u_out[1] * sign, u_out[0] * sign)  # towards the centre
+    t_out = (corner[0] + u_out[0] * lead, corner[1] + u_out[1] * lead)
+    centre = (t_out[0] + right[0] * radius, t_out[1] + right[1] * radius)
+    return Fillet(corner, u_in, u_out, lead, centre, radius, turn > 0)
+
+
+def on_arc(f: Fillet, pos: tuple[float, float], exit_early: float = 0.0) -> bool:
+    """Whether ``pos`` is between the two tangent points (leaving ``exit_early`` m short)."""
+    rel = (pos[0] - f.corner[0], pos[1] - f.corner[1])
+    along_in = rel[0] * f.u_in[0] + rel[1] * f.u_in[1]
+    along_out = rel[0] * f.u_out[0] + rel[1] * f.u_out[1]
+    return along_in > -f.lead and along_out < f.lead - exit_early
