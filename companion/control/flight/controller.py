@@ -24,6 +24,9 @@ from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 
 AIRBORNE_AGL_M = 10.0
 LANDED_SPEED = 8.0  # m/s: slower than this near the ground is "on the ground"
+# Turns are planned at this fraction of the bank limit: the rest is for gusts and for
+# the airspeed a turn gains or loses.
+TURN_BANK_FRACTION = 0.7
 MAX_TURN_WIND = 15.0  # m/s: a wind estimate beyond this is not trusted to size turns
 
 
@@ -325,15 +328,15 @@ class FlightController:
         return out
 
     def _turn_radius(self) -> float:
-        """The radius of a turn at 80 % of the bank limit at the fastest ground speed of the
-        turn (cruise airspeed with the wind behind).
+        """The radius of a turn at ``TURN_BANK_FRACTION`` of the bank limit at the fastest
+        ground speed of the turn (cruise airspeed with the wind behind).
 
         From the planned speed and the slowly changing wind estimate, not the measured
         speed: a circle whose radius followed every gust would never be flown round.
         """
         wind = min(math.hypot(*self.wind.wind_ne), MAX_TURN_WIND)
         v = self.config["AIRSPEED_CRUISE"] + wind
-        return v * v / (G * math.tan(self.config.roll_limit * 0.8))
+        return v * v / (G * math.tan(self.config.roll_limit * TURN_BANK_FRACTION))
 
     def _lateral(
         self, sp: Setpoint, pos: tuple[float, float], vel: tuple[float, float], dt: float

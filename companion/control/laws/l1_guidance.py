@@ -21,7 +21,7 @@ MIN_SPEED = 1.0  # below this the ground course is meaningless
 XTRACK_I_CAPTURE_RAD = math.radians(5.0)
 XTRACK_I_MAX_RAD = 0.1
 # The wings take about this long to level: leave the arc that much before its end.
-ROLL_OUT_S = 0.6
+ROLL_OUT_S = 1.0
 
 
 @dataclass(frozen=True)
