@@ -2,7 +2,7 @@
 
 Usage: uv run python benchmarks/mission_tracking.py [--aircraft c172p] [--plan square.plan]
        [--lockstep exact|fast|both] [--calm-only]
-(aircraft and plan repeatable; default: c172p and J3Cub, square.plan and jump.plan, exact)
+(aircraft and plan repeatable; default: c172p and J3Cub, the plans in DEFAULT_PLANS, exact)
 
 ``--lockstep fast`` flies the same flights in fast lockstep (``--fast``: the vehicle may
 trail the physics by one navigation period, never more), ``both`` flies each both ways,
@@ -15,9 +15,14 @@ flight; watched until the mission completes; ground/campaign/flight_run.py) and
 prints from the truth CSV:
 cross-track error RMS and 95th percentile on the straight part of each
 waypoint-to-waypoint leg (past the turn onto it and before the turn off it), and height
-error RMS and airspeed error RMS over the same samples (ground/campaign/scoring.py).
-Targets (issue 8): calm cross-track RMS ≤ 3 m, height RMS ≤ 3 m; in wind the mission
-completes and cross-track p95 ≤ 10 m.
+error RMS and airspeed error RMS over the same samples (ground/campaign/scoring.py);
+then, per leg as flown (ground/campaign/legs.py): the turn onto it, the distance flown
+from its first waypoint until within 2 m of the line for good, the cross-track RMS / p95 /
+mean and height RMS more than 500 m from either corner, and the bank-angle and heading
+standard deviations there (the wobble).
+Targets (issue 27): calm cross-track RMS ≤ 1 m and p95 ≤ 2 m, in 5 m/s wind with light
+turbulence p95 ≤ 3 m, height RMS ≤ 1 m, settled within 600 m after a 90° turn and 900 m
+after 135°.
 """
 
 from __future__ import annotations
@@ -31,10 +36,17 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from companion.control.mission.plan import checked_plan  # noqa: E402
+from companion.navigation.estimate_csv import read_estimate  # noqa: E402
 from ground.campaign.flight_run import FlightJob, fly_flight  # noqa: E402
+from ground.campaign.legs import LegFigures, flight_legs  # noqa: E402
 from ground.campaign.spec import PLANS, SIM_CONFIG, Flight  # noqa: E402
 
 CONDITIONS = {"calm": ((0.0, 0.0, 0.0), "none"), "wind 5 m/s W + light": ((0.0, 5.0, 0.0), "light")}
+# The shipped plans and three long ones (benchmarks/plans/): a 3 km square, a zigzag of
+# 90° turns, and a DO_JUMP loop with two 135° turns.
+DEFAULT_PLANS = ["square.plan", "jump.plan", "square_3km.plan", "zigzag.plan", "jump_135.plan"]
+HERE_PLANS = Path(__file__).resolve().parent / "plans"
 START_AT_S = 10.0  # exact lockstep: the simulator arms and starts the mission then
 
 
@@ -48,7 +60,7 @@ def main() -> None:
     modes = {"exact": [False], "fast": [True], "both": [False, True]}[args.lockstep]
     conditions = {"calm": CONDITIONS["calm"]} if args.calm_only else CONDITIONS
     aircraft = args.aircraft or ["c172p", "J3Cub"]
-    plans = [PLANS / p for p in (args.plan or ["square.plan", "jump.plan"])]
+    plans = [_plan(p) for p in (args.plan or DEFAULT_PLANS)]
     head = f"{'airframe':8} {'plan':12} {'condition':22} {'pace':5} {'done':5} {'xt rms':>7}"
     head += f" {'xt p95':>7}"
     print(head + f" {'alt rms':>8} {'spd rms':>8} {'n':>6}")
@@ -59,6 +71,7 @@ def main() -> None:
                                 False, 900.0, START_AT_S, fast)  # fmt: skip
                 with tempfile.TemporaryDirectory() as tmp:
                     r = fly_flight(FlightJob(flight, tmp, timeout_s=600.0))
+                    legs = _legs(Path(tmp) / flight.flight_id / "truth.csv", plan, name, wind)
                 done = r["completed"] if r["status"] == "ok" else r["error"]
                 pace = "fast" if fast else "exact"
                 print(
@@ -67,6 +80,31 @@ def main() -> None:
                     f"{r['airspeed_rms_m_s']:8.2f} {r['samples']:6d}",
                     flush=True,
                 )
+                for k, leg in enumerate(legs):
+                    print(_leg_row(k, leg), flush=True)
+
+
+def _plan(name: str) -> Path:
+    """A plan by path, or by name from qgc_plans/ or benchmarks/plans/."""
+    for candidate in (Path(name), PLANS / name, HERE_PLANS / name):
+        if candidate.exists():
+            return candidate.resolve()
+    raise SystemExit(f"no plan {name}")
+
+
+def _legs(truth: Path, plan: Path, airframe: str, wind: tuple) -> list[LegFigures]:
+    if not truth.exists():
+        return []
+    return flight_legs(read_estimate(truth), checked_plan(plan)[0], airframe, wind)
+
+
+def _leg_row(k: int, f: LegFigures) -> str:
+    return (
+        f"    leg {k + 1}: turn {f.turn_deg:5.0f}° length {f.length_m:5.0f} m "
+        f"settled {f.settled_m:5.0f} m | xt rms {f.xt_rms_m:5.2f} p95 {f.xt_p95_m:5.2f} "
+        f"mean {f.xt_mean_m:+5.2f} height rms {f.height_rms_m:4.2f} | "
+        f"bank sd {f.bank_sd_deg:4.2f}° heading sd {f.heading_sd_deg:4.2f}° n {f.samples}"
+    )
 
 
 if __name__ == "__main__":

@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from companion.actuators.airframe import load_airframe
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.params import control_params, flight_config
@@ -32,6 +34,7 @@ class Sample:
     alt_agl: float
     airspeed: float
     roll: float
+    yaw: float
     out: ControlOutput
 
 
@@ -103,5 +106,12 @@ class ClosedLoop:
                 "throttle": out.throttle,
             }
         )
-        truth = (s.lat_deg, s.lon_deg, s.alt_msl_m, s.alt_agl_m, s.airspeed_m_s, s.roll)
+        truth = (s.lat_deg, s.lon_deg, s.alt_msl_m, s.alt_agl_m, s.airspeed_m_s, s.roll, s.yaw)
         self.samples.append(Sample(s.t_s, *truth, out))
+
+    def truth(self) -> dict[str, np.ndarray]:
+        """The record as the columns of a truth file (those the scoring reads)."""
+        cols = {"t": "t_s", "lat": "lat", "lon": "lon", "alt": "alt_msl", "roll": "roll"}
+        out = {k: np.array([getattr(x, v) for x in self.samples]) for k, v in cols.items()}
+        out["yaw"] = np.array([x.yaw for x in self.samples])
+        return out
