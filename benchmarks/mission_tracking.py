@@ -56,6 +56,7 @@ def main() -> None:
     ap.add_argument("--plan", action="append")
     ap.add_argument("--lockstep", choices=("exact", "fast", "both"), default="exact")
     ap.add_argument("--calm-only", action="store_true")
+    ap.add_argument("--noise", type=float, default=1.0, help="sensor noise scale (0: perfect)")
     args = ap.parse_args()
     modes = {"exact": [False], "fast": [True], "both": [False, True]}[args.lockstep]
     conditions = {"calm": CONDITIONS["calm"]} if args.calm_only else CONDITIONS
@@ -68,7 +69,7 @@ def main() -> None:
         for plan in plans:
             for (cond, (wind, turbulence)), fast in product(conditions.items(), modes):
                 flight = Flight(str(plan), name, wind, turbulence, (), 1, str(SIM_CONFIG),
-                                False, 900.0, START_AT_S, fast)  # fmt: skip
+                                False, 900.0, START_AT_S, fast, args.noise)  # fmt: skip
                 with tempfile.TemporaryDirectory() as tmp:
                     r = fly_flight(FlightJob(flight, tmp, timeout_s=600.0))
                     legs = _legs(Path(tmp) / flight.flight_id / "truth.csv", plan, name, wind)

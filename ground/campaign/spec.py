@@ -80,6 +80,7 @@ class Flight:
     max_sim_s: float
     start_at_s: float | None = None  # exact lockstep, armed and started by the simulator then
     fast: bool = False  # with start_at_s: fast lockstep instead of exact (to compare the two)
+    noise: float = 1.0  # sensor noise scale (0: perfect sensors)
 
     @property
     def condition(self) -> str:
@@ -104,9 +105,11 @@ class Flight:
 
     def _key(self) -> tuple:
         plan, config = Path(self.plan).name, Path(self.config).name
-        return (plan, self.airframe, self.wind_ned, self.turbulence, self.outages, self.seed,
-                config, self.airborne, self.max_sim_s, self.start_at_s,
-                *(("fast",) if self.fast else ()))  # fmt: skip
+        key = (plan, self.airframe, self.wind_ned, self.turbulence, self.outages, self.seed,
+               config, self.airborne, self.max_sim_s, self.start_at_s,
+               *(("fast",) if self.fast else ()))  # fmt: skip
+        # Left out at its default so that earlier flights keep their ids.
+        return key + ((self.noise,) if self.noise != 1.0 else ())
 
 
 @dataclass(frozen=True)

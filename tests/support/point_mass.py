@@ -55,13 +55,15 @@ def fly_legs(
     points: list[tuple[float, float]],
     turn_radius: float,
     dt: float = 0.02,
+    arcs: bool = True,
 ) -> list[list[tuple[float, float]]]:
     """Fly the legs between ``points`` (switching at the turn lead as the executor does);
-    the positions flown while each leg was the current one."""
+    the positions flown while each leg was the current one. ``arcs=False``: guidance is
+    not told where the leg before came from (L1 alone turns the corners)."""
     legs: list[list[tuple[float, float]]] = [[] for _ in points[1:]]
     for k in range(1, len(points)):
         a, b = points[k - 1], points[k]
-        prev = points[k - 2] if k >= 2 else None
+        prev = points[k - 2] if k >= 2 and arcs else None
         lead = _lead(a, b, points[k + 1] if k + 1 < len(points) else None, turn_radius)
         for _ in range(int(4 * math.dist(a, b) / aircraft.airspeed / dt)):
             pos = (aircraft.north, aircraft.east)

@@ -1,0 +1,119 @@
+"""Corners and straight legs against a point-mass aircraft, with each airframe's tuning.
+
+The aircraft (tests/support/point_mass.py) flies at the airframe's cruise speed with a
+roll response as quick as its roll loop gives and the bank limit it is set to; guidance
+uses the airframe's L1 period and damping and the turn radius the controller plans
+with. A tuning change in an airframe file shows here first, in milliseconds, before any
+JSBSim flight.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from companion.actuators.airframe import load_airframe
+from companion.control.flight.controller import TURN_BANK_FRACTION
+from companion.control.flight.params import control_params
+from companion.control.laws.fillet import fillet, on_arc
+from companion.control.laws.l1_guidance import L1Guidance
+from companion.geodesy import STANDARD_GRAVITY as G
+from tests.support.point_mass import PointMass, cross_track, fly_legs
+
+AIRFRAMES = ("c172p", "J3Cub")
+SQUARE = [(0.0, 0.0), (0.0, 3000.0), (-3000.0, 3000.0), (-3000.0, 0.0), (0.0, 0.0)]
+# Two 135° turns: out along a diagonal, back along a line that crosses it.
+SHARP = [(0.0, 0.0), (0.0, 2500.0), (-2000.0, 500.0), (-2000.0, 3000.0), (0.0, 1000.0)]
+STRAIGHT_MARGIN_M = 500.0  # the straight part of a leg, as the tracking score takes it
+
+
+def setup(
+    airframe: str, wind: tuple[float, float] = (0.0, 0.0)
+) -> tuple[L1Guidance, PointMass, float]:
+    v = {p.name: p.default for p in control_params(load_airframe(airframe).control)}
+    cruise, limit = v["AIRSPEED_CRUISE"], math.radians(v["ROLL_LIMIT_DEG"])
+    radius = (cruise + math.hypot(*wind)) ** 2 / (G * math.tan(limit * TURN_BANK_FRACTION))
+    guidance = L1Guidance(v["NAVL1_PERIOD"], v["NAVL1_DAMPING"], v["NAVL1_XTRACK_I"])
+    aircraft = PointMass(airspeed=cruise, bank_limit=limit, wind_ne=wind, east=-300.0)
+    aircraft.heading = math.pi / 2
+    return guidance, aircraft, radius
+
+
+def settled_after(track: list[tuple[float, float]], a, b) -> float:  # type: ignore[no-untyped-def]
+    """Distance along a→b from which the aircraft stays within 2 m of the line."""
+    length = math.dist(a, b)
+    rows = [(al, x) for al, x in cross_track(track, a, b) if al < length - STRAIGHT_MARGIN_M]
+    off = [al for al, x in rows if abs(x) >= 2.0]
+    return max(off, default=0.0)
+
+
+def straight_worst(
+    track: list[tuple[float, float]], a, b, start: float = STRAIGHT_MARGIN_M
+) -> float:  # type: ignore[no-untyped-def]
+    """Largest cross-track error between ``start`` m past ``a`` and 500 m before ``b``."""
+    length = math.dist(a, b)
+    rows = cross_track(track, a, b)
+    return max(abs(x) for al, x in rows if start < al < length - STRAIGHT_MARGIN_M)
+
+
+def test_an_arc_is_tangent_to_both_legs():
+    f = fillet((0.0, -1000.0), (0.0, 0.0), (1000.0, 0.0), 200.0)  # east, then a left turn north
+    assert f is not None and not f.clockwise
+    assert f.lead == pytest.approx(200.0)  # R·tan(45°)
+    assert f.centre == pytest.approx((200.0, -200.0))
+    assert (
+        on_arc(f, (50.0, -100.0)) and not on_arc(f, (0.0, -300.0)) and not on_arc(f, (300.0, 0.0))
+    )
+
+
+def test_short_legs_get_a_tighter_arc_that_still_fits():
+    f = fillet((0.0, -100.0), (0.0, 0.0), (100.0, 0.0), 200.0)
+    assert f is not None and f.lead == pytest.approx(50.0) and f.radius == pytest.approx(50.0)
+
+
+def test_no_arc_for_a_straight_on_corner():
+    assert fillet((0.0, -1000.0), (0.0, 0.0), (0.0, 1000.0), 200.0) is None
+
+
+@pytest.mark.parametrize("airframe", AIRFRAMES)
+def test_after_a_right_angle_it_is_on_the_new_leg_within_600_m(airframe: str):
+    guidance, aircraft, radius = setup(airframe)
+    legs = fly_legs(guidance, aircraft, SQUARE, radius)
+    for k in (1, 2, 3):
+        a, b = SQUARE[k], SQUARE[k + 1]
+        assert settled_after(legs[k], a, b) < 600.0
+        assert straight_worst(legs[k], a, b) < 0.5
+
+
+@pytest.mark.parametrize("airframe", AIRFRAMES)
+def test_after_a_135_degree_turn_it_is_on_the_new_leg_within_900_m(airframe: str):
+    guidance, aircraft, radius = setup(airframe)
+    legs = fly_legs(guidance, aircraft, SHARP, radius)
+    for k in (1, 2):
+        a, b = SHARP[k], SHARP[k + 1]
+        assert settled_after(legs[k], a, b) < 900.0
+        # The arc of a 135° turn ends R·tan(67.5°) past the corner: the straight part
+        # begins there, for a C172 a little beyond the usual 500 m.
+        arc = fillet(SHARP[k - 1], a, b, radius)
+        assert arc is not None
+        assert straight_worst(legs[k], a, b, max(STRAIGHT_MARGIN_M, arc.lead + 100.0)) < 0.5
+
+
+@pytest.mark.parametrize("airframe", AIRFRAMES)
+def test_in_a_5_m_s_wind_the_corners_still_end_on_the_new_leg(airframe: str):
+    guidance, aircraft, radius = setup(airframe, wind=(0.0, 5.0))
+    legs = fly_legs(guidance, aircraft, SQUARE, radius)
+    for k in (1, 2, 3):
+        a, b = SQUARE[k], SQUARE[k + 1]
+        assert settled_after(legs[k], a, b) < 600.0
+        assert straight_worst(legs[k], a, b) < 1.0
+
+
+def test_without_the_arc_a_right_angle_overshoots_the_new_leg():
+    """What the arc is for: L1 alone starts turning one L1 distance from the new line."""
+    guidance, aircraft, radius = setup("c172p")
+    legs = fly_legs(guidance, aircraft, SQUARE, radius, arcs=False)
+    rows = cross_track(legs[1], SQUARE[1], SQUARE[2])
+    overshoot = max(-x for _, x in rows)  # the square turns right: overshoot is to the left
+    assert overshoot > 10.0
