@@ -1,8 +1,8 @@
 """A point-mass aircraft for closed-loop tests of the guidance laws, without JSBSim.
 
-Constant airspeed, coordinated turns (heading rate ``g·tan φ / V``), a first-order roll
-response towards the demanded bank with a rate limit, and a steady wind: what lateral
-guidance sees of an aeroplane, at thousands of steps a second.
+Constant airspeed, coordinated turns (heading rate ``g·tan φ / V``, reached with a lag),
+a first-order roll response towards the demanded bank with a rate limit, and a steady
+wind: what lateral guidance sees of an aeroplane, at thousands of steps a second.
 """
 
 from __future__ import annotations
@@ -21,12 +21,16 @@ class PointMass:
     airspeed: float = 36.0
     roll_tau_s: float = 0.35
     roll_rate_max: float = math.radians(60.0)
+    # The heading rate follows the bank with a lag (sideslip, yaw damping): a JSBSim
+    # Cessna keeps turning for a moment after its wings are level.
+    turn_lag_s: float = 0.4
     bank_limit: float = math.radians(35.0)
     wind_ne: tuple[float, float] = (0.0, 0.0)
     north: float = 0.0
     east: float = 0.0
     heading: float = 0.0
     bank: float = 0.0
+    turn_rate: float = 0.0
     track: list[tuple[float, float]] = field(default_factory=list)
 
     @property
@@ -42,7 +46,9 @@ class PointMass:
         rate = (bank_dem - self.bank) / self.roll_tau_s
         rate = max(-self.roll_rate_max, min(self.roll_rate_max, rate))
         self.bank += rate * dt
-        self.heading += G * math.tan(self.bank) / self.airspeed * dt
+        target = G * math.tan(self.bank) / self.airspeed
+        self.turn_rate += (target - self.turn_rate) * min(1.0, dt / self.turn_lag_s)
+        self.heading += self.turn_rate * dt
         vn, ve = self.velocity
         self.north += vn * dt
         self.east += ve * dt
@@ -84,7 +90,7 @@ def _lead(a, b, nxt, radius: float) -> float:  # type: ignore[no-untyped-def]
             math.tau,
         )
     )
-    return min(radius * math.tan(min(turn, math.radians(150.0)) / 2.0), math.dist(a, b) / 2)
+    return min(radius * math.tan(min(turn, math.radians(135.0)) / 2.0), math.dist(a, b) / 2)
 
 
 def cross_track(
