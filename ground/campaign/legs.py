@@ -26,6 +26,7 @@ from mavlink_dialect import companion as d
 SETTLED_M = 2.0
 STRAIGHT_MARGIN_M = 500.0
 MAX_JUMPS = 1000
+LEAD_SLACK_M = 50.0
 OFF_LINE_M = 150.0  # a leg's first waypoint counts as reached this close to its line
 
 
@@ -133,7 +134,12 @@ def leg_figures(
         if leg.first:  # skip the flight to the leg's start (the take-off, a loiter)
             on = np.nonzero((along[start:] >= 0.0) & (np.abs(cross[start:]) < OFF_LINE_M))[0]
             start = start + int(on[0]) if len(on) else len(north)
-        ahead = np.nonzero(along[start:] >= length - max(leg.lead_out, 1.0))[0]
+        # The leg ends where the executor switches (the lead, give or take a wind
+        # estimate), or where the aircraft leaves its line in the second half.
+        done = (along[start:] >= length - max(leg.lead_out + LEAD_SLACK_M, 1.0)) | (
+            (np.abs(cross[start:]) > OFF_LINE_M) & (along[start:] > length / 2)
+        )
+        ahead = np.nonzero(done & (along[start:] > 0.0))[0]
         end = start + int(ahead[0]) if len(ahead) else len(north)
         out.append(_figures(truth, leg, length, along[start:end], cross[start:end], start, end))
         start = end
