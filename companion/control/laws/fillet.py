@@ -55,9 +55,11 @@ def fillet(
     return Fillet(corner, u_in, u_out, lead, centre, radius, turn > 0)
 
 
-def on_arc(f: Fillet, pos: tuple[float, float], exit_early: float = 0.0) -> bool:
-    """Whether ``pos`` is between the two tangent points (leaving ``exit_early`` m short)."""
+def arc_phase(f: Fillet, pos: tuple[float, float], exit_early: float = 0.0) -> int:
+    """0 before the arc's start, 1 on it, 2 within ``exit_early`` m of its end or past it."""
     rel = (pos[0] - f.corner[0], pos[1] - f.corner[1])
     along_in = rel[0] * f.u_in[0] + rel[1] * f.u_in[1]
     along_out = rel[0] * f.u_out[0] + rel[1] * f.u_out[1]
-    return along_in > -f.lead and along_out < f.lead - exit_early
+    if along_out >= f.lead - exit_early:
+        return 2
+    return 1 if along_in > -f.lead else 0

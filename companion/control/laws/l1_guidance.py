@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from companion.control.laws.fillet import Fillet, fillet, on_arc
+from companion.control.laws.fillet import Fillet, arc_phase, fillet
 from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import wrap_pi
 
@@ -86,8 +86,9 @@ class L1Guidance:
         f = self._fillet
         if f is not None and self._arc_state < 2:
             speed = max(math.hypot(*vel), MIN_SPEED)
-            if on_arc(f, pos, speed * ROLL_OUT_S):
-                self._arc_state = 1
+            # Phases only move on: a gust never puts the aircraft back on an arc it left.
+            self._arc_state = max(self._arc_state, arc_phase(f, pos, speed * ROLL_OUT_S))
+            if self._arc_state == 1:
                 arc = self.circle(pos, vel, f.centre, f.radius, f.clockwise)
                 to_b = (b[0] - pos[0], b[1] - pos[1])
                 bearing = math.atan2(to_b[1], to_b[0])
@@ -95,7 +96,6 @@ class L1Guidance:
             if self._arc_state == 0:  # not yet at the arc: still on the leg into it
                 assert prev is not None
                 return self._line_law(pos, vel, prev, a, b, 0.0)
-            self._arc_state = 2
         return self._line_law(pos, vel, a, b, b, dt)
 
     def _line_law(

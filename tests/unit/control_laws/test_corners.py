@@ -16,7 +16,7 @@ import pytest
 from companion.actuators.airframe import load_airframe
 from companion.control.flight.controller import TURN_BANK_FRACTION
 from companion.control.flight.params import control_params
-from companion.control.laws.fillet import fillet, on_arc
+from companion.control.laws.fillet import arc_phase, fillet
 from companion.control.laws.l1_guidance import L1Guidance
 from companion.geodesy import STANDARD_GRAVITY as G
 from tests.support.point_mass import PointMass, cross_track, fly_legs
@@ -62,14 +62,29 @@ def test_an_arc_is_tangent_to_both_legs():
     assert f is not None and not f.clockwise
     assert f.lead == pytest.approx(200.0)  # R·tan(45°)
     assert f.centre == pytest.approx((200.0, -200.0))
-    assert (
-        on_arc(f, (50.0, -100.0)) and not on_arc(f, (0.0, -300.0)) and not on_arc(f, (300.0, 0.0))
-    )
+    assert arc_phase(f, (0.0, -300.0)) == 0
+    assert arc_phase(f, (50.0, -100.0)) == 1
+    assert arc_phase(f, (300.0, 0.0)) == 2
+    assert arc_phase(f, (180.0, -20.0), exit_early=30.0) == 2  # the wings level before its end
 
 
 def test_short_legs_get_a_tighter_arc_that_still_fits():
     f = fillet((0.0, -100.0), (0.0, 0.0), (100.0, 0.0), 200.0)
     assert f is not None and f.lead == pytest.approx(50.0) and f.radius == pytest.approx(50.0)
+
+
+def test_a_slight_corner_whose_arc_is_shorter_than_the_roll_out_is_not_followed_for_ever():
+    """The arc's start and the point to leave it can be passed in one step: then the new
+    leg is flown, never the line into the corner continued."""
+    guidance, aircraft, radius = setup("J3Cub")
+    turn = math.radians(10.0)  # to the left, off a leg flown due east
+    points = [
+        (0.0, 0.0),
+        (0.0, 1000.0),
+        (3000.0 * math.sin(turn), 1000.0 + 3000.0 * math.cos(turn)),
+    ]
+    legs = fly_legs(guidance, aircraft, points, radius)
+    assert straight_worst(legs[1], points[1], points[2]) < 0.5
 
 
 def test_no_arc_for_a_straight_on_corner():
