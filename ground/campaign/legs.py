@@ -26,7 +26,7 @@ from mavlink_dialect import companion as d
 SETTLED_M = 2.0
 STRAIGHT_MARGIN_M = 500.0
 MAX_JUMPS = 1000
-LEAD_SLACK_M = 50.0
+LEAD_SLACK_M = 150.0
 OFF_LINE_M = 150.0  # a leg's first waypoint counts as reached this close to its line
 
 
@@ -131,11 +131,16 @@ def leg_figures(
         u = ((leg.b[0] - leg.a[0]) / length, (leg.b[1] - leg.a[1]) / length)
         along = (north - leg.a[0]) * u[0] + (east - leg.a[1]) * u[1]
         cross = -(north - leg.a[0]) * u[1] + (east - leg.a[1]) * u[0]
-        if leg.first:  # skip the flight to the leg's start (the take-off, a loiter)
-            on = np.nonzero((along[start:] >= 0.0) & (np.abs(cross[start:]) < OFF_LINE_M))[0]
-            start = start + int(on[0]) if len(on) else len(north)
-        # The leg ends where the executor switches (the lead, give or take a wind
-        # estimate), or where the aircraft leaves its line in the second half.
+        # Skip the flight to the leg's start (the take-off, a loiter) and the part of a
+        # sharp turn still far from the new line.
+        near = np.abs(cross[start:]) < OFF_LINE_M
+        if leg.first:
+            near &= along[start:] >= 0.0
+        on = np.nonzero(near)[0]
+        start = start + int(on[0]) if len(on) else len(north)
+        # The leg ends where the executor switches (the lead, give or take what the
+        # wind estimate adds to the turn radius), or where the aircraft leaves its line
+        # in the second half.
         done = (along[start:] >= length - max(leg.lead_out + LEAD_SLACK_M, 1.0)) | (
             (np.abs(cross[start:]) > OFF_LINE_M) & (along[start:] > length / 2)
         )
