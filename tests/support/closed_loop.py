@@ -16,8 +16,10 @@ from companion.actuators.airframe import load_airframe
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.params import control_params, flight_config
 from companion.control.mission.items import MissionItem
+from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 from ground.sitl.bridge.fdm import Flight, Home
+from mavlink_dialect import companion as d
 
 PHYSICS_HZ = 100
 CONTROL_EVERY = 2  # control at 50 Hz
@@ -115,3 +117,21 @@ class ClosedLoop:
         out = {k: np.array([getattr(x, v) for x in self.samples]) for k, v in cols.items()}
         out["yaw"] = np.array([x.yaw for x in self.samples])
         return out
+
+
+def mission(points: list[tuple[float, float]]) -> list[MissionItem]:
+    """Take off eastwards, fly the points at 100 m, return home."""
+    home = Home()
+    frame = LocalFrame(home.lat_deg, home.lon_deg)
+    rel = d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+    items = []
+    for cmd, (n, e) in [(d.MAV_CMD_NAV_TAKEOFF, (0.0, 600.0))] + [
+        (d.MAV_CMD_NAV_WAYPOINT, p) for p in points
+    ]:
+        lat, lon = frame.latlon(n, e)
+        p1 = 15.0 if cmd == d.MAV_CMD_NAV_TAKEOFF else 0.0
+        x, y = round(lat * 1e7), round(lon * 1e7)
+        items.append(MissionItem(len(items), rel, cmd, 0, 1, p1, 0, 0, 0, x, y, 100.0))
+    rtl = d.MAV_CMD_NAV_RETURN_TO_LAUNCH
+    items.append(MissionItem(len(items), rel, rtl, 0, 1, 0, 0, 0, 0, 0, 0, 0.0))
+    return items

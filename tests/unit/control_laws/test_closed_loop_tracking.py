@@ -14,34 +14,12 @@ import math
 
 import pytest
 
-from companion.control.mission.items import MissionItem
-from companion.geodesy import LocalFrame
 from ground.campaign.legs import flight_legs
-from ground.sitl.bridge.fdm import Home
-from mavlink_dialect import companion as d
-from tests.support.closed_loop import ClosedLoop
+from tests.support.closed_loop import ClosedLoop, mission
 
 SQUARE = [(500.0, 1200.0), (3500.0, 1200.0), (3500.0, -1800.0), (500.0, -1800.0), (500.0, 1200.0)]
 SHARP = [(0.0, 2500.0), (-2000.0, 500.0), (-2000.0, 3000.0), (0.0, 1000.0)]
 WIND = (0.0, 5.0, 0.0)  # from the west: across the square's north-south legs
-
-
-def mission(points: list[tuple[float, float]]) -> list[MissionItem]:
-    """Take off eastwards, fly the points at 100 m, return home."""
-    home = Home()
-    frame = LocalFrame(home.lat_deg, home.lon_deg)
-    rel = d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
-    items = []
-    for cmd, (n, e) in [(d.MAV_CMD_NAV_TAKEOFF, (0.0, 600.0))] + [
-        (d.MAV_CMD_NAV_WAYPOINT, p) for p in points
-    ]:
-        lat, lon = frame.latlon(n, e)
-        p1 = 15.0 if cmd == d.MAV_CMD_NAV_TAKEOFF else 0.0
-        x, y = round(lat * 1e7), round(lon * 1e7)
-        items.append(MissionItem(len(items), rel, cmd, 0, 1, p1, 0, 0, 0, x, y, 100.0))
-    rtl = d.MAV_CMD_NAV_RETURN_TO_LAUNCH
-    items.append(MissionItem(len(items), rel, rtl, 0, 1, 0, 0, 0, 0, 0, 0, 0.0))
-    return items
 
 
 def fly(airframe: str, points, wind=(0.0, 0.0, 0.0)):  # type: ignore[no-untyped-def]
