@@ -36,6 +36,10 @@ async def _session(port: int, vehicle) -> dict:
         assert system is not None, "MAVSDK found no autopilot"
         telemetry, action = TelemetryAsync(system), ActionAsync(system)
         position = await asyncio.wait_for(_first(telemetry.subscribe_position()), 10)
+        # As a MAVSDK user does: arm once the vehicle says it is armable (its pre-arm checks
+        # pass: the GPS plug-in, started beside the link, may not have a fix yet).
+        armable = _first(telemetry.subscribe_health(), lambda health: health.is_armable)
+        await asyncio.wait_for(armable, 30)
         await action.arm()
         armed = await asyncio.wait_for(_first(telemetry.subscribe_armed(), bool), 5)
         flight_pid = vehicle.row("flight").pid
