@@ -96,8 +96,9 @@ class SimBridge:
         lag = 0 if exact else FAST_LAG_PERIODS
         answers = self.bus.latest_reader("actuators/servos")
         self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]), lag)
-        nav = self.bus.latest_reader("nav/state")
-        self.nav_sync = FlightSync(period_us, nav, self.bus.waiter([nav]), lag, "t_us", True)
+        if not exact:  # exact lockstep keeps in step with every sample and servo answer
+            nav = self.bus.latest_reader("nav/state")
+            self.nav_sync = FlightSync(period_us, nav, self.bus.waiter([nav]), lag, "t_us", True)
         if exact:
             readers = {
                 device: {c: self.bus.queue_reader(c) for c in channels}
@@ -131,9 +132,10 @@ class SimBridge:
 
     def _sync_summary(self) -> str:
         sync, nav, samples = self.sync, self.nav_sync, self.samples
-        assert sync is not None and nav is not None
-        text = f"{sync.stalls} (waited {sync.wait_s:.1f} s); nav stalls {nav.stalls}"
-        text += f" (waited {nav.wait_s:.1f} s)"
+        assert sync is not None
+        text = f"{sync.stalls} (waited {sync.wait_s:.1f} s)"
+        if nav is not None:
+            text += f"; nav stalls {nav.stalls} (waited {nav.wait_s:.1f} s)"
         if samples is not None:
             text += f"; late samples {samples.late} (waited {samples.wait_s:.1f} s)"
         return text
