@@ -13,6 +13,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from companion.control.mission.items import MAX_ALT_M
 from companion.messages import (
     CommandId,
     CommandResult,
@@ -45,9 +46,6 @@ MODE_COMMANDS = frozenset(
         CommandId.SET_HOME,
     }
 )
-
-
-MAX_ALT_M = 100_000.0  # above this an altitude is a broken input, not a target
 
 
 class Commander:

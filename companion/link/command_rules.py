@@ -13,12 +13,12 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from companion.control.mission.items import GLOBAL_FRAMES, MAX_ALT_M
 from companion.link.codec import dialect as d
 from companion.link.command_service import SET_MODE_MESSAGE, CommandArgs
 
 MAX_MSG_ID = 16_777_215  # MAVLink 2 message ids are 24 bits
 MAX_INTERVAL_US = 2**31 - 1
-MAX_ALT_M = 100_000.0
 
 
 @dataclass(frozen=True)
@@ -120,14 +120,6 @@ EXTRA_CHECKS: dict[int, Callable[[CommandArgs], str | None]] = {
 }
 
 
-GLOBAL_FRAMES = frozenset(
-    {
-        d.MAV_FRAME_GLOBAL,
-        d.MAV_FRAME_GLOBAL_INT,
-        d.MAV_FRAME_GLOBAL_RELATIVE_ALT,
-        d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
-    }
-)
 POSITION_COMMANDS = frozenset(
     {d.MAV_CMD_DO_REPOSITION, d.MAV_CMD_NAV_LOITER_UNLIM, d.MAV_CMD_DO_SET_HOME}
 )

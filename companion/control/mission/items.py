@@ -68,7 +68,7 @@ INVALID_PARAM = (
     d.MAV_MISSION_INVALID_PARAM3,
     d.MAV_MISSION_INVALID_PARAM4,
 )
-MAX_ALT_M = 100_000.0
+MAX_ALT_M = 100_000.0  # above this an altitude is a broken input, not a target
 MAX_PARAM = 1e7  # no parameter of a supported item means anything beyond this
 
 
