@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from companion.bus.namespace import cleanup_namespace
+from companion.control.mission.plan import load_plan
 from ground.campaign.scoring import TrackScore, score_track
 from ground.campaign.spec import REPO, Flight
 
@@ -146,6 +147,7 @@ def _fly(job: FlightJob, folder: Path, tl: Timeline) -> None:
         )  # fmt: skip
         try:
             pilot = _Pilot(gcs, proc, time.monotonic() + job.timeout_s, tl, job.silent_s)
+            pilot.endless_seq = endless_final_item(flight.plan)
             pilot.fly(flight.start_at_s)
         finally:
             _end(proc)
@@ -174,6 +176,14 @@ def _sim_command(flight: Flight, folder: Path, port: int, namespace: str) -> lis
     return cmd
 
 
+def endless_final_item(plan: str | Path) -> int | None:
+    """The seq of the plan's last mission item when it is an unlimited loiter."""
+    items = load_plan(plan).get(0, [])
+    if items and items[-1].command == d.MAV_CMD_NAV_LOITER_UNLIM:
+        return items[-1].seq
+    return None
+
+
 def _armed(msg: Any) -> bool:
     return (
         msg.get_type() == "HEARTBEAT"
@@ -190,6 +200,7 @@ class _Pilot:
     ) -> None:
         self.gcs, self.proc, self.deadline, self.tl = gcs, proc, deadline, tl
         self.silent_s = silent_s
+        self.endless_seq: int | None = None  # a final item that never ends (see _complete)
         self.heard = time.monotonic()
         self.next_beat = 0.0
 
@@ -218,7 +229,9 @@ class _Pilot:
             return False
         if not self.tl.seqs or self.tl.seqs[-1] != msg.seq:
             self.tl.seqs.append(msg.seq)
-        if msg.mission_state == d.MISSION_STATE_COMPLETE:
+        # A plan that ends in an unlimited loiter is never COMPLETE: it is done once that
+        # loiter is the current item, with nothing left to fly.
+        if msg.mission_state == d.MISSION_STATE_COMPLETE or msg.seq == self.endless_seq:
             self.tl.completed, self.tl.complete_ms = True, self.tl.last_ms
             return True
         return False
