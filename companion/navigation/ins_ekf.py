@@ -36,12 +36,20 @@ from companion.navigation.ins_core import TH, InsCore
 from companion.navigation.ins_gps import GpsLag
 from companion.navigation.ins_mag import MagHeading, MagMonitor, mag_heading, yaw_jacobian
 from companion.navigation.local_frame import LocalFrame, normal_gravity
+from companion.navigation.yaw_gsf import YawGsf
 
 MAX_IMU_GAP_S = 0.5
 COMPASS_TILT_TO_HEADING = 3.0
 LAG_MAX_WANDER = 0.5
 LOST_TILT_STD = math.radians(5.0)
 LOST_YAW_STD = math.radians(30.0)
+GSF_MIN_VEL_STD = 0.5  # m/s: the bank ignores the GPS lag, which this allows for
+GSF_STEP_S = 0.04  # the yaw estimator bank integrates the IMU in steps of this
+# The bank's heading is believed over the INS's only when the bank is this sure, and the two
+# disagree by more than a heading error anyone would accept, for longer than a manoeuvre.
+GSF_TRUST_STD = math.radians(10.0)
+GSF_DISAGREE_RAD = math.radians(30.0)
+GSF_DISAGREE_S = 2.0
 _I15 = np.eye(15)
 _YAW_ONLY = np.array([True] * 6 + [False, False, True] + [False] * 3 + [True] * 3)
 __all__ = ["InsEkf", "InsEkfConfig"]
@@ -66,6 +74,11 @@ class InsEkf(InsCore):
         self.baro = BaroDatum(c.baro_interval_s, c.baro_timeout_s, c.baro_offset_tau_s)
         self.lag = GpsLag(c.gps_lag_window_s, c.gps_delay_s or 0.0)
         self.mag_monitor = MagMonitor(c.mag_window_s, c.mag_max_nis)
+        self.gsf = YawGsf()
+        self.gsf_dt = 0.0
+        self.gsf_f, self.gsf_w = np.zeros(3), np.zeros(3)
+        self.gsf_disagree_us: int | None = None
+        self.yaw_resets = 0  # headings taken from the bank
 
     # -- inputs ---------------------------------------------------------------------
     def on_imu(self, imu: Imu) -> None:
@@ -93,6 +106,21 @@ class InsEkf(InsCore):
         f = (values[0] - ba[0], values[1] - ba[1], values[2] - ba[2])
         w = (values[3] - bg[0], values[4] - bg[1], values[5] - bg[2])
         self._integrate(dt, f, w)
+        self._feed_gsf(dt, f, w)
+
+    def _feed_gsf(self, dt: float, f: tuple[float, ...], w: tuple[float, ...]) -> None:
+        """The yaw estimator bank gets the IMU averaged over a few samples (at 200-400 Hz
+        every sample would cost more than the bank's heading is worth)."""
+        self.gsf_dt += dt
+        self.gsf_f += np.multiply(f, dt)
+        self.gsf_w += np.multiply(w, dt)
+        if self.gsf_dt < GSF_STEP_S:
+            return
+        roll, pitch, _ = rot.quaternion_to_euler(self.q)
+        step = self.gsf_dt
+        self.gsf.predict(step, self.gsf_f / step, self.gsf_w / step, roll, pitch)
+        self.gsf_dt = 0.0
+        self.gsf_f, self.gsf_w = np.zeros(3), np.zeros(3)
 
     def on_gps(self, fix: GpsFix) -> None:
         """Position and velocity update (or the first fix, which anchors the frame)."""
@@ -107,7 +135,36 @@ class InsEkf(InsCore):
         if not self.aligned:
             self.pending_fix = fix
             return
+        self.gsf.update(fix.vn_m_s, fix.ve_m_s, max(self.cfg.gps_vel_std, GSF_MIN_VEL_STD))
         self._gps_update(fix)
+        self._watch_yaw(fix.t_us)
+
+    def _trusted_gsf_heading(self) -> tuple[float, float] | None:
+        found = self.gsf.heading()
+        return found if found is not None and found[1] < GSF_TRUST_STD else None
+
+    def _watch_yaw(self, t_us: int) -> None:
+        """A heading far from the one GPS velocity alone gives, for seconds, is a lost one
+        (a magnetometer that took it, a wrong alignment): take the bank's (PX4's yaw reset)."""
+        found = self._trusted_gsf_heading()
+        yj = yaw_jacobian(self.q)
+        if found is None or yj is None:
+            self.gsf_disagree_us = None
+            return
+        off = abs(math.remainder(found[0] - yj[0], math.tau))
+        ins_std = math.sqrt(max(self.P[8, 8], 0.0))
+        if off < max(GSF_DISAGREE_RAD, 3.0 * math.hypot(found[1], ins_std)):
+            self.gsf_disagree_us = None
+            return
+        if self.gsf_disagree_us is None:
+            self.gsf_disagree_us = t_us
+        elif t_us - self.gsf_disagree_us >= GSF_DISAGREE_S * 1e6:
+            self._take_gsf_heading(found)
+
+    def _take_gsf_heading(self, found: tuple[float, float]) -> None:
+        self._set_yaw(found[0], max(found[1], self.cfg.mag_heading_std))
+        self.gsf_disagree_us = None
+        self.yaw_resets += 1
 
     def _earth_field(self, lat: float, lon: float, alt: float) -> EarthField:
         field = wmm_field(lat, lon, alt, self.cfg.field_year)
@@ -284,6 +341,10 @@ class InsEkf(InsCore):
         att = np.sqrt(np.maximum(np.diag(self.P)[6:9], 0.0))
         relearn = np.maximum(att, [LOST_TILT_STD, LOST_TILT_STD, LOST_YAW_STD]).tolist()
         self._reset_block([6, 7, 8], relearn)
+        found = self._trusted_gsf_heading()
+        if found is not None:  # the bank knows the heading: no need to learn it again
+            self._take_gsf_heading(found)
+            self._reset_block([6, 7], relearn[:2])
 
     def _heading_update(self, heading: float, std: float) -> None:
         """A yaw-only update: a heading must never tilt the attitude."""

@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 MODELS = 5
-ACCEL_NOISE = 2.0  # m/s² (1-σ): tilt errors of ~10° and vibration in the levelled force
+ACCEL_NOISE = 1.0  # m/s² (1-σ): tilt errors of ~10° and vibration in the levelled force
 YAW_RATE_NOISE = 0.015  # rad/s (1-σ): gyro bias and the tilt error's part in the yaw rate
 MIN_WEIGHT = 1e-4  # no hypothesis dies for good: a later manoeuvre may favour it again
 MAX_NIS = 50.0  # a single wild fix must not kill every hypothesis but one

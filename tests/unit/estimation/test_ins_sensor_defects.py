@@ -151,4 +151,7 @@ def test_a_navigator_that_has_lost_its_heading_finds_it_again():
     _, states = fly(runner, flight(), drop={"compass"})
     t, yaw_err = yaw_errors_deg(states, flight())
     assert done and yaw_err[(t > 40.0) & (t < 41.0)].min() > 60.0
-    assert yaw_err[t > 70.0].max() < 10.0
+    # The bank of yaw hypotheses learnt the heading from GPS velocity in the turn before;
+    # the INS takes it after two seconds of disagreement instead of learning it again.
+    assert runner.nav.yaw_resets >= 1
+    assert yaw_err[t > 45.0].max() < 10.0
