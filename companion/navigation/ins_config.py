@@ -45,4 +45,5 @@ class InsEkfConfig:
     covariance_interval_s: float = 0.04
     align_window_s: float = 0.5
     settle_s: float = 5.0  # GPS is not gated for this long after the alignment
+    still_window_s: float = 1.0  # standing still this long measures the gyro biases
     noise_window_s: float = 10.0  # the IMU's sample noise is measured over this

@@ -35,6 +35,7 @@ from companion.navigation.ins_config import InsEkfConfig
 from companion.navigation.ins_core import TH, InsCore
 from companion.navigation.ins_gps import GpsLag
 from companion.navigation.ins_mag import MagHeading, MagMonitor, mag_heading, yaw_jacobian
+from companion.navigation.ins_still import StillDetector
 from companion.navigation.local_frame import LocalFrame, normal_gravity
 from companion.navigation.yaw_gsf import YawGsf
 
@@ -78,6 +79,9 @@ class InsEkf(InsCore):
         self.gsf_dt = 0.0
         self.gsf_f, self.gsf_w = np.zeros(3), np.zeros(3)
         self.gsf_disagree_us: int | None = None
+        self.still = StillDetector(c.still_window_s)
+        self.ground_speed = math.nan
+        self.still_updates = 0
         self.yaw_resets = 0  # headings taken from the bank
 
     # -- inputs ---------------------------------------------------------------------
@@ -107,6 +111,23 @@ class InsEkf(InsCore):
         w = (values[3] - bg[0], values[4] - bg[1], values[5] - bg[2])
         self._integrate(dt, f, w)
         self._feed_gsf(dt, f, w)
+        speed = self.ground_speed if self._fresh_fix(imu.t_us) else math.nan
+        found = self.still.add(imu.t_us, values[:3], values[3:], speed)
+        if found is not None:
+            self._still_update(*found)
+
+    def _fresh_fix(self, t_us: int) -> bool:
+        return self.last_fix_us is not None and (t_us - self.last_fix_us) / 1e6 < 1.0
+
+    def _still_update(self, gyro_mean: np.ndarray, variance: float) -> None:
+        """Standing still: the gyros' mean is their bias (``ins_still``)."""
+        # The yaw-rate bias only: roll and pitch rate biases are seen in flight through the
+        # tilt (gravity, GPS), and with the propellers turning they shift from the ground's
+        # (vibration, g-sensitivity); the yaw-rate bias has nothing but a magnetometer in
+        # flight, and a stationary window measures it to a few thousandths of a degree/s.
+        ok = self._update(gyro_mean[2:] - self.bg[2:], _I15[14:15], np.array([[variance]]))
+        if ok:
+            self.still_updates += 1
 
     def _feed_gsf(self, dt: float, f: tuple[float, ...], w: tuple[float, ...]) -> None:
         """The yaw estimator bank gets the IMU averaged over a few samples (at 200-400 Hz
@@ -127,6 +148,7 @@ class InsEkf(InsCore):
         if fix.fix_type < 2 or not (math.isfinite(fix.lat_deg) and math.isfinite(fix.lon_deg)):
             return
         self.last_fix_us = fix.t_us if self.last_fix_us is None else max(self.last_fix_us, fix.t_us)
+        self.ground_speed = math.hypot(fix.vn_m_s, fix.ve_m_s)
         if self.frame is None:
             alt = fix.alt_msl_m if math.isfinite(fix.alt_msl_m) else 0.0
             self.frame = LocalFrame(fix.lat_deg, fix.lon_deg, alt)
