@@ -77,7 +77,7 @@ class InsEkf(InsCore):
         self.mag_monitor = MagMonitor(c.mag_window_s, c.mag_max_nis)
         self.gsf = YawGsf()
         self.gsf_dt = 0.0
-        self.gsf_f, self.gsf_w = np.zeros(3), np.zeros(3)
+        self.gsf_sums = [0.0] * 6  # specific force and rate, times dt
         self.gsf_disagree_us: int | None = None
         self.still = StillDetector(c.still_window_s)
         self.ground_speed = math.nan
@@ -133,15 +133,16 @@ class InsEkf(InsCore):
         """The yaw estimator bank gets the IMU averaged over a few samples (at 200-400 Hz
         every sample would cost more than the bank's heading is worth)."""
         self.gsf_dt += dt
-        self.gsf_f += np.multiply(f, dt)
-        self.gsf_w += np.multiply(w, dt)
+        s = self.gsf_sums
+        s[0], s[1], s[2] = s[0] + f[0] * dt, s[1] + f[1] * dt, s[2] + f[2] * dt
+        s[3], s[4], s[5] = s[3] + w[0] * dt, s[4] + w[1] * dt, s[5] + w[2] * dt
         if self.gsf_dt < GSF_STEP_S:
             return
         roll, pitch, _ = rot.quaternion_to_euler(self.q)
-        step = self.gsf_dt
-        self.gsf.predict(step, self.gsf_f / step, self.gsf_w / step, roll, pitch)
+        mean = np.array(s) / self.gsf_dt
+        self.gsf.predict(self.gsf_dt, mean[:3], mean[3:], roll, pitch)
         self.gsf_dt = 0.0
-        self.gsf_f, self.gsf_w = np.zeros(3), np.zeros(3)
+        self.gsf_sums = [0.0] * 6
 
     def on_gps(self, fix: GpsFix) -> None:
         """Position and velocity update (or the first fix, which anchors the frame)."""

@@ -35,7 +35,8 @@ class StillDetector:
         self.g = gravity
         self.start_us: int | None = None
         self.n = 0
-        self.sums = np.zeros(12)  # accel, gyro, and their squares
+        # Plain floats: this runs on every IMU sample, where numpy's per-call cost dominates.
+        self.sums = [0.0] * 12  # accel, gyro, and their squares
 
     def add(
         self, t_us: int, accel: tuple[float, ...], gyro: tuple[float, ...], ground_speed: float
@@ -43,22 +44,24 @@ class StillDetector:
         """One raw IMU sample and the latest GPS ground speed (NaN when unknown)."""
         if self.start_us is None:
             self.start_us = t_us
-        values = np.array((*accel, *gyro))
-        self.sums[:6] += values
-        self.sums[6:] += values * values
+        sums = self.sums
+        for i, v in enumerate((*accel, *gyro)):
+            sums[i] += v
+            sums[6 + i] += v * v
         self.n += 1
         if t_us - self.start_us < self.window_us:
             return None
         result = self._verdict(ground_speed)
         self.start_us, self.n = t_us, 0
-        self.sums[:] = 0.0
+        self.sums = [0.0] * 12
         return result
 
     def _verdict(self, ground_speed: float) -> tuple[np.ndarray, float] | None:
         if self.n < 5 or not ground_speed < MAX_GROUND_SPEED:  # NaN: not known still
             return None
-        mean = self.sums[:6] / self.n
-        spread = np.sqrt(np.maximum(self.sums[6:] / self.n - mean * mean, 0.0))
+        sums = np.array(self.sums)
+        mean = sums[:6] / self.n
+        spread = np.sqrt(np.maximum(sums[6:] / self.n - mean * mean, 0.0))
         if spread[:3].max() > MAX_ACCEL_SPREAD or spread[3:].max() > MAX_GYRO_SPREAD:
             return None
         if abs(float(np.linalg.norm(mean[:3])) - self.g) > MAX_GRAVITY_ERROR:
