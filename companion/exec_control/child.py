@@ -14,11 +14,15 @@ from typing import Any
 import psutil
 
 from companion.exec_control.config import PluginSpec
+from companion.exec_control.zygote import CHILD_ENV, ForkedProcess, ForkServer
 from companion.messages import NAME_LEN, PluginHealth, PluginState, PluginStats
 
 log = logging.getLogger(__name__)
 
-FIRST_BACKOFF_S = 0.1
+# A plug-in that dies after running a while is restarted at once; one that keeps dying
+# waits 0.1, 0.2, 0.4 ... up to 5 s between attempts.
+FIRST_BACKOFF_S = 0.0
+SECOND_BACKOFF_S = 0.1
 MAX_BACKOFF_S = 5.0
 STABLE_AFTER_S = 10.0  # a plug-in that ran this long starts its back-off afresh
 
@@ -29,7 +33,8 @@ class Child:
     def __init__(self, spec: PluginSpec, base: dict[str, Any]) -> None:
         self.spec = spec
         self._argv_spec = json.dumps({**base, **_spec_dict(spec)})
-        self.proc: subprocess.Popen[bytes] | None = None
+        self.proc: subprocess.Popen[bytes] | ForkedProcess | None = None
+        self.forker: ForkServer | None = None  # spawn a fresh interpreter when None
         self.state = PluginState.STOPPED
         self.restarts = 0
         self.wanted = False  # should be running (its group is started)
@@ -46,10 +51,12 @@ class Child:
         return self.proc.pid if self.proc and self.proc.poll() is None else 0
 
     def start(self) -> None:
-        """Spawn the plug-in process now."""
-        self.proc = subprocess.Popen(
+        """Start the plug-in process now: forked by the fork server, or else spawned."""
+        forked = self.forker.spawn(self._argv_spec) if self.forker is not None else None
+        self.proc = forked or subprocess.Popen(
             [sys.executable, "-m", "companion.exec_control.plugin_host", self._argv_spec],
             start_new_session=True,  # a terminal's Ctrl-C reaches the supervisor only
+            env={**os.environ, **CHILD_ENV},
         )
         self._ps = psutil.Process(self.proc.pid)
         self._ps.cpu_percent(None)
@@ -73,7 +80,7 @@ class Child:
         log.warning(
             "%s died (%s); restart in %.1f s", self.spec.name, _describe(code), self.backoff_s
         )
-        self.backoff_s = min(self.backoff_s * 2, MAX_BACKOFF_S)
+        self.backoff_s = min(max(self.backoff_s * 2, SECOND_BACKOFF_S), MAX_BACKOFF_S)
         self.state = PluginState.BACKOFF
         return True
 

@@ -17,6 +17,7 @@ from companion.bus import BusNode, MonotonicClock, Reader, cleanup_namespace
 from companion.exec_control.child import FIRST_BACKOFF_S, Child
 from companion.exec_control.config import VehicleConfig
 from companion.exec_control.registry import load
+from companion.exec_control.zygote import READY_TIMEOUT_S, ForkServer, become_subreaper
 from companion.messages import (
     NAME_LEN,
     CommandAck,
@@ -30,6 +31,7 @@ from companion.messages import (
 log = logging.getLogger(__name__)
 
 HEALTH_PERIOD_S = 1.0
+FORKER_BACKOFF_S = 1.0
 REAP_PERIOD_S = 0.1  # how soon a dead plug-in is noticed (restart target: within 1 s)
 STOP_GRACE_S = 1.2  # SIGTERM, then SIGKILL: total shutdown stays under 2 s
 
@@ -47,6 +49,8 @@ class Supervisor:
             "param_decls": decls,
         }
         self.children = [Child(spec, base) for spec in cfg.plugins]
+        self.forker = ForkServer(sorted({spec.kind for spec in cfg.plugins}), log_level)
+        self.next_forker_at = 0.0
         self.flight_running = False
         self.reason = ""  # why the last command was refused, for its ack
         self.stopping = False
@@ -128,7 +132,18 @@ class Supervisor:
             if child is not None and child.pid == msg.pid:
                 child.stats = msg
 
+    def supervise_forker(self) -> None:
+        """Restart a dead fork server (plug-ins are spawned meanwhile, and never lost)."""
+        if self.children[0].forker is None if self.children else True:
+            return  # no sub-reaper here: every plug-in is spawned
+        now = time.monotonic()
+        if self.forker.reap():
+            self.next_forker_at = now + min(FORKER_BACKOFF_S * self.forker.starts, 30.0)
+        if self.forker.proc is None and now >= self.next_forker_at:
+            self.forker.start()
+
     def restart_dead(self) -> None:
+        self.supervise_forker()
         now = time.monotonic()
         for child in self.children:
             child.reap(now)
@@ -147,6 +162,12 @@ class Supervisor:
         self.until = None if duration_s is None else time.monotonic() + duration_s
         signal.signal(signal.SIGTERM, self.request_stop)
         signal.signal(signal.SIGINT, self.request_stop)
+        # A plug-in's death interrupts the wait below, so its restart is not left to a timer.
+        signal.signal(signal.SIGCHLD, lambda *_: None)
+        if become_subreaper():  # forked plug-ins need an adopting parent
+            for child in self.children:
+                child.forker = self.forker
+            self.forker.start()
         cleanup_namespace(self.cfg.namespace)  # leftovers of a crashed earlier run
         bus = BusNode(self.cfg.namespace, "exec_control")
         try:
@@ -154,6 +175,8 @@ class Supervisor:
         finally:
             self.stop_children([c for c in self.children if c.spec.group == "flight"])
             self.stop_children(self.children)
+            self.forker.stop()
+            signal.signal(signal.SIGCHLD, signal.SIG_DFL)
             bus.close()
             cleanup_namespace(self.cfg.namespace)
         log.info("stopped")
@@ -165,6 +188,8 @@ class Supervisor:
         commands = bus.queue_reader("link/commands")
         stats = bus.queue_reader("system/plugin_stats")
         waiter = bus.waiter([commands, stats])
+        if self.forker.proc is not None and not self.forker.wait_ready(READY_TIMEOUT_S):
+            log.warning("fork server not ready: spawning plug-ins until it is")
         self.start_group("core")
         next_health = time.monotonic()
         while not self.stopping:
