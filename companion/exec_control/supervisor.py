@@ -39,7 +39,9 @@ STOP_GRACE_S = 1.2  # SIGTERM, then SIGKILL: total shutdown stays under 2 s
 class Supervisor:
     """Runs one vehicle config until a stop signal."""
 
-    def __init__(self, cfg: VehicleConfig, log_level: str = "INFO") -> None:
+    def __init__(
+        self, cfg: VehicleConfig, log_level: str = "INFO", forker: ForkServer | None = None
+    ) -> None:
         self.cfg = cfg
         decls = [asdict(d) for spec in cfg.plugins for d in spec.params]
         base = {
@@ -49,7 +51,8 @@ class Supervisor:
             "param_decls": decls,
         }
         self.children = [Child(spec, base) for spec in cfg.plugins]
-        self.forker = ForkServer(sorted({spec.kind for spec in cfg.plugins}), log_level)
+        # A fork server started early (while the simulator loads) may be handed in.
+        self.forker = forker or ForkServer(sorted({s.kind for s in cfg.plugins}), log_level)
         self.next_forker_at = 0.0
         self.flight_running = False
         self.reason = ""  # why the last command was refused, for its ack
@@ -167,7 +170,8 @@ class Supervisor:
         if become_subreaper():  # forked plug-ins need an adopting parent
             for child in self.children:
                 child.forker = self.forker
-            self.forker.start()
+            if self.forker.proc is None:
+                self.forker.start()
         cleanup_namespace(self.cfg.namespace)  # leftovers of a crashed earlier run
         bus = BusNode(self.cfg.namespace, "exec_control")
         try:

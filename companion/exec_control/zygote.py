@@ -36,7 +36,7 @@ log = logging.getLogger(__name__)
 PRELOAD = (
     "numpy",
     "iceoryx2",
-    "pymavlink.mavutil",
+    "mavlink_dialect.companion",
     "companion.bus",
     "companion.messages",
     "companion.exec_control.plugin_host",

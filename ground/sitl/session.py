@@ -30,6 +30,7 @@ from companion.control.modes import BY_MODE
 from companion.exec_control.config import VehicleConfig, load_config
 from companion.exec_control.plugin_host import die_with_parent
 from companion.exec_control.supervisor import Supervisor
+from companion.exec_control.zygote import ForkServer
 from companion.messages import FlightMode, PluginState
 from ground.sitl.bridge.options import BridgeOptions
 
@@ -239,6 +240,16 @@ def nav_grid_hz(config: Path) -> float:
     return 0.0
 
 
+def plugin_kinds(config: Path) -> list[str]:
+    """The plug-in kinds a config names (for the fork server to import ahead)."""
+    try:
+        with config.open("rb") as f:
+            plugins = tomllib.load(f).get("plugins", [])
+    except (OSError, tomllib.TOMLDecodeError):
+        return []  # load_config reports it properly
+    return sorted({p["plugin"] for p in plugins if isinstance(p, dict) and "plugin" in p})
+
+
 def run_sim(req: SimRequest, opts: BridgeOptions, log_level: str = "INFO") -> int:
     """Start the bridge, then the vehicle on its ptys; return when both have stopped."""
     # Lockstep, fast or exact, keeps in step with the navigator's grid (fast: a period
@@ -247,16 +258,24 @@ def run_sim(req: SimRequest, opts: BridgeOptions, log_level: str = "INFO") -> in
     if opts.exact and not sync_hz:
         log.warning("--exact: only lockstep (--speed max) with nav.ins_ekf can follow control")
     opts = dataclasses.replace(opts, hold=True, sync_hz=sync_hz)
-    bridge = BridgeProcess(opts)
+    # The fork server imports the vehicle's libraries while JSBSim loads its model.
+    forker = ForkServer(plugin_kinds(req.config), log_level)
+    forker.start()
+    try:
+        bridge = BridgeProcess(opts)
+    except BaseException:
+        forker.stop()
+        raise
     try:
         cfg = vehicle_config(req, opts, bridge.devices)
-        supervisor = Supervisor(cfg, log_level)
+        supervisor = Supervisor(cfg, log_level, forker)
         monitor = Monitor(cfg, bridge, lambda: supervisor.request_stop(signal.SIGTERM, None))
         monitor.start()
         code = supervisor.run()
         monitor.finished.set()
         monitor.join(5.0)
     finally:
+        forker.stop()  # when the config was refused, the supervisor never ran
         bridge.stop()
         cleanup_namespace(opts.namespace)  # what a killed bridge may have left
     return code
