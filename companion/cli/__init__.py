@@ -8,10 +8,17 @@ nothing on board imports: they are found through the ``companion.commands`` entr
 
 from __future__ import annotations
 
-import importlib
-from importlib.metadata import entry_points
+import os
 
-from companion.cli.app import app
+# The vehicle's matrices are tiny: one BLAS thread (set before numpy loads), and so no
+# thread in the supervisor when it forks its fork server.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import importlib  # noqa: E402
+from importlib.metadata import entry_points  # noqa: E402
+
+from companion.cli.app import app  # noqa: E402
 
 __all__ = ["app", "main"]
 

@@ -12,9 +12,13 @@ the middle exits at once, the kernel hands the plug-in to the supervisor (a chil
 sub-reaper): the supervisor is its parent as before, reaps it, sees its exit status and is
 told by SIGCHLD when it dies; a dead fork server takes no plug-in with it.
 
-Protocol: the supervisor writes one JSON spec per line on the fork server's stdin; the
-fork server answers the new plug-in's pid on its reply pipe (``ready`` first, once its
-imports are done). End of input: the fork server exits.
+The first fork server is forked from the supervisor itself, before it has a thread or a
+bus node, so that what the supervisor imported is shared too; one started later (after
+the first died) is a fresh interpreter.
+
+Protocol: the supervisor writes one JSON spec per line on the request pipe; the fork
+server answers the new plug-in's pid on the reply pipe (``ready`` first, once its imports
+are done). End of input: the fork server exits.
 """
 
 from __future__ import annotations
@@ -109,27 +113,40 @@ class ForkServer:
 
     def __init__(self, kinds: list[str], log_level: str) -> None:
         self.kinds, self.log_level = kinds, log_level
-        self.proc: subprocess.Popen[bytes] | None = None
+        self.proc: subprocess.Popen[bytes] | ForkedProcess | None = None
         self._replies: IO[bytes] | None = None
+        self._requests: IO[bytes] | None = None
         self.ready = False
         self.starts = 0
 
     def start(self) -> None:
         """Start the fork server (it imports in the background; see ``wait_ready``)."""
         read_fd, write_fd = os.pipe()
-        arg = json.dumps({"kinds": self.kinds, "reply_fd": write_fd, "log_level": self.log_level})
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "companion.exec_control.zygote", arg],
-            stdin=subprocess.PIPE,
-            pass_fds=(write_fd,),
-            env={**os.environ, **CHILD_ENV},
-            start_new_session=True,
-        )
+        request_fd, feed_fd = os.pipe()
+        if self.starts == 0 and _threads() == 1:
+            pid = os.fork()
+            if pid == 0:
+                os.close(read_fd)
+                os.close(feed_fd)
+                _forked_server(self.kinds, request_fd, write_fd)
+            self.proc, how = ForkedProcess(pid), "forked"
+        else:
+            fds = {"request_fd": request_fd, "reply_fd": write_fd}
+            arg = json.dumps({"kinds": self.kinds, "log_level": self.log_level, **fds})
+            self.proc = subprocess.Popen(
+                [sys.executable, "-m", "companion.exec_control.zygote", arg],
+                stdin=subprocess.DEVNULL,
+                pass_fds=(request_fd, write_fd),
+                env={**os.environ, **CHILD_ENV},
+                start_new_session=True,
+            )
+            how = "spawned"
         os.close(write_fd)
-        self._replies = os.fdopen(read_fd, "rb")
+        os.close(request_fd)
+        self._replies, self._requests = os.fdopen(read_fd, "rb"), os.fdopen(feed_fd, "wb")
         self.ready = False
         self.starts += 1
-        log.info("fork server started, pid %d", self.proc.pid)
+        log.info("fork server %s, pid %d", how, self.proc.pid)
 
     def alive(self) -> bool:
         return self.proc is not None and self.proc.poll() is None
@@ -144,10 +161,10 @@ class ForkServer:
         """A forked plug-in process, or None if the fork server cannot give one now."""
         if not self.alive() or not self.wait_ready(0.0):
             return None
-        assert self.proc is not None and self.proc.stdin is not None
+        assert self._requests is not None
         try:
-            self.proc.stdin.write(spec_json.encode() + b"\n")
-            self.proc.stdin.flush()
+            self._requests.write(spec_json.encode() + b"\n")
+            self._requests.flush()
             pid = int(self._read_line(REPLY_TIMEOUT_S) or b"0")
         except (OSError, ValueError):
             pid = 0
@@ -175,8 +192,8 @@ class ForkServer:
         if self.proc is None:
             return
         try:
-            if self.proc.stdin is not None:
-                self.proc.stdin.close()
+            if self._requests is not None:
+                self._requests.close()
             self.proc.wait(1.0)
         except (OSError, subprocess.TimeoutExpired):
             self.proc.kill()
@@ -184,9 +201,13 @@ class ForkServer:
         self._forget()
 
     def _forget(self) -> None:
-        if self._replies is not None:
-            self._replies.close()
-        self.proc, self._replies, self.ready = None, None, False
+        for pipe in (self._replies, self._requests):
+            if pipe is not None:
+                try:
+                    pipe.close()
+                except OSError:
+                    pass  # a request half-written to a dead fork server
+        self.proc, self._replies, self._requests, self.ready = None, None, None, False
 
 
 # --- the fork server process ---------------------------------------------------------
@@ -247,7 +268,7 @@ def _run_child(spec_json: str, middle: int, supervisor: int, fds: tuple[int, ...
         os._exit(code)
 
 
-def _fork_plugin(spec_json: str, supervisor: int, reply_fd: int) -> int:
+def _fork_plugin(spec_json: str, supervisor: int, fds: tuple[int, int]) -> int:
     """Fork a plug-in process (through a middle one that exits); its pid."""
     read_fd, write_fd = os.pipe()
     middle = os.fork()
@@ -255,7 +276,7 @@ def _fork_plugin(spec_json: str, supervisor: int, reply_fd: int) -> int:
         try:
             pid = os.fork()
             if pid == 0:
-                _run_child(spec_json, os.getppid(), supervisor, (read_fd, write_fd, reply_fd))
+                _run_child(spec_json, os.getppid(), supervisor, (read_fd, write_fd, *fds))
             os.write(write_fd, f"{pid}\n".encode())
         finally:
             os._exit(0)
@@ -266,19 +287,38 @@ def _fork_plugin(spec_json: str, supervisor: int, reply_fd: int) -> int:
     return int(text or b"0")
 
 
-def serve(kinds: list[str], reply_fd: int) -> int:
+def serve(kinds: list[str], request_fd: int, reply_fd: int) -> int:
     """Preload, say ``ready``, then fork one plug-in per spec line until end of input."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the supervisor decides when this ends
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGCHLD, signal.SIG_DFL)
     supervisor = os.getppid()
     _preload(kinds)
     if _threads() > 1:  # a thread in a forked child would be a copy without its owner
         log.warning("fork server has %d threads before forking", _threads())
     os.write(reply_fd, b"ready\n")
-    for line in sys.stdin.buffer:
-        spec_json = line.decode().strip()
-        if spec_json:
-            os.write(reply_fd, f"{_fork_plugin(spec_json, supervisor, reply_fd)}\n".encode())
+    fds = (request_fd, reply_fd)
+    with os.fdopen(request_fd, "rb") as requests:
+        for line in requests:
+            if spec_json := line.decode().strip():
+                os.write(reply_fd, f"{_fork_plugin(spec_json, supervisor, fds)}\n".encode())
     return 0
+
+
+def _forked_server(kinds: list[str], request_fd: int, reply_fd: int) -> None:
+    """The fork server forked from the supervisor: serve, then leave without unwinding."""
+    code = 1
+    try:
+        os.setsid()
+        from companion.exec_control.plugin_host import die_with_parent
+
+        die_with_parent()
+        code = serve(kinds, request_fd, reply_fd)
+    except BaseException:
+        log.exception("fork server failed")
+    finally:
+        logging.shutdown()
+        os._exit(code)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -290,7 +330,7 @@ def main(argv: list[str] | None = None) -> int:
     from companion.exec_control.plugin_host import die_with_parent
 
     die_with_parent()
-    return serve(args["kinds"], args["reply_fd"])
+    return serve(args["kinds"], args["request_fd"], args["reply_fd"])
 
 
 if __name__ == "__main__":
