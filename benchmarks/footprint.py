@@ -144,7 +144,7 @@ class Vehicle:
         names = self.names()
         out: dict[str, int] = {}
         for pid in vehicle_pids(self.proc.pid):
-            label = names.get(pid) or _guess(pid)
+            label = names.get(pid) or _guess(pid, self.proc.pid)
             out[label if label not in out else f"{label}.{pid}"] = pid
         return out
 
@@ -235,12 +235,14 @@ class Vehicle:
         cleanup_namespace(self.namespace)
 
 
-def _guess(pid: int) -> str:
+def _guess(pid: int, supervisor: int) -> str:
+    """Not in the health table: the fork server (spawned, or forked from the supervisor)."""
     try:
-        cmd = " ".join(psutil.Process(pid).cmdline())
+        proc = psutil.Process(pid)
+        cmd, parent = " ".join(proc.cmdline()), proc.ppid()
     except psutil.Error:
         return f"pid {pid}"
-    return "fork server" if "zygote" in cmd else f"other {pid}"
+    return "fork server" if "zygote" in cmd or parent == supervisor else f"other {pid}"
 
 
 def fly_once(cpu_seconds: float) -> dict[str, object]:

@@ -141,6 +141,8 @@ class Monitor(threading.Thread):
         self.tty = sys.stderr.isatty()
 
     def run(self) -> None:
+        # A plug-in's death must interrupt the supervisor's wait in the main thread.
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGCHLD})
         bus = BusNode(self.cfg.namespace, "sim_monitor")
         try:
             self._hold_until_ready(bus)
