@@ -63,3 +63,34 @@ def test_a_plugin_that_raises_is_restarted_with_back_off(vehicle_factory):
     vehicle = vehicle_factory(vehicle_config("crashy", plugin("crash", CRASH_AFTER, steps=3)))
     wait_for(lambda: (r := vehicle.row("crash")) and r.restarts >= 3, 15, "three restarts")
     assert vehicle.proc.poll() is None, "the supervisor must survive its plug-ins"
+
+
+def fork_server_pid(vehicle) -> int:
+    """The supervisor's child that is no plug-in of the health table."""
+    import psutil
+
+    plugins = {r.pid for r in vehicle.health().rows()}
+    kids = [c.pid for c in psutil.Process(vehicle.proc.pid).children()]
+    return next((pid for pid in kids if pid not in plugins), 0)
+
+
+def test_plugins_outlive_their_fork_server_and_are_still_restarted(vehicle_factory):
+    vehicle = vehicle_factory(pipeline())
+    vehicle.nav = vehicle.bus.latest_reader("nav/state")
+    pids = {name: vehicle.wait_running(name) for name in ("imu", "relay", "idle")}
+    forker = wait_for(lambda: fork_server_pid(vehicle), 10, "the fork server")
+
+    os.kill(forker, signal.SIGKILL)
+    wait_for(lambda: fork_server_pid(vehicle) not in (0, forker), 20, "a new fork server")
+    for name, pid in pids.items():
+        assert vehicle.row(name).pid == pid, f"{name} was taken along by its fork server"
+
+    os.kill(pids["relay"], signal.SIGKILL)
+    wait_for(
+        lambda: (r := vehicle.row("relay")) and r.pid not in (0, pids["relay"]),
+        10,
+        "the relay restarted",
+    )
+    before = newest_nav_t(vehicle)
+    wait_for(lambda: newest_nav_t(vehicle) > before, 10, "data flowing after the restart")
+    assert vehicle.proc.poll() is None
