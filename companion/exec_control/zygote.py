@@ -125,6 +125,10 @@ class ForkServer:
         read_fd, write_fd = os.pipe()
         request_fd, feed_fd = os.pipe()
         if self.starts == 0 and _threads() == 1:
+            # The supervisor's collector must not walk (and so copy) the pages it now
+            # shares with the fork server and every plug-in.
+            gc.collect()
+            gc.freeze()
             pid = os.fork()
             if pid == 0:
                 os.close(read_fd)
