@@ -3,8 +3,11 @@
 Pure: commands and navigation in, decisions and a ``VehicleStatus`` out. The
 ``vehicle.commander`` plug-in wraps it; the link reports what it decides.
 Rules (as PX4 and ArduPilot have them): MISSION needs a stored mission; RTL needs a home;
-GUIDED and LOITER need a position (or a given point); home is the first valid position,
-and is set again at arming.
+GUIDED and LOITER need a position (or a given point); LAND is refused (no automatic
+landing yet); home is the first valid position, and is set again at arming.
+A reposition without a point (QGroundControl's Pause and Change altitude, PX4's
+DO_REPOSITION with NaN latitude/longitude) keeps the point being flown to, or circles here,
+at the altitude given (or the present one).
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from companion.control.mission.items import MAX_ALT_M
+from companion.control.modes import INITIAL_MODE
 from companion.messages import (
     CommandId,
     CommandResult,
@@ -24,7 +28,7 @@ from companion.messages import (
     VehicleStatus,
 )
 
-INITIAL_MODE = FlightMode.LOITER  # PX4's "Hold": a fixed wing without a pilot circles
+MAX_RADIUS_M = 10_000.0  # an orbit wider than this is a mistake, not a plan
 
 
 @dataclass(frozen=True)
@@ -44,8 +48,11 @@ MODE_COMMANDS = frozenset(
         CommandId.REPOSITION,
         CommandId.LOITER,
         CommandId.SET_HOME,
+        CommandId.TAKEOFF,
+        CommandId.ORBIT,
     }
 )
+NO_POINT = (math.nan, math.nan, math.nan)
 
 
 class Commander:
@@ -56,7 +63,8 @@ class Commander:
         self.mode = INITIAL_MODE
         self.armed = False
         self.home: tuple[float, float, float] | None = None
-        self.target = (math.nan, math.nan, math.nan)
+        self.target = NO_POINT
+        self.radius = math.nan
         self.mission_first = 0
         self.changes = 0
         self.position: tuple[float, float, float] | None = None
@@ -92,20 +100,49 @@ class Commander:
             return decision
         if kind == CommandId.RETURN_TO_LAUNCH:
             return self._enter(FlightMode.RTL)
-        if kind in (CommandId.REPOSITION, CommandId.LOITER):
-            if not _usable_point(p[0], p[1], p[2]):
-                return Decision(CommandResult.DENIED, "Go to: position out of range")
-            mode = FlightMode.GUIDED if kind == CommandId.REPOSITION else FlightMode.LOITER
-            return self._enter(mode, (p[0], p[1], p[2]))
+        if kind in (CommandId.REPOSITION, CommandId.LOITER, CommandId.ORBIT):
+            return self._go_to(kind, p)
+        if kind == CommandId.TAKEOFF:
+            return self._takeoff(p[2])
         if kind == CommandId.SET_HOME:
             return self._set_home(p)
         return None
+
+    def _go_to(self, kind: CommandId, p: list[float]) -> Decision:
+        if not _usable_point(p[0], p[1], p[2]):
+            return Decision(CommandResult.DENIED, "Go to: position out of range")
+        radius = p[3] if kind == CommandId.ORBIT else math.nan
+        if not (math.isnan(radius) or 0 < abs(radius) <= MAX_RADIUS_M):
+            return Decision(CommandResult.DENIED, "Orbit: radius out of range")
+        if kind == CommandId.REPOSITION and math.isnan(p[0]) and math.isnan(p[1]):
+            return self._pause(p[2])
+        mode = FlightMode.GUIDED if kind == CommandId.REPOSITION else FlightMode.LOITER
+        return self._enter(mode, (p[0], p[1], p[2]), abs(radius))
+
+    def _pause(self, alt: float) -> Decision:
+        """Keep flying to (or circling) the present point, else circle here; new height."""
+        if self.mode in (FlightMode.GUIDED, FlightMode.LOITER) and math.isfinite(self.target[0]):
+            lat, lon, old_alt = self.target
+            return self._enter(self.mode, (lat, lon, alt if math.isfinite(alt) else old_alt))
+        return self._enter(FlightMode.LOITER, (math.nan, math.nan, alt), self.radius)
+
+    def _takeoff(self, alt: float) -> Decision:
+        if not math.isnan(alt) and not (math.isfinite(alt) and abs(alt) <= MAX_ALT_M):
+            return Decision(CommandResult.DENIED, "Takeoff: altitude out of range")
+        decision = self._enter(FlightMode.TAKEOFF)
+        if decision.result == CommandResult.ACCEPTED:
+            self.target = (math.nan, math.nan, alt)
+        return decision
 
     def failsafe(self, mode: FlightMode) -> Decision:
         """A failsafe's mode change (Return, or Loiter where the aircraft is)."""
         return self._enter(mode)
 
-    def _enter(self, mode: FlightMode, point: tuple[float, ...] | None = None) -> Decision:
+    def _enter(
+        self, mode: FlightMode, point: tuple[float, ...] | None = None, radius: float = math.nan
+    ) -> Decision:
+        if mode == FlightMode.LAND:
+            return Decision(CommandResult.DENIED, "Land: no automatic landing on this vehicle")
         if mode == FlightMode.MISSION and self.mission_count() == 0:
             return Decision(CommandResult.DENIED, "Mission: no mission stored")
         if mode == FlightMode.RTL and self.home is None:
@@ -115,11 +152,12 @@ class Commander:
             if target is None:
                 name = "Go to" if mode == FlightMode.GUIDED else "Loiter"
                 return Decision(CommandResult.DENIED, f"{name}: no position yet")
-            self.target = target
+            self.target, self.radius = target, radius
         else:
-            self.target = (math.nan, math.nan, math.nan)
-        if mode != self.mode:
-            self.changes += 1
+            self.target, self.radius = NO_POINT, math.nan
+        # Every accepted command counts, not only a change of mode: a second go-to in
+        # Guided is a new target the controller must turn to.
+        self.changes += 1
         self.mode = mode
         return ACCEPTED
 
@@ -128,6 +166,8 @@ class Commander:
         if point is not None and math.isfinite(point[0]) and math.isfinite(point[1]):
             alt = point[2] if math.isfinite(point[2]) else (here[2] if here else math.nan)
             return (point[0], point[1], alt)
+        if here is not None and point is not None and math.isfinite(point[2]):
+            return (here[0], here[1], point[2])  # here, at the height asked for
         return here
 
     def _set_home(self, p: list[float]) -> Decision:
@@ -147,6 +187,7 @@ class Commander:
         msg.home_valid = int(self.home is not None)
         msg.home_lat_deg, msg.home_lon_deg, msg.home_alt_msl_m = self.home or (math.nan,) * 3
         msg.target_lat_deg, msg.target_lon_deg, msg.target_alt_msl_m = self.target
+        msg.target_radius_m = self.radius
         msg.mission_first, msg.changes = self.mission_first, self.changes
         return msg
 

@@ -1,14 +1,27 @@
 """Flight modes as the ground tools name and number them.
 
-One table says, for each ``FlightMode``: its name (AVAILABLE_MODES), PX4's custom_mode
-(main mode in bits 16-23, sub mode in bits 24-31: what MAVSDK decodes for every autopilot
-but ArduPilot, and what QGroundControl's PX4 plug-in shows), ArduPlane's mode number (what
-pymavlink and MAVProxy send for a fixed-wing that is not PX4), and MAVLink's standard mode.
+One table says, for each ``FlightMode``: its name (AVAILABLE_MODES), its custom_mode in
+PX4's packing (main mode in bits 16-23, sub mode in bits 24-31), ArduPlane's mode number
+(what pymavlink and MAVProxy send for a fixed-wing that is not PX4), and MAVLink's
+standard mode. The vehicle reports itself as PX4 because QGroundControl's PX4 plug-in is
+the one that offers every guided action for a fixed wing (Takeoff, Start/Continue Mission,
+Pause, Return, Go to, Change altitude, Orbit; src/FirmwarePlugin/PX4/PX4FirmwarePlugin.cc,
+isCapable); its ArduPilot plug-in offers no take-off for a plane and its generic one no
+guided action at all. Every mode has a custom_mode of its own: the PX4 ones QGroundControl
+(both 4.4 and 5), MAVSDK and MAVProxy already name (Loiter is PX4's "Hold", MAVProxy's
+LOITER), and Guided, which PX4 has no built-in mode for, is PX4's first *external* mode
+(AUTO, sub mode 11): the slot PX4 gives a mode that a companion computer adds, named by
+AVAILABLE_MODES (QGroundControl 5 shows "Guided"; a 4.4 release build does not read
+AVAILABLE_MODES and shows it as "Unknown").
+
+Standard modes: only the ones that mean what we fly (Mission, Return = SAFE_RECOVERY,
+Take-off, Land); our Loiter is automatic, not MAVLink's pilot-driven ORBIT or
+POSITION_HOLD (which QGroundControl 5 would also rename "Orbit" or "Position").
 
 ``decode_set_mode`` reads DO_SET_MODE / SET_MODE in either encoding:
 1. a full 32-bit PX4 custom_mode (≥ 65536) → PX4;
 2. a sub mode (param3) → PX4 main/sub (MAVSDK, pymavlink for PX4);
-3. reporting PX4, a main mode alone → PX4;
+3. reporting PX4, a main mode alone → PX4 (ArduPlane's number if PX4 has no such mode);
 4. otherwise ArduPlane's numbers (MAVProxy's ``mode AUTO``: 10), except 1 and 7, which are
    PX4's MANUAL and STABILIZED as MAVSDK sends them (ArduPlane's CIRCLE and CRUISE, which
    we do not fly, lose out);
@@ -23,7 +36,13 @@ from companion.messages import FlightMode
 from mavlink_dialect import companion as d
 
 PX4_MAIN_MANUAL, PX4_MAIN_AUTO, PX4_MAIN_STABILIZED = 1, 4, 7
-PX4_SUB_TAKEOFF, PX4_SUB_LOITER, PX4_SUB_MISSION, PX4_SUB_RTL = 2, 3, 4, 5
+PX4_SUB_TAKEOFF, PX4_SUB_LOITER, PX4_SUB_MISSION, PX4_SUB_RTL, PX4_SUB_LAND = 2, 3, 4, 5, 6
+PX4_SUB_EXTERNAL1 = 11  # PX4's first mode added from outside (a companion computer)
+
+
+# The mode the commander starts in (PX4's "Hold": a fixed wing without a pilot circles);
+# the link names it from the first heartbeat, before the commander has spoken.
+INITIAL_MODE = FlightMode.LOITER
 
 
 def px4_custom_mode(main: int, sub: int = 0) -> int:
@@ -46,28 +65,31 @@ class ModeInfo:
 
 _AUTO = d.MAV_MODE_FLAG_AUTO_ENABLED | d.MAV_MODE_FLAG_GUIDED_ENABLED
 _STAB = d.MAV_MODE_FLAG_STABILIZE_ENABLED
+_NONE = d.MAV_STANDARD_MODE_NON_STANDARD
 MODES: tuple[ModeInfo, ...] = (
     ModeInfo(FlightMode.MANUAL, "Manual", px4_custom_mode(PX4_MAIN_MANUAL), 0,
-             d.MAV_STANDARD_MODE_NON_STANDARD, d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED),
+             _NONE, d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED),
     ModeInfo(FlightMode.STABILIZED, "Stabilized", px4_custom_mode(PX4_MAIN_STABILIZED), 5,
-             d.MAV_STANDARD_MODE_NON_STANDARD, _STAB | d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED),
+             _NONE, _STAB | d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED),
     ModeInfo(FlightMode.MISSION, "Mission", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_MISSION), 10,
              d.MAV_STANDARD_MODE_MISSION, _STAB | _AUTO),
     ModeInfo(FlightMode.LOITER, "Loiter", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_LOITER), 12,
-             d.MAV_STANDARD_MODE_POSITION_HOLD, _STAB | _AUTO),
+             _NONE, _STAB | _AUTO),
     ModeInfo(FlightMode.RTL, "Return", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_RTL), 11,
              d.MAV_STANDARD_MODE_SAFE_RECOVERY, _STAB | _AUTO),
-    # PX4 flies "go to" in Hold: MAVSDK and QGroundControl's PX4 plug-in show it as Hold.
-    ModeInfo(FlightMode.GUIDED, "Guided", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_LOITER), 15,
-             d.MAV_STANDARD_MODE_NON_STANDARD, _STAB | d.MAV_MODE_FLAG_GUIDED_ENABLED),
+    ModeInfo(FlightMode.GUIDED, "Guided", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_EXTERNAL1), 15,
+             _NONE, _STAB | d.MAV_MODE_FLAG_GUIDED_ENABLED),
     ModeInfo(FlightMode.TAKEOFF, "Takeoff", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_TAKEOFF), 13,
              d.MAV_STANDARD_MODE_TAKEOFF, _STAB | _AUTO),
+    # Listed so every tool can name it, but not offered (no automatic landing yet).
+    ModeInfo(FlightMode.LAND, "Land", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_LAND), 26,
+             d.MAV_STANDARD_MODE_LAND, _STAB | _AUTO, user_selectable=False),
 )  # fmt: skip
 BY_MODE = {m.mode: m for m in MODES}
 _ARDUPLANE = {m.arduplane: m.mode for m in MODES} | {1: FlightMode.LOITER, 2: FlightMode.STABILIZED}
-_PX4 = {m.px4: m.mode for m in MODES if m.mode != FlightMode.GUIDED}
+_PX4 = {m.px4: m.mode for m in MODES}
 _STANDARD = {m.standard: m.mode for m in MODES if m.standard != d.MAV_STANDARD_MODE_NON_STANDARD}
-_STANDARD[d.MAV_STANDARD_MODE_ORBIT] = FlightMode.LOITER
+_STANDARD[d.MAV_STANDARD_MODE_ORBIT] = FlightMode.LOITER  # the nearest we fly
 
 
 def from_px4(main: int, sub: int) -> FlightMode | None:
@@ -86,7 +108,9 @@ def decode_set_mode(
     if custom >= 1 << 16:
         return from_px4((custom >> 16) & 0xFF, (custom >> 24) & 0xFF)
     if sub or reporting_px4 or custom in (PX4_MAIN_MANUAL, PX4_MAIN_STABILIZED):
-        return from_px4(custom, sub)
+        mode = from_px4(custom, sub)
+        if mode is not None or sub:
+            return mode
     return _ARDUPLANE.get(custom)
 
 

@@ -104,6 +104,13 @@ RULES: dict[int, tuple[Param, ...]] = {
     ),
     d.MAV_CMD_NAV_LOITER_UNLIM: (Param(3, "radius", -1e5, 1e5, optional=True), _yaw(4), *POINT),
     d.MAV_CMD_DO_SET_HOME: (Param(1, "use current", 0, 1, optional=True, whole=True), *POINT),
+    d.MAV_CMD_NAV_TAKEOFF: (Param(1, "pitch", -90, 90, optional=True), _yaw(4), *POINT),
+    d.MAV_CMD_DO_ORBIT: (
+        Param(1, "radius", -1e4, 1e4, optional=True),
+        Param(2, "velocity", -1e3, 1e3, optional=True),
+        Param(4, "orbits", 0, 1e6, optional=True),
+        *POINT,
+    ),
 }
 
 
@@ -121,7 +128,13 @@ EXTRA_CHECKS: dict[int, Callable[[CommandArgs], str | None]] = {
 
 
 POSITION_COMMANDS = frozenset(
-    {d.MAV_CMD_DO_REPOSITION, d.MAV_CMD_NAV_LOITER_UNLIM, d.MAV_CMD_DO_SET_HOME}
+    {
+        d.MAV_CMD_DO_REPOSITION,
+        d.MAV_CMD_NAV_LOITER_UNLIM,
+        d.MAV_CMD_DO_SET_HOME,
+        d.MAV_CMD_NAV_TAKEOFF,
+        d.MAV_CMD_DO_ORBIT,
+    }
 )
 
 

@@ -9,6 +9,7 @@ retransmission (confirmation > 0) is never executed twice.
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -20,6 +21,9 @@ log = logging.getLogger(__name__)
 
 RETRY_MEMORY_S = 10.0  # how long a finished command's result is kept for retransmissions
 SET_MODE_MESSAGE = 11  # the SET_MODE message's id, used as its command number
+
+
+INT32_MAX = 2**31 - 1
 
 
 @dataclass(frozen=True)
@@ -82,8 +86,8 @@ class CommandService:
                 msg.param2,
                 msg.param3,
                 msg.param4,
-                msg.x / 1e7,
-                msg.y / 1e7,
+                _degrees(msg.x),
+                _degrees(msg.y),
                 msg.z,
             )
             return CommandArgs(msg.command, params, 0, peer, True, msg.frame)
@@ -180,3 +184,8 @@ def command_name(command: int) -> str:
         return "SET_MODE"
     entry = d.enums["MAV_CMD"].get(command)
     return entry.name.removeprefix("MAV_CMD_") if entry is not None else f"command {command}"
+
+
+def _degrees(e7: int) -> float:
+    """COMMAND_INT's x/y in degrees; INT32_MAX is the spec's "not given" (NaN here)."""
+    return math.nan if e7 == INT32_MAX else e7 / 1e7

@@ -2,14 +2,15 @@
 
 CURRENT_MODE is streamed and sent on every change; AVAILABLE_MODES is sent on request, all
 of them (param2 = 0) or one by its 1-based index, as QGroundControl asks; the monitor's
-sequence number never changes because the set of modes never does.
+sequence number never changes because the set of modes never does. Until the commander
+has spoken, the mode reported is the one it starts in, so no tool ever reads "Unknown".
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from companion.control.modes import BY_MODE, MODES, ModeInfo
+from companion.control.modes import BY_MODE, INITIAL_MODE, MODES, ModeInfo
 from companion.messages import FlightMode, VehicleStatus
 from mavlink_dialect import companion as d
 
@@ -17,8 +18,8 @@ MODES_SEQ = 1
 
 
 def _info(status: VehicleStatus | None) -> ModeInfo | None:
-    if status is None:
-        return None
+    if status is None:  # the commander has not spoken yet: it starts in INITIAL_MODE
+        return BY_MODE[INITIAL_MODE]
     try:
         return BY_MODE[FlightMode(status.mode)]
     except ValueError:
@@ -32,7 +33,7 @@ def heartbeat_mode(status: VehicleStatus | None) -> tuple[int, int]:
 
 
 def current_mode(mav: Any, status: VehicleStatus | None) -> Any:
-    """CURRENT_MODE, or None before the commander has spoken."""
+    """CURRENT_MODE (the initial mode before the commander has spoken)."""
     info = _info(status)
     return None if info is None else mav.current_mode_encode(info.standard, info.px4, info.px4)
 

@@ -25,6 +25,8 @@ class CommandId(enum.IntEnum):
     LOITER = 8  # param1..3 = lat_deg, lon_deg, alt_msl_m (NaN: where it is)
     SET_HOME = 9  # param1 = 1: here; else param5..7 = lat_deg, lon_deg, alt_msl_m
     INJECT_FAILURE = 10  # param1..3 = MAVLink FAILURE_UNIT, FAILURE_TYPE, instance (simulator)
+    TAKEOFF = 11  # param3 = alt_msl_m to climb to (NaN: the default height)
+    ORBIT = 12  # param1..4 = lat_deg, lon_deg, alt_msl_m, radius_m (NaN: here / default)
 
 
 class CommandResult(enum.IntEnum):
@@ -74,7 +76,8 @@ class FlightMode(enum.IntEnum):
     LOITER = 4  # circle where it is
     RTL = 5  # fly home and circle there
     GUIDED = 6  # fly to a commanded point and circle there
-    TAKEOFF = 7
+    TAKEOFF = 7  # climb out from the runway and circle at the take-off height
+    LAND = 8  # named and numbered for the ground tools; refused until landing exists
 
 
 class VehicleStatus(Message):
@@ -91,8 +94,9 @@ class VehicleStatus(Message):
         ("target_lat_deg", ctypes.c_double),  # GUIDED: where to go (NaN otherwise)
         ("target_lon_deg", ctypes.c_double),
         ("target_alt_msl_m", ctypes.c_double),
+        ("target_radius_m", ctypes.c_double),  # LOITER/ORBIT circle radius (NaN: default)
         ("mission_first", ctypes.c_int32),  # MISSION: the item to start from
-        ("changes", ctypes.c_uint32),  # mode changes since start
+        ("changes", ctypes.c_uint32),  # accepted mode commands since start (new target too)
     ]
 
 

@@ -235,13 +235,18 @@ class FlightController:
         assert self.frame is not None
         radius = self.config["WP_LOITER_RAD"]
         alt = nav.alt_msl_m
-        if mode == FlightMode.TAKEOFF:
-            return Setpoint(Kind.TAKEOFF, pos, pos, self.home_alt + self.config["RTL_ALT_M"])
+        if mode == FlightMode.TAKEOFF:  # to the height asked for, else the return height
+            climb_to = status.target_alt_msl_m
+            if not math.isfinite(climb_to):
+                climb_to = self.home_alt + self.config["RTL_ALT_M"]
+            return Setpoint(Kind.TAKEOFF, pos, pos, climb_to)
         if mode == FlightMode.RTL:
             rtl_alt = self.home_alt + self.config["RTL_ALT_M"]
             return Setpoint(Kind.LINE, pos, (0.0, 0.0), rtl_alt, radius)
         target = (status.target_lat_deg, status.target_lon_deg, status.target_alt_msl_m)
         has_target = math.isfinite(target[0]) and math.isfinite(target[1])
+        if math.isfinite(status.target_radius_m) and status.target_radius_m > 0:
+            radius = status.target_radius_m  # an orbit's own radius
         if mode in (FlightMode.GUIDED, FlightMode.LOITER) and has_target:
             point = self.frame.ne(target[0], target[1])
             alt = target[2] if math.isfinite(target[2]) else alt  # NaN: hold the height

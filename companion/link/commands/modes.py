@@ -18,12 +18,11 @@ RELATIVE_FRAMES = frozenset(
         d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
     }
 )
-NO_POINT = (math.nan, math.nan, math.nan)
 
 
 class ModeCommands:
     """DO_SET_MODE, DO_SET_STANDARD_MODE, SET_MODE, MISSION_START, RTL, DO_REPOSITION,
-    NAV_LOITER_UNLIM and DO_SET_HOME."""
+    NAV_LOITER_UNLIM, DO_ORBIT, NAV_TAKEOFF and DO_SET_HOME."""
 
     def __init__(self, port: VehiclePort, autopilot: int) -> None:
         self.port = port
@@ -38,6 +37,8 @@ class ModeCommands:
         service.register(d.MAV_CMD_DO_REPOSITION, self.reposition)
         service.register(d.MAV_CMD_NAV_LOITER_UNLIM, self.loiter)
         service.register(d.MAV_CMD_DO_SET_HOME, self.set_home)
+        service.register(d.MAV_CMD_DO_ORBIT, self.orbit)
+        service.register(d.MAV_CMD_NAV_TAKEOFF, self.takeoff)
 
     def to_commander(self, command: CommandId, params: tuple[float, ...] = ()) -> Outcome:
         if not self.port.has_commander():
@@ -71,14 +72,22 @@ class ModeCommands:
         return self.to_commander(CommandId.RETURN_TO_LAUNCH)
 
     def reposition(self, args: CommandArgs) -> Outcome:
-        target = self.point(args)
-        if not math.isfinite(target[0]):
-            self.port.statustext("Go to: no position given")
-            return Outcome(d.MAV_RESULT_DENIED)
-        return self.to_commander(CommandId.REPOSITION, target)
+        """Go to a point; without one (NaN latitude and longitude, as QGroundControl's
+        Pause and Change altitude send it) hold here or keep the point, at the altitude."""
+        return self.to_commander(CommandId.REPOSITION, self.point(args))
 
     def loiter(self, args: CommandArgs) -> Outcome:
         return self.to_commander(CommandId.LOITER, self.point(args))
+
+    def orbit(self, args: CommandArgs) -> Outcome:
+        """Circle a point (here when none is given); radius param1, NaN or 0: the default."""
+        radius = args.params[0]
+        radius = math.nan if not math.isfinite(radius) or radius == 0 else radius
+        return self.to_commander(CommandId.ORBIT, (*self.point(args), radius))
+
+    def takeoff(self, args: CommandArgs) -> Outcome:
+        """Take off and climb to param7 (AMSL, or above home in a relative frame)."""
+        return self.to_commander(CommandId.TAKEOFF, (math.nan, math.nan, self.point(args)[2]))
 
     def set_home(self, args: CommandArgs) -> Outcome:
         use_current = float(whole_or(args.params[0], 0))
@@ -88,7 +97,7 @@ class ModeCommands:
         """(lat, lon, alt AMSL) of params 5-7; NaN where not given (0, 0 = here)."""
         lat, lon, alt = args.params[4:7]
         if not (math.isfinite(lat) and math.isfinite(lon)) or (lat == 0 and lon == 0):
-            return NO_POINT
+            lat = lon = math.nan
         status = self.port.snapshot.status
         if args.frame in RELATIVE_FRAMES and status is not None and status.home_valid:
             alt += status.home_alt_msl_m

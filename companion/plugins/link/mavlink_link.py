@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from companion.control.mission.store import MissionStore
+from companion.control.modes import INITIAL_MODE
 from companion.control.prearm import PREARM_PARAMS, Readiness, failures
 from companion.link.codec import dialect as d
 from companion.link.codec import new_encoder
@@ -75,7 +76,9 @@ class MavlinkLink(Plugin):
             " options as a query: ?budget=BYTES_PER_S&tlog=PATH",
         ),
         "compid": Setting(int, 1, "MAVLink component id of the autopilot", min=1, max=255),
-        "autopilot": Setting(str, "generic", "MAV_AUTOPILOT reported", choices=tuple(AUTOPILOTS)),
+        # PX4: the QGroundControl plug-in that offers every guided action for a fixed wing
+        # (companion.control.modes says why); generic: no guided action in QGroundControl.
+        "autopilot": Setting(str, "px4", "MAV_AUTOPILOT reported", choices=tuple(AUTOPILOTS)),
         "signing_key": Setting(
             str, "", "signing key: 64 hex digits, or a passphrase (SHA-256, as MAVProxy)"
         ),
@@ -126,6 +129,8 @@ class MavlinkLink(Plugin):
                 raise RuntimeError(f"endpoint {url}: {exc}") from exc
         autopilot = AUTOPILOTS[ctx.settings["autopilot"]]
         self.identity = IdentityService(self.mav, sysid, autopilot, CAPABILITIES)
+        # The first heartbeat already names a mode (the commander's initial one).
+        self.identity.state.custom_mode, self.identity.state.mode_flags = heartbeat_mode(None)
         self.commands = CommandService(self.mav, sysid, ctx.settings["compid"])
         self.snapshot = Snapshot()
         self.boot_us = ctx.clock.now_us()
@@ -312,7 +317,7 @@ class MavlinkLink(Plugin):
     def prearm_failures(self) -> list[str]:
         """Why arming would be refused now, from what the link sees (VehiclePort)."""
         snap = self.snapshot
-        mode = FlightMode.LOITER
+        mode = INITIAL_MODE
         if snap.status is not None and snap.status.mode in FlightMode._value2member_map_:
             mode = FlightMode(snap.status.mode)
         items = self.missions.store.items
