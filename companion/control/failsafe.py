@@ -9,7 +9,10 @@ As ArduPlane and PX4 do it:
   time) → the controller holds heading and height; when GPS has been steady again for
   ``FS_GPS_BACK_S`` the aircraft loiters where it is;
 - outside the fence (or inside an exclusion zone) while flying → Return.
-Each is announced once when it triggers and once when it clears. The GPS is judged by
+Each is announced once when it triggers and once when it clears. A failsafe that still
+holds is acted on again when the operator changes the mode (as ArduPlane re-triggers its
+fence action), unless the operator takes Manual or Stabilized: that is taking control.
+The GPS is judged by
 the navigator's time stamps with hysteresis (``Hysteresis``), never by one flag on one
 sample nor by how late a process ran, so it cannot flap; a failsafe never fires on the
 ground or during a take-off roll (``flying`` is false there).
@@ -31,6 +34,7 @@ FAILSAFE_PARAMS = (
     ParamDecl("FS_GPS_BACK_S", 3.0, 0.0, 60.0, "s", "good fixes this long: GPS back"),
     ParamDecl("FENCE_ENABLE", 1.0, 0.0, 1.0, "", "return home when the fence is breached"),
 )
+PILOT_MODES = frozenset({FlightMode.MANUAL, FlightMode.STABILIZED})  # the operator flies
 
 
 @dataclass(frozen=True)
@@ -104,11 +108,27 @@ class Failsafes:
         self.params = params
         self.gcs_lost = self.gps_lost = self.fence_breached = False
         self.mode_before_gcs: FlightMode | None = None
+        self.mode_seen: FlightMode | None = None  # the mode at the last step
         self.gps = Hysteresis(params["FS_GPS_LOST_S"], params["FS_GPS_BACK_S"])
 
     def step(self, s: Situation) -> list[Action]:
         """The actions this situation calls for (usually none)."""
-        return [*self._gcs(s), *self._gps(s), *self._fence(s)]
+        changed = self.mode_seen is not None and s.mode != self.mode_seen
+        actions = [*self._gcs(s), *self._gps(s), *self._fence(s)]
+        if changed and not actions and s.flying and s.mode not in PILOT_MODES:
+            actions = self._reassert(s.mode)
+        self.mode_seen = s.mode
+        return actions
+
+    def _reassert(self, mode: FlightMode) -> list[Action]:
+        """The operator chose another mode while a failsafe still holds: act on it again."""
+        if self.fence_breached and mode != FlightMode.RTL:
+            return [Action(FlightMode.RTL, "Fence still breached: returning home")]
+        if self.gcs_lost and mode != FlightMode.RTL:
+            return [Action(FlightMode.RTL, "Ground station still lost: returning home")]
+        if self.gps_lost:  # the controller holds heading and height in every mode but Manual
+            return [Action(None, "GPS still lost: holding heading and height")]
+        return []
 
     def _gcs(self, s: Situation) -> list[Action]:
         p = self.params

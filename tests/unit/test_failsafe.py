@@ -95,3 +95,40 @@ def test_late_and_repeated_samples_say_nothing_new():
     assert hyst.update(5_000_000, False) is None
     assert hyst.update(5_500_000, False) is None
     assert hyst.update(6_000_000, False) is True
+
+
+def _at(t_s: float, mode: FlightMode, breach: str | None = None, silence: float = 0.0):
+    t_us = round(t_s * 1e6)
+    return Situation(
+        now_us=t_us, mode=mode, flying=True, gcs_silence_s=silence, nav_flags=GOOD,
+        fence_breach=breach, nav_t_us=t_us,
+    )  # fmt: skip
+
+
+def _modes(fs: Failsafes, situations) -> list[FlightMode | None]:
+    return [a.mode for s in situations for a in fs.step(s)]
+
+
+def test_a_fence_breach_that_still_holds_takes_back_an_operators_mode_change():
+    fs = _failsafes()
+    first = _modes(fs, [_at(0.0, FlightMode.MISSION), _at(0.1, FlightMode.MISSION, "fence")])
+    assert first == [FlightMode.RTL]
+    # QGroundControl's one-click Start Mission while still outside: Return again at once.
+    again = _modes(fs, [_at(0.2, FlightMode.RTL, "fence"), _at(0.3, FlightMode.MISSION, "fence")])
+    assert again == [FlightMode.RTL]
+    assert _modes(fs, [_at(0.4, FlightMode.GUIDED, "fence")]) == [FlightMode.RTL]
+    # Taking Manual or Stabilized is taking control: the failsafe leaves it alone.
+    assert _modes(fs, [_at(0.5, FlightMode.STABILIZED, "fence")]) == []
+    assert _modes(fs, [_at(0.6, FlightMode.MANUAL, "fence")]) == []
+    # Back inside: a mode change is the operator's.
+    texts = [a.text for a in fs.step(_at(0.7, FlightMode.MANUAL))]
+    assert texts == ["Back inside the fence"]
+    assert _modes(fs, [_at(0.8, FlightMode.MISSION)]) == []
+
+
+def test_a_lost_ground_station_still_silent_takes_back_a_mode_change():
+    fs = _failsafes(FS_GCS_TIMEOUT=5.0)
+    assert _modes(fs, [_at(0.0, FlightMode.MISSION, silence=6.0)]) == [FlightMode.RTL]
+    assert _modes(fs, [_at(0.1, FlightMode.LOITER, silence=6.1)]) == [FlightMode.RTL]
+    assert _modes(fs, [_at(0.2, FlightMode.RTL, silence=6.2)]) == []  # its own change
+    assert _modes(fs, [_at(0.3, FlightMode.STABILIZED, silence=6.3)]) == []

@@ -60,12 +60,16 @@ def test_mode_commands_without_a_commander_are_unsupported():
     assert vehicle.published == []
 
 
-def test_go_to_needs_a_position_and_relative_heights_are_over_the_commanders_home():
+def test_go_to_without_a_point_pauses_and_relative_heights_are_over_the_commanders_home():
     vehicle = RecordingVehicle()
-    modes = ModeCommands(vehicle, m.MAV_AUTOPILOT_GENERIC)
-    nowhere = modes.reposition(args(m.MAV_CMD_DO_REPOSITION, -1, 0, 0, math.nan, 0, 0, 100))
-    assert nowhere.result == m.MAV_RESULT_DENIED
-    assert vehicle.texts == ["Go to: no position given"]
+    modes = ModeCommands(vehicle, m.MAV_AUTOPILOT_PX4)
+    # QGroundControl's Pause (PX4FirmwarePlugin::pauseVehicle): no point, no height.
+    pause = modes.reposition(args(m.MAV_CMD_DO_REPOSITION, -1, 1, 0, *[math.nan] * 4))
+    assert pause.defer_seq == 1
+    assert vehicle.texts == []
+    here = vehicle.published[0]
+    assert here[0] == CommandId.REPOSITION and all(math.isnan(v) for v in here[1])
+    vehicle.published.clear()
     status = VehicleStatus(home_valid=1, home_alt_msl_m=50.0)
     vehicle.snapshot.status = status
     relative = m.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
