@@ -8,6 +8,7 @@ import time
 import pytest
 from pymavlink.dialects.v20 import common as m
 
+from companion.control.modes import BY_MODE, INITIAL_MODE
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.support.configs import client_vehicle, link_vehicle
 from tests.support.plugins import FakeNav
@@ -27,7 +28,8 @@ def link(vehicle_factory, tmp_path):
 def test_heartbeat_identifies_a_fixed_wing_in_mavlink2_at_1hz(link):
     _, gcs, first = link
     assert first.type == m.MAV_TYPE_FIXED_WING
-    assert first.autopilot == m.MAV_AUTOPILOT_GENERIC
+    assert first.autopilot == m.MAV_AUTOPILOT_PX4  # QGroundControl's PX4 plug-in: guided actions
+    assert first.custom_mode == BY_MODE[INITIAL_MODE].px4  # named from the first heartbeat
     assert first.get_srcComponent() == 1
     assert first.get_msgbuf()[0] == 0xFD  # a MAVLink 2 frame
     t0 = time.monotonic()
@@ -75,9 +77,7 @@ def test_arm_starts_the_flight_group_and_disarm_stops_it(link):
     gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 1, 21196)
     assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_ACCEPTED
     wait_for(lambda: vehicle.row("relay_in_flight").pid, 5, "flight group running")
-    gcs.recv(
-        "HEARTBEAT", 3, base_mode=m.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | m.MAV_MODE_FLAG_SAFETY_ARMED
-    )
+    assert _armed_beat(gcs, True).base_mode & m.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
     # A retransmission of the same command is answered, not executed again.
     restarts = vehicle.row("relay_in_flight").restarts
     gcs.command(m.MAV_CMD_COMPONENT_ARM_DISARM, 1, 21196, confirmation=1)
@@ -86,7 +86,16 @@ def test_arm_starts_the_flight_group_and_disarm_stops_it(link):
     assert gcs.ack(m.MAV_CMD_COMPONENT_ARM_DISARM).result == m.MAV_RESULT_ACCEPTED
     wait_for(lambda: vehicle.row("relay_in_flight").pid == 0, 5, "flight group stopped")
     assert vehicle.row("relay_in_flight").restarts == restarts
-    gcs.recv("HEARTBEAT", 3, base_mode=m.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED)
+    _armed_beat(gcs, False)
+
+
+def _armed_beat(gcs: GroundStation, armed: bool):
+    deadline = time.monotonic() + 3
+    while time.monotonic() < deadline:
+        beat = gcs.recv("HEARTBEAT", 3)
+        if bool(beat.base_mode & m.MAV_MODE_FLAG_SAFETY_ARMED) == armed:
+            return beat
+    raise AssertionError(f"no heartbeat with armed={armed}")
 
 
 def test_telemetry_reflects_the_bus_and_rates_can_be_changed(link):

@@ -57,11 +57,18 @@ def test_modes_are_listed_and_reported(station):
     listed = [gcs.recv("AVAILABLE_MODES", 3.0, mode_index=i) for i in range(1, len(MODES) + 1)]
     assert [x.mode_name for x in listed] == [info.name for info in MODES]
     assert {x.number_modes for x in listed} == {len(MODES)}
+    # Each its own custom_mode: a tool that names modes by it never shows two as one.
+    assert len({x.custom_mode for x in listed}) == len(MODES)
+    selectable = {
+        x.mode_name for x in listed if not x.properties & m.MAV_MODE_PROPERTY_NOT_USER_SELECTABLE
+    }
+    assert "Land" not in selectable and {"Loiter", "Guided", "Return", "Mission"} <= selectable
     gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AVAILABLE_MODES, 3)  # QGC 5.0 style
     assert gcs.recv("AVAILABLE_MODES", 3.0, mode_index=3).mode_name == "Mission"
     current = gcs.recv("CURRENT_MODE", 5.0)
     assert current.custom_mode == PX4[FlightMode.LOITER]
-    assert current.standard_mode == m.MAV_STANDARD_MODE_POSITION_HOLD
+    # Our Loiter is automatic: not MAVLink's pilot-driven POSITION_HOLD or ORBIT.
+    assert current.standard_mode == m.MAV_STANDARD_MODE_NON_STANDARD
 
 
 def test_mission_mode_without_a_mission_is_refused_with_a_reason(station):
