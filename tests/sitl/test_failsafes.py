@@ -180,3 +180,51 @@ def _upload_circle_fence(station: Station, lat: float, lon: float, radius: float
     )  # fmt: skip
     ack = station.conn.recv_match(type="MISSION_ACK", blocking=True, timeout=10)
     assert ack is not None and ack.type == d.MAV_MISSION_ACCEPTED
+
+
+@pytest.mark.timeout(300)
+def test_a_fence_breach_that_holds_takes_back_the_operators_mission_but_not_stabilized(tmp_path):
+    """QGroundControl's one-click Start Mission outside the fence must not end its Return."""
+    with flying(tmp_path) as station:
+        lat, lon = -37.9105, 145.1340
+        station.fly_mission()
+        station.until(lambda: station.mission_seq >= 1, 120, "past the take-off")
+        # A fence 5 km north that home is not in: the breach holds however the aircraft flies.
+        _upload_circle_fence(station, lat + 0.045, lon, 500.0)
+        station.until(lambda: station.in_mode(FlightMode.RTL), 60, "returning")
+        mission = BY_MODE[FlightMode.MISSION].px4
+        for round_ in range(1, 3):  # Start Mission as QGroundControl's PX4 plug-in sends it
+            assert station.acked(d.MAV_CMD_DO_SET_MODE, 1, mission) == d.MAV_RESULT_ACCEPTED
+            station.until(lambda n=round_: _count(station, "Fence still breached") == n, 60,
+                          "the Return taken back")  # fmt: skip
+            station.until(lambda: station.in_mode(FlightMode.RTL), 20, "returning again")
+        # Stabilized is taking control: left alone for seconds of vehicle time.
+        stabilized = BY_MODE[FlightMode.STABILIZED].px4
+        assert station.acked(d.MAV_CMD_DO_SET_MODE, 1, stabilized) == d.MAV_RESULT_ACCEPTED
+        station.until(lambda: station.in_mode(FlightMode.STABILIZED), 20, "in Stabilized")
+        modes = _modes_for(station, 3.0)
+        assert set(modes) == {stabilized}, modes
+
+
+def _count(station: Station, words: str) -> int:
+    return sum(words in t for t in station.texts)
+
+
+def _modes_for(station: Station, vehicle_s: float) -> list[int]:
+    """The heartbeats' modes over the next ``vehicle_s`` of the vehicle's own time
+    (GLOBAL_POSITION_INT's time_boot_ms), however fast the simulation runs."""
+    modes: list[int] = []
+    start = None
+    while True:
+        msg = station.conn.recv_match(
+            type=["HEARTBEAT", "GLOBAL_POSITION_INT"], blocking=True, timeout=30
+        )
+        assert msg is not None, "the vehicle went quiet"
+        if msg.get_srcSystem() != 1:
+            continue
+        if msg.get_type() == "HEARTBEAT":
+            modes.append(msg.custom_mode)
+            continue
+        start = msg.time_boot_ms if start is None else start
+        if msg.time_boot_ms - start >= vehicle_s * 1000 and modes:
+            return modes
