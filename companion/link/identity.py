@@ -12,6 +12,7 @@ from typing import Any
 
 from companion import __version__
 from companion.link.codec import dialect as mav_dialect
+from companion.link.px4_compat import PX4_COMPAT_VERSION
 from companion.link.service import Outgoing, Peer
 
 HEARTBEAT_PERIOD_S = 1.0
@@ -65,9 +66,12 @@ class IdentityService:
         )
 
     def autopilot_version(self) -> Any:
-        version = version_number(__version__)
+        ours = version_number(__version__)
+        flight = ours
+        if self.autopilot == mav_dialect.MAV_AUTOPILOT_PX4:  # the PX4 behaviour we follow
+            flight = version_number(".".join(map(str, PX4_COMPAT_VERSION)))
         return self.mav.autopilot_version_encode(
-            self.capabilities, version, 0, 0, 0, b"\0" * 8, b"\0" * 8, b"\0" * 8, 0, 0, self.uid
+            self.capabilities, flight, ours, 0, 0, b"\0" * 8, b"\0" * 8, b"\0" * 8, 0, 0, self.uid
         )
 
     def protocol_version(self) -> Any:

@@ -192,3 +192,23 @@ def test_the_old_set_mode_message_works_too(qgc):
         assert gcs.ack(11).result == m.MAV_RESULT_ACCEPTED
         shown(gcs, mode)
         settled(status, lambda s, mode=mode: s.mode == mode, mode.name)
+
+
+def test_parameters_qgroundcontrols_px4_setup_pages_read_are_there(qgc):
+    """PX4AutoPilotPlugin asks each setup page setupComplete() once the parameters are in;
+    a parameter it reads and the vehicle lacks ends in a "missing parameters" dialog."""
+    gcs, _, _ = qgc
+    read_at_connect = {
+        "SYS_AUTOSTART",  # AirframeComponent
+        "CAL_ACC0_ID", "CAL_GYRO0_ID", "CAL_MAG0_ID", "SYS_HAS_NUM_ASPD",  # SensorsComponent
+        "COM_RC_IN_MODE", "RC_MAP_ROLL", "RC_MAP_PITCH", "RC_MAP_YAW", "RC_MAP_THROTTLE",
+    }  # fmt: skip
+    gcs.mav.param_request_list_send(1, 0)
+    first = gcs.recv("PARAM_VALUE", 5.0)
+    names = {first.param_id}
+    while len(names) < first.param_count:
+        names.add(gcs.recv("PARAM_VALUE", 5.0).param_id)
+    assert read_at_connect <= names, read_at_connect - names
+    # They describe the vehicle: a write does not change them.
+    gcs.mav.param_set_send(1, 1, b"COM_RC_IN_MODE", 1.0, m.MAV_PARAM_TYPE_REAL32)
+    assert gcs.recv("PARAM_VALUE", 5.0, param_id="COM_RC_IN_MODE").param_value == 4.0

@@ -35,6 +35,7 @@ from companion.link.link_router import LinkRouter
 from companion.link.mission_service import MissionService
 from companion.link.mode_messages import current_mode, heartbeat_mode
 from companion.link.params_service import ParamsService
+from companion.link.px4_compat import PX4_SETUP_PARAMS
 from companion.link.refusal_texts import RefusalTexts
 from companion.link.service import Outgoing
 from companion.link.signing import key_from
@@ -89,6 +90,7 @@ class MavlinkLink(Plugin):
         ParamDecl("SR_GPS", 2.0, 0.0, 10.0, "Hz", "GPS_RAW_INT rate"),
         ParamDecl("SYS_FAILURE_EN", 0.0, 0.0, 1.0, "", "accept MAV_CMD_INJECT_FAILURE (simulator)"),
         *PREARM_PARAMS,
+        *PX4_SETUP_PARAMS,
     )
     optional_inputs = (
         "nav/state",
