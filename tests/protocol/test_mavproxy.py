@@ -101,7 +101,11 @@ def test_mavproxy_switches_modes_auto_rtl_loiter(vehicle_factory, tmp_path):
     from companion.messages import FlightMode
 
     port = free_udp_port()
-    vehicle = vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path / "state"))
+    # MAVProxy's `mode NAME` passes pymavlink's PX4 mode tuple where a number belongs
+    # (mavproxy_mode.cmd_mode → set_mode_px4), so a PX4-reporting vehicle cannot be switched
+    # by name: MAVProxy users set the link's autopilot to "generic" (ArduPlane mode numbers).
+    endpoint = f"udpin://127.0.0.1:{port}"
+    vehicle = vehicle_factory(client_vehicle(endpoint, tmp_path / "state", autopilot="generic"))
     status = vehicle.bus.latest_reader("vehicle/status")
     wait_for(status.get, 20, "the commander up")
     wp = tmp_path / "wp.txt"

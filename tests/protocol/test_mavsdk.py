@@ -140,7 +140,7 @@ def test_mavsdk_imports_the_shipped_square_plan_and_uploads_it(vehicle_factory, 
     assert (stored / "fence.json").exists() and (stored / "rally.json").exists()
 
 
-async def _mode_session(port: int, vehicle) -> dict:
+async def _mode_session(port: int, status) -> dict:
     from mavsdk.plugins.telemetry import FlightMode
 
     config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
@@ -165,7 +165,11 @@ async def _mode_session(port: int, vehicle) -> dict:
         await action.return_to_launch()
         seen["rtl"] = await mode_becomes(FlightMode.RETURN_TO_LAUNCH)
         await action.goto_location(-37.9, 145.12, 150.0, float("nan"))
-        seen["goto"] = await mode_becomes(FlightMode.HOLD)
+        # Guided is PX4's first external mode: MAVSDK's enumeration has no name for it.
+        seen["goto"] = await mode_becomes(FlightMode.UNKNOWN)
+        seen["target"] = status.get()
+        await action.hold()
+        seen["hold"] = await mode_becomes(FlightMode.HOLD)
         await action.disarm()
     return seen
 
@@ -180,13 +184,13 @@ def test_mavsdk_flight_modes_start_mission_return_and_go_to(vehicle_factory, tmp
     vehicle = vehicle_factory(client_vehicle(f"udpout://127.0.0.1:{port}", tmp_path))
     status = vehicle.bus.latest_reader("vehicle/status")
     wait_for(status.get, 20, "the commander up")
-    seen = asyncio.run(_mode_session(port, vehicle))
-    seen["target"] = status.get()
+    seen = asyncio.run(_mode_session(port, status))
     assert seen["initial"] == FlightMode.HOLD  # a fixed wing without a pilot circles
     assert seen["mission"] == FlightMode.MISSION
     assert seen["rtl"] == FlightMode.RETURN_TO_LAUNCH
+    assert seen["hold"] == FlightMode.HOLD  # our Loiter, PX4's Hold
     status = seen["target"]
-    assert status.mode == Mode.GUIDED  # PX4 flies "go to" in Hold; MAVSDK names it so
+    assert status.mode == Mode.GUIDED
     assert (status.target_lat_deg, status.target_lon_deg) == pytest.approx((-37.9, 145.12))
     assert status.target_alt_msl_m == pytest.approx(150.0)
 

@@ -111,12 +111,13 @@ def client_vehicle(
     extra: tuple[PluginEntry, ...] = (),
     flight: PluginEntry | None = None,
     name: str = "client",
+    autopilot: str = "px4",
 ) -> str:
     """A link on ``endpoint``, a known navigation solution, ``extra``, the commander, and
     ``flight`` in the flight group (a stand-in by default)."""
     return vehicle_config(
         name,
-        link(endpoint),
+        link(endpoint, autopilot=autopilot),
         plugin("nav", FAKE_NAV),
         plugin("gps", FAKE_GPS),  # a 3-D fix: the pre-arm checks pass
         *extra,
