@@ -1,0 +1,118 @@
+"""QGroundControl's Takeoff, Change altitude and Go to, as its PX4 plug-in sends them
+(src/FirmwarePlugin/PX4/PX4FirmwarePlugin.cc: guidedModeTakeoff then arming on the accept,
+guidedModeChangeAltitude, guidedModeGotoLocation), fly the simulated aircraft.
+
+Lockstep JSBSim; every wait is on the vehicle's telemetry, never on how fast it ran.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import pytest
+from pymavlink import mavutil
+
+from companion.control.modes import BY_MODE
+from companion.geodesy import LocalFrame
+from companion.messages import FlightMode
+from mavlink_dialect import companion as d
+from tests.protocol.mav_client import free_udp_port
+from tests.sim.sim_run import finish, start_sim
+
+NAN = math.nan
+WAIT_S = 240.0  # wall seconds for any one stage: generous, for a loaded machine
+
+
+class Qgc:
+    """Just enough of QGroundControl: a heartbeat, commands, and what the vehicle says."""
+
+    def __init__(self, port: int) -> None:
+        self.conn = mavutil.mavlink_connection(f"udpin:127.0.0.1:{port}", source_system=255,
+                                               source_component=190)  # fmt: skip
+        self.mode = -1
+        self.position = None
+        self.acks: dict[int, int] = {}
+
+    def pump_until(self, predicate, what: str) -> None:
+        deadline = time.monotonic() + WAIT_S
+        while time.monotonic() < deadline:
+            self.conn.mav.heartbeat_send(d.MAV_TYPE_GCS, d.MAV_AUTOPILOT_INVALID, 0, 0, 0)
+            for _ in range(50):
+                msg = self.conn.recv_match(blocking=True, timeout=0.02)
+                if msg is not None and msg.get_srcSystem() == 1:
+                    self._take(msg)
+            if predicate():
+                return
+        raise AssertionError(f"never {what}")
+
+    def _take(self, msg) -> None:
+        kind = msg.get_type()
+        if kind == "HEARTBEAT":
+            self.mode = msg.custom_mode
+        elif kind == "GLOBAL_POSITION_INT":
+            self.position = msg
+        elif kind == "COMMAND_ACK":
+            self.acks[msg.command] = msg.result
+
+    def command(self, command: int, *params: float) -> int:
+        self.acks.pop(command, None)
+        self.conn.mav.command_long_send(1, 1, command, 0, *params)
+        self.pump_until(lambda: command in self.acks, f"an answer to {command}")
+        return self.acks[command]
+
+    def command_int(self, command: int, *params: float, lat: float, lon: float, alt: float):
+        self.acks.pop(command, None)
+        self.conn.mav.command_int_send(1, 1, d.MAV_FRAME_GLOBAL, command, 0, 0, *params,
+                                       round(lat * 1e7), round(lon * 1e7), alt)  # fmt: skip
+        self.pump_until(lambda: command in self.acks, f"an answer to {command}")
+        return self.acks[command]
+
+    def in_mode(self, mode: FlightMode) -> bool:
+        return self.mode == BY_MODE[mode].px4
+
+
+@pytest.mark.timeout(900)
+def test_qgroundcontrol_takeoff_change_altitude_and_go_to_fly(tmp_path):
+    port = free_udp_port()
+    proc, namespace, _truth = start_sim(
+        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "900"
+    )
+    qgc = Qgc(port)
+    try:
+        home = qgc.conn.recv_match(type="HOME_POSITION", blocking=True, timeout=60)
+        assert home is not None, "no home position"
+        home_amsl = home.altitude / 1000.0
+        frame = LocalFrame(home.latitude / 1e7, home.longitude / 1e7)
+        arm = d.MAV_CMD_COMPONENT_ARM_DISARM
+        qgc.pump_until(lambda: qgc.position is not None, "a position")
+        # Takeoff to 60 m (the slider), then arm once the command is accepted; the pre-arm
+        # checks may still wait for the GPS: QGroundControl's user presses again.
+        takeoff = (-1, 0, 0, NAN, NAN, NAN, home_amsl + 60.0)
+        assert qgc.command(d.MAV_CMD_NAV_TAKEOFF, *takeoff) == d.MAV_RESULT_ACCEPTED
+        qgc.pump_until(lambda: qgc.command(arm, 1, 0, 0, 0, 0, 0, 0) == 0, "armed")
+        qgc.pump_until(lambda: qgc.position.relative_alt > 50_000, "at the take-off height")
+        assert qgc.in_mode(FlightMode.TAKEOFF)
+        # Change altitude (pause first, then the new height): circle here 40 m higher.
+        assert qgc.command(d.MAV_CMD_DO_REPOSITION, -1, 1, 0, NAN, NAN, NAN, NAN) == 0
+        assert qgc.command(d.MAV_CMD_DO_REPOSITION, -1, 1, 0, NAN, NAN, NAN, home_amsl + 100) == 0
+        qgc.pump_until(lambda: qgc.in_mode(FlightMode.LOITER), "in Hold (our Loiter)")
+        qgc.pump_until(lambda: qgc.position.relative_alt > 90_000, "40 m higher")
+        # Go to a point 1.5 km east, at the present height (COMMAND_INT, frame GLOBAL).
+        lat, lon = frame.latlon(0.0, 1500.0)
+        go = qgc.command_int(d.MAV_CMD_DO_REPOSITION, -1, 1, 0, NAN, lat=lat, lon=lon,
+                             alt=qgc.position.alt / 1000.0)  # fmt: skip
+        assert go == d.MAV_RESULT_ACCEPTED
+        qgc.pump_until(lambda: qgc.in_mode(FlightMode.GUIDED), "in Guided")
+
+        def near() -> bool:
+            n, e = frame.ne(qgc.position.lat / 1e7, qgc.position.lon / 1e7)
+            return math.hypot(n, e - 1500.0) < 300.0
+
+        qgc.pump_until(near, "at the go-to point")
+        assert qgc.in_mode(FlightMode.GUIDED)  # it circles there, still Guided
+        assert abs(qgc.position.relative_alt / 1000.0 - 100.0) < 20.0
+    finally:
+        proc.terminate()
+        finish(proc, namespace, 60)
+        qgc.conn.close()
