@@ -24,6 +24,7 @@ from companion.messages.control import (
 )
 from companion.messages.link import LinkStatus, MissionChanged, StatusText
 from companion.messages.navigation import NavFlags, NavState
+from companion.messages.pilot import RC_MAX_CHANNELS, PilotFlags, PilotInput, PilotSource
 from companion.messages.sensors import Baro, Compass, GpsFix, GpsFixType, Imu, Magnetometer
 from companion.messages.simulation import SimClock, SimTruth
 from companion.messages.system import (
@@ -39,6 +40,7 @@ __all__ = [
     "MAX_PLUGINS",
     "NAME_LEN",
     "NAN",
+    "RC_MAX_CHANNELS",
     "ActuatorCommand",
     "Baro",
     "Channel",
@@ -59,6 +61,9 @@ __all__ = [
     "NavFlags",
     "NavState",
     "ParamChange",
+    "PilotFlags",
+    "PilotInput",
+    "PilotSource",
     "PluginHealth",
     "PluginState",
     "PluginStats",

@@ -19,7 +19,8 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import serial
 
@@ -56,8 +57,15 @@ def open_problem(url: str, baud: int) -> str | None:
 class ReopeningSerial:
     """A port that is opened on first use and reopened, with back-off, whenever it fails."""
 
-    def __init__(self, url: str, baud: int = 9600, read_timeout_s: float = 0.2) -> None:
+    def __init__(
+        self,
+        url: str,
+        baud: int = 9600,
+        read_timeout_s: float = 0.2,
+        framing: Mapping[str, Any] | None = None,
+    ) -> None:
         self.url = url
+        self.framing = dict(framing or {})  # pyserial's parity/stopbits/bytesize, if not 8N1
         self.path, self.baud = split_device(url, baud)
         self.read_timeout_s = read_timeout_s
         self.reopens = 0  # times the device was lost and reopening began
@@ -159,6 +167,7 @@ class ReopeningSerial:
                 baudrate=self.baud,
                 timeout=self.read_timeout_s,
                 write_timeout=self.read_timeout_s,
+                **self.framing,
             )
         except _PORT_ERRORS as exc:
             self.open_failures += 1

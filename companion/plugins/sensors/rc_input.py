@@ -1,0 +1,98 @@
+"""``sensors.rc_input``: an SBUS radio receiver on a serial port (or pty).
+
+SBUS because nearly every receiver speaks it (Futaba and FrSky natively, ExpressLRS,
+Crossfire and FlySky receivers as an option), it is documented in the open (ArduPilot,
+PX4 and several open receivers decode and write it), and its frame carries the
+receiver's own failsafe and frame-lost flags, which the vehicle honours. On hardware it
+needs 100000 baud 8E2 on an inverted line (an inverter, or a UART that inverts its RX);
+the settings ask pyserial for 8E2. The codec is ``companion.sensors.sbus``, the stick
+mapping ``companion.sensors.rc_channels`` (ArduPilot's RCn_* and RCMAP_* parameters).
+
+Every frame goes on ``sensors/rc`` (the newest wins); a frame whose mode-switch position
+differs from the last one announced, seen in two frames running and not in failsafe,
+also goes on ``sensors/rc_switch``, which wakes the commander at once.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import serial
+
+from companion.messages import RC_MAX_CHANNELS, PilotFlags, PilotInput, PilotSource
+from companion.params.live import LiveParams
+from companion.plugin import Plugin, PluginContext
+from companion.plugins.sensors.serial_sensor import serial_settings
+from companion.sensors.rc_channels import RC_PARAMS, sticks
+from companion.sensors.sbus import SbusDecoder, SbusFrame
+from companion.sensors.serial_port import ReopeningSerial
+
+SBUS_FRAMING = {"parity": serial.PARITY_EVEN, "stopbits": serial.STOPBITS_TWO}
+
+
+class RcInput(Plugin):
+    """Publishes the pilot's sticks and mode switch from every SBUS frame."""
+
+    settings = serial_settings("serial:///dev/ttyAMA0:100000", 100000)
+    params = RC_PARAMS
+    optional_inputs = ("params/changes",)
+    outputs = ("sensors/rc", "sensors/rc_switch")
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        framing = SBUS_FRAMING
+        self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"], framing=framing)
+        self.decoder = SbusDecoder()
+        self.live = LiveParams(ctx.bus, self.params, Path(ctx.vehicle.get("state_dir", ".")))
+        self.out = ctx.bus.writer("sensors/rc")
+        self.switch_out = ctx.bus.writer("sensors/rc_switch")
+        self.announced = -1  # the switch position last put on sensors/rc_switch
+        self.candidate = -1  # a new position seen once, waiting for a second frame
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:  # waiting for the receiver is not busy time
+            data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
+        frames = self.decoder.feed(data)
+        if frames:
+            self.live.poll()
+        for frame in frames:
+            self._publish(frame, t_us)
+        c = self.decoder.counters
+        self.ctx.health.frames_ok = c.ok
+        self.ctx.health.frames_bad = c.bad_frames
+        self.ctx.health.dropped = c.garbage_bytes
+
+    def _publish(self, frame: SbusFrame, t_us: int) -> None:
+        pulses = frame.pulses_us()
+        s = sticks(pulses, self.live.values)
+        msg = PilotInput(t_us=t_us, source=PilotSource.RC, rssi=255)
+        msg.roll, msg.pitch, msg.yaw, msg.throttle = s.roll, s.pitch, s.yaw, s.throttle
+        msg.mode_switch = s.mode_switch
+        flags = PilotFlags(0)
+        if frame.failsafe:
+            flags |= PilotFlags.FAILSAFE
+        if frame.frame_lost:
+            flags |= PilotFlags.FRAME_LOST
+        if s.throttle_low:
+            flags |= PilotFlags.THROTTLE_LOW
+        msg.flags = int(flags)
+        msg.channel_count = min(len(pulses), RC_MAX_CHANNELS)
+        for i, pulse in enumerate(pulses[:RC_MAX_CHANNELS]):
+            msg.channels_us[i] = pulse
+        self.out.publish(msg)
+        self._switch(msg)
+
+    def _switch(self, msg: PilotInput) -> None:
+        """A debounced switch: a position counts once two frames running show it."""
+        position = msg.mode_switch
+        if not msg.usable() or position < 0 or position == self.announced:
+            self.candidate = -1
+            return
+        if position != self.candidate:
+            self.candidate = position
+            return
+        self.announced, self.candidate = position, -1
+        self.switch_out.publish(msg)
+
+    def close(self) -> None:
+        self.port.close()

@@ -1,0 +1,109 @@
+"""SBUS, the serial protocol of Futaba and FrSky receivers (and of most others as an option).
+
+A frame is 25 bytes: 0x0F; 22 bytes holding 16 channels of 11 bits each, least significant
+bit first; a flags byte (bit 0 digital channel 17, bit 1 channel 18, bit 2 frame lost,
+bit 3 failsafe; bits 4-7 zero); and an end byte, 0x00 (SBUS2 receivers put telemetry slot
+numbers 0x04, 0x14, 0x24, 0x34 there). The line is 100000 baud, 8 data bits, even parity,
+2 stop bits, with the signal inverted: a flight computer needs an inverter (or a UART that
+inverts its RX) and a UART that takes 100000 baud; a pty takes any framing.
+
+SBUS has no checksum, so a frame is only accepted when its header, flag bits and end byte
+are right; anything else is skipped a byte at a time and counted, never raised. Pure: bytes
+in, frames out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+FRAME_LEN = 25
+HEADER = 0x0F
+END_BYTES = frozenset({0x00, 0x04, 0x14, 0x24, 0x34})
+CHANNELS = 16
+FLAG_CH17, FLAG_CH18, FLAG_FRAME_LOST, FLAG_FAILSAFE = 1, 2, 4, 8
+_UNUSED_FLAGS = 0xF0
+RAW_MIN, RAW_MAX = 0, 2047
+
+
+def raw_to_us(raw: int) -> int:
+    """A channel's 11-bit value as a pulse width: 172 → 988 µs, 992 → 1500, 1811 → 2012,
+    the scale FrSky and Futaba receivers use (and ArduPilot and PX4 decode)."""
+    return round(880 + raw * 0.625)
+
+
+@dataclass(frozen=True)
+class SbusFrame:
+    """One decoded frame: 16 raw channels (0-2047), the two digital ones and the flags."""
+
+    channels: tuple[int, ...]
+    ch17: bool
+    ch18: bool
+    frame_lost: bool
+    failsafe: bool
+
+    def pulses_us(self) -> list[int]:
+        """All 18 channels as pulse widths (the digital ones as 1000 or 2000 µs)."""
+        digital = [2000 if on else 1000 for on in (self.ch17, self.ch18)]
+        return [raw_to_us(raw) for raw in self.channels] + digital
+
+
+@dataclass
+class SbusCounters:
+    """What the decoder accepted and skipped."""
+
+    ok: int = 0
+    bad_frames: int = 0  # a header whose flag bits or end byte were wrong
+    garbage_bytes: int = 0  # bytes skipped while looking for a header
+
+
+def decode_frame(frame: bytes) -> SbusFrame | None:
+    """One 25-byte frame, or None when it is not one."""
+    if len(frame) != FRAME_LEN or frame[0] != HEADER:
+        return None
+    flags, end = frame[23], frame[24]
+    if flags & _UNUSED_FLAGS or end not in END_BYTES:
+        return None
+    bits = int.from_bytes(frame[1:23], "little")
+    channels = tuple((bits >> (11 * i)) & 0x7FF for i in range(CHANNELS))
+    return SbusFrame(
+        channels,
+        bool(flags & FLAG_CH17),
+        bool(flags & FLAG_CH18),
+        bool(flags & FLAG_FRAME_LOST),
+        bool(flags & FLAG_FAILSAFE),
+    )
+
+
+class SbusDecoder:
+    """Finds frames in a byte stream, whatever arrives in between."""
+
+    def __init__(self) -> None:
+        self.counters = SbusCounters()
+        self._buf = bytearray()
+
+    def feed(self, data: bytes) -> list[SbusFrame]:
+        """The frames completed by ``data``."""
+        buf = self._buf
+        buf += data
+        frames: list[SbusFrame] = []
+        while True:
+            start = buf.find(HEADER)
+            if start < 0:
+                self.counters.garbage_bytes += len(buf)
+                buf.clear()
+                break
+            if start:
+                self.counters.garbage_bytes += start
+                del buf[:start]
+            if len(buf) < FRAME_LEN:
+                break
+            frame = decode_frame(bytes(buf[:FRAME_LEN]))
+            if frame is None:
+                # Not a frame: the 0x0F was data; look again from the next byte.
+                self.counters.bad_frames += 1
+                del buf[:1]
+                continue
+            self.counters.ok += 1
+            frames.append(frame)
+            del buf[:FRAME_LEN]
+        return frames
