@@ -129,3 +129,8 @@ def _from_base_flags(base_mode: int) -> FlightMode | None:
     if base_mode & d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED:
         return FlightMode.MANUAL
     return None
+
+
+def from_arduplane(number: int) -> FlightMode | None:
+    """An ArduPlane mode number (FLTMODE1..6 hold these), whatever the other encodings say."""
+    return _ARDUPLANE.get(number)

@@ -2,7 +2,8 @@
 
 Takes the mode commands off ``link/commands`` (SET_MODE, MISSION_START, RTL, REPOSITION,
 LOITER, SET_HOME), answers each on ``link/command_acks`` (with the reason when refused),
-applies the failsafes (ground-station link, GPS, geofence; ``companion.control.failsafe``) and
+applies the failsafes (ground-station link, GPS, geofence; ``companion.control.failsafe``),
+the pilot's mode switch and the RC and joystick failsafes (``companion.control.pilot_watch``), and
 publishes ``vehicle/status`` on every change and four times a second, and what the
 operator should read on ``vehicle/statustext``.
 """
@@ -17,6 +18,7 @@ from companion.control.commander import MODE_COMMANDS, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.control.mission.fence import Fence
 from companion.control.mission.store import MissionStore, StoreFollower
+from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch
 from companion.messages import NAME_LEN, CommandAck, FlightMode, NavFlags, StatusText
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
@@ -30,7 +32,7 @@ FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) secon
 class CommanderPlugin(Plugin):
     """Mode state for the link and the flight controller."""
 
-    params = FAILSAFE_PARAMS
+    params = (*FAILSAFE_PARAMS, *PILOT_PARAMS)
     inputs = ("link/commands",)
     optional_inputs = (
         "nav/state",
@@ -38,6 +40,9 @@ class CommanderPlugin(Plugin):
         "control/status",
         "link/status",
         "mission/changed",
+        "sensors/rc",
+        "sensors/rc_switch",
+        "link/manual_control",
     )
     outputs = ("vehicle/status", "link/command_acks", "vehicle/statustext")
 
@@ -51,6 +56,7 @@ class CommanderPlugin(Plugin):
         self.commander = Commander(lambda: len(self.store.items[d.MAV_MISSION_TYPE_MISSION]))
         self.live = LiveParams(ctx.bus, self.params, state_dir)
         self.failsafes = Failsafes(self.live.values)
+        self.pilot = PilotWatch(self.live.values)
         bus = ctx.bus
         self.commands = bus.queue_reader("link/commands")
         self.nav = bus.latest_reader("nav/state")
@@ -58,10 +64,14 @@ class CommanderPlugin(Plugin):
         self.control = bus.latest_reader("control/status")
         self.link = bus.latest_reader("link/status")
         self.mission_changes = bus.latest_reader("mission/changed")
-        # Commands wake it at once; the rest (navigation at 100 Hz and more) is read when
-        # it wakes on its own, 20 times a wall second: waking for every navigation sample
-        # cost a lockstep simulation a tenth of its speed.
-        self.waiter = bus.waiter([self.commands])
+        self.rc = bus.latest_reader("sensors/rc")
+        self.rc_switch = bus.queue_reader("sensors/rc_switch")
+        self.joystick = bus.latest_reader("link/manual_control")
+        # Commands and the mode switch wake it at once; the rest (navigation at 100 Hz and
+        # more, the sticks at 50 Hz) is read when it wakes on its own, 20 times a wall
+        # second: waking for every navigation sample cost a lockstep simulation a tenth of
+        # its speed.
+        self.waiter = bus.waiter([self.commands, self.rc_switch])
         self.acks = bus.writer("link/command_acks")
         self.out = bus.writer("vehicle/status")
         self.texts = bus.writer("vehicle/statustext")
@@ -80,7 +90,7 @@ class CommanderPlugin(Plugin):
         self.live.poll()
         if d.MAV_MISSION_TYPE_FENCE in self.follower.follow(self.mission_changes.get()):
             self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
-        changed = self._commands()
+        changed = self._commands() | self._mode_switch(now)
         if now >= self.next_failsafe_us or now < self.next_failsafe_us - FAILSAFE_PERIOD_US:
             self.next_failsafe_us = now + FAILSAFE_PERIOD_US
             changed |= self._failsafes(now, nav)
@@ -122,12 +132,37 @@ class CommanderPlugin(Plugin):
             nav_t_us=int(nav.t_us) if nav is not None else None,
             fence_breach=self.fence.breach(nav.lat_deg, nav.lon_deg) if valid else None,
         )
+        actions = self.failsafes.step(situation)
+        if nav is not None:  # the pilot's inputs are judged against the sensors' time
+            rc, joystick = self.rc.get(), self.joystick.get()
+            actions += self.pilot.step(int(nav.t_us), c.mode, bool(flying), rc, joystick)
+        return self._act(now, actions)
+
+    def _mode_switch(self, now: int) -> bool:
+        """The pilot's switch wins over the ground station each time it moves."""
         changed = False
-        for action in self.failsafes.step(situation):
+        for frame in self.rc_switch.drain():
+            mode = self.pilot.switch_mode(frame.mode_switch)
+            if mode is None or mode == self.commander.mode:
+                continue
+            decision = self.commander.failsafe(mode)
+            name = mode.name.title()
+            text = f"Mode switch: {name}" if decision.result == 0 else decision.reason
+            self._say(now, text, d.MAV_SEVERITY_INFO)
+            changed |= decision.result == 0
+        return changed
+
+    def _say(self, now: int, text: str, severity: int) -> None:
+        msg = StatusText(t_us=now, severity=severity)
+        msg.text = text.encode()[:199]
+        self.texts.publish(msg)
+
+    def _act(self, now: int, actions: list[Any]) -> bool:
+        c = self.commander
+        changed = False
+        for action in actions:
             self.ctx.log.warning("%s", action.text)
-            msg = StatusText(t_us=now, severity=action.severity)
-            msg.text = action.text.encode()[:199]
-            self.texts.publish(msg)
+            self._say(now, action.text, action.severity)
             if action.mode is not None and action.mode != c.mode:
                 changed |= c.failsafe(FlightMode(action.mode)).result == 0
         return changed

@@ -1,0 +1,116 @@
+"""The pilot on the sticks: the mode switch, and what to do when the pilot's radio goes.
+
+Pure: the pilot's newest inputs (RC receiver, MAVLink joystick), the navigation's sensor
+time and the mode in; mode changes and operator messages out. As ArduPlane does it:
+- the mode switch (``FLTMODE_CH``, read by ``sensors.rc_input``) selects ``FLTMODE1..6``
+  (ArduPlane mode numbers) when it moves, and wins over the ground station, which may
+  change the mode again until the switch moves next;
+- RC lost (``THR_FAILSAFE``): no usable receiver frame (none at all, or the receiver's
+  failsafe flag, or throttle below ``THR_FS_VALUE``) for ``FS_LONG_TIMEOUT`` seconds of
+  the navigation's sensor time → Return from the modes the pilot flies (Manual,
+  Stabilized; ``FS_LONG_ACTN`` 1: from every mode), and the mission goes on in Auto;
+- the joystick (MANUAL_CONTROL) lost for ``RC_OVERRIDE_TIME`` while it flies the
+  aircraft in Manual or Stabilized → Return.
+Only a receiver or joystick that has been heard can be lost; each loss is said once.
+"""
+
+from __future__ import annotations
+
+from companion.control.failsafe import Action
+from companion.control.modes import from_arduplane
+from companion.messages import FlightMode, PilotInput
+from companion.params import ParamDecl
+from mavlink_dialect import companion as d
+
+PILOT_MODES = frozenset({FlightMode.MANUAL, FlightMode.STABILIZED})
+# A three-position switch (1000, 1500, 2000 µs) gives positions 0, 3 and 5:
+# Manual, Stabilized (FBWA), Auto.
+_DEFAULT_FLTMODES = (0, 0, 5, 5, 10, 10)
+PILOT_PARAMS = (
+    *(
+        ParamDecl(f"FLTMODE{i + 1}", float(m), 0.0, 24.0, "", f"mode switch position {i + 1}")
+        for i, m in enumerate(_DEFAULT_FLTMODES)
+    ),
+    ParamDecl("THR_FAILSAFE", 1.0, 0.0, 1.0, "", "act when the RC receiver is lost"),
+    ParamDecl("FS_LONG_TIMEOUT", 5.0, 1.0, 300.0, "s", "RC silence that counts as lost"),
+    ParamDecl("FS_LONG_ACTN", 0.0, 0.0, 1.0, "", "RC lost: 0 Return unless in Auto, 1 Return"),
+    ParamDecl("RC_OVERRIDE_TIME", 3.0, 0.5, 60.0, "s", "joystick silence that counts as lost"),
+)
+
+
+class PilotWatch:
+    """Remembers what it has announced."""
+
+    def __init__(self, params: dict[str, float]) -> None:
+        self.params = params
+        self.last_usable_rc_us: int | None = None
+        self.rc_lost = False
+        self.joystick_lost = False
+
+    def switch_mode(self, position: int) -> FlightMode | None:
+        """The mode a switch position selects (None: no such position or mode)."""
+        if not 0 <= position <= 5:
+            return None
+        return from_arduplane(round(self.params[f"FLTMODE{position + 1}"]))
+
+    def step(
+        self,
+        now_us: int,
+        mode: FlightMode,
+        flying: bool,
+        rc: PilotInput | None,
+        joystick: PilotInput | None,
+    ) -> list[Action]:
+        """The actions the pilot's inputs call for at sensor time ``now_us``."""
+        return [
+            *self._rc(now_us, mode, flying, rc),
+            *self._joystick(now_us, mode, flying, rc, joystick),
+        ]
+
+    def rc_fresh(self, now_us: int, rc: PilotInput | None) -> bool:
+        """Whether the receiver is flying the aircraft now."""
+        return (
+            rc is not None
+            and rc.usable()
+            and now_us - rc.t_us < self.params["FS_LONG_TIMEOUT"] * 1e6
+        )
+
+    def _rc(
+        self, now_us: int, mode: FlightMode, flying: bool, rc: PilotInput | None
+    ) -> list[Action]:
+        p = self.params
+        if rc is None:
+            return []
+        if rc.usable():
+            self.last_usable_rc_us = max(self.last_usable_rc_us or rc.t_us, rc.t_us)
+        since = self.last_usable_rc_us if self.last_usable_rc_us is not None else rc.t_us
+        silent = now_us - since >= p["FS_LONG_TIMEOUT"] * 1e6
+        if silent and not self.rc_lost and flying and p["THR_FAILSAFE"] >= 0.5:
+            self.rc_lost = True
+            if mode in PILOT_MODES or (p["FS_LONG_ACTN"] >= 0.5 and mode != FlightMode.RTL):
+                return [Action(FlightMode.RTL, "Failsafe: RC lost, returning home")]
+            return [Action(None, "Failsafe: RC lost, carrying on")]
+        if self.rc_lost and not silent:
+            self.rc_lost = False
+            return [Action(None, "RC back", d.MAV_SEVERITY_NOTICE)]
+        return []
+
+    def _joystick(
+        self,
+        now_us: int,
+        mode: FlightMode,
+        flying: bool,
+        rc: PilotInput | None,
+        joystick: PilotInput | None,
+    ) -> list[Action]:
+        if joystick is None:
+            return []
+        silent = now_us - joystick.t_us >= self.params["RC_OVERRIDE_TIME"] * 1e6
+        flies = mode in PILOT_MODES and not self.rc_fresh(now_us, rc)
+        if silent and flies and flying and not self.joystick_lost:
+            self.joystick_lost = True
+            return [Action(FlightMode.RTL, "Failsafe: joystick lost, returning home")]
+        if self.joystick_lost and not silent:
+            self.joystick_lost = False
+            return [Action(None, "Joystick back", d.MAV_SEVERITY_NOTICE)]
+        return []
