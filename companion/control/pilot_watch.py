@@ -17,12 +17,12 @@ Only a receiver or joystick that has been heard can be lost; each loss is said o
 from __future__ import annotations
 
 from companion.control.failsafe import Action
+from companion.control.flight.pilot import PILOT_MODES
 from companion.control.modes import from_arduplane
 from companion.messages import FlightMode, PilotInput
 from companion.params import ParamDecl
 from mavlink_dialect import companion as d
 
-PILOT_MODES = frozenset({FlightMode.MANUAL, FlightMode.STABILIZED})
 # A three-position switch (1000, 1500, 2000 µs) gives positions 0, 3 and 5:
 # Manual, Stabilized (FBWA), Auto.
 _DEFAULT_FLTMODES = (0, 0, 5, 5, 10, 10)

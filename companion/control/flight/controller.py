@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass, field
 
 from companion.control.flight.params import FlightConfig
+from companion.control.flight.pilot import PILOT_MODES, Sticks, fly_pilot
 from companion.control.flight.takeoff import Phase, RunwayTakeoff
 from companion.control.laws.attitude import AttitudeController
 from companion.control.laws.l1_guidance import L1Guidance, LateralDemand, bank_for
@@ -103,8 +104,11 @@ class FlightController:
         self.home_alt = home[2]
         return self.frame
 
-    def step(self, nav: NavState, status: VehicleStatus, t_s: float) -> ControlOutput:
-        """Surface commands for this navigation solution."""
+    def step(
+        self, nav: NavState, status: VehicleStatus, t_s: float, sticks: Sticks | None = None
+    ) -> ControlOutput:
+        """Surface commands for this navigation solution (and the pilot's ``sticks``, which
+        fly Manual and Stabilized when given)."""
         dt = 0.0 if self._last_t is None else max(0.0, min(t_s - self._last_t, 0.2))
         self._last_t = t_s
         if not status.home_valid and (self.landed is None or self.landed):
@@ -120,6 +124,9 @@ class FlightController:
         self._update_landed(nav, airspeed)
         out = ControlOutput(airspeed=airspeed, landed=bool(self.landed))
         mode = FlightMode(status.mode) if status.mode else FlightMode.LOITER
+        if mode in PILOT_MODES and sticks is not None:
+            self._mode_key = (int(mode), int(status.changes))
+            return self._fly_pilot(mode, sticks, nav, airspeed, dt, out)
         if mode == FlightMode.MANUAL:
             out.throttle = self.config["TRIM_THROTTLE"] if not self.landed else 0.0
             return out
@@ -131,6 +138,22 @@ class FlightController:
             return self._fly_takeoff(setpoint, pos, nav, airspeed, dt, out)
         self.takeoff = None
         return self._fly(setpoint, pos, vel, nav, airspeed, dt, out)
+
+    def _fly_pilot(
+        self,
+        mode: FlightMode,
+        sticks: Sticks,
+        nav: NavState,
+        airspeed: float,
+        dt: float,
+        out: ControlOutput,
+    ) -> ControlOutput:
+        demand = fly_pilot(mode, sticks, nav, airspeed, dt, self.attitude, self.config)
+        out.aileron, out.elevator, out.rudder = demand.aileron, demand.elevator, demand.rudder
+        out.throttle = demand.throttle
+        out.nav_roll, out.nav_pitch = demand.roll, demand.pitch
+        self.tecs.reset(nav.pitch_rad)  # Auto takes over from the attitude the pilot left
+        return out
 
     def _dead_reckoning(
         self, setpoint: Setpoint | None, pos: tuple[float, float], nav: NavState

@@ -1,7 +1,9 @@
 """``control.fixed_wing``: flies the modes and the stored mission (group ``flight``).
 
-Runs on every navigation solution: the commander's mode and targets in, normalised
-surface commands out on ``control/actuators`` (the servo plug-in turns them into bytes),
+Runs on every navigation solution: the commander's mode and targets (and, for Manual and
+Stabilized, the pilot's sticks from the receiver or the ground station's joystick) in,
+normalised surface commands out on ``control/actuators`` (the servo plug-in turns them
+into bytes),
 and guidance and mission progress on ``control/status`` for the link. Every gain, limit
 and speed is a parameter: the airframe file gives the defaults, the ground station may
 change them in flight (they arrive on ``params/changes``).
@@ -17,6 +19,7 @@ from typing import Any
 from companion.actuators.airframe import AirframeError, load_airframe
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.params import control_params, flight_config
+from companion.control.flight.pilot import pilot_sticks
 from companion.control.mission.store import MissionStore, StoreFollower
 from companion.messages import (
     ActuatorCommand,
@@ -41,7 +44,13 @@ class FixedWingPlugin(Plugin):
         "airframe": Setting(str, "c172p", "airframe name (companion/airframes) or TOML path"),
     }
     inputs = ("nav/state",)
-    optional_inputs = ("vehicle/status", "params/changes", "mission/changed")
+    optional_inputs = (
+        "vehicle/status",
+        "params/changes",
+        "mission/changed",
+        "sensors/rc",
+        "link/manual_control",
+    )
     outputs = ("control/actuators", "control/status")
 
     @classmethod
@@ -70,6 +79,8 @@ class FixedWingPlugin(Plugin):
         self.nav = bus.latest_reader("nav/state")
         self.status_in = bus.latest_reader("vehicle/status")
         self.mission_changes = bus.latest_reader("mission/changed")
+        self.rc = bus.latest_reader("sensors/rc")
+        self.joystick = bus.latest_reader("link/manual_control")
         self.surfaces = bus.writer("control/actuators")
         self.status_out = bus.writer("control/status")
         self.reached_count = 0
@@ -92,7 +103,9 @@ class FixedWingPlugin(Plugin):
         now_us = self.ctx.clock.now_us()
         self._follow_changes(now_us)
         status = self.status_in.get() or self.default_status
-        out = self.controller.step(nav, status, nav.t_us / 1e6)
+        # The receiver first: a safety pilot's sticks win over the ground station's joystick.
+        sticks = pilot_sticks(nav.t_us, self.rc.get(), self.joystick.get())
+        out = self.controller.step(nav, status, nav.t_us / 1e6, sticks)
         cmd = ActuatorCommand(t_us=nav.t_us, armed=1)
         cmd.aileron, cmd.elevator, cmd.rudder = out.aileron, out.elevator, out.rudder
         cmd.throttle = out.throttle
