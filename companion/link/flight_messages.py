@@ -49,3 +49,13 @@ def landed_state(c: ControlStatus | None) -> int | None:
     if c is None:
         return None
     return d.MAV_LANDED_STATE_ON_GROUND if c.landed else d.MAV_LANDED_STATE_IN_AIR
+
+
+def rc_channels(mav: Any, s: Any) -> Any:
+    """RC_CHANNELS from a telemetry snapshot's receiver frame (none without a receiver:
+    QGroundControl's radio page then stays empty)."""
+    rc = s.rc
+    if rc is None:
+        return None
+    count = min(rc.channel_count, len(rc.channels_us))
+    return mav.rc_channels_encode(s.time_boot_ms, count, *list(rc.channels_us), rc.rssi)

@@ -11,6 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from companion.link import flight_messages
 from companion.link.codec import dialect as d
 from companion.link.flight_messages import landed_state, mission_current, nav_controller_output
 from companion.link.mode_messages import available_modes_monitor, current_mode
@@ -20,6 +21,7 @@ from companion.messages import (
     Imu,
     NavFlags,
     NavState,
+    PilotInput,
     ServoOutput,
     SystemHealth,
     VehicleStatus,
@@ -37,6 +39,7 @@ class Snapshot:
     imu: Imu | None = None
     health: SystemHealth | None = None
     servos: ServoOutput | None = None
+    rc: PilotInput | None = None  # the RC receiver's newest frame
     status: VehicleStatus | None = None
     control: ControlStatus | None = None  # None while the flight controller is not running
     home_alt_m: float = math.nan
@@ -310,6 +313,7 @@ STREAMS: dict[int, Stream] = {
         Stream("SYS_STATUS", d.MAVLINK_MSG_ID_SYS_STATUS, 1.0, _sys_status),
         Stream("SYSTEM_TIME", d.MAVLINK_MSG_ID_SYSTEM_TIME, 0.5, _system_time),
         Stream("SERVO_OUTPUT_RAW", d.MAVLINK_MSG_ID_SERVO_OUTPUT_RAW, 2.0, _servo_output),
+        Stream("RC_CHANNELS", d.MAVLINK_MSG_ID_RC_CHANNELS, 2.0, flight_messages.rc_channels),
         Stream("SCALED_IMU", d.MAVLINK_MSG_ID_SCALED_IMU, 2.0, _scaled_imu),
         Stream("EXTENDED_SYS_STATE", d.MAVLINK_MSG_ID_EXTENDED_SYS_STATE, 1.0, _extended_sys_state),
         Stream("MISSION_CURRENT", d.MAVLINK_MSG_ID_MISSION_CURRENT, 1.0, _mission_current),

@@ -32,6 +32,7 @@ from companion.link.endpoints import (
 from companion.link.gcs_watch import GcsWatch
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
+from companion.link.manual_control import ManualControlService
 from companion.link.mission_service import MissionService
 from companion.link.mode_messages import current_mode, heartbeat_mode
 from companion.link.params_service import ParamsService
@@ -102,8 +103,15 @@ class MavlinkLink(Plugin):
         "link/command_acks",
         "control/status",
         "vehicle/statustext",
+        "sensors/rc",
     )
-    outputs = ("link/commands", "params/changes", "link/status", "mission/changed")
+    outputs = (
+        "link/commands",
+        "params/changes",
+        "link/status",
+        "mission/changed",
+        "link/manual_control",
+    )
 
     @classmethod
     def validate(cls, settings: Mapping[str, Any]) -> list[str]:
@@ -143,6 +151,7 @@ class MavlinkLink(Plugin):
             "servos": bus.latest_reader("actuators/servos"),
             "status": bus.latest_reader("vehicle/status"),
             "control": bus.latest_reader("control/status"),
+            "rc": bus.latest_reader("sensors/rc"),
             "gps": bus.queue_reader("sensors/gps"),
             "imu": bus.queue_reader("sensors/imu"),
         }
@@ -163,12 +172,20 @@ class MavlinkLink(Plugin):
         self.router = LinkRouter(self.mav, self.endpoints, services, key)
         self.gcs = GcsWatch()
         self.router.add_service(self.gcs)
+        self._serve_joystick(ctx, sysid)
         self._serve_params(ctx, sysid)
         self._serve_missions(ctx, sysid)
         register_commands(self.commands, self, self.identity, self.router)
         self.commands.on_refusal = self.refusal_text
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         self._seq = 0
+
+    def _serve_joystick(self, ctx: PluginContext, sysid: int) -> None:
+        joystick = ctx.bus.writer("link/manual_control")
+        self.manual = ManualControlService(
+            sysid, joystick.publish, ctx.clock.now_us, self.refusal_text
+        )
+        self.router.add_service(self.manual)
 
     def _serve_missions(self, ctx: PluginContext, sysid: int) -> None:
         store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
@@ -218,7 +235,7 @@ class MavlinkLink(Plugin):
     def _refresh_snapshot(self) -> None:
         s, r = self.snapshot, self.readers
         s.nav, s.health, s.servos = r["nav"].get(), r["health"].get(), r["servos"].get()
-        s.status = r["status"].get()
+        s.status, s.rc = r["status"].get(), r["rc"].get()
         s.control = self._fresh_control()
         for key in ("gps", "imu"):
             latest = None
@@ -301,7 +318,10 @@ class MavlinkLink(Plugin):
         counts = self.router.counters
         self.ctx.health.frames_ok, self.ctx.health.frames_bad = counts.ok, counts.bad
         self.ctx.health.refused = (
-            self.commands.refused + self._params_service.refused + self.missions.refused
+            self.commands.refused
+            + self._params_service.refused
+            + self.missions.refused
+            + self.manual.refused
         )
 
     def has_commander(self) -> bool:
