@@ -133,6 +133,13 @@ def sim(
     ] = None,
     noise: Annotated[float, typer.Option(help="sensor noise scale (0: perfect)")] = 1.0,
     truth: Annotated[Path | None, typer.Option(help="write the true state CSV here")] = None,
+    pilot: Annotated[
+        Path | None,
+        typer.Option(help="scripted RC pilot: CSV t,roll,pitch,yaw,throttle,switch,signal"),
+    ] = None,
+    servo_log: Annotated[
+        Path | None, typer.Option(help="write the surface commands received (CSV) here")
+    ] = None,
     config: Annotated[Path, CONFIG_OPT] = CONFIGS / "sim.toml",
     namespace: Annotated[str | None, NS_OPT] = None,
     state_dir: Annotated[str | None, typer.Option(help="parameters and missions dir")] = None,
@@ -176,6 +183,8 @@ def sim(
             outages=[_outage(o) for o in gps_outage or []], noise_scale=noise, seed=seed,
             exact=exact, start_at_s=start_at,
             duration_s=duration, truth_path=str(truth) if truth else None,
+            pilot_path=str(pilot) if pilot else None,
+            servo_log_path=str(servo_log) if servo_log else None,
             namespace=namespace or default_namespace(),
         )  # fmt: skip
     except ValueError as exc:

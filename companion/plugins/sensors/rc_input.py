@@ -10,7 +10,8 @@ mapping ``companion.sensors.rc_channels`` (ArduPilot's RCn_* and RCMAP_* paramet
 
 Every frame goes on ``sensors/rc`` (the newest wins); a frame whose mode-switch position
 differs from the last one announced, seen in two frames running and not in failsafe,
-also goes on ``sensors/rc_switch``, which wakes the commander at once.
+also goes on ``sensors/rc_switch``, which wakes the commander at once (the position found
+at start-up is only noted: the switch acts when it moves).
 """
 
 from __future__ import annotations
@@ -46,7 +47,10 @@ class RcInput(Plugin):
         self.live = LiveParams(ctx.bus, self.params, Path(ctx.vehicle.get("state_dir", ".")))
         self.out = ctx.bus.writer("sensors/rc")
         self.switch_out = ctx.bus.writer("sensors/rc_switch")
-        self.announced = -1  # the switch position last put on sensors/rc_switch
+        # The switch position last put on sensors/rc_switch; None until the first one, which
+        # is only noted: a switch is obeyed when it moves, so the vehicle starts in its own
+        # mode wherever the switch happens to be.
+        self.announced: int | None = None
         self.candidate = -1  # a new position seen once, waiting for a second frame
 
     def step(self) -> None:
@@ -91,8 +95,10 @@ class RcInput(Plugin):
         if position != self.candidate:
             self.candidate = position
             return
+        first = self.announced is None
         self.announced, self.candidate = position, -1
-        self.switch_out.publish(msg)
+        if not first:
+            self.switch_out.publish(msg)
 
     def close(self) -> None:
         self.port.close()

@@ -26,13 +26,14 @@ from ground.sitl.bridge.lockstep import (
 )
 from ground.sitl.bridge.options import BridgeOptions
 from ground.sitl.bridge.ptys import PtyPort
+from ground.sitl.bridge.rc_receiver import EmulatedReceiver, load_pilot
 from ground.sitl.bridge.servo_card import MiniSscReader
-from ground.sitl.bridge.truth_log import TruthLog
+from ground.sitl.bridge.truth_log import ServoLog, TruthLog
 from ground.sitl.bridge.vehicle_commands import VehicleCommands
 
 log = logging.getLogger(__name__)
 
-SENSORS = ("gps", "compass", "imu")
+SENSORS = ("gps", "compass", "imu", "rc")
 # What the vehicle's driver of each emulated device publishes (the sim config's drivers).
 DEVICE_CHANNELS = {
     "imu": ("sensors/imu", "sensors/mag", "sensors/baro"),
@@ -66,6 +67,8 @@ class SimBridge:
         errors = SensorErrors(NoiseModel(scale=opts.noise_scale), MagneticField(), opts.seed)
         self.devices = EmulatedDevices(errors, opts.rates, opts.outages)
         self.failures = DeviceFailures(opts.seed)
+        pilot = load_pilot(opts.pilot_path) if opts.pilot_path else None
+        self.receiver = EmulatedReceiver(pilot, opts.rates.rc_hz)
         self.ports = {name: PtyPort(name) for name in (*SENSORS, "servos")}
         self.pending: list[tuple[float, int, str, bytes]] = []  # (release, order, port, data)
         self.order = 0
@@ -76,6 +79,7 @@ class SimBridge:
         stall_s = EXACT_STALL_S if exact else STALL_S
         self.lockstep = Lockstep([self.ports[n] for n in SENSORS], stall_s)
         self.truth = TruthLog(opts.truth_path) if opts.truth_path else None
+        self.servo_log = ServoLog(opts.servo_log_path) if opts.servo_log_path else None
         self.bus = BusNode(opts.namespace, "sim_bridge")
         self.clock = self.bus.writer("sim/clock")
         self.truth_out = self.bus.writer("sim/truth")
@@ -159,7 +163,10 @@ class SimBridge:
         t_us = round(s.t_s * 1e6)
         self.clock.publish(SimClock(t_us=t_us, frame=self.frames))
         self._publish_truth(s, t_us)
-        for name, release, measured in self.devices.due(s, pressure_kpa(s.alt_msl_m)):
+        due = self.devices.due(s, pressure_kpa(s.alt_msl_m))
+        if (frame := self.receiver.due(s.t_s)) is not None:
+            due.append(("rc", s.t_s, frame))
+        for name, release, measured in due:
             data = self.failures.filter(name, measured)
             if data is None:
                 continue
@@ -213,11 +220,15 @@ class SimBridge:
             if servo is not None:
                 controls[servo.surface] = servo.command(received.position)
         self.flight.set_controls(controls)
+        if self.servo_log is not None:
+            self.servo_log.add(self.flight.t_s, controls)
 
     def close(self) -> None:
         """Release the ptys, the truth file and the bus."""
         if self.truth is not None:
             self.truth.close()
+        if self.servo_log is not None:
+            self.servo_log.close()
         for port in self.ports.values():
             port.close()
         self.bus.close()

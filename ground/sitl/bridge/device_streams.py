@@ -121,6 +121,7 @@ class DeviceRates:
     compass_hz: float = 20.0
     gps_hz: float = 5.0
     gps_latency_s: float = 0.1
+    rc_hz: float = 50.0  # SBUS receivers send every 7-20 ms
 
 
 class EmulatedDevices:

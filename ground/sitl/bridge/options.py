@@ -32,6 +32,8 @@ class BridgeOptions:
     seed: int = 1
     duration_s: float | None = None
     truth_path: str | None = None
+    pilot_path: str | None = None  # the scripted RC pilot (rc_receiver.py); None: hands off
+    servo_log_path: str | None = None  # the surface commands received, by simulation time
     namespace: str = "companion"
     hold: bool = False  # wait for "run" on stdin before the first step
 

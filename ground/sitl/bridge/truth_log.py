@@ -38,3 +38,26 @@ class TruthLog:
     def close(self) -> None:
         """Flush and close."""
         self._file.close()
+
+
+class ServoLog:
+    """The surface commands the simulated servos received, by simulation time: one row each
+    time the servo card got bytes, ``t,aileron,elevator,rudder,throttle`` (stick convention,
+    empty when that servo was not among them)."""
+
+    SURFACES = ("aileron", "elevator", "rudder", "throttle")
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._file: TextIO = self.path.open("w", buffering=1 << 16)
+        self._file.write("t," + ",".join(self.SURFACES) + "\n")
+
+    def add(self, t_s: float, controls: dict[str, float]) -> None:
+        """One delivery of servo bytes."""
+        values = [f"{controls[k]:.4f}" if k in controls else "" for k in self.SURFACES]
+        self._file.write(f"{t_s:.4f}," + ",".join(values) + "\n")
+
+    def close(self) -> None:
+        """Flush and close."""
+        self._file.close()
