@@ -10,7 +10,8 @@ sticks centred, throttle closed, switch 1, signal ok. Without a script the pilot
 hands off and the switch where it is, so the vehicle's modes are the ground station's.
 
 The transmitter's channel order is AETR (1 roll, 2 pitch, 3 throttle, 4 yaw) with the mode
-switch on 8, as ArduPilot's defaults expect; sticks span 1000-2000 µs. The frame is written
+switch on 8, as ArduPilot's defaults expect; sticks span 1100-1900 µs (a Futaba-style
+transmitter at ±100 %, which ArduPilot's default RCn_MIN/MAX match). The frame is written
 from the SBUS description here (11-bit channels least significant bit first, 988-2012 µs
 as 172-1811), not with the vehicle's decoder.
 """
@@ -24,7 +25,7 @@ from pathlib import Path
 
 SIGNALS = ("ok", "silent", "failsafe")
 SWITCH_US = (1100, 1295, 1425, 1555, 1685, 1900)  # the middle of each of ArduPilot's bands
-FAILSAFE_THROTTLE_US = 1000
+FAILSAFE_THROTTLE_US = 900  # below THR_FS_VALUE, as ArduPilot asks receivers to be set
 SBUS_FAILSAFE_FLAG = 0x08
 
 
@@ -45,10 +46,10 @@ class PilotRow:
         out = [1500] * 16
 
         def stick(v: float) -> int:
-            return round(1500 + 500 * max(-1.0, min(1.0, v)))
+            return round(1500 + 400 * max(-1.0, min(1.0, v)))
 
         out[0], out[1], out[3] = stick(self.roll), stick(self.pitch), stick(self.yaw)
-        out[2] = round(1000 + 1000 * max(0.0, min(1.0, self.throttle)))
+        out[2] = round(1100 + 800 * max(0.0, min(1.0, self.throttle)))
         out[7] = SWITCH_US[max(1, min(6, self.switch)) - 1]
         return out
 
