@@ -53,3 +53,9 @@ def servo_rows(path: Path) -> list[tuple[float, dict[str, float]]]:
 def matches(surfaces: dict[str, float], expected: dict[str, float], tol: float = 0.02) -> bool:
     """Whether every expected surface got its command (to the servo card's resolution)."""
     return all(abs(surfaces.get(k, 99.0) - v) <= tol for k, v in expected.items())
+
+
+def joystick_times(state_dir: Path) -> list[float]:
+    """When the link put accepted MANUAL_CONTROL sticks on the bus (simulation seconds)."""
+    (log,) = sorted((state_dir / "logs").glob("*_armed.ulg"))[:1]
+    return [t / 1e6 for t in ULog(str(log)).get_dataset("link_manual_control").data["timestamp"]]

@@ -68,7 +68,7 @@ def test_pilot_takes_over_gives_back_and_a_silent_receiver_returns_home(tmp_path
 
     # Back to Auto: the same mission goes on from where it was, not from its start.
     auto = first_entry(modes, FlightMode.MISSION, AUTO_AT)
-    assert auto - AUTO_AT < 1.0
+    assert auto - AUTO_AT < 2.0  # the commander acts on the switch at once (a busy one later)
     after = [(seq, n) for t, seq, n in progress if auto < t < STABILIZED_AT]
     reached_before = max(n for t, _, n in progress if t < MANUAL_AT)
     assert min(seq for seq, _ in after) >= seq_before
@@ -80,6 +80,7 @@ def test_pilot_takes_over_gives_back_and_a_silent_receiver_returns_home(tmp_path
     stabilized = first_entry(modes, FlightMode.STABILIZED, STABILIZED_AT)
     assert stabilized < SILENT_AT
     rtl = first_entry(modes, FlightMode.RTL, SILENT_AT)
-    assert FS_LONG_TIMEOUT <= rtl - SILENT_AT <= FS_LONG_TIMEOUT + 1.0, rtl - SILENT_AT
+    # Judged ten times a vehicle second; a busy commander may act a little later.
+    assert FS_LONG_TIMEOUT <= rtl - SILENT_AT <= FS_LONG_TIMEOUT + 2.0, rtl - SILENT_AT
     assert [m for t, m in modes if stabilized <= t < rtl] == [FlightMode.STABILIZED]
     assert "RC lost, returning home" in out

@@ -31,6 +31,8 @@ DEFAULT_CHANNELS = [
     "sensors/gps",
     "sensors/compass",
     "sensors/baro",
+    "sensors/rc",
+    "link/manual_control",
     "nav/state",
     "control/actuators",
     "control/status",
