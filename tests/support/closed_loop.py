@@ -15,6 +15,7 @@ import numpy as np
 from companion.actuators.airframe import load_airframe
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.params import control_params, flight_config
+from companion.control.flight.pilot import Sticks
 from companion.control.mission.items import MissionItem
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
@@ -51,6 +52,7 @@ class ClosedLoop:
     turbulence: str = "none"
     airborne_agl_m: float | None = None
     overrides: dict[str, float] = field(default_factory=dict)
+    sticks: Sticks | None = None  # a pilot's, for Manual and Stabilized
 
     def __post_init__(self) -> None:
         frame = load_airframe(self.airframe)
@@ -98,7 +100,7 @@ class ClosedLoop:
 
     def _control(self) -> None:
         s = self.flight.state()
-        out = self.controller.step(self.nav(), self.status, s.t_s)
+        out = self.controller.step(self.nav(), self.status, s.t_s, self.sticks)
         self.reached += out.reached
         self.flight.set_controls(
             {
