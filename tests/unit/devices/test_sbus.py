@@ -1,5 +1,5 @@
 """The SBUS codec: frames written bit by bit as the receiver sends them (not with the
-codec's own packing), garbage in between, and the receiver's flags."""
+codec's own packing: tests/support/sbus.py), garbage in between, and the receiver's flags."""
 
 from __future__ import annotations
 
@@ -10,19 +10,9 @@ from hypothesis import strategies as st
 
 from companion.sensors.rc_channels import RC_PARAMS, sticks, switch_position
 from companion.sensors.sbus import SbusDecoder, raw_to_us
+from tests.support.sbus import frame
 
 DEFAULTS = {p.name: p.default for p in RC_PARAMS}
-
-
-def frame(channels: list[int], flags: int = 0, end: int = 0x00) -> bytes:
-    """A frame packed one bit at a time, least significant bit of channel 1 first."""
-    bits = []
-    for value in channels:
-        bits += [(value >> b) & 1 for b in range(11)]
-    data = bytearray(22)
-    for i, bit in enumerate(bits):
-        data[i // 8] |= bit << (i % 8)
-    return bytes([0x0F, *data, flags, end])
 
 
 def test_channels_and_flags_come_through():
