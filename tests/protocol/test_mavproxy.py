@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from companion.control.failsafe import FAILSAFE_PARAMS
+from companion.control.pilot_watch import PILOT_PARAMS
 from companion.plugins.link.mavlink_link import MavlinkLink
 from tests.protocol.mav_client import free_udp_port
 from tests.support.configs import client_vehicle
@@ -78,8 +79,10 @@ def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
     wp = tmp_path / "wp.txt"
     wp.write_text(WAYPOINTS)
     mission = tmp_path / "state" / "missions" / "mission.json"
-    # Every parameter the config's plug-ins declare: the link's rates, the failsafes.
-    said = f"Received {len(MavlinkLink.params) + len(FAILSAFE_PARAMS)} parameters"
+    # Every parameter the config's plug-ins declare: the link's rates, the commander's
+    # failsafes and mode switch.
+    count = len(MavlinkLink.params) + len(FAILSAFE_PARAMS) + len(PILOT_PARAMS)
+    said = f"Received {count} parameters"
     mavproxy = MavProxy(port, tmp_path)
     try:
         mavproxy.connected(vehicle)
