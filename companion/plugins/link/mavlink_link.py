@@ -131,12 +131,7 @@ class MavlinkLink(Plugin):
         super().init(ctx)
         sysid = int(ctx.vehicle.get("sysid", 1))
         self.mav = new_encoder(sysid, ctx.settings["compid"])
-        self.endpoints: list[Endpoint] = []
-        for url in ctx.settings["endpoints"]:
-            try:
-                self.endpoints.append(open_endpoint(url))
-            except (EndpointError, OSError) as exc:
-                raise RuntimeError(f"endpoint {url}: {exc}") from exc
+        self.endpoints = _open_endpoints(ctx.settings["endpoints"])
         autopilot = AUTOPILOTS[ctx.settings["autopilot"]]
         self.identity = IdentityService(self.mav, sysid, autopilot, CAPABILITIES)
         # The first heartbeat already names a mode (the commander's initial one).
@@ -367,3 +362,13 @@ class MavlinkLink(Plugin):
         self.router.close()
         for endpoint in self.endpoints:
             endpoint.close()
+
+
+def _open_endpoints(urls: list[str]) -> list[Endpoint]:
+    endpoints: list[Endpoint] = []
+    for url in urls:
+        try:
+            endpoints.append(open_endpoint(url))
+        except (EndpointError, OSError) as exc:
+            raise RuntimeError(f"endpoint {url}: {exc}") from exc
+    return endpoints
