@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import logging
 import re
 from pathlib import Path
+from typing import BinaryIO
 
 log = logging.getLogger(__name__)
 
@@ -53,6 +56,42 @@ class LogDirectory:
             total -= sizes[path]
             removed.append(path)
         return removed
+
+    def erase(self) -> list[Path]:
+        """Remove every log but one being written (another process holds it locked);
+        the removed paths."""
+        removed = []
+        for path in self.files():
+            if being_written(path):
+                continue
+            try:
+                path.unlink()
+            except OSError as exc:
+                log.warning("cannot erase log %s: %s", path, exc)
+                continue
+            removed.append(path)
+        return removed
+
+
+def hold(stream: BinaryIO) -> None:
+    """Mark a log as being written, for as long as ``stream`` is open (or its writer lives):
+    an advisory lock, released by the kernel even when the writer is killed."""
+    fcntl.flock(stream.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+
+def being_written(path: Path) -> bool:
+    """Whether a writer holds the log (see ``hold``)."""
+    try:
+        with path.open("rb") as probe:
+            try:
+                fcntl.flock(probe.fileno(), fcntl.LOCK_SH | fcntl.LOCK_NB)
+            except OSError:
+                return True
+            with contextlib.suppress(OSError):
+                fcntl.flock(probe.fileno(), fcntl.LOCK_UN)
+    except OSError:
+        return False
+    return False
 
 
 def _size(path: Path) -> int:

@@ -18,6 +18,7 @@ from typing import Any
 from companion.control.mission.store import MissionStore
 from companion.control.modes import INITIAL_MODE
 from companion.control.prearm import PREARM_PARAMS, Readiness, failures
+from companion.flight_log import LogDirectory
 from companion.link.codec import dialect as d
 from companion.link.codec import new_encoder
 from companion.link.command_service import CommandService
@@ -33,6 +34,7 @@ from companion.link.gcs_watch import GcsWatch
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
 from companion.link.manual_control import ManualControlService
+from companion.link.log_transfer import LogTransferService
 from companion.link.mission_service import MissionService
 from companion.link.mode_messages import current_mode, heartbeat_mode
 from companion.link.params_service import ParamsService
@@ -170,6 +172,7 @@ class MavlinkLink(Plugin):
         self._serve_joystick(ctx, sysid)
         self._serve_params(ctx, sysid)
         self._serve_missions(ctx, sysid)
+        self._serve_logs(ctx, sysid)
         register_commands(self.commands, self, self.identity, self.router)
         self.commands.on_refusal = self.refusal_text
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
@@ -190,6 +193,18 @@ class MavlinkLink(Plugin):
         self.mission_changes = ctx.bus.writer("mission/changed")
         self.missions.on_change = self._mission_changed
         self._mission_changed(0)
+
+    def _serve_logs(self, ctx: PluginContext, sysid: int) -> None:
+        """The flight logs system.logger writes, for QGroundControl's Log Download page."""
+        logs = LogDirectory(Path(ctx.vehicle.get("state_dir", ".")) / "logs", budget_bytes=0)
+        budgets = self.router.budgets
+        self.log_transfer = LogTransferService(
+            self.mav, logs, sysid, ctx.settings["compid"],
+            rate_bytes_s=lambda i: budgets[i].rate_bytes_s * budgets[i].scale,
+            armed=lambda: self.identity.state.armed,
+        )  # fmt: skip
+        self.log_transfer.on_refusal = self.refusal_text
+        self.router.add_service(self.log_transfer)
 
     def _mission_changed(self, mission_type: int) -> None:
         now = self.ctx.clock.now_us()
@@ -317,6 +332,7 @@ class MavlinkLink(Plugin):
             + self._params_service.refused
             + self.missions.refused
             + self.manual.refused
+            + self.log_transfer.refused
         )
 
     def has_commander(self) -> bool:

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any, BinaryIO
 
 from companion import __version__
-from companion.flight_log import LogDirectory, ULogWriter, topic_name
+from companion.flight_log import LogDirectory, ULogWriter, hold, topic_name
 from companion.messages.channels import CHANNELS
 from companion.params.store import ParamStore
 from companion.plugin import Plugin, PluginContext, Ports, Setting
@@ -200,6 +200,7 @@ class LoggerPlugin(Plugin):
     def _open(self, label: str) -> None:
         self.path = self.logs.new_path(label)
         self.file = open(self.path, "wb", buffering=256 * 1024)  # noqa: SIM115 - kept open
+        hold(self.file)  # LOG_ERASE leaves it alone while it is written
         topics = [(topic, kind) for _, topic, kind in self.topics]
         self.writer = ULogWriter(self.file, self.ctx.clock.now_us(), topics, self.info, self.params)
         self._flush()  # the definitions are on disk before any data
