@@ -4,10 +4,12 @@ As QGroundControl's Log Download page and MAVProxy's ``log`` module use it:
 LOG_REQUEST_LIST (a range of ids) → one LOG_ENTRY per log (id, size, time), ids from 0 in
 the order the logs were started (``num_logs`` 0 when there is none); LOG_REQUEST_DATA
 (id, offset, count) → LOG_DATA of 90 bytes each from that offset, the last one shorter.
-A request that reaches past the end of a log ending on a 90-byte boundary gets a final
-LOG_DATA with ``count`` 0 (MAVProxy waits for it); a new request replaces the one under
-way (QGroundControl asks for the holes it finds while the rest still streams);
-LOG_REQUEST_END stops. LOG_ERASE removes every log but the one being written, and is
+A request that reaches past the end of a log ending on a 90-byte boundary, or asks from
+the end (up to the next boundary), gets a final LOG_DATA with ``count`` 0 (MAVProxy waits
+for one). A request overlapping the range under
+way replaces it (QGroundControl, after a silence, asks again from its first hole); one
+beside it waits its turn (MAVProxy asks for up to twenty holes at once); LOG_REQUEST_END
+stops. LOG_ERASE removes every log but the one being written, and is
 refused while armed.
 
 The data goes out at a share of the link's byte budget, paced here, so telemetry and
@@ -36,6 +38,7 @@ SHARE = 0.5  # of the link's byte budget; telemetry keeps the rest
 BURST_S = 0.05  # the pacing bucket holds this many seconds of log data
 MAX_FRAMES_PER_TICK = 64  # one link step stays short whatever the budget
 MAX_UINT32 = 0xFFFFFFFF
+MAX_QUEUED = 64  # ranges waiting behind the one under way
 
 
 @dataclass(frozen=True)
@@ -48,13 +51,22 @@ class LogEntry:
 
 
 @dataclass
+class _Range:
+    ofs: int  # next byte to send
+    end: int  # one past the last byte to send
+    eof_marker: bool  # a count-0 LOG_DATA at ``end`` once the data is out
+
+    def overlaps(self, other: _Range) -> bool:
+        return self.ofs <= other.end and other.ofs <= self.end
+
+
+@dataclass
 class _Transfer:
     peer: Peer
     log_id: int
     stream: BinaryIO
-    ofs: int  # next byte to send
-    end: int  # one past the last byte to send
-    eof_marker: bool  # a count-0 LOG_DATA at ``end`` once the data is out
+    now: _Range
+    queued: deque[_Range]
 
 
 class LogTransferService:
@@ -148,14 +160,30 @@ class LogTransferService:
             size = min(path.stat().st_size, MAX_UINT32)
         except OSError as exc:
             return self._refuse(f"log {log_id} ({path.name}) cannot be read: {exc}")
-        if ofs > size:
+        if ofs > -(-size // CHUNK) * CHUNK:
             stream.close()
             return self._refuse(f"LOG_REQUEST_DATA for log {log_id}: offset {ofs} > size {size}")
-        end = min(size, ofs + count)
-        self._stop()
-        eof_marker = ofs + count > size and (size - ofs) % CHUNK == 0
-        self.transfer = _Transfer(peer, log_id, stream, ofs, end, eof_marker)
+        # Past the end (MAVProxy asks there after the short last packet): just the marker.
+        eof_marker = ofs + count > size and (ofs >= size or (size - ofs) % CHUNK == 0)
+        end = max(ofs, min(size, ofs + count))
+        self._add(_Range(ofs, end, eof_marker), log_id, peer, stream)
         return self.tick(now_s)
+
+    def _add(self, wanted: _Range, log_id: int, peer: Peer, stream: BinaryIO) -> None:
+        t = self.transfer
+        if t is None or t.log_id != log_id:
+            self._stop()
+            self.transfer = _Transfer(peer, log_id, stream, wanted, deque())
+            return
+        stream.close()  # the same log: the open one serves
+        t.peer = peer
+        t.queued = deque(r for r in t.queued if not r.overlaps(wanted))
+        if t.now.overlaps(wanted):
+            t.now = wanted
+        elif len(t.queued) < MAX_QUEUED:
+            t.queued.append(wanted)
+        else:
+            self.refused += 1
 
     def _stop(self) -> None:
         if self.transfer is not None:
@@ -204,28 +232,37 @@ class LogTransferService:
     def _next_data(self) -> list[Outgoing]:
         t = self.transfer
         assert t is not None
-        if t.ofs >= t.end:
+        r = t.now
+        if r.ofs >= r.end:
             out = []
-            if t.eof_marker:
-                msg = self.mav.log_data_encode(t.log_id, t.end, 0, bytes(CHUNK))
+            if r.eof_marker:
+                msg = self.mav.log_data_encode(t.log_id, r.end, 0, bytes(CHUNK))
                 out.append(Outgoing(msg, t.peer))
                 self.tokens -= FRAME_BYTES
-            self._stop()
+            self._next_range()
             return out
         try:
-            t.stream.seek(t.ofs)
-            data = t.stream.read(min(CHUNK, t.end - t.ofs))
+            t.stream.seek(r.ofs)
+            data = t.stream.read(min(CHUNK, r.end - r.ofs))
         except OSError as exc:
-            log.warning("log %d: read failed at %d: %s", t.log_id, t.ofs, exc)
+            log.warning("log %d: read failed at %d: %s", t.log_id, r.ofs, exc)
             data = b""
-        if not data:  # the file shrank or vanished: nothing more to send
-            self._stop()
+        if not data:  # the file shrank or vanished: nothing more of this range
+            self._next_range()
             return []
-        msg = self.mav.log_data_encode(t.log_id, t.ofs, len(data), data.ljust(CHUNK, b"\0"))
-        t.ofs += len(data)
+        msg = self.mav.log_data_encode(t.log_id, r.ofs, len(data), data.ljust(CHUNK, b"\0"))
+        r.ofs += len(data)
         self.tokens -= FRAME_BYTES
         self.bytes_sent += len(data)
         return [Outgoing(msg, t.peer)]
+
+    def _next_range(self) -> None:
+        t = self.transfer
+        assert t is not None
+        if t.queued:
+            t.now = t.queued.popleft()
+        else:
+            self._stop()
 
     def next_due(self) -> float:
         """When the pacing allows the next frame (the link waits no longer than that)."""

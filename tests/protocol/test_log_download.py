@@ -3,6 +3,7 @@ Log Download page and MAVProxy's ``log`` module do it, from a vehicle that recor
 
 from __future__ import annotations
 
+import logging
 import time
 from pathlib import Path
 
@@ -155,5 +156,6 @@ def test_mavproxy_log_list_and_download(vehicle_factory, tmp_path):
         wait_for(lambda: "Finished downloading" in "".join(mavproxy.lines), 120, "the download")
     finally:
         output = mavproxy.close()
+        logging.getLogger(__name__).info("MAVProxy said:\n%s", output[-3000:])
     assert f"size {on_board.stat().st_size}" in output
     assert (tmp_path / "flight.ulg").read_bytes() == on_board.read_bytes()
