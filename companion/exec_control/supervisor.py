@@ -13,7 +13,14 @@ import signal
 import time
 from dataclasses import asdict
 
-from companion.bus import BusNode, MonotonicClock, Reader, cleanup_namespace
+from companion.bus import (
+    BusNode,
+    MonotonicClock,
+    Reader,
+    SimulationClock,
+    VehicleClock,
+    cleanup_namespace,
+)
 from companion.exec_control.child import FIRST_BACKOFF_S, Child
 from companion.exec_control.config import VehicleConfig
 from companion.exec_control.registry import load
@@ -59,7 +66,7 @@ class Supervisor:
         self.flight_running = False
         self.reason = ""  # why the last command was refused, for its ack
         self.stopping = False
-        self.clock = MonotonicClock()
+        self.clock: VehicleClock = MonotonicClock()
         self.until: float | None = None
 
     def request_stop(self, signum: int, _frame: object) -> None:
@@ -189,6 +196,10 @@ class Supervisor:
         return 0
 
     def _loop(self, bus: BusNode) -> None:
+        if self.cfg.vehicle.get("clock") == "sim":
+            # The health table and the acks share the plug-ins' time base: one timeline
+            # in the flight log, not sim time beside the host's uptime.
+            self.clock = SimulationClock(bus.latest_reader("sim/clock"))
         health = bus.writer("system/health")
         acks = bus.writer("link/command_acks")
         commands = bus.queue_reader("link/commands")

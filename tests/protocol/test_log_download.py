@@ -46,9 +46,7 @@ def record_flight(vehicle: Vehicle, logs: Path) -> Path:
     """Arm, record until the log is a few chunks long, disarm; the closed log."""
     wait_for(lambda: (r := vehicle.row("logger")) is not None and r.step_p50_us > 0, 30, "logger")
     _command(vehicle, CommandId.START, 1)
-    wait_for(
-        lambda: any(p.stat().st_size > MIN_LOG_BYTES for p in logs.glob("*.ulg")), 60, "a log"
-    )
+    wait_for(lambda: any(p.stat().st_size > MIN_LOG_BYTES for p in logs.glob("*.ulg")), 60, "a log")
     _command(vehicle, CommandId.STOP, 2)
     (path,) = logs.glob("*.ulg")
     wait_for(lambda: not being_written(path), 30, "the log closed")

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from pyulog import ULog
 
-from companion.messages import CommandId, VehicleCommand
+from companion.messages import CommandId, SimClock, VehicleCommand
 from tests.support.configs import plugin, vehicle_config
 from tests.support.vehicle import Vehicle, wait_for
 
@@ -114,3 +114,40 @@ def test_from_boot_logs_while_disarmed(vehicle_factory, tmp_path):
     # The Ticker numbers its samples: from the first the logger saw, none lost or repeated.
     assert len(ax) >= 50
     assert ax == [ax[0] + i for i in range(len(ax))]
+
+
+def test_a_simulated_vehicle_logs_on_one_time_base(vehicle_factory, tmp_path):
+    """In SITL every stamp is simulation time, the supervisor's health table included: a
+    log that mixed in the host's uptime would span hours in Flight Review."""
+    state = tmp_path / "state"
+    vehicle = vehicle_factory(
+        vehicle_config(
+            "simtime",
+            plugin("logger", "system.logger", from_boot=True, flush_s=0.2),
+            plugin("imu", "tests.support.plugins:Ticker", rate_hz=100.0),
+            state_dir=state,
+            clock="sim",
+        )
+    )
+    assert vehicle.bus is not None
+    clock = vehicle.bus.writer("sim/clock")
+    first_us = t_us = 5_000_000_000  # far from this host's uptime
+
+    def health_logged() -> bool:
+        nonlocal t_us
+        t_us += 10_000
+        clock.publish(SimClock(t_us=t_us))
+        ulog = read_log(state / "logs")
+        try:
+            return ulog is not None and len(ulog.get_dataset("system_health").data["timestamp"]) > 2
+        except (KeyError, IndexError, ValueError):
+            return False
+
+    wait_for(health_logged, 60, "health tables in the log", period_s=0.01)
+    vehicle.stop()
+    ulog = read_log(state / "logs")
+    assert ulog is not None
+    for data in ulog.data_list:
+        stamps = [int(t) for t in data.data["timestamp"]]
+        assert all(first_us <= t <= t_us for t in stamps if t), (data.name, stamps[:3])
+    assert {d.name for d in ulog.data_list} >= {"system_health", "sensors_imu"}
