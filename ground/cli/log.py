@@ -15,8 +15,13 @@ from ground.cli.extras import require_ground_extra
 def log(
     ulog: Annotated[Path, typer.Argument(metavar="FLIGHT.ulg", help="an on-board flight log")],
     out_path: Annotated[Path, typer.Option("--out", "-o", help="sensor log CSV to write")],
+    estimate: Annotated[
+        Path | None,
+        typer.Option(help="also write the estimate the vehicle made in flight (estimate CSV)"),
+    ] = None,
 ) -> None:
-    """Convert an on-board ULog flight log to the sensor log CSV `companion replay` reads."""
+    """Convert an on-board ULog flight log to the sensor log CSV `companion replay` reads
+    (and, with --estimate, the vehicle's own navigation estimate)."""
     require_ground_extra("log", "pyulog")
     from ground.flight_log_csv import write_sensor_log
 
@@ -26,6 +31,12 @@ def log(
     try:
         with out_path.open("w", newline="") as handle:
             rows = write_sensor_log(ulog, handle)
+        if estimate is not None:
+            from ground.replay.flight_log import write_flight_estimate
+
+            out.print(
+                f"{write_flight_estimate(ulog, estimate)} estimate rows written to {estimate}"
+            )
     except (OSError, ValueError, IndexError) as exc:
         err.print(f"[red]cannot convert {ulog}: {exc}[/red]")
         raise typer.Exit(EXIT_CONFIG) from None

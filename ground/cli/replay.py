@@ -23,7 +23,8 @@ def replay(
         list[str],
         typer.Argument(
             metavar="LOG",
-            help="sensor log CSVs (the design's format), folders of them or quoted patterns",
+            help="sensor log CSVs (the design's format) or on-board flight logs (.ulg), "
+            "folders of them or quoted patterns",
         ),
     ],
     out_path: Annotated[
@@ -95,10 +96,13 @@ def _replay_one(
     _print_replay_summary(summary)
     if plot is not None:
         from companion.navigation.estimate_csv import read_estimate
+        from ground.replay.flight_log import as_track
         from ground.replay.plot import plot_replay
 
-        plot_replay(states, plot, f"{log.name}: {navigator}", fixes,
-                    read_estimate(truth) if truth else None)  # fmt: skip
+        reference, label = (read_estimate(truth), "truth") if truth else (None, "")
+        if reference is None and summary.flown:
+            reference, label = as_track(summary.flown), "in flight"
+        plot_replay(states, plot, f"{log.name}: {navigator}", fixes, reference, label)
         err.print(f"plot written to {plot}")
 
 
@@ -136,3 +140,11 @@ def _print_replay_summary(s) -> None:
         f"longest GPS gap {s.longest_outage_s:.1f} s; final horizontal 1-sigma "
         f"{s.final_pos_std_m:.1f} m; samples flagged {s.flagged}"
     )
+    f = s.flight
+    if f is not None:
+        out.print(
+            f"against the estimate made in flight ({f.compared} solutions): horizontal "
+            f"RMS {f.horizontal_rms_m:.2f} m (max {f.horizontal_max_m:.2f} m), altitude RMS "
+            f"{f.altitude_rms_m:.2f} m, tilt RMS {f.tilt_rms_deg:.2f}°, yaw RMS "
+            f"{f.yaw_rms_deg:.2f}°"
+        )

@@ -24,6 +24,7 @@ def plot_replay(
     title: str,
     fixes: list[GpsFix] | None = None,
     truth: dict[str, np.ndarray] | None = None,
+    truth_label: str = "truth",
 ) -> None:
     """Write a PNG with the path (left) and attitude / velocity against time (right)."""
     valid = [s for s in states if s.flags & NavFlags.POSITION_VALID]
@@ -45,7 +46,7 @@ def plot_replay(
         path.plot([f.lon_deg for f in fixes], [f.lat_deg for f in fixes], "x", ms=3,
                   color="tab:gray", label="GPS fixes")  # fmt: skip
     if truth is not None:
-        path.plot(truth["lon"], truth["lat"], "--", lw=0.8, color="black", label="truth")
+        path.plot(truth["lon"], truth["lat"], "--", lw=0.8, color="black", label=truth_label)
     if len(col["lat_deg"]):
         path.set_aspect(1.0 / math.cos(math.radians(float(np.nanmean(col["lat_deg"])))))
     path.set(xlabel="longitude (°)", ylabel="latitude (°)", title=title)

@@ -17,6 +17,14 @@ from companion.messages import GpsFix, Message, NavFlags, NavState
 from companion.navigation.estimate_csv import EstimateWriter
 from companion.navigation.offline import NAVIGATORS, run_navigator, true_headings
 from companion.sensors.sensorlog import LogStats, read_sensor_log
+from ground.replay.flight_log import (
+    FlightComparison,
+    compare,
+    flight_estimate,
+    is_flight_log,
+    load,
+    sensor_samples,
+)
 
 PROGRESS_ROWS = 2000
 # A gap between fixes counts as an outage beyond this: twice the period of the slowest
@@ -47,6 +55,9 @@ class ReplaySummary:
     final_tilt_std_deg: float = math.nan  # the larger of roll and pitch
     final_yaw_std_deg: float = math.nan
     flagged: dict[str, int] = field(default_factory=dict)
+    # An on-board log: the replay against the estimate the vehicle made in flight.
+    flight: FlightComparison | None = None
+    flown: list[NavState] = field(default_factory=list, repr=False)
 
     @property
     def speed(self) -> float:
@@ -54,8 +65,10 @@ class ReplaySummary:
         return self.log_seconds / self.wall_seconds if self.wall_seconds else math.inf
 
 
-def count_rows(path: Path) -> int:
-    """Data rows in a CSV file (for the progress bar)."""
+def count_rows(path: Path) -> int | None:
+    """Data rows in a CSV file (for the progress bar); None for an on-board log."""
+    if is_flight_log(path):
+        return None  # it would be read twice
     with path.open("rb") as handle:
         return max(
             0, sum(chunk.count(b"\n") for chunk in iter(lambda: handle.read(1 << 20), b"")) - 1
@@ -94,9 +107,13 @@ def replay_log(
     summary = ReplaySummary(log, navigator)
     stats = LogStats()
     nav = NAVIGATORS[navigator](declination_deg)
-    samples = _watch_gps(
-        true_headings(read_sensor_log(log, stats), declination_deg), summary, fixes
-    )
+    if is_flight_log(log):
+        ulog = load(log)
+        summary.flown = flight_estimate(ulog)
+        source = sensor_samples(ulog, stats)
+    else:
+        source = read_sensor_log(log, stats)
+    samples = _watch_gps(true_headings(source, declination_deg), summary, fixes)
     writer = EstimateWriter(out)
     states: list[NavState] = []
     started = time.perf_counter()
@@ -122,6 +139,8 @@ def replay_log(
         progress(stats.rows - summary.rows)
     summary.wall_seconds = time.perf_counter() - started
     _summarise(summary, stats, writer.rows, states)
+    if is_flight_log(log):
+        summary.flight = compare(states, summary.flown)
     return summary, states
 
 
