@@ -2,10 +2,11 @@
 station would fly it, watched until the mission completes, then scored from the truth.
 
 Each flight has its own bus namespace, UDP port, state dir and process group, so flights
-on one machine never meet; its directory keeps the simulator's log, the truth CSV and
-the timeline (mission progress, STATUSTEXTs). A flight that dies, stalls or runs past its
-wall-clock limit ends as ``failed`` with the reason; its processes are ended by their own
-process group.
+on one machine never meet; its directory keeps the simulator's log, the truth CSV, the
+timeline (mission progress, STATUSTEXTs) and the vehicle's own flight log
+(``flight.ulg``, for ``companion replay`` and the ULog tools, also when the flight
+failed). A flight that dies, stalls or runs past its wall-clock limit ends as ``failed``
+with the reason; its processes are ended by their own process group.
 """
 
 from __future__ import annotations
@@ -88,7 +89,23 @@ def fly_flight(job: FlightJob) -> dict[str, Any]:
         error = str(exc)
     (folder / "timeline.json").write_text(json.dumps(timeline.__dict__, indent=1))
     row = _row(flight, folder, timeline, error, time.monotonic() - started)
+    row["flight_log"] = ";".join(str(p) for p in keep_flight_logs(folder))
     return row
+
+
+def keep_flight_logs(folder: Path) -> list[Path]:
+    """The vehicle's on-board logs of the flight moved beside its results: ``flight.ulg``
+    (``flight_2.ulg``... if it armed more than once); the kept paths."""
+    kept = []
+    for i, path in enumerate(sorted((folder / "state" / "logs").glob("*.ulg")), 1):
+        target = folder / ("flight.ulg" if i == 1 else f"flight_{i}.ulg")
+        try:
+            path.replace(target)
+        except OSError as exc:
+            log.warning("cannot keep the flight log %s: %s", path, exc)
+            continue
+        kept.append(target)
+    return kept
 
 
 def failed_row(job: FlightJob, error: str) -> dict[str, Any]:

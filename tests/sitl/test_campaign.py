@@ -16,6 +16,7 @@ from pathlib import Path
 
 import psutil
 import pytest
+from pyulog import ULog
 
 from ground.campaign.flight_run import FlightJob, fly_flight
 from ground.campaign.spec import Flight
@@ -81,6 +82,11 @@ def test_a_small_campaign_scores_each_flight_and_survives_hung_ones(tmp_path):
         assert float(row["alt_rms_m"]) < 5.0 and int(row["samples"]) > 100
         assert 60.0 < float(row["time_to_complete_s"]) < float(row["sim_s"])
         assert row["failsafes"] == "", row  # nothing went wrong on these flights
+        # The vehicle's own log of the flight is kept beside the results, whole.
+        ulog = ULog(row["flight_log"])
+        assert Path(row["flight_log"]).parent == out / row["flight_id"]
+        assert ulog.last_timestamp / 1e6 > float(row["time_to_complete_s"])
+        assert len(ulog.get_dataset("nav_state").data["timestamp"]) > 1000
     for row in hung:
         assert row["status"] == "failed" and "hung" in row["error"], row
         assert math.isnan(float(row["xtrack_rms_m"]))
