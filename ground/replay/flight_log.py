@@ -45,12 +45,13 @@ def load(path: Path) -> ULog:
 
 def _columns(msg_type: type[Message], data: dict[str, np.ndarray]) -> list[tuple[str, Any]]:
     """(field, values) for every field; an array field's values are one column per element."""
-    columns = []
+    columns: list[tuple[str, Any]] = []
     for name, ctype, *_ in msg_type._fields_:
         if name == "t_us":
             columns.append((name, data["timestamp"]))
         elif issubclass(ctype, ctypes.Array):
-            columns.append((name, [data[f"{name}[{i}]"] for i in range(ctype._length_)]))
+            length = int(getattr(ctype, "_length_"))  # noqa: B009 - ctypes' own attribute
+            columns.append((name, [data[f"{name}[{i}]"] for i in range(length)]))
         else:
             columns.append((name, data[name]))
     return columns
