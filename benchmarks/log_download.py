@@ -89,15 +89,15 @@ def over_udp(tmp: Path, log: Path | None, size: int) -> None:
     port = free_udp_port()
     proc, target = start_vehicle(f"udpin://127.0.0.1:{port}", tmp / "udp", log, size)
     gcs = GroundStation(port)
+    counting = Counting(gcs.conn)
     try:
         gcs.connect()
-        counting = Counting(gcs.conn)
         t0 = time.monotonic()
         while time.monotonic() - t0 < 3.0:
             gcs.heartbeat()
             counting.recv_match(type="NONE", timeout=0.5)
         before, counting.counts = counting.counts, Counter()
-        gcs.conn = counting
+        gcs.conn = counting  # type: ignore[assignment]
         real = target.stat().st_size
         dl = QgcDownload(gcs, 0, real)
         t0 = time.monotonic()
@@ -106,8 +106,10 @@ def over_udp(tmp: Path, log: Path | None, size: int) -> None:
         assert data == target.read_bytes(), "the download differs from the file"
         report("UDP", real, seconds, dl, before, counting.counts, 3.0)
     finally:
-        gcs.close()
-        stop(proc)
+        try:
+            counting.conn.close()
+        finally:
+            stop(proc)
 
 
 class Radio:
