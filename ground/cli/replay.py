@@ -43,6 +43,13 @@ def replay(
             "default: the World Magnetic Model's at the first fix"
         ),
     ] = None,
+    gps_delay: Annotated[
+        float | None,
+        typer.Option(
+            help="ins_ekf: seconds a fix reaches the navigator after it was measured (the nav "
+            "plug-in's gps_delay_s, 0.1 in companion sim); default: measured from the log"
+        ),
+    ] = None,
     address: Annotated[
         str | None, typer.Option(help="many logs: Ray cluster address (default: local)")
     ] = None,
@@ -66,12 +73,12 @@ def replay(
             raise typer.BadParameter("--truth goes with a single log")
         _replay_batch(logs, out_path, navigator, plot, rate, declination, address, cpus)
     else:
-        _replay_one(Path(logs[0]), out_path, navigator, plot, truth, rate, declination)
+        _replay_one(Path(logs[0]), out_path, navigator, plot, truth, rate, declination, gps_delay)
 
 
 def _replay_one(
     log: Path, out_path: Path, navigator: str, plot: Path | None, truth: Path | None,
-    rate: float, declination: float | None,
+    rate: float, declination: float | None, gps_delay: float | None = None,
 ) -> None:  # fmt: skip
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
@@ -88,7 +95,7 @@ def _replay_one(
         try:
             summary, states = replay_log(
                 log, navigator, out_path, rate, declination,
-                lambda n: bar.advance(task, n), fixes if plot else None,
+                lambda n: bar.advance(task, n), fixes if plot else None, gps_delay,
             )  # fmt: skip
         except ValueError as exc:
             err.print(f"[red]{exc}[/red]", highlight=False, soft_wrap=True)

@@ -15,7 +15,14 @@ from pathlib import Path
 
 from companion.messages import GpsFix, Message, NavFlags, NavState
 from companion.navigation.estimate_csv import EstimateWriter
-from companion.navigation.offline import NAVIGATORS, run_navigator, true_headings
+from companion.navigation.ins_config import InsEkfConfig
+from companion.navigation.offline import (
+    NAVIGATORS,
+    InsEkfRunner,
+    Navigator,
+    run_navigator,
+    true_headings,
+)
 from companion.sensors.sensorlog import LogStats, read_sensor_log
 from ground.replay.flight_log import (
     FlightComparison,
@@ -102,11 +109,19 @@ def replay_log(
     declination_deg: float | None = None,
     progress: Callable[[int], None] | None = None,
     fixes: list[GpsFix] | None = None,
+    gps_delay_s: float | None = None,
 ) -> tuple[ReplaySummary, list[NavState]]:
-    """Run the navigator over the log; write the estimate; return a summary and the states."""
+    """Run the navigator over the log; write the estimate; return a summary and the states.
+
+    ``gps_delay_s`` (ins_ekf): how late fixes arrive, as the nav plug-in's setting; None:
+    measured from the log."""
     summary = ReplaySummary(log, navigator)
     stats = LogStats()
-    nav = NAVIGATORS[navigator](declination_deg)
+    if navigator == "ins_ekf" and gps_delay_s is not None:
+        config = InsEkfConfig(declination_deg=declination_deg, gps_delay_s=gps_delay_s)
+        nav: Navigator = InsEkfRunner(config=config)
+    else:
+        nav = NAVIGATORS[navigator](declination_deg)
     if is_flight_log(log):
         ulog = load(log)
         summary.flown = flight_estimate(ulog)

@@ -40,7 +40,7 @@ def test_a_flown_ulog_replays_near_the_flight_estimate(tmp_path):
     estimate = tmp_path / "replayed.csv"
     result = subprocess.run(
         [sys.executable, "-m", "companion", "replay", str(flight), "--out", str(estimate),
-         "--declination", "11.7"],
+         "--declination", "11.7", "--gps-delay", "0.1"],  # the nav plug-in's in sim.toml
         cwd=REPO, capture_output=True, text=True, timeout=120,
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
@@ -48,8 +48,9 @@ def test_a_flown_ulog_replays_near_the_flight_estimate(tmp_path):
     assert "against the estimate made in flight" in said, said
     figures = {k: float(v) for k, v in re.findall(r"(\w+) RMS ([0-9.]+)", said)}
     line = said
-    assert figures["horizontal"] < 10.0 and figures["altitude"] < 5.0, line
-    assert figures["tilt"] < 2.0 and figures["yaw"] < 5.0, line
+    # Quiet runs see 0.3 m, 0.6 m, 0.2° and 0.7°; a navigator starved of CPU in flight lags.
+    assert figures["horizontal"] < 5.0 and figures["altitude"] < 3.0, line
+    assert figures["tilt"] < 1.5 and figures["yaw"] < 3.0, line
     replayed = read_estimate(estimate)
     assert replayed["t"][-1] == pytest.approx(DURATION_S, abs=0.5)
 
