@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 from pyulog import ULog
+from pyulog.exceptions import ULogException
 
 from companion.flight_log import topic_name
 from companion.messages import Message, NavFlags, NavState
@@ -39,7 +40,7 @@ def load(path: Path) -> ULog:
     """The log with only what replay uses parsed."""
     try:
         return ULog(str(path), [topic_name(c) for c in (*SENSOR_CHANNELS, NAV_CHANNEL)])
-    except (OSError, ValueError, IndexError, KeyError) as exc:
+    except (OSError, ValueError, IndexError, KeyError, ULogException) as exc:
         raise ValueError(f"{path}: not a readable ULog file ({exc})") from None
 
 

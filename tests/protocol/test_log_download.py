@@ -12,6 +12,7 @@ from pyulog import ULog
 
 from companion.flight_log import being_written
 from companion.messages import CommandId, VehicleCommand
+from mavlink_dialect import companion as m
 from tests.protocol.log_client import QgcDownload, list_logs
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.protocol.test_mavproxy import MavProxy
@@ -128,6 +129,8 @@ def test_hostile_requests_are_refused_and_erase_waits_for_disarm(vehicle_factory
 
         _command(vehicle, CommandId.START, 3)
         wait_for(lambda: len(list(on_board.parent.glob("*.ulg"))) == 2, 30, "a second log")
+        armed = m.MAV_MODE_FLAG_SAFETY_ARMED
+        wait_for(lambda: gcs.recv("HEARTBEAT", 5).base_mode & armed, 30, "armed, as QGC sees")
         mav.log_erase_send(1, 1)
         gcs.recv("STATUSTEXT", 10, text="Logs not erased: armed")  # told why
         assert on_board.exists()

@@ -8,6 +8,7 @@ import signal
 from pathlib import Path
 
 from pyulog import ULog
+from pyulog.exceptions import ULogException
 
 from companion.messages import CommandId, SimClock, VehicleCommand
 from tests.support.configs import plugin, vehicle_config
@@ -36,7 +37,7 @@ def read_log(logs: Path) -> ULog | None:
     try:
         ulog = ULog(str(files[-1]))
         ulog.get_dataset("sensors_imu")
-    except (IndexError, ValueError, KeyError):
+    except (IndexError, ValueError, KeyError, ULogException):  # not written far enough yet
         return None
     return ulog
 

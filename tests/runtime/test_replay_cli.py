@@ -45,3 +45,14 @@ def test_a_missing_log_is_a_clear_error(tmp_path):
         cwd=REPO, capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert result.returncode == 2 and "no such file" in result.stderr
+
+
+def test_a_file_that_is_not_a_ulog_is_a_clear_error(tmp_path):
+    broken = tmp_path / "flight.ulg"
+    broken.write_bytes(b"ULog\x01garbage")
+    result = subprocess.run(
+        [sys.executable, "-m", "companion", "replay", str(broken), "--out",
+         str(tmp_path / "e.csv")],
+        cwd=REPO, capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert result.returncode == 2 and "not a readable ULog file" in result.stderr, result.stderr

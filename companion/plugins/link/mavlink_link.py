@@ -201,10 +201,15 @@ class MavlinkLink(Plugin):
         self.log_transfer = LogTransferService(
             self.mav, logs, sysid, ctx.settings["compid"],
             rate_bytes_s=lambda i: budgets[i].rate_bytes_s * budgets[i].scale,
-            armed=lambda: self.identity.state.armed,
+            armed=self._armed_now,
         )  # fmt: skip
         self.log_transfer.on_refusal = self.refusal_text
         self.router.add_service(self.log_transfer)
+
+    def _armed_now(self) -> bool:
+        """Armed as the health table says at this moment (not as of the last step)."""
+        health = self.readers["health"].get()
+        return health is not None and bool(health.flight_running)
 
     def _mission_changed(self, mission_type: int) -> None:
         now = self.ctx.clock.now_us()
