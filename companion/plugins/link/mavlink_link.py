@@ -33,8 +33,8 @@ from companion.link.endpoints import (
 from companion.link.gcs_watch import GcsWatch
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
-from companion.link.manual_control import ManualControlService
 from companion.link.log_transfer import LogTransferService
+from companion.link.manual_control import ManualControlService
 from companion.link.mission_service import MissionService
 from companion.link.mode_messages import current_mode, heartbeat_mode
 from companion.link.params_service import ParamsService
