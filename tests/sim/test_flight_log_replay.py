@@ -12,6 +12,7 @@ from pyulog import ULog
 
 from companion.messages import NavFlags
 from companion.navigation.estimate_csv import read_estimate
+from ground.replay.flight_log import SENSOR_CHANNELS
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
 from tests.support.vehicle import REPO
@@ -62,7 +63,9 @@ def test_a_flown_ulog_replays_near_the_flight_estimate(tmp_path):
         cwd=REPO, capture_output=True, text=True, timeout=120,
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
-    logged = sum(len(d.data["timestamp"]) for d in ulog.data_list if d.name.startswith("sensors_"))
+    # Every navigation sensor's sample (the pilot's sticks, also under sensors/, are not one).
+    navigation = {channel.replace("/", "_") for channel in SENSOR_CHANNELS}
+    logged = sum(len(d.data["timestamp"]) for d in ulog.data_list if d.name in navigation)
     assert len(sensors.read_text().splitlines()) == logged + 1
     in_flight = read_estimate(flown)
     nav = ulog.get_dataset("nav_state").data
