@@ -6553,6 +6553,8 @@ enums["MAV_COMPONENT"][251] = EnumEntry("MAV_COMPONENT_ENUM_END", """""")
 MAVLINK_MSG_ID_BAD_DATA = -1
 MAVLINK_MSG_ID_UNKNOWN = -2
 MAVLINK_MSG_ID_PROTOCOL_VERSION = 300
+MAVLINK_MSG_ID_COMPONENT_INFORMATION = 395
+MAVLINK_MSG_ID_COMPONENT_METADATA = 397
 MAVLINK_MSG_ID_PLUGIN_HEALTH = 52000
 MAVLINK_MSG_ID_NAV_STATUS = 52001
 MAVLINK_MSG_ID_MISSION_CHECKSUM = 53
@@ -6816,6 +6818,97 @@ class MAVLink_protocol_version_message(MAVLink_message):
 # Define name on the class for backwards compatibility (it is now msgname).
 # Done with setattr to hide the class variable from mypy.
 setattr(MAVLink_protocol_version_message, "name", mavlink_msg_deprecated_name_property())
+
+
+class MAVLink_component_information_message(MAVLink_message):
+    """
+    Where the component's general metadata file is (QGroundControl 4.x
+    asks for it when COMPONENT_METADATA is refused). Defined here
+    because the common.xml pymavlink ships lacks it; wire-compatible
+    with the upstream definition (id 395).
+    """
+
+    id = MAVLINK_MSG_ID_COMPONENT_INFORMATION
+    msgname = "COMPONENT_INFORMATION"
+    fieldnames = ["time_boot_ms", "general_metadata_file_crc", "general_metadata_uri", "peripherals_metadata_file_crc", "peripherals_metadata_uri"]
+    ordered_fieldnames = ["time_boot_ms", "general_metadata_file_crc", "peripherals_metadata_file_crc", "general_metadata_uri", "peripherals_metadata_uri"]
+    fieldtypes = ["uint32_t", "uint32_t", "char", "uint32_t", "char"]
+    fielddisplays_by_name: Dict[str, str] = {}
+    fieldenums_by_name: Dict[str, str] = {}
+    fieldunits_by_name: Dict[str, str] = {"time_boot_ms": "ms"}
+    native_format = bytearray(b"<IIIcc")
+    orders = [0, 1, 3, 2, 4]
+    lengths = [1, 1, 1, 1, 1]
+    array_lengths = [0, 0, 0, 100, 100]
+    crc_extra = 0
+    unpacker = struct.Struct("<III100s100s")
+    instance_field = None
+    instance_offset = -1
+
+    def __init__(self, time_boot_ms: int, general_metadata_file_crc: int, general_metadata_uri: bytes, peripherals_metadata_file_crc: int, peripherals_metadata_uri: bytes):
+        MAVLink_message.__init__(self, MAVLink_component_information_message.id, MAVLink_component_information_message.msgname)
+        self._fieldnames = MAVLink_component_information_message.fieldnames
+        self._instance_field = MAVLink_component_information_message.instance_field
+        self._instance_offset = MAVLink_component_information_message.instance_offset
+        self.time_boot_ms = time_boot_ms
+        self.general_metadata_file_crc = general_metadata_file_crc
+        self._general_metadata_uri_raw = general_metadata_uri
+        self.general_metadata_uri = general_metadata_uri.split(b"\x00", 1)[0].decode("ascii", errors="replace")
+        self.peripherals_metadata_file_crc = peripherals_metadata_file_crc
+        self._peripherals_metadata_uri_raw = peripherals_metadata_uri
+        self.peripherals_metadata_uri = peripherals_metadata_uri.split(b"\x00", 1)[0].decode("ascii", errors="replace")
+
+    def pack(self, mav: "MAVLink", force_mavlink1: bool = False) -> bytes:
+        return self._pack(mav, self.crc_extra, self.unpacker.pack(self.time_boot_ms, self.general_metadata_file_crc, self.peripherals_metadata_file_crc, self._general_metadata_uri_raw, self._peripherals_metadata_uri_raw), force_mavlink1=force_mavlink1)
+
+
+# Define name on the class for backwards compatibility (it is now msgname).
+# Done with setattr to hide the class variable from mypy.
+setattr(MAVLink_component_information_message, "name", mavlink_msg_deprecated_name_property())
+
+
+class MAVLink_component_metadata_message(MAVLink_message):
+    """
+    Where the component's general metadata file is, and its CRC for
+    caching (the component information protocol). Defined here because
+    the common.xml pymavlink ships lacks it; wire-compatible with the
+    upstream definition (id 397).
+    """
+
+    id = MAVLINK_MSG_ID_COMPONENT_METADATA
+    msgname = "COMPONENT_METADATA"
+    fieldnames = ["time_boot_ms", "file_crc", "uri"]
+    ordered_fieldnames = ["time_boot_ms", "file_crc", "uri"]
+    fieldtypes = ["uint32_t", "uint32_t", "char"]
+    fielddisplays_by_name: Dict[str, str] = {}
+    fieldenums_by_name: Dict[str, str] = {}
+    fieldunits_by_name: Dict[str, str] = {"time_boot_ms": "ms"}
+    native_format = bytearray(b"<IIc")
+    orders = [0, 1, 2]
+    lengths = [1, 1, 1]
+    array_lengths = [0, 0, 100]
+    crc_extra = 182
+    unpacker = struct.Struct("<II100s")
+    instance_field = None
+    instance_offset = -1
+
+    def __init__(self, time_boot_ms: int, file_crc: int, uri: bytes):
+        MAVLink_message.__init__(self, MAVLink_component_metadata_message.id, MAVLink_component_metadata_message.msgname)
+        self._fieldnames = MAVLink_component_metadata_message.fieldnames
+        self._instance_field = MAVLink_component_metadata_message.instance_field
+        self._instance_offset = MAVLink_component_metadata_message.instance_offset
+        self.time_boot_ms = time_boot_ms
+        self.file_crc = file_crc
+        self._uri_raw = uri
+        self.uri = uri.split(b"\x00", 1)[0].decode("ascii", errors="replace")
+
+    def pack(self, mav: "MAVLink", force_mavlink1: bool = False) -> bytes:
+        return self._pack(mav, self.crc_extra, self.unpacker.pack(self.time_boot_ms, self.file_crc, self._uri_raw), force_mavlink1=force_mavlink1)
+
+
+# Define name on the class for backwards compatibility (it is now msgname).
+# Done with setattr to hide the class variable from mypy.
+setattr(MAVLink_component_metadata_message, "name", mavlink_msg_deprecated_name_property())
 
 
 class MAVLink_plugin_health_message(MAVLink_message):
@@ -17363,6 +17456,8 @@ setattr(MAVLink_heartbeat_message, "name", mavlink_msg_deprecated_name_property(
 
 mavlink_map: Dict[int, Type[MAVLink_message]] = {
     MAVLINK_MSG_ID_PROTOCOL_VERSION: MAVLink_protocol_version_message,
+    MAVLINK_MSG_ID_COMPONENT_INFORMATION: MAVLink_component_information_message,
+    MAVLINK_MSG_ID_COMPONENT_METADATA: MAVLink_component_metadata_message,
     MAVLINK_MSG_ID_PLUGIN_HEALTH: MAVLink_plugin_health_message,
     MAVLINK_MSG_ID_NAV_STATUS: MAVLink_nav_status_message,
     MAVLINK_MSG_ID_MISSION_CHECKSUM: MAVLink_mission_checksum_message,
@@ -18007,6 +18102,66 @@ class MAVLink(object):
 
         """
         self.send(self.protocol_version_encode(version, min_version, max_version, spec_version_hash, library_version_hash), force_mavlink1=force_mavlink1)
+
+    def component_information_encode(self, time_boot_ms: int, general_metadata_file_crc: int, general_metadata_uri: bytes, peripherals_metadata_file_crc: int, peripherals_metadata_uri: bytes) -> MAVLink_component_information_message:
+        """
+        Where the component's general metadata file is (QGroundControl 4.x
+        asks for it when COMPONENT_METADATA is refused). Defined here
+        because the common.xml pymavlink ships lacks it; wire-
+        compatible with the upstream definition (id 395).
+
+        time_boot_ms              : Timestamp (time since system boot). [ms] (type:uint32_t)
+        general_metadata_file_crc        : CRC32 of the general metadata file (general_metadata_uri). (type:uint32_t)
+        general_metadata_uri        : MAVLink FTP URI of the general metadata file, zero terminated. (type:char)
+        peripherals_metadata_file_crc        : CRC32 of the peripherals metadata file (peripherals_metadata_uri). (type:uint32_t)
+        peripherals_metadata_uri        : (Optional) MAVLink FTP URI of the peripherals metadata file, zero terminated. (type:char)
+
+        """
+        return MAVLink_component_information_message(time_boot_ms, general_metadata_file_crc, general_metadata_uri, peripherals_metadata_file_crc, peripherals_metadata_uri)
+
+    def component_information_send(self, time_boot_ms: int, general_metadata_file_crc: int, general_metadata_uri: bytes, peripherals_metadata_file_crc: int, peripherals_metadata_uri: bytes, force_mavlink1: bool = False) -> None:
+        """
+        Where the component's general metadata file is (QGroundControl 4.x
+        asks for it when COMPONENT_METADATA is refused). Defined here
+        because the common.xml pymavlink ships lacks it; wire-
+        compatible with the upstream definition (id 395).
+
+        time_boot_ms              : Timestamp (time since system boot). [ms] (type:uint32_t)
+        general_metadata_file_crc        : CRC32 of the general metadata file (general_metadata_uri). (type:uint32_t)
+        general_metadata_uri        : MAVLink FTP URI of the general metadata file, zero terminated. (type:char)
+        peripherals_metadata_file_crc        : CRC32 of the peripherals metadata file (peripherals_metadata_uri). (type:uint32_t)
+        peripherals_metadata_uri        : (Optional) MAVLink FTP URI of the peripherals metadata file, zero terminated. (type:char)
+
+        """
+        self.send(self.component_information_encode(time_boot_ms, general_metadata_file_crc, general_metadata_uri, peripherals_metadata_file_crc, peripherals_metadata_uri), force_mavlink1=force_mavlink1)
+
+    def component_metadata_encode(self, time_boot_ms: int, file_crc: int, uri: bytes) -> MAVLink_component_metadata_message:
+        """
+        Where the component's general metadata file is, and its CRC for
+        caching (the component information protocol). Defined here
+        because the common.xml pymavlink ships lacks it; wire-
+        compatible with the upstream definition (id 397).
+
+        time_boot_ms              : Timestamp (time since system boot). [ms] (type:uint32_t)
+        file_crc                  : CRC32 of the general metadata file. (type:uint32_t)
+        uri                       : MAVLink FTP URI of the general metadata file, zero terminated. (type:char)
+
+        """
+        return MAVLink_component_metadata_message(time_boot_ms, file_crc, uri)
+
+    def component_metadata_send(self, time_boot_ms: int, file_crc: int, uri: bytes, force_mavlink1: bool = False) -> None:
+        """
+        Where the component's general metadata file is, and its CRC for
+        caching (the component information protocol). Defined here
+        because the common.xml pymavlink ships lacks it; wire-
+        compatible with the upstream definition (id 397).
+
+        time_boot_ms              : Timestamp (time since system boot). [ms] (type:uint32_t)
+        file_crc                  : CRC32 of the general metadata file. (type:uint32_t)
+        uri                       : MAVLink FTP URI of the general metadata file, zero terminated. (type:char)
+
+        """
+        self.send(self.component_metadata_encode(time_boot_ms, file_crc, uri), force_mavlink1=force_mavlink1)
 
     def plugin_health_encode(self, time_boot_ms: int, pid: int, restarts: int, frames_ok: int, frames_bad: int, dropped: int, cpu: float, step_p99: float, index: int, count: int, state: int, name: bytes) -> MAVLink_plugin_health_message:
         """

@@ -53,3 +53,12 @@ def test_protocol_version_is_mavlink2_only():
     identity = IdentityService(mav, 1, dialect.MAV_AUTOPILOT_GENERIC, 0)
     (msg,) = new_parser().parse_buffer(identity.protocol_version().pack(mav))
     assert (msg.version, msg.min_version, msg.max_version) == (200, 100, 200)
+
+
+def test_component_information_messages_are_wire_compatible_with_upstream():
+    # CRC_EXTRA of upstream common.xml: a different field list would make QGroundControl
+    # drop every COMPONENT_METADATA the vehicle sends.
+    assert dialect.MAVLink_component_metadata_message.crc_extra == 182
+    assert dialect.MAVLink_component_information_message.crc_extra == 0
+    assert dialect.MAVLINK_MSG_ID_COMPONENT_METADATA == 397
+    assert dialect.MAVLINK_MSG_ID_COMPONENT_INFORMATION == 395

@@ -30,13 +30,15 @@ def test_qgroundcontrol_connect_sequence_gets_every_answer_at_once(vehicle_facto
         assert caps & getattr(m, f"MAV_PROTOCOL_CAPABILITY_{bit}"), bit
     assert caps & m.MAV_PROTOCOL_CAPABILITY_MISSION_FENCE
     assert caps & m.MAV_PROTOCOL_CAPABILITY_MISSION_RALLY
-    assert not caps & m.MAV_PROTOCOL_CAPABILITY_FTP
+    assert caps & m.MAV_PROTOCOL_CAPABILITY_FTP  # read-only: the metadata files
 
     ask(gcs, m.MAVLINK_MSG_ID_PROTOCOL_VERSION, m.MAV_RESULT_ACCEPTED)
     version = gcs.recv("PROTOCOL_VERSION")
     assert (version.version, version.min_version, version.max_version) == (200, 100, 200)
 
-    for unsupported in (397, 395, 259, 280):  # metadata, information, camera, gimbal
+    ask(gcs, 397, m.MAV_RESULT_ACCEPTED)  # COMPONENT_METADATA (test_component_metadata)
+    assert gcs.recv("COMPONENT_METADATA").uri.startswith("mftp://")
+    for unsupported in (259, 280):  # camera, gimbal
         ask(gcs, unsupported, m.MAV_RESULT_UNSUPPORTED)
     gcs.command(521)  # MAV_CMD_REQUEST_CAMERA_INFORMATION
     assert gcs.ack(521, 1.0).result == m.MAV_RESULT_UNSUPPORTED

@@ -16,6 +16,7 @@ from companion.link.commands.modes import ModeCommands
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
+from companion.link.metadata_service import MetadataService
 
 __all__ = [
     "BUS_ACK_TIMEOUT_S",
@@ -28,11 +29,15 @@ __all__ = [
 
 
 def register_commands(
-    service: CommandService, port: VehiclePort, identity: IdentityService, router: LinkRouter
+    service: CommandService,
+    port: VehiclePort,
+    identity: IdentityService,
+    router: LinkRouter,
+    metadata: MetadataService | None = None,
 ) -> None:
     """Register every supported MAV_CMD with ``service``, behind the parameter rules."""
     service.check = refusal
     service.on_refusal = port.statustext
     ArmingCommands(port).register(service)
     ModeCommands(port, identity.autopilot).register(service)
-    MessageRequests(port, identity, router).register(service)
+    MessageRequests(port, identity, router, metadata).register(service)

@@ -8,18 +8,28 @@ from companion.link.command_service import CommandArgs, CommandService, Outcome
 from companion.link.commands.port import VehiclePort
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
+from companion.link.metadata_service import MetadataService
 from companion.link.mode_messages import available_modes
 from companion.link.telemetry import STREAMS
+
+METADATA_MESSAGES = (d.MAVLINK_MSG_ID_COMPONENT_METADATA, d.MAVLINK_MSG_ID_COMPONENT_INFORMATION)
 
 
 class MessageRequests:
     """REQUEST_MESSAGE, REQUEST_AUTOPILOT_CAPABILITIES, SET_ and GET_MESSAGE_INTERVAL."""
 
-    def __init__(self, port: VehiclePort, identity: IdentityService, router: LinkRouter) -> None:
+    def __init__(
+        self,
+        port: VehiclePort,
+        identity: IdentityService,
+        router: LinkRouter,
+        metadata: MetadataService | None = None,
+    ) -> None:
         self.port = port
         self.identity = identity
         self.router = router
         self.mav = router.mav
+        self.metadata = metadata  # None: no component information (UNSUPPORTED at once)
 
     def register(self, service: CommandService) -> None:
         service.register(d.MAV_CMD_REQUEST_MESSAGE, self.request_message)
@@ -36,6 +46,11 @@ class MessageRequests:
         if msg_id == d.MAVLINK_MSG_ID_AVAILABLE_MODES:
             modes = available_modes(self.mav, whole_or(args.params[1], 0))
             return Outcome(extra=modes) if modes else Outcome(d.MAV_RESULT_DENIED)
+        if self.metadata is not None and msg_id in METADATA_MESSAGES:
+            time_boot_ms = self.port.snapshot.time_boot_ms
+            if msg_id == d.MAVLINK_MSG_ID_COMPONENT_METADATA:
+                return Outcome(extra=[self.metadata.component_metadata(time_boot_ms)])
+            return Outcome(extra=[self.metadata.component_information(time_boot_ms)])
         if msg_id in STREAMS:
             msg = STREAMS[msg_id].build(self.mav, self.port.snapshot)
             if msg is None:

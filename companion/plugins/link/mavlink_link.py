@@ -35,6 +35,7 @@ from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
 from companion.link.log_transfer import LogTransferService
 from companion.link.manual_control import ManualControlService
+from companion.link.metadata_service import MetadataService
 from companion.link.mission_service import MissionService
 from companion.link.mode_messages import current_mode, heartbeat_mode
 from companion.link.params_service import ParamsService
@@ -66,6 +67,7 @@ CAPABILITIES = (
     | d.MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_C_CAST
     | d.MAV_PROTOCOL_CAPABILITY_MISSION_FENCE
     | d.MAV_PROTOCOL_CAPABILITY_MISSION_RALLY
+    | d.MAV_PROTOCOL_CAPABILITY_FTP  # read-only: the component metadata files
 )
 
 
@@ -173,7 +175,7 @@ class MavlinkLink(Plugin):
         self._serve_params(ctx, sysid)
         self._serve_missions(ctx, sysid)
         self._serve_logs(ctx, sysid)
-        register_commands(self.commands, self, self.identity, self.router)
+        register_commands(self.commands, self, self.identity, self.router, self.metadata)
         self.commands.on_refusal = self.refusal_text
         self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         self._seq = 0
@@ -224,6 +226,8 @@ class MavlinkLink(Plugin):
         self.router.add_service(service)
         self._apply_rates()
         self._params_service = service
+        self.metadata = MetadataService(self.mav, self.store.decls.values(), sysid, service.compid)
+        self.router.add_service(self.metadata)
 
     def _param_changed(self, name: str, value: float) -> None:
         """Tell the parameter's owner (it follows params/changes) and apply our own."""
@@ -338,6 +342,7 @@ class MavlinkLink(Plugin):
             + self.missions.refused
             + self.manual.refused
             + self.log_transfer.refused
+            + self.metadata.refused
         )
 
     def has_commander(self) -> bool:
