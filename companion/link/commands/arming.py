@@ -11,6 +11,7 @@ from companion.messages import CommandId
 
 FORCE_DISARM = FORCE_ARM  # param2 of COMPONENT_ARM_DISARM that means "even in the air"
 MAX_PREARM_TEXTS = 3
+ALERT = d.MAV_SEVERITY_EMERGENCY  # QGroundControl shows it over the map and speaks it
 
 
 class ArmingCommands:
@@ -33,6 +34,8 @@ class ArmingCommands:
             # aircraft, so it takes the magic number to mean it.
             self.port.statustext("Disarm refused: flying (param2 21196 forces it)")
             return Outcome(d.MAV_RESULT_DENIED)
+        if command == CommandId.STOP and in_air:  # the operator must hear that it falls
+            self.port.statustext("Disarmed in flight (forced): motor and surfaces off", ALERT)
         forced = whole_or(args.params[1], 0) == FORCE_ARM
         checked = (
             command == CommandId.START and not forced and self.port.param("ARMING_CHECK") >= 0.5

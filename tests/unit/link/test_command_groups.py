@@ -35,6 +35,14 @@ def test_disarm_in_the_air_needs_the_force_number():
     forced = arming.arm_disarm(args(m.MAV_CMD_COMPONENT_ARM_DISARM, 0, 21196))
     assert forced.defer_seq == 1
     assert vehicle.published == [(CommandId.STOP, ())]
+    assert vehicle.texts[-1].startswith("Disarmed in flight (forced)")
+
+
+def test_a_disarm_on_the_ground_says_nothing_more():
+    vehicle = RecordingVehicle()
+    vehicle.snapshot.control = ControlStatus(landed=1)
+    ArmingCommands(vehicle).arm_disarm(args(m.MAV_CMD_COMPONENT_ARM_DISARM, 0, 21196))
+    assert vehicle.texts == [] and vehicle.published == [(CommandId.STOP, ())]
 
 
 def test_failure_injection_is_off_until_its_parameter_and_needs_the_simulator():
