@@ -15,10 +15,15 @@ from companion.link import flight_messages
 from companion.link.codec import dialect as d
 from companion.link.flight_messages import landed_state, mission_current, nav_controller_output
 from companion.link.mode_messages import available_modes_monitor, current_mode
+from companion.link.system_messages import battery_status, sensor_bits, sys_status
 from companion.messages import (
+    Baro,
+    Battery,
+    Compass,
     ControlStatus,
     GpsFix,
     Imu,
+    Magnetometer,
     NavFlags,
     NavState,
     PilotInput,
@@ -27,6 +32,8 @@ from companion.messages import (
     VehicleStatus,
 )
 
+__all__ = ["STREAMS", "Snapshot", "StreamSchedule", "sensor_bits"]
+
 
 @dataclass
 class Snapshot:
@@ -34,9 +41,14 @@ class Snapshot:
 
     time_boot_ms: int = 0
     unix_us: int = 0
+    now_us: int = 0  # the vehicle clock when the snapshot was taken (sensor freshness)
     nav: NavState | None = None
     gps: GpsFix | None = None
     imu: Imu | None = None
+    mag: Magnetometer | None = None
+    compass: Compass | None = None
+    baro: Baro | None = None
+    battery: Battery | None = None
     health: SystemHealth | None = None
     servos: ServoOutput | None = None
     rc: PilotInput | None = None  # the RC receiver's newest frame
@@ -160,37 +172,6 @@ def _vfr_hud(mav: Any, s: Snapshot) -> Any:
     return mav.vfr_hud_encode(airspeed, ground, heading, throttle, alt, climb)
 
 
-def _sys_status(mav: Any, s: Snapshot) -> Any:
-    present, healthy = sensor_bits(s)
-    load = 0
-    if s.health is not None:
-        load = min(1000, round(sum(r.cpu_pct for r in s.health.rows()) * 10 / 2))
-    return mav.sys_status_encode(present, present, healthy, load, 0, -1, -1, 0, 0, 0, 0, 0, 0)
-
-
-def sensor_bits(s: Snapshot) -> tuple[int, int]:
-    """SYS_STATUS present and healthy bits, true to what the bus shows."""
-    present = healthy = 0
-    if s.imu is not None:
-        bits = d.MAV_SYS_STATUS_SENSOR_3D_ACCEL | d.MAV_SYS_STATUS_SENSOR_3D_GYRO
-        present |= bits
-        healthy |= bits
-    if s.gps is not None:
-        present |= d.MAV_SYS_STATUS_SENSOR_GPS
-        if s.gps.fix_type >= 3:
-            healthy |= d.MAV_SYS_STATUS_SENSOR_GPS
-    if s.nav is not None:
-        bits = d.MAV_SYS_STATUS_AHRS
-        present |= bits
-        if s.nav.flags & NavFlags.ATTITUDE_VALID:
-            healthy |= bits
-    if s.prearm_ok is not None:  # as ArduPilot: QGroundControl shows "Ready To Fly" on it
-        present |= d.MAV_SYS_STATUS_PREARM_CHECK
-        if s.prearm_ok:
-            healthy |= d.MAV_SYS_STATUS_PREARM_CHECK
-    return present, healthy
-
-
 def _system_time(mav: Any, s: Snapshot) -> Any:
     return mav.system_time_encode(s.unix_us, s.time_boot_ms)
 
@@ -310,7 +291,8 @@ STREAMS: dict[int, Stream] = {
         Stream("GLOBAL_POSITION_INT", d.MAVLINK_MSG_ID_GLOBAL_POSITION_INT, 5.0, _global_position),
         Stream("GPS_RAW_INT", d.MAVLINK_MSG_ID_GPS_RAW_INT, 2.0, _gps_raw),
         Stream("VFR_HUD", d.MAVLINK_MSG_ID_VFR_HUD, 4.0, _vfr_hud),
-        Stream("SYS_STATUS", d.MAVLINK_MSG_ID_SYS_STATUS, 1.0, _sys_status),
+        Stream("SYS_STATUS", d.MAVLINK_MSG_ID_SYS_STATUS, 1.0, sys_status),
+        Stream("BATTERY_STATUS", d.MAVLINK_MSG_ID_BATTERY_STATUS, 0.5, battery_status),
         Stream("SYSTEM_TIME", d.MAVLINK_MSG_ID_SYSTEM_TIME, 0.5, _system_time),
         Stream("SERVO_OUTPUT_RAW", d.MAVLINK_MSG_ID_SERVO_OUTPUT_RAW, 2.0, _servo_output),
         Stream("RC_CHANNELS", d.MAVLINK_MSG_ID_RC_CHANNELS, 2.0, flight_messages.rc_channels),

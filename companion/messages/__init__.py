@@ -25,7 +25,16 @@ from companion.messages.control import (
 from companion.messages.link import LinkStatus, MissionChanged, StatusText
 from companion.messages.navigation import NavFlags, NavState
 from companion.messages.pilot import RC_MAX_CHANNELS, PilotFlags, PilotInput, PilotSource
-from companion.messages.sensors import Baro, Compass, GpsFix, GpsFixType, Imu, Magnetometer
+from companion.messages.sensors import (
+    Baro,
+    Battery,
+    BatteryLevel,
+    Compass,
+    GpsFix,
+    GpsFixType,
+    Imu,
+    Magnetometer,
+)
 from companion.messages.simulation import SimClock, SimTruth
 from companion.messages.system import (
     ParamChange,
@@ -43,6 +52,8 @@ __all__ = [
     "RC_MAX_CHANNELS",
     "ActuatorCommand",
     "Baro",
+    "Battery",
+    "BatteryLevel",
     "Channel",
     "CommandAck",
     "CommandId",

@@ -11,7 +11,7 @@ from companion.messages.control import CommandAck, ControlStatus, VehicleCommand
 from companion.messages.link import LinkStatus, MissionChanged, StatusText
 from companion.messages.navigation import NavState
 from companion.messages.pilot import PilotInput
-from companion.messages.sensors import Baro, Compass, GpsFix, Imu, Magnetometer
+from companion.messages.sensors import Baro, Battery, Compass, GpsFix, Imu, Magnetometer
 from companion.messages.simulation import SimClock, SimTruth
 from companion.messages.system import ParamChange, PluginStats, SystemHealth
 
@@ -41,6 +41,7 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("sensors/rc", PilotInput, "latest", doc="the RC receiver's newest frame"),
     Channel("sensors/rc_switch", PilotInput, "queue", 8, "frames where the mode switch moved"),
     Channel("link/manual_control", PilotInput, "latest", doc="the ground station's joystick"),
+    Channel("sensors/battery", Battery, "latest", doc="flight battery voltage, current, charge"),
     Channel("nav/state", NavState, "latest", doc="navigation solution"),
     Channel("sim/truth", SimTruth, "latest", doc="simulator's true state"),
     Channel("sim/clock", SimClock, "latest", doc="simulation time"),

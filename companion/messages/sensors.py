@@ -106,3 +106,28 @@ class Baro(Message):
         ("alt_rel_m", ctypes.c_double),
         ("pressure_pa", ctypes.c_double),  # NaN when unknown
     ]
+
+
+class BatteryLevel(enum.IntEnum):
+    """How much is left, as the battery plug-in judges it against its BATT_* thresholds."""
+
+    OK = 0
+    LOW = 1  # BATT_LOW_VOLT for BATT_LOW_TIMER, or BATT_LOW_MAH left
+    CRITICAL = 2  # BATT_CRT_VOLT for BATT_LOW_TIMER, or BATT_CRT_MAH left
+
+
+class Battery(Message):
+    """The flight battery: measured voltage and current, and what the gauge makes of them.
+
+    Producer: sensors.battery. Consumers: link (BATTERY_STATUS, SYS_STATUS), the commander
+    (low-battery failsafe), logger.
+    """
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),  # when the monitor measured it
+        ("voltage_v", ctypes.c_double),  # pack voltage, filtered over ~1 s of sensor time
+        ("current_a", ctypes.c_double),  # drawn from the pack (positive discharging); NaN unknown
+        ("consumed_mah", ctypes.c_double),  # integrated current since start; NaN unknown
+        ("remaining", ctypes.c_double),  # 0..1 of BATT_CAPACITY; NaN when capacity is 0
+        ("level", ctypes.c_uint8),  # BatteryLevel
+    ]

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from companion.link.codec import new_encoder, new_parser
 from companion.link.telemetry import STREAMS, Snapshot
-from companion.messages import ControlStatus, GpsFix, Imu, NavFlags, NavState
+from companion.messages import Battery, ControlStatus, GpsFix, Imu, NavFlags, NavState
 
 floats = st.floats(allow_nan=True, allow_infinity=True, width=64)
 
@@ -24,6 +24,7 @@ def test_every_stream_encodes_whatever_the_sensors_say(ax, gz, roll, lat, vn, al
     gps.course_rad = yaw
     snap = Snapshot(time_boot_ms=5, nav=nav, imu=Imu(t_us=1, ax_m_s2=ax, gz_rad_s=gz), gps=gps)
     snap.control = ControlStatus(t_us=1, airspeed_m_s=speed, throttle=roll)
+    snap.battery = Battery(t_us=1, voltage_v=alt, current_a=vn, consumed_mah=lat, remaining=ax)
     for stream in STREAMS.values():
         msg = stream.build(mav, snap)  # must not raise, whatever the values
         if msg is not None:
@@ -40,3 +41,61 @@ def test_vfr_hud_shows_the_estimated_airspeed_and_the_throttle_in_flight():
     snap.control = ControlStatus(t_us=1, airspeed_m_s=24.5, throttle=0.62)
     flying = STREAMS[74].build(mav, snap)  # into a 4.5 m/s head wind
     assert (flying.airspeed, flying.groundspeed, flying.throttle) == (24.5, 20.0, 62)
+
+
+def _sensors_at(t_us: int) -> dict:
+    from companion.messages import Baro, Battery, Compass
+
+    gps = GpsFix(t_us=t_us, fix_type=3)
+    battery = Battery(t_us=t_us, voltage_v=12.31, current_a=14.5, consumed_mah=250.4)
+    battery.remaining = 0.886
+    imu, compass, baro = Imu(t_us=t_us), Compass(t_us=t_us), Baro(t_us=t_us)
+    return {"imu": imu, "compass": compass, "baro": baro, "gps": gps, "battery": battery}
+
+
+def test_sys_status_lists_every_sensor_in_use_healthy_while_its_samples_are_recent():
+    from mavlink_dialect import companion as d
+
+    mav = new_encoder(1)
+    snap = Snapshot(now_us=10_000_000, **_sensors_at(9_900_000))
+    every = (
+        d.MAV_SYS_STATUS_SENSOR_3D_ACCEL | d.MAV_SYS_STATUS_SENSOR_3D_GYRO
+        | d.MAV_SYS_STATUS_SENSOR_3D_MAG | d.MAV_SYS_STATUS_SENSOR_ABSOLUTE_PRESSURE
+        | d.MAV_SYS_STATUS_SENSOR_GPS | d.MAV_SYS_STATUS_SENSOR_BATTERY
+    )  # fmt: skip
+    fresh = STREAMS[d.MAVLINK_MSG_ID_SYS_STATUS].build(mav, snap)
+    assert fresh.onboard_control_sensors_present & every == every
+    assert fresh.onboard_control_sensors_enabled & every == every
+    assert fresh.onboard_control_sensors_health & every == every
+    assert (fresh.voltage_battery, fresh.current_battery, fresh.battery_remaining) == (
+        12310,
+        1450,
+        89,
+    )
+    snap.now_us = 12_000_000  # 2.1 s later by the vehicle clock, nothing new from any sensor
+    stale = STREAMS[d.MAVLINK_MSG_ID_SYS_STATUS].build(mav, snap)
+    assert stale.onboard_control_sensors_present & every == every
+    assert stale.onboard_control_sensors_health & every == 0
+    assert (stale.voltage_battery, stale.current_battery, stale.battery_remaining) == (
+        65535,
+        -1,
+        -1,
+    )
+
+
+def test_battery_status_reports_the_pack_and_its_charge_state():
+    from companion.messages import BatteryLevel
+    from mavlink_dialect import companion as d
+
+    mav = new_encoder(1)
+    snap = Snapshot(now_us=1_000_000, **_sensors_at(1_000_000))
+    msg = STREAMS[d.MAVLINK_MSG_ID_BATTERY_STATUS].build(mav, snap)
+    assert msg.voltages[0] == 12310 and set(msg.voltages[1:]) == {65535}
+    assert (msg.current_battery, msg.current_consumed, msg.battery_remaining) == (1450, 250, 89)
+    assert msg.charge_state == d.MAV_BATTERY_CHARGE_STATE_OK
+    snap.battery.level = BatteryLevel.LOW
+    low = STREAMS[d.MAVLINK_MSG_ID_BATTERY_STATUS].build(mav, snap)
+    assert low.charge_state == d.MAV_BATTERY_CHARGE_STATE_LOW
+    sys_status = STREAMS[d.MAVLINK_MSG_ID_SYS_STATUS].build(mav, snap)
+    assert not sys_status.onboard_control_sensors_health & d.MAV_SYS_STATUS_SENSOR_BATTERY
+    assert STREAMS[d.MAVLINK_MSG_ID_BATTERY_STATUS].build(mav, Snapshot()) is None

@@ -101,6 +101,10 @@ class MavlinkLink(Plugin):
         "nav/state",
         "sensors/gps",
         "sensors/imu",
+        "sensors/mag",
+        "sensors/compass",
+        "sensors/baro",
+        "sensors/battery",
         "actuators/servos",
         "vehicle/status",
         "system/health",
@@ -151,8 +155,12 @@ class MavlinkLink(Plugin):
             "status": bus.latest_reader("vehicle/status"),
             "control": bus.latest_reader("control/status"),
             "rc": bus.latest_reader("sensors/rc"),
+            "battery": bus.latest_reader("sensors/battery"),
             "gps": bus.queue_reader("sensors/gps"),
             "imu": bus.queue_reader("sensors/imu"),
+            "mag": bus.queue_reader("sensors/mag"),
+            "compass": bus.queue_reader("sensors/compass"),
+            "baro": bus.queue_reader("sensors/baro"),
         }
         self.acks = bus.queue_reader("link/command_acks")
         self.to_vehicle = bus.writer("link/commands")
@@ -254,9 +262,10 @@ class MavlinkLink(Plugin):
     def _refresh_snapshot(self) -> None:
         s, r = self.snapshot, self.readers
         s.nav, s.health, s.servos = r["nav"].get(), r["health"].get(), r["servos"].get()
-        s.status, s.rc = r["status"].get(), r["rc"].get()
+        s.status, s.rc, s.battery = r["status"].get(), r["rc"].get(), r["battery"].get()
         s.control = self._fresh_control()
-        for key in ("gps", "imu"):
+        s.now_us = self.ctx.clock.now_us()
+        for key in ("gps", "imu", "mag", "compass", "baro"):
             latest = None
             for latest in r[key].drain():  # noqa: B007 - only the newest matters here
                 pass

@@ -69,7 +69,9 @@ class SimBridge:
         self.failures = DeviceFailures(opts.seed)
         pilot = load_pilot(opts.pilot_path) if opts.pilot_path else None
         self.receiver = EmulatedReceiver(pilot, opts.rates.rc_hz)
-        self.ports = {name: PtyPort(name) for name in (*SENSORS, "servos")}
+        # The battery monitor is not in lockstep (nothing steers by it at physics rate), so
+        # a vehicle without its driver leaves the bridge unhindered.
+        self.ports = {name: PtyPort(name) for name in (*SENSORS, "battery", "servos")}
         self.pending: list[tuple[float, int, str, bytes]] = []  # (release, order, port, data)
         self.order = 0
         self.servo_card = MiniSscReader()
@@ -163,7 +165,8 @@ class SimBridge:
         t_us = round(s.t_s * 1e6)
         self.clock.publish(SimClock(t_us=t_us, frame=self.frames))
         self._publish_truth(s, t_us)
-        due = self.devices.due(s, pressure_kpa(s.alt_msl_m))
+        throttle = self.flight.controls()["throttle"]
+        due = self.devices.due(s, pressure_kpa(s.alt_msl_m), throttle)
         if (frame := self.receiver.due(s.t_s)) is not None:
             due.append(("rc", s.t_s, frame))
         for name, release, measured in due:

@@ -1,4 +1,5 @@
-"""The emulated devices' bytes: NMEA GPS, the OS-3000 ``$C`` sentence, VectorNav ``$VNIMU``.
+"""The emulated devices' bytes: NMEA GPS, the OS-3000 ``$C`` sentence, VectorNav ``$VNIMU``,
+and the battery monitor's ``$PCBAT``.
 
 Each device turns the true state (through ``SensorErrors``) into the exact text the real
 part sends, at its own rate. NMEA is rendered by pynmea2 and the other sentences are
@@ -14,6 +15,7 @@ from dataclasses import dataclass
 
 import pynmea2
 
+from ground.simulation.battery import BatteryModel
 from ground.simulation.sensor_errors import ImuSample, SensorErrors
 from ground.simulation.true_state import TrueState
 
@@ -101,6 +103,11 @@ def vnimu_sentence(s: ImuSample) -> bytes:
     return checked(text)
 
 
+def battery_sentence(voltage_v: float, current_a: float) -> bytes:
+    """The power monitor's ``$PCBAT,<mV>,<mA>`` (companion.sensors.battery_monitor)."""
+    return checked(f"PCBAT,{round(voltage_v * 1000)},{round(current_a * 1000)}")
+
+
 @dataclass
 class Outage:
     """A window of simulation time with no GPS fix."""
@@ -122,6 +129,7 @@ class DeviceRates:
     gps_hz: float = 5.0
     gps_latency_s: float = 0.1
     rc_hz: float = 50.0  # SBUS receivers send every 7-20 ms
+    battery_hz: float = 10.0
 
 
 class EmulatedDevices:
@@ -129,14 +137,23 @@ class EmulatedDevices:
 
     def __init__(self, errors: SensorErrors, rates: DeviceRates, outages: list[Outage]) -> None:
         self.errors, self.rates, self.outages = errors, rates, outages
-        self.next_s = {"imu": 0.0, "compass": 0.0, "gps": 0.0}
+        self.next_s = {"imu": 0.0, "compass": 0.0, "gps": 0.0, "battery": 0.0}
         self.last_imu_s = 0.0
         self.last_gps_s = 0.0
+        self.battery = BatteryModel()
+        self.last_battery_s: float | None = None
 
-    def due(self, s: TrueState, pressure_kpa: float) -> list[tuple[str, float, bytes]]:
+    def due(
+        self, s: TrueState, pressure_kpa: float, throttle: float = 0.0
+    ) -> list[tuple[str, float, bytes]]:
         """(device, release time, bytes) for everything measured at ``s.t_s``."""
         out: list[tuple[str, float, bytes]] = []
         t = s.t_s
+        self._drain_battery(t, throttle)
+        if t + 1e-9 >= self.next_s["battery"]:
+            sentence = battery_sentence(self.battery.voltage_v(), self.battery.current_a)
+            out.append(("battery", t, sentence))
+            self.next_s["battery"] += 1.0 / self.rates.battery_hz
         if t + 1e-9 >= self.next_s["imu"]:
             sample = self.errors.imu(s, t - self.last_imu_s, pressure_kpa)
             out.append(("imu", t, vnimu_sentence(sample)))
@@ -149,6 +166,11 @@ class EmulatedDevices:
             out.append(("gps", t + self.rates.gps_latency_s, self._gps(s)))
             self.next_s["gps"] += 1.0 / self.rates.gps_hz
         return out
+
+    def _drain_battery(self, t_s: float, throttle: float) -> None:
+        dt = 0.0 if self.last_battery_s is None else t_s - self.last_battery_s
+        self.battery.step(throttle, dt)
+        self.last_battery_s = t_s
 
     def _gps(self, s: TrueState) -> bytes:
         lat, lon, alt, vel = self.errors.gps(s, s.t_s - self.last_gps_s)

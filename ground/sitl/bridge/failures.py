@@ -7,7 +7,8 @@ so the vehicle's own drivers and navigator meet it exactly as they would in the 
 
 Units map onto the devices the bridge emulates: GPS → the NMEA receiver, MAG → the
 OS-3000 compass, GYRO and ACCEL → the serial IMU (one device carries both, so either unit
-fails the whole line). Instance 0 means every instance; each device has one (instance 1).
+fails the whole line), SYSTEM_BATTERY → the battery's power monitor. Instance 0 means every
+instance; each device has one (instance 1).
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ DEVICE_OF_UNIT = {
     d.FAILURE_UNIT_SENSOR_MAG: "compass",
     d.FAILURE_UNIT_SENSOR_GYRO: "imu",
     d.FAILURE_UNIT_SENSOR_ACCEL: "imu",
+    d.FAILURE_UNIT_SYSTEM_BATTERY: "battery",
 }
 SUPPORTED_TYPES = {
     d.FAILURE_TYPE_OK: "ok",

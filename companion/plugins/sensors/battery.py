@@ -1,0 +1,67 @@
+"""``sensors.battery``: the flight battery's power monitor on a serial port.
+
+Reads the ``$PCBAT`` sentence (``companion.sensors.battery_monitor``), keeps the fuel gauge
+and publishes ``sensors/battery`` once a reading. Owns the BATT_* parameters, named as
+ArduPilot names them, so a ground station's battery page and a user who knows ArduPilot
+find them where they expect.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from companion.params import ParamDecl
+from companion.params.live import LiveParams
+from companion.plugin import PluginContext
+from companion.plugins.sensors.serial_sensor import SerialSensor, serial_settings
+from companion.sensors.battery_monitor import (
+    BatteryGauge,
+    BatteryMonitorDecoder,
+    GaugeSettings,
+    MonitorReading,
+)
+
+BATTERY_PARAMS = (
+    ParamDecl("BATT_CAPACITY", 2200.0, 0.0, 100_000.0, "mAh", "Pack capacity (0: unknown)"),
+    ParamDecl("BATT_LOW_VOLT", 10.5, 0.0, 100.0, "V", "Low-battery voltage (0: off)"),
+    ParamDecl("BATT_CRT_VOLT", 9.9, 0.0, 100.0, "V", "Critical-battery voltage (0: off)"),
+    ParamDecl("BATT_LOW_MAH", 0.0, 0.0, 100_000.0, "mAh", "Low when less is left (0: off)"),
+    ParamDecl("BATT_CRT_MAH", 0.0, 0.0, 100_000.0, "mAh", "Critical when less is left (0: off)"),
+    ParamDecl("BATT_LOW_TIMER", 10.0, 0.0, 120.0, "s", "Voltage below a threshold this long"),
+)
+
+
+class BatteryMonitor(SerialSensor[MonitorReading]):
+    """Publishes the gauge's view of the pack on sensors/battery."""
+
+    settings = serial_settings("serial:///dev/ttyAMA1:57600", 57600)
+    params = BATTERY_PARAMS
+    outputs = ("sensors/battery",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        state_dir = Path(ctx.vehicle.get("state_dir", "."))
+        self.live = LiveParams(ctx.bus, self.params, state_dir)
+        self.gauge = BatteryGauge(self._gauge_settings())
+        self.out = ctx.bus.writer("sensors/battery")
+
+    def _gauge_settings(self) -> GaugeSettings:
+        v = self.live.values
+        return GaugeSettings(
+            capacity_mah=v["BATT_CAPACITY"],
+            low_volt=v["BATT_LOW_VOLT"],
+            crt_volt=v["BATT_CRT_VOLT"],
+            low_mah=v["BATT_LOW_MAH"],
+            crt_mah=v["BATT_CRT_MAH"],
+            low_timer_s=v["BATT_LOW_TIMER"],
+        )
+
+    def make_decoder(self, settings: Mapping[str, Any]) -> BatteryMonitorDecoder:
+        return BatteryMonitorDecoder()
+
+    def publish(self, reading: MonitorReading, t_us: int) -> None:
+        if self.live.poll():
+            self.gauge.settings = self._gauge_settings()
+        self.out.publish(self.gauge.update(reading))
