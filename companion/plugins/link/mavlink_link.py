@@ -148,20 +148,7 @@ class MavlinkLink(Plugin):
         self.snapshot = Snapshot()
         self.boot_us = ctx.clock.now_us()
         bus = ctx.bus
-        self.readers = {
-            "nav": bus.latest_reader("nav/state"),
-            "health": bus.latest_reader("system/health"),
-            "servos": bus.latest_reader("actuators/servos"),
-            "status": bus.latest_reader("vehicle/status"),
-            "control": bus.latest_reader("control/status"),
-            "rc": bus.latest_reader("sensors/rc"),
-            "battery": bus.latest_reader("sensors/battery"),
-            "gps": bus.queue_reader("sensors/gps"),
-            "imu": bus.queue_reader("sensors/imu"),
-            "mag": bus.queue_reader("sensors/mag"),
-            "compass": bus.queue_reader("sensors/compass"),
-            "baro": bus.queue_reader("sensors/baro"),
-        }
+        self.readers = self._readers(bus)
         self.acks = bus.queue_reader("link/command_acks")
         self.to_vehicle = bus.writer("link/commands")
         self.param_changes = bus.writer("params/changes")
@@ -194,6 +181,23 @@ class MavlinkLink(Plugin):
             sysid, joystick.publish, ctx.clock.now_us, self.refusal_text
         )
         self.router.add_service(self.manual)
+
+    @staticmethod
+    def _readers(bus: Any) -> dict[str, Any]:
+        """Latest for state, queues (drained to their newest) for sensor samples."""
+        latest = {
+            "nav": "nav/state",
+            "health": "system/health",
+            "servos": "actuators/servos",
+            "status": "vehicle/status",
+            "control": "control/status",
+            "rc": "sensors/rc",
+            "battery": "sensors/battery",
+        }
+        readers = {key: bus.latest_reader(name) for key, name in latest.items()}
+        for key in ("gps", "imu", "mag", "compass", "baro"):
+            readers[key] = bus.queue_reader(f"sensors/{key}")
+        return readers
 
     def _serve_missions(self, ctx: PluginContext, sysid: int) -> None:
         store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
