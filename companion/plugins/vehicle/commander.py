@@ -3,7 +3,8 @@
 Takes the mode commands off ``link/commands`` (SET_MODE, MISSION_START, RTL, REPOSITION,
 LOITER, SET_HOME), answers each on ``link/command_acks`` (with the reason when refused),
 applies the failsafes (ground-station link, GPS, geofence; ``companion.control.failsafe``),
-the pilot's mode switch and the RC and joystick failsafes (``companion.control.pilot_watch``), and
+the pilot's mode switch and the RC and joystick failsafes (``companion.control.pilot_watch``), the
+low-battery failsafe (``companion.control.battery_failsafe``), and
 publishes ``vehicle/status`` on every change and four times a second, and what the
 operator should read on ``vehicle/statustext``.
 """
@@ -14,6 +15,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from companion.control.battery_failsafe import BATTERY_FS_PARAMS, BatteryFailsafe
 from companion.control.commander import MODE_COMMANDS, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.control.mission.fence import Fence
@@ -32,7 +34,7 @@ FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) secon
 class CommanderPlugin(Plugin):
     """Mode state for the link and the flight controller."""
 
-    params = (*FAILSAFE_PARAMS, *PILOT_PARAMS)
+    params = (*FAILSAFE_PARAMS, *PILOT_PARAMS, *BATTERY_FS_PARAMS)
     inputs = ("link/commands",)
     optional_inputs = (
         "nav/state",
@@ -43,6 +45,7 @@ class CommanderPlugin(Plugin):
         "sensors/rc",
         "sensors/rc_switch",
         "link/manual_control",
+        "sensors/battery",
     )
     outputs = ("vehicle/status", "link/command_acks", "vehicle/statustext")
 
@@ -57,6 +60,7 @@ class CommanderPlugin(Plugin):
         self.live = LiveParams(ctx.bus, self.params, state_dir)
         self.failsafes = Failsafes(self.live.values)
         self.pilot = PilotWatch(self.live.values)
+        self.battery_failsafe = BatteryFailsafe(self.live.values)
         bus = ctx.bus
         self.commands = bus.queue_reader("link/commands")
         self.nav = bus.latest_reader("nav/state")
@@ -64,6 +68,7 @@ class CommanderPlugin(Plugin):
         self.control = bus.latest_reader("control/status")
         self.link = bus.latest_reader("link/status")
         self.mission_changes = bus.latest_reader("mission/changed")
+        self.battery = bus.latest_reader("sensors/battery")
         self.rc = bus.latest_reader("sensors/rc")
         self.rc_switch = bus.queue_reader("sensors/rc_switch")
         self.joystick = bus.latest_reader("link/manual_control")
@@ -132,7 +137,9 @@ class CommanderPlugin(Plugin):
             nav_t_us=int(nav.t_us) if nav is not None else None,
             fence_breach=self.fence.breach(nav.lat_deg, nav.lon_deg) if valid else None,
         )
-        actions = self.failsafes.step(situation)
+        battery = self.battery.get()
+        level = int(battery.level) if battery is not None else None
+        actions = self.failsafes.step(situation) + self.battery_failsafe.step(level, bool(flying))
         if nav is not None:  # the pilot's inputs are judged against the sensors' time
             rc, joystick = self.rc.get(), self.joystick.get()
             actions += self.pilot.step(int(nav.t_us), c.mode, bool(flying), rc, joystick)
