@@ -3,8 +3,6 @@ protocol, MISSION_START, RTL, go-to; refusals say why."""
 
 from __future__ import annotations
 
-import json
-
 import pytest
 
 from companion.control.mission.plan import checked_plan
@@ -126,25 +124,3 @@ def test_set_mode_message_standard_modes_mission_start_and_go_to(station):
     assert now.mode == FlightMode.GUIDED
     assert (now.target_lat_deg, now.target_lon_deg) == (-37.9, 145.12)
     assert now.target_alt_msl_m == pytest.approx(now.home_alt_msl_m + 50.0)
-
-
-def test_the_shipped_qgroundcontrol_custom_actions_each_change_the_mode(station):
-    """qgc/CustomActions.json gives a GENERIC vehicle QGC's missing Fly-view buttons."""
-    actions = json.loads((REPO / "qgc/CustomActions.json").read_text())
-    assert actions["fileType"] == "MavlinkActions" and actions["version"] == 1
-    expected = {
-        "Start Mission": FlightMode.MISSION,
-        "Return": FlightMode.RTL,
-        "Loiter": FlightMode.LOITER,
-        "Stabilized": FlightMode.STABILIZED,
-    }
-    assert [a["label"] for a in actions["actions"]] == list(expected)
-    _, gcs, status = station(with_mission=True)
-    for action in actions["actions"]:
-        # As QGroundControl sends it: COMMAND_LONG, absent params as 0, to compid 1.
-        params = [float(action.get(f"param{i}", 0)) for i in range(1, 8)]
-        gcs.command(action["mavCmd"], *params, target=(1, action.get("compId", 1)))
-        assert gcs.ack(action["mavCmd"]).result == m.MAV_RESULT_ACCEPTED, action["label"]
-        mode = expected[action["label"]]
-        wait_for(lambda mode=mode: status.get().mode == mode, 3.0, action["label"])
-        heartbeat_mode(gcs, PX4[mode])
