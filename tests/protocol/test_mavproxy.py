@@ -12,9 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from companion.control.failsafe import FAILSAFE_PARAMS
-from companion.control.pilot_watch import PILOT_PARAMS
 from companion.plugins.link.mavlink_link import MavlinkLink
+from companion.plugins.vehicle.commander import CommanderPlugin
 from tests.protocol.mav_client import free_udp_port
 from tests.support.configs import client_vehicle
 from tests.support.vehicle import wait_for
@@ -80,9 +79,8 @@ def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
     wp.write_text(WAYPOINTS)
     mission = tmp_path / "state" / "missions" / "mission.json"
     # Every parameter the config's plug-ins declare: the link's rates, the commander's
-    # failsafes and mode switch.
-    count = len(MavlinkLink.params) + len(FAILSAFE_PARAMS) + len(PILOT_PARAMS)
-    said = f"Received {count} parameters"
+    # failsafes (battery too) and mode switch.
+    said = f"Received {len(MavlinkLink.params) + len(CommanderPlugin.params)} parameters"
     mavproxy = MavProxy(port, tmp_path)
     try:
         mavproxy.connected(vehicle)
@@ -90,7 +88,8 @@ def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
             mavproxy.type(line)
         wait_for(lambda: vehicle.row("flight").pid, 30, "MAVProxy's arm to start the flight group")
         wait_for(mission.exists, 20, "the uploaded mission stored")
-        # MAVProxy tries MAVLink FTP first (the vehicle does not offer it), then the protocol.
+        # MAVProxy asks MAVLink FTP for @PARAM/param.pck first (ArduPilot's packed list);
+        # the vehicle's FTP has no such file and says so, and MAVProxy uses the protocol.
         wait_for(lambda: any(said in x for x in mavproxy.lines), 30, "param fetch")
     finally:
         output = mavproxy.close()
