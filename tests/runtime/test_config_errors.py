@@ -149,7 +149,8 @@ def test_an_unknown_simulated_device_is_named(tmp_path):
 
 
 def test_the_shipped_sim_config_loads_with_the_bridge_devices():
-    refs = {n: f"/dev/pts/{i}" for i, n in enumerate(("gps", "compass", "imu", "rc", "servos"))}
+    devices = ("gps", "compass", "imu", "rc", "battery", "servos")  # the bridge's ptys
+    refs = {n: f"/dev/pts/{i}" for i, n in enumerate(devices)}
     cfg = load_config(REPO / "companion/configs/sim.toml", sim_refs={**refs, "airframe": "J3Cub"})
     check_topology(cfg)
     servos = next(p for p in cfg.plugins if p.kind == "actuators.minissc")

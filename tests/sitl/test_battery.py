@@ -11,6 +11,7 @@ from __future__ import annotations
 import time
 
 import pytest
+from pyulog import ULog
 
 from companion.messages import FlightMode
 from mavlink_dialect import companion as d
@@ -111,3 +112,8 @@ def test_battery_and_sensors_are_shown_true_and_low_battery_returns_home(tmp_pat
         station.until(
             lambda: station.battery.charge_state == d.MAV_BATTERY_CHARGE_STATE_LOW, 10, "LOW"
         )
+    # The flight log (one ULog per arming) records the gauge beside the other sensors.
+    (log,) = (tmp_path / "state" / "logs").glob("*_armed.ulg")
+    battery = ULog(str(log), ["sensors_battery"]).data_list[0].data
+    assert battery["voltage_v"].max() > 11.5 and battery["current_a"].max() > 5.0
+    assert battery["consumed_mah"][-1] > 10.0 and battery["level"][-1] == 1  # LOW

@@ -33,6 +33,7 @@ DEFAULT_CHANNELS = [
     "sensors/baro",
     "sensors/rc",
     "link/manual_control",
+    "sensors/battery",
     "nav/state",
     "control/actuators",
     "control/status",
