@@ -183,17 +183,10 @@ class MavlinkLink(Plugin):
         self.router.add_service(self.manual)
 
     @staticmethod
-    def _readers(bus: Any) -> dict[str, Any]:
-        """Latest for state, queues (drained to their newest) for sensor samples."""
-        latest = {
-            "nav": "nav/state",
-            "health": "system/health",
-            "servos": "actuators/servos",
-            "status": "vehicle/status",
-            "control": "control/status",
-            "rc": "sensors/rc",
-            "battery": "sensors/battery",
-        }
+    def _readers(bus: Any) -> dict[str, Any]:  # queues are drained to their newest sample
+        latest = {"nav": "nav/state", "health": "system/health", "servos": "actuators/servos",
+                  "status": "vehicle/status", "control": "control/status",
+                  "rc": "sensors/rc", "battery": "sensors/battery"}  # fmt: skip
         readers = {key: bus.latest_reader(name) for key, name in latest.items()}
         for key in ("gps", "imu", "mag", "compass", "baro"):
             readers[key] = bus.queue_reader(f"sensors/{key}")
@@ -349,14 +342,8 @@ class MavlinkLink(Plugin):
         self.router.stream_telemetry(self.snapshot, now_s)
         counts = self.router.counters
         self.ctx.health.frames_ok, self.ctx.health.frames_bad = counts.ok, counts.bad
-        self.ctx.health.refused = (
-            self.commands.refused
-            + self._params_service.refused
-            + self.missions.refused
-            + self.manual.refused
-            + self.log_transfer.refused
-            + self.metadata.refused
-        )
+        parts = self.commands, self._params_service, self.missions, self.manual, self.metadata
+        self.ctx.health.refused = sum(p.refused for p in (*parts, self.log_transfer))
 
     def has_commander(self) -> bool:
         """Whether the vehicle runs a commander to answer mode commands."""
