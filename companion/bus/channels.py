@@ -195,9 +195,37 @@ class LatestReader(Reader[M]):
         subscriber: iox2.Subscriber,
         listener: iox2.Listener,
         idle: IdleTally | None = None,
+        service: iox2.PortFactoryPublishSubscribe | None = None,
     ) -> None:
         super().__init__(name, msg_type, subscriber, listener, idle)
         self._latest: M | None = None
+        self._service = service
+        self._waited = False
+
+    def writers(self) -> int:
+        """How many writers the channel has now (0 when unknown)."""
+        if self._service is None:
+            return 0
+        return int(self._service.dynamic_config.number_of_publishers)
+
+    def first(self, timeout_s: float) -> M | None:
+        """The newest value; the first call waits up to ``timeout_s`` for one if a writer exists.
+
+        A value published before this reader joined reaches it only once the writer's
+        process sends again or updates its connections, an instant set by that process's
+        scheduling: a reader that must start from the writer's state (the flight
+        controller from the commander's mode) waits for it rather than acting without it.
+        """
+        value = self.get()
+        if value is None and not self._waited and self.writers() > 0:
+            value = self.wait(timeout_s)
+        self._waited = True  # once: a writer that never speaks costs one wait, not one a call
+        return value
+
+    def close(self) -> None:
+        """Release the iceoryx2 ports and the service."""
+        super().close()
+        self._service = None
 
     def _count_gap(self, writer_id: int, seq: int) -> None:
         """Skipping superseded values is what Latest is for: nothing counts as lost."""

@@ -115,9 +115,10 @@ class BusNode:
         chan = channel(name)
         if chan.pattern != "latest":
             raise ValueError(f"channel {name!r} is a Queue channel; use queue_reader()")
-        sub = self._pubsub(chan).subscriber_builder().create()
+        service = self._pubsub(chan)
+        sub = service.subscriber_builder().create()
         listener = self._event(chan).listener_builder().create()
-        port: LatestReader[Any] = LatestReader(name, chan.type, sub, listener, self.idle)
+        port: LatestReader[Any] = LatestReader(name, chan.type, sub, listener, self.idle, service)
         self._ports.append(port)
         return port
 

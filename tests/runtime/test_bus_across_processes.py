@@ -112,3 +112,20 @@ def test_a_value_published_once_reaches_a_reader_that_connects_much_later(vehicl
     late = vehicle.bus.latest_reader("nav/state")
     value = wait_for(late.get, 2.0, "the value published before the reader existed")
     assert value.yaw_rad == pytest.approx(0.25)
+
+
+def test_first_waits_for_the_value_a_writer_published_before_the_reader_joined(vehicle_factory):
+    vehicle = vehicle_factory(vehicle_config("once", plugin("once", PUBLISH_ONCE)))
+    vehicle.wait_running("once")
+    late = vehicle.bus.latest_reader("nav/state")
+    wait_for(late.writers, 30.0, "the plug-in's writer")
+    # Handed over when the writer's process next updates its connections: first() waits.
+    value = late.first(30.0)
+    assert value is not None and value.yaw_rad == pytest.approx(0.25)
+
+
+def test_first_without_a_writer_is_none(namespace):
+    with BusNode(namespace, "r") as bus:
+        nobody = bus.latest_reader("vehicle/status")
+        assert nobody.writers() == 0
+        assert nobody.first(30.0) is None

@@ -34,6 +34,7 @@ from companion.plugin import Plugin, PluginContext, Setting
 from mavlink_dialect import companion as d
 
 WAIT_S = 0.5
+STATUS_WAIT_S = 5.0  # the commander's last status, once, when this process starts
 STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item is reached)
 
 
@@ -102,7 +103,10 @@ class FixedWingPlugin(Plugin):
             return  # no navigation: the servo plug-in goes safe when commands stop
         now_us = self.ctx.clock.now_us()
         self._follow_changes(now_us)
-        status = self.status_in.get() or self.default_status
+        # Started by START, this process joined after the commander last spoke: its mode
+        # (Take-off, say) is waited for, not guessed, or the first commands would depend on
+        # which process the scheduler ran first. Without a commander: loiter, armed.
+        status = self.status_in.first(STATUS_WAIT_S) or self.default_status
         # The receiver first: a safety pilot's sticks win over the ground station's joystick.
         sticks = pilot_sticks(nav.t_us, self.rc.get(), self.joystick.get())
         out = self.controller.step(nav, status, nav.t_us / 1e6, sticks)

@@ -87,10 +87,13 @@ class SimBridge:
         self.truth_out = self.bus.writer("sim/truth")
         self.sync: FlightSync | None = None
         self.nav_sync: FlightSync | None = None
+        self.navigated: FlightSync | None = None
         self.samples: SampleSync | None = None
         if lockstep:
             self._keep_in_step(round(1e6 / opts.sync_hz), exact)
-        self.commands = VehicleCommands(self.bus, self.failures, self.sync, opts.start_at_s)
+        self.commands = VehicleCommands(
+            self.bus, self.failures, self.sync, opts.start_at_s, self.navigated
+        )
         self.frames = 0
         self.stopping = False
         self.clock.publish(SimClock(t_us=0, frame=0))
@@ -102,6 +105,8 @@ class SimBridge:
         lag = 0 if exact else FAST_LAG_PERIODS
         answers = self.bus.latest_reader("actuators/servos")
         self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]), lag)
+        nav = self.bus.latest_reader("nav/state")
+        self.navigated = FlightSync(period_us, nav, self.bus.waiter([nav]), 0, "t_us", True)
         if not exact:  # exact lockstep keeps in step with every sample and servo answer
             nav = self.bus.latest_reader("nav/state")
             self.nav_sync = FlightSync(period_us, nav, self.bus.waiter([nav]), lag, "t_us", True)
@@ -149,7 +154,7 @@ class SimBridge:
     def stop(self) -> None:
         """Ask the loop to end after the current frame (also ends any wait for the vehicle)."""
         self.stopping = True
-        for waiting in (self.sync, self.nav_sync, self.samples):
+        for waiting in (self.sync, self.nav_sync, self.navigated, self.samples):
             if waiting is not None:
                 waiting.cancelled = True
 

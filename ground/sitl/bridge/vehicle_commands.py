@@ -38,12 +38,14 @@ class VehicleCommands:
         failures: DeviceFailures,
         sync: FlightSync | None,
         start_at_s: float | None = None,
+        navigated: FlightSync | None = None,
     ) -> None:
         self.commands = bus.queue_reader("link/commands")
         self.acks_in = bus.queue_reader("link/command_acks")
         self.out = bus.writer("link/commands")
         self.acks = bus.writer("link/command_acks")
         self.failures, self.sync = failures, sync
+        self.navigated = navigated  # the navigator's answers, waited for before arming
         self.start_at_s = start_at_s
         self.seq = SEQ_BASE
         self.answers: dict[int, int] = {}  # our seq → result
@@ -58,6 +60,10 @@ class VehicleCommands:
                 self._inject(cmd, t_us)
         if self.start_at_s is not None and t_us >= self.start_at_s * 1e6:
             self.start_at_s = None
+            if self.navigated is not None:
+                # Arming sets home where the navigator says the aircraft is: from this
+                # frame's solution, not whichever one the navigator had finished by then.
+                self.navigated.wait(t_us)
             for command in (CommandId.START, CommandId.MISSION_START):
                 if not self._send(command, t_us):
                     break
