@@ -37,8 +37,4 @@ def test_two_exact_runs_write_the_same_truth(tmp_path):
     truth = read_truth(tmp_path / "first" / "truth.csv")
     climb = np.array(truth["alt"])
     assert climb[-1] - climb[0] > 20, "the aircraft took off"
-    if first != second:
-        # A known regression, left open: since the busy-machine work merged, about one
-        # pair in two (fewer when the machine is idle) differs from the frame after
-        # arming on (t = 5.02 s). Reported, not hidden: the test shows as XFAIL then.
-        pytest.xfail("exact lockstep differed from the arming on (known, open)")
+    assert first == second, "two exact runs with the same seed flew different flights"

@@ -107,12 +107,9 @@ def test_a_small_campaign_scores_each_flight_and_survives_hung_ones(tmp_path):
                     (), 3, sim_toml, False, 900.0, 10.0)  # fmt: skip
     alone = fly_flight(FlightJob(flight, str(tmp_path / "alone"), timeout_s=300.0))
     assert alone["flight_id"] == calm["flight_id"]
-    # The same flight flown alone scores as it did inside the busy campaign. Not to the last
-    # digit for now: one suite run in three saw 1.250 m against 1.266 m of cross-track RMS
-    # (a timing dependence in exact lockstep that is not found yet; the byte-for-byte check
-    # of exact lockstep is tests/sim/test_exact_lockstep.py).
+    # The same flight flown alone scores as it did inside the busy campaign, to the last digit.
     for key in ("xtrack_rms_m", "xtrack_p95_m", "alt_rms_m", "airspeed_rms_m_s", "samples"):
-        assert float(alone[key]) == pytest.approx(float(calm[key]), rel=0.05), key
+        assert float(alone[key]) == float(calm[key]), key
     # Completion is seen in the telemetry, which flows in wall time: to its resolution.
     assert abs(alone["time_to_complete_s"] - float(calm["time_to_complete_s"])) < 2.0
 
