@@ -37,7 +37,7 @@ def test_replay_publishes_every_sample_in_order_with_log_times(vehicle_factory, 
     imu = vehicle.bus.queue_reader("sensors/imu")
     gps = vehicle.bus.queue_reader("sensors/gps")
     commands = vehicle.bus.writer("link/commands")
-    wait_for(vehicle.health, 10, "the health table")
+    wait_for(vehicle.health, 60, "the health table")
     # The replay is in the flight group so it starts (START) only once the readers exist.
     commands.publish(VehicleCommand(t_us=0, seq=1, command=int(CommandId.START)))
     got_imu, got_gps = [], []
