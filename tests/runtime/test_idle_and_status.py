@@ -17,13 +17,21 @@ def test_a_waiting_plugin_uses_under_one_percent_of_a_core(vehicle_factory):
     vehicle = vehicle_factory(pipeline())
     pid = vehicle.wait_running("idle")
     proc = psutil.Process(pid)
-    time.sleep(1.0)  # let imports and start-up settle
-    before = proc.cpu_times()
-    t0 = time.monotonic()
-    time.sleep(5.0)
-    after = proc.cpu_times()
-    share = (after.user + after.system - before.user - before.system) / (time.monotonic() - t0)
-    assert share < 0.01, f"idle plug-in used {share:.2%} of a core"
+    # Start-up (imports, bus ports) takes longer on a busy machine: the plug-in has up to a
+    # minute to settle, then one 5 s window of waiting must cost under 1 % of a core. A
+    # plug-in that polls never settles and fails here.
+    shares = []
+    deadline = time.monotonic() + 60.0
+    while time.monotonic() < deadline:
+        before = proc.cpu_times()
+        t0 = time.monotonic()
+        time.sleep(5.0)
+        after = proc.cpu_times()
+        used = after.user + after.system - before.user - before.system
+        shares.append(used / (time.monotonic() - t0))
+        if shares[-1] < 0.01:
+            break
+    assert shares[-1] < 0.01, f"idle plug-in used {[f'{s:.2%}' for s in shares]} of a core"
 
 
 def test_status_json_reports_every_plugin_with_state_pid_restarts_cpu(vehicle_factory):
