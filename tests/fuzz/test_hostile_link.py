@@ -32,6 +32,15 @@ def drain(gcs: GroundStation, acks: Counter, seen: Counter) -> None:
             acks[msg.command] += 1
 
 
+def all_answered(gcs: GroundStation, sent: Counter, acks: Counter, seen: Counter) -> None:
+    try:
+        answered = lambda: drain(gcs, acks, seen) or acks == sent  # noqa: E731
+        wait_for(answered, 20, "an answer to every command", period_s=0.005)
+    except AssertionError:
+        missing = {c: (n, acks[c]) for c, n in sent.items() if acks[c] != n}
+        raise AssertionError(f"sent vs answered: {missing}; seen {dict(seen)}") from None
+
+
 def attitude_rate(gcs: GroundStation, seconds: float) -> float:
     count, end = 0, time.monotonic() + seconds
     while time.monotonic() < end:
@@ -58,14 +67,11 @@ def test_a_hostile_stream_changes_nothing_and_every_command_is_answered(vehicle_
         gcs.conn.port.sendto(frame.data, gcs.conn.destination_addr)
         if frame.command is not None:
             sent[frame.command] += 1
-        if i % BURST == BURST - 1:
-            drain(gcs, acks, seen)
-            time.sleep(0.002)
-    try:
-        wait_for(lambda: drain(gcs, acks, seen) or acks == sent, 20, "an answer to every command")
-    except AssertionError:
-        missing = {c: (n, acks[c]) for c, n in sent.items() if acks[c] != n}
-        raise AssertionError(f"sent vs answered: {missing}; seen {dict(seen)}") from None
+        if i % BURST == BURST - 1 or i == FRAMES - 1:
+            # Each burst's commands answered before the next, as a ground station waits for
+            # its acks: a link process starved by a busy machine then never has more than a
+            # burst queued, and the kernel's socket buffer never drops a datagram.
+            all_answered(gcs, sent, acks, seen)
 
     wait_for(lambda: vehicle.row("link").refused > 0, 10, "the link's refusals counted")
     rows = {row.name.decode(): row for row in vehicle.health().rows()}

@@ -33,7 +33,10 @@ def station(vehicle_factory, tmp_path):
         gcs.connect()
         made.append(gcs)
         status = vehicle.bus.latest_reader("vehicle/status")
-        wait_for(status.get, 15, "the commander's first status")
+        wait_for(status.get, 60, "the commander's first status")
+        # Return needs home, which the commander takes from the navigator's first solution:
+        # later than the first status on a busy machine.
+        wait_for(lambda: status.get().home_valid, 60, "home from the first solution")
         return vehicle, gcs, status
 
     made: list[GroundStation] = []
