@@ -55,6 +55,7 @@ class Timeline:
     last_ms: int = 0
     seqs: list[int] = field(default_factory=list)
     texts: list[str] = field(default_factory=list)
+    armed: bool | None = None  # as the vehicle's last heartbeat said
 
     def time_to_complete_s(self) -> float:
         if self.start_ms is None or self.complete_ms is None:
@@ -145,6 +146,7 @@ def _row(flight: Flight, folder: Path, tl: Timeline, error: str, wall_s: float) 
         "sim_s": sim_s,
         "wall_s": wall_s,
         "failsafes": ";".join(tl.failsafes()),
+        "armed_at_end": tl.armed,
         "log": str(folder / "sim.log"),
     }  # fmt: skip
 
@@ -302,6 +304,8 @@ class _Pilot:
             self.tl.last_ms = max(self.tl.last_ms, int(ms))
         if msg.get_type() == "STATUSTEXT":
             self.tl.texts.append(msg.text)
+        elif msg.get_type() == "HEARTBEAT" and msg.get_srcSystem() == 1:
+            self.tl.armed = bool(msg.base_mode & d.MAV_MODE_FLAG_SAFETY_ARMED)
 
 
 def _end(proc: subprocess.Popen) -> None:

@@ -66,7 +66,9 @@ class ClosedLoop:
         s = self.flight.state()
         self.status = VehicleStatus(mode=int(self.mode), armed=1, home_valid=1)
         self.status.home_lat_deg, self.status.home_lon_deg = s.lat_deg, s.lon_deg
-        self.status.home_alt_msl_m = s.alt_msl_m - s.alt_agl_m
+        # Home is where the navigator is at arming: the resting aircraft, not the ground.
+        airborne = bool(self.airborne_agl_m)
+        self.status.home_alt_msl_m = s.alt_msl_m - s.alt_agl_m if airborne else s.alt_msl_m
         self.status.target_lat_deg = self.status.target_lon_deg = math.nan
         self.status.target_alt_msl_m = math.nan
         self.samples: list[Sample] = []
@@ -108,6 +110,7 @@ class ClosedLoop:
                 "elevator": out.elevator,
                 "rudder": out.rudder,
                 "throttle": out.throttle,
+                "flaps": out.flaps if math.isfinite(out.flaps) else 0.0,
             }
         )
         truth = (s.lat_deg, s.lon_deg, s.alt_msl_m, s.alt_agl_m, s.airspeed_m_s, s.roll, s.yaw)

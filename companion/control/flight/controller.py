@@ -8,8 +8,9 @@ plug-in runs it on the bus; tests and benchmarks run it against JSBSim directly.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
+from companion.control.flight.landing import AircraftState, Landing, LandingDemand, LandPhase
 from companion.control.flight.params import FlightConfig
 from companion.control.flight.pilot import PILOT_MODES, Sticks, fly_pilot
 from companion.control.flight.takeoff import Phase, RunwayTakeoff
@@ -51,6 +52,9 @@ class ControlOutput:
     mission_finished: bool = False
     reached: list[int] = field(default_factory=list)
     landed: bool = True
+    disarm: bool = False  # landed and stopped: the flight is over
+    land_phase: int = 0  # LandPhase while landing, else 0
+    flaps: float = 0.0  # 0 up .. 1 fully down
 
 
 class FlightController:
@@ -64,6 +68,7 @@ class FlightController:
         self.home_alt = 0.0
         self.executor: MissionExecutor | None = None
         self.takeoff: RunwayTakeoff | None = None
+        self.landing: Landing | None = None
         self.landed: bool | None = None
         self._last_t: float | None = None
         self._mode_key: tuple[int, int] | None = None
@@ -134,9 +139,13 @@ class FlightController:
         if setpoint is None:
             self.attitude.reset()
             return out  # on the ground with nothing that flies from there: idle
+        self.tecs.gains = self.config.tecs
         if setpoint.kind == Kind.TAKEOFF or self._taking_off(nav):
             return self._fly_takeoff(setpoint, pos, nav, airspeed, dt, out)
         self.takeoff = None
+        if setpoint.kind == Kind.LAND:
+            return self._fly_landing(setpoint, pos, nav, airspeed, dt, out)
+        self.landing = None
         return self._fly(setpoint, pos, vel, nav, airspeed, dt, out)
 
     def _fly_pilot(
@@ -248,7 +257,7 @@ class FlightController:
         out.mission_seq = ex.current
         out.mission_finished = ex.finished
         out.reached = ex.drain_reached()
-        if self.landed and setpoint.kind != Kind.TAKEOFF:
+        if self.landed and setpoint.kind not in (Kind.TAKEOFF, Kind.LAND):
             return None  # a mission must start with a take-off from the ground
         return setpoint
 
@@ -321,6 +330,74 @@ class FlightController:
         out.alt_error = setpoint.alt_msl - nav.alt_msl_m
         return out
 
+    def _fly_landing(
+        self,
+        sp: Setpoint,
+        pos: tuple[float, float],
+        nav: NavState,
+        airspeed: float,
+        dt: float,
+        out: ControlOutput,
+    ) -> ControlOutput:
+        land = self.landing
+        if land is None or (land.start, land.touchdown, land.land_alt) != (sp.a, sp.b, sp.alt_msl):
+            from_alt = sp.from_alt if math.isfinite(sp.from_alt) else nav.alt_msl_m
+            land = self.landing = Landing(sp.a, from_alt, sp.b, sp.alt_msl)
+        vel = (nav.vn_m_s, nav.ve_m_s)
+        state = AircraftState(pos, vel, nav.alt_msl_m, -nav.vd_m_s, nav.pitch_rad, nav.yaw_rad,
+                              nav.yaw_rate_rad_s)  # fmt: skip
+        dem = land.step(state, self.config, dt)
+        out.land_phase = int(dem.phase)
+        out.flaps = dem.flaps
+        if dem.phase in (LandPhase.APPROACH, LandPhase.GO_AROUND):
+            line = Setpoint(Kind.LINE, dem.line[0], dem.line[1], dem.alt_msl, speed=dem.speed)
+            if dem.phase == LandPhase.APPROACH:  # the glide path before the speed
+                self.tecs.gains = replace(self.config.tecs, speed_weight=self.config["TECS_LAND_SPDWGT"])
+            return self._fly(line, pos, vel, nav, airspeed, dt, out, dem.speed, dem.climb_ff)
+        if dem.disarm and self.executor is not None:
+            self.executor.land_complete()
+            out.mission_finished = True
+            out.reached += self.executor.drain_reached()
+        out.disarm = dem.disarm
+        return self._fly_attitude(dem, pos, vel, nav, airspeed, dt, out)
+
+    def _fly_attitude(
+        self,
+        dem: LandingDemand,
+        pos: tuple[float, float],
+        vel: tuple[float, float],
+        nav: NavState,
+        airspeed: float,
+        dt: float,
+        out: ControlOutput,
+    ) -> ControlOutput:
+        """The flare and the rollout: pitch and throttle given, bank limited, L1 on the
+        centreline for what bank is allowed."""
+        line = Setpoint(Kind.LINE, dem.line[0], dem.line[1], dem.alt_msl)
+        lateral = self._lateral(line, pos, vel, dt)
+        roll_dem = bank_for(lateral.lat_acc, min(dem.roll_limit, self.config.roll_limit))
+        flying = dem.phase == LandPhase.FLARE
+        surfaces = self.attitude.step(
+            roll_dem,
+            dem.pitch,
+            (nav.roll_rad, nav.pitch_rad),
+            (nav.roll_rate_rad_s, nav.pitch_rate_rad_s, nav.yaw_rate_rad_s),
+            max(airspeed, self.config["TKOFF_ROTATE_SPD"] * 0.5),
+            dt,
+            integrate=flying,
+        )
+        self.tecs.reset(dem.pitch)
+        out.aileron, out.elevator = surfaces.aileron, surfaces.elevator
+        if math.isfinite(dem.elevator):
+            out.elevator = dem.elevator
+        out.rudder = dem.rudder if math.isfinite(dem.rudder) else surfaces.rudder
+        out.throttle = dem.throttle
+        out.nav_roll, out.nav_pitch = roll_dem, dem.pitch
+        out.target_bearing = lateral.target_bearing
+        out.xtrack = lateral.xtrack
+        out.alt_error = dem.alt_msl - nav.alt_msl_m
+        return out
+
     def _fly(
         self,
         sp: Setpoint,
@@ -330,13 +407,19 @@ class FlightController:
         airspeed: float,
         dt: float,
         out: ControlOutput,
+        least_speed: float = math.inf,
+        climb_ff: float = 0.0,
     ) -> ControlOutput:
         cfg = self.config
         speed_dem = sp.speed if math.isfinite(sp.speed) else cfg["AIRSPEED_CRUISE"]
-        speed_dem = max(cfg["AIRSPEED_MIN"], min(cfg["AIRSPEED_MAX"], speed_dem))
+        # The landing approach alone may fly slower than AIRSPEED_MIN.
+        speed_min = min(cfg["AIRSPEED_MIN"], least_speed)
+        speed_dem = max(speed_min, min(cfg["AIRSPEED_MAX"], speed_dem))
         lateral = self._lateral(sp, pos, vel, dt)
         roll_dem = bank_for(lateral.lat_acc, cfg.roll_limit)
-        energy = self.tecs.step(nav.alt_msl_m, -nav.vd_m_s, airspeed, sp.alt_msl, speed_dem, dt)
+        energy = self.tecs.step(
+            nav.alt_msl_m, -nav.vd_m_s, airspeed, sp.alt_msl, speed_dem, dt, climb_ff
+        )
         surfaces = self.attitude.step(
             roll_dem,
             energy.pitch,

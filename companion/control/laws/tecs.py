@@ -74,12 +74,18 @@ class Tecs:
         height_dem: float,
         speed_dem: float,
         dt: float,
+        climb_ff: float = 0.0,
     ) -> EnergyDemand:
-        """Pitch and throttle for the demanded height (m) and airspeed (m/s)."""
+        """Pitch and throttle for the demanded height (m) and airspeed (m/s).
+
+        ``climb_ff`` (m/s) is how fast the demanded height itself moves (a glide path):
+        without it the height would trail a moving demand by a constant error.
+        """
         g = self.gains
         self._track_speed(speed, dt)
         v = max(speed, 5.0)
-        climb_dem = clamp((height_dem - height) / g.time_const, -g.sink_max, g.climb_max)
+        climb_dem = (height_dem - height) / g.time_const + climb_ff
+        climb_dem = clamp(climb_dem, -g.sink_max, g.climb_max)
         accel_dem = clamp((speed_dem - speed) / g.speed_time_const, -g.accel_max, g.accel_max)
         # Specific (per unit weight) energy rates, m/s.
         ste_rate_dem = climb_dem + v * accel_dem / G

@@ -15,7 +15,7 @@ import enum
 import math
 from dataclasses import dataclass, field
 
-from companion.control.mission.items import MissionItem
+from companion.control.mission.items import CAMERA_STOPS, MissionItem
 from companion.geodesy import LocalFrame, wrap_pi
 from mavlink_dialect import companion as d
 
@@ -28,12 +28,19 @@ MAX_LEAD_TURN_DEG = 135.0
 MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
 
 
+# Markers and camera stops: nothing to fly (DO_LAND_START only marks where a landing begins).
+SKIPPED = CAMERA_STOPS | {d.MAV_CMD_DO_LAND_START}
+LOITER_ALT_MARGIN_M = 5.0  # LOITER_TO_ALT: this close to its height counts as there
+TANGENT_WINDOW = math.radians(30.0)  # leave a LOITER_TO_ALT this soon past the tangent point
+
+
 class Kind(enum.IntEnum):
     """What the controller is asked to fly."""
 
     TAKEOFF = 1  # runway take-off, then climb along the runway heading
     LINE = 2  # track a → b
     CIRCLE = 3  # circle b
+    LAND = 4  # approach along a → b down to alt_msl at b, flare, roll out, stop
 
 
 @dataclass(frozen=True)
@@ -47,6 +54,7 @@ class Setpoint:
     radius: float = 0.0
     clockwise: bool = True
     speed: float = math.nan  # NaN: the cruise speed
+    from_alt: float = math.nan  # LAND: the height at a, where the glide path starts
 
 
 @dataclass
@@ -166,6 +174,13 @@ class MissionExecutor:
             return None
         if cmd == d.MAV_CMD_DO_JUMP:
             return self._jump(item)
+        if cmd in SKIPPED:
+            self._advance(False, self._prev, self._prev_alt)
+            return None
+        if cmd == d.MAV_CMD_NAV_LAND:
+            return self._land(item, pos)
+        if cmd == d.MAV_CMD_NAV_LOITER_TO_ALT:
+            return self._loiter_to_alt(item, pos, alt)
         if cmd == d.MAV_CMD_NAV_TAKEOFF:
             return self._takeoff(item, pos, alt)
         if cmd == d.MAV_CMD_NAV_WAYPOINT:
@@ -227,7 +242,9 @@ class MissionExecutor:
                 seq = round(item.param1) if repeats < 0 or done < repeats else seq + 1
             elif item.command == d.MAV_CMD_NAV_RETURN_TO_LAUNCH:
                 return (0.0, 0.0)
-            elif item.command == d.MAV_CMD_NAV_WAYPOINT:
+            elif item.command in SKIPPED:
+                seq += 1
+            elif item.command in (d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_NAV_LAND):
                 return self.point_of(item, here)
             else:
                 return None
@@ -245,6 +262,56 @@ class MissionExecutor:
         if self.finished:
             return Setpoint(Kind.CIRCLE, home, home, rtl_alt, radius, speed=self.speed)
         return Setpoint(Kind.LINE, self._prev, home, rtl_alt, speed=self.speed)
+
+    def _land(self, item: MissionItem, pos: tuple[float, float]) -> Setpoint:
+        """NAV_LAND: the approach runs from the previous point; the controller lands."""
+        point = self.point_of(item, pos)
+        return Setpoint(Kind.LAND, self._prev, point, self.alt_of(item), from_alt=self._prev_alt)
+
+    def land_complete(self) -> None:
+        """The aircraft has landed and stopped on the current NAV_LAND: the mission is done."""
+        if not self.finished:
+            self.reached.append(self.items[self.current].seq)
+            self.finished = True
+
+    def _loiter_to_alt(
+        self, item: MissionItem, pos: tuple[float, float], alt: float
+    ) -> Setpoint | None:
+        """Circle until at the item's height, then (param1 = 1) leave on the tangent that
+        points at the next waypoint, so the next leg starts on the circle's edge."""
+        centre = self.point_of(item, self._prev)
+        given = math.isfinite(item.param2) and item.param2 != 0
+        radius = abs(item.param2) if given else self.config.loiter_radius
+        # The controller flies a circle tighter than it can turn at the tightest it can.
+        radius = max(radius, self._turn_radius)
+        clockwise = item.param2 >= 0
+        target_alt = self.alt_of(item)
+        circle = Setpoint(Kind.CIRCLE, centre, centre, target_alt, radius, clockwise, self.speed)
+        on_circle = abs(_distance(pos, centre) - radius) <= radius * ON_CIRCLE
+        if abs(alt - target_alt) > LOITER_ALT_MARGIN_M or not on_circle:
+            return circle
+        nxt = self._next_point(centre)
+        nominal = abs(item.param2) if given else self.config.loiter_radius
+        exit_angle = None
+        if nxt is not None and item.param1 >= 0.5:
+            exit_angle = tangent_angle(centre, nominal, clockwise, nxt)
+        if exit_angle is None:
+            self._advance(True, pos, target_alt)
+            return None
+        # The leg starts at the tangent point of the circle as planned. The circle flown
+        # may be wider (the bank limit): leave it where its course is the leg's course.
+        start = (
+            centre[0] + nominal * math.cos(exit_angle),
+            centre[1] + nominal * math.sin(exit_angle),
+        )
+        course = math.atan2(nxt[1] - start[1], nxt[0] - start[0])
+        leave_at = course - math.pi / 2 if clockwise else course + math.pi / 2
+        angle = math.atan2(pos[1] - centre[1], pos[0] - centre[0])
+        past = wrap_pi(angle - leave_at) * (1.0 if clockwise else -1.0)
+        if not 0.0 <= past <= TANGENT_WINDOW:
+            return circle
+        self._advance(True, start, target_alt)
+        return None
 
     def _loiter_item(
         self, item: MissionItem, pos: tuple[float, float], alt: float, t_s: float
@@ -275,6 +342,19 @@ class MissionExecutor:
             self._advance(True, centre, target_alt)
             return None
         return circle
+
+
+def tangent_angle(
+    centre: tuple[float, float], radius: float, clockwise: bool, target: tuple[float, float]
+) -> float | None:
+    """The angle (from north, about ``centre``) of the point where a circle flown that way
+    is left straight towards ``target``; None when the target is inside the circle."""
+    dist = _distance(centre, target)
+    if dist <= radius:
+        return None
+    bearing = math.atan2(target[1] - centre[1], target[0] - centre[0])
+    beta = math.acos(radius / dist)
+    return wrap_pi(bearing - beta if clockwise else bearing + beta)
 
 
 def _distance(a: tuple[float, float], b: tuple[float, float]) -> float:

@@ -1,8 +1,9 @@
 """Mission items (MISSION_ITEM_INT fields) and what the vehicle can fly.
 
-Only what the executor flies is accepted: no landing (the aircraft has no landing
-controller yet) and no terrain frames (it has no terrain data), so such a plan is refused
-at upload with the matching MAV_MISSION_RESULT instead of being skipped in flight.
+Only what the executor flies is accepted: no terrain frames (it has no terrain data), so
+such a plan is refused at upload with the matching MAV_MISSION_RESULT instead of being
+skipped in flight. The camera stops that QGroundControl's landing pattern puts before the
+approach are accepted and do nothing: there is no camera on board to stop.
 """
 
 from __future__ import annotations
@@ -22,9 +23,17 @@ NAV_COMMANDS = frozenset(
         d.MAV_CMD_NAV_LOITER_TIME,
         d.MAV_CMD_NAV_RETURN_TO_LAUNCH,
         d.MAV_CMD_NAV_TAKEOFF,
+        d.MAV_CMD_NAV_LOITER_TO_ALT,
+        d.MAV_CMD_NAV_LAND,
     }
 )
-DO_COMMANDS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_JUMP})
+CAMERA_STOPS = frozenset(
+    {d.MAV_CMD_IMAGE_STOP_CAPTURE, d.MAV_CMD_DO_SET_CAM_TRIGG_DIST, d.MAV_CMD_VIDEO_STOP_CAPTURE}
+)
+DO_COMMANDS = (
+    frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_JUMP, d.MAV_CMD_DO_LAND_START})
+    | CAMERA_STOPS
+)
 SUPPORTED = {
     d.MAV_MISSION_TYPE_MISSION: NAV_COMMANDS | DO_COMMANDS,
     d.MAV_MISSION_TYPE_FENCE: frozenset(
@@ -46,8 +55,16 @@ GLOBAL_FRAMES = frozenset(
         d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
     }
 )
-POSITIONLESS = frozenset(
-    {d.MAV_CMD_NAV_RETURN_TO_LAUNCH, d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_JUMP}
+POSITIONLESS = (
+    frozenset(
+        {
+            d.MAV_CMD_NAV_RETURN_TO_LAUNCH,
+            d.MAV_CMD_DO_CHANGE_SPEED,
+            d.MAV_CMD_DO_JUMP,
+            d.MAV_CMD_DO_LAND_START,
+        }
+    )
+    | CAMERA_STOPS
 )
 
 

@@ -1,7 +1,8 @@
 """QGroundControl ``.plan`` files: import to mission/fence/rally items and export back.
 
 A plan is JSON: ``mission.items`` (SimpleItems with command, frame, params[7],
-autoContinue; ComplexItems are not flown and are refused by name), ``geoFence`` (polygons
+autoContinue; of the ComplexItems the fixed-wing landing pattern is expanded to the items
+QGroundControl uploads for it, the others are refused by name), ``geoFence`` (polygons
 with inclusion flags, circles) and ``rallyPoints.points``. Exported plans always carry
 ``geoFence`` and ``rallyPoints`` objects, which MAVSDK's importer requires.
 """
@@ -45,10 +46,46 @@ def _simple(raw: dict[str, Any], seq: int) -> MissionItem:
     )
 
 
+LANDING_PATTERN = "fwLandingPattern"
+
+
+def _landing(raw: dict[str, Any]) -> list[dict[str, Any]]:
+    """The items QGroundControl uploads for a fixed-wing landing pattern: DO_LAND_START,
+    the camera stops asked for, the final approach (LOITER_TO_ALT leaving on the tangent
+    towards the landing point, or a waypoint), NAV_LAND."""
+    frame = (
+        d.MAV_FRAME_GLOBAL_RELATIVE_ALT if raw.get("altitudesAreRelative", True)
+        else d.MAV_FRAME_GLOBAL
+    )  # fmt: skip
+    approach = raw.get("landingApproachCoordinate", raw.get("loiterCoordinate"))
+    land = raw["landCoordinate"]
+    out = [{"command": d.MAV_CMD_DO_LAND_START, "frame": d.MAV_FRAME_MISSION, "params": [0] * 7}]
+    if raw.get("stopTakingPhotos", False):
+        out.append({"command": d.MAV_CMD_IMAGE_STOP_CAPTURE, "frame": 2, "params": [0] * 7})
+    if raw.get("stopTakingVideo", False):
+        out.append({"command": d.MAV_CMD_VIDEO_STOP_CAPTURE, "frame": 2, "params": [0] * 7})
+    if raw.get("useLoiterToAlt", True):
+        radius = float(raw["loiterRadius"]) * (1.0 if raw.get("loiterClockwise", True) else -1.0)
+        params = [1.0, radius, 0.0, 1.0, approach[0], approach[1], approach[2]]
+        out.append({"command": d.MAV_CMD_NAV_LOITER_TO_ALT, "frame": frame, "params": params})
+    else:
+        params = [0.0, 0.0, 0.0, None, approach[0], approach[1], approach[2]]
+        out.append({"command": d.MAV_CMD_NAV_WAYPOINT, "frame": frame, "params": params})
+    params = [0.0, 0.0, 0.0, None, land[0], land[1], land[2]]
+    out.append({"command": d.MAV_CMD_NAV_LAND, "frame": frame, "params": params})
+    return out
+
+
 def _mission_items(plan: dict[str, Any], path: Path) -> list[MissionItem]:
     items: list[MissionItem] = []
     jump_ids: dict[int, int] = {}  # QGroundControl's doJumpId → our sequence number
     for index, raw in enumerate(plan.get("mission", {}).get("items", [])):
+        if raw.get("complexItemType") == LANDING_PATTERN:
+            try:
+                items += [_simple(r, len(items) + k) for k, r in enumerate(_landing(raw))]
+            except (KeyError, TypeError, ValueError, IndexError) as exc:
+                raise PlanError(f"{path}: mission item {index}: {exc}") from None
+            continue
         if raw.get("type") != "SimpleItem":
             kind = raw.get("complexItemType", raw.get("type"))
             raise PlanError(f"{path}: mission item {index}: {kind} items are not supported")

@@ -23,9 +23,11 @@ from companion.control.flight.pilot import pilot_sticks
 from companion.control.mission.store import MissionStore, StoreFollower
 from companion.messages import (
     ActuatorCommand,
+    CommandId,
     ControlStatus,
     FlightMode,
     MissionState,
+    VehicleCommand,
     VehicleStatus,
 )
 from companion.params import ParamDecl
@@ -52,7 +54,7 @@ class FixedWingPlugin(Plugin):
         "sensors/rc",
         "link/manual_control",
     )
-    outputs = ("control/actuators", "control/status")
+    outputs = ("control/actuators", "control/status", "link/commands")
 
     @classmethod
     def validate(cls, settings: Mapping[str, Any]) -> list[str]:
@@ -84,6 +86,10 @@ class FixedWingPlugin(Plugin):
         self.joystick = bus.latest_reader("link/manual_control")
         self.surfaces = bus.writer("control/actuators")
         self.status_out = bus.writer("control/status")
+        # Landed and stopped: the controller disarms as a pilot would (execution control
+        # stops the flight group, servos safe).
+        self.commands = bus.writer("link/commands")
+        self.disarm_sent = False
         self.reached_count = 0
         self.last_reached = -1
         self.next_status_us = 0
@@ -115,7 +121,10 @@ class FixedWingPlugin(Plugin):
         cmd.throttle = out.throttle
         for i in range(len(cmd.aux)):
             cmd.aux[i] = math.nan
+        cmd.aux[0] = out.flaps
         self.surfaces.publish(cmd)
+        if out.disarm and not self.disarm_sent:
+            self._disarm(now_us, out, status)
         self.ctx.health.ok()
         if out.reached:
             self.reached_count += len(out.reached)
@@ -123,6 +132,13 @@ class FixedWingPlugin(Plugin):
         if out.reached or now_us >= self.next_status_us:
             self.status_out.publish(self._status(now_us, out, status))
             self.next_status_us = now_us + STATUS_PERIOD_US
+
+    def _disarm(self, now_us: int, out: ControlOutput, status: VehicleStatus) -> None:
+        # The ground station hears the mission complete before the controller stops.
+        self.status_out.publish(self._status(now_us, out, status))
+        self.ctx.log.info("landed and stopped: disarming")
+        self.commands.publish(VehicleCommand(t_us=now_us, command=int(CommandId.STOP)))
+        self.disarm_sent = True
 
     def _status(self, now_us: int, out: ControlOutput, status: VehicleStatus) -> ControlStatus:
         msg = ControlStatus(t_us=now_us)

@@ -1,0 +1,92 @@
+"""Automatic landings of both airframes, scored from the simulator's truth.
+
+Usage: uv run python benchmarks/landing.py [--aircraft c172p] [--plan land_east.plan]
+       [--calm-only]
+(aircraft and plan repeatable; default: c172p and J3Cub, benchmarks/plans/land_east.plan)
+
+Each airframe, plan and condition (calm; 5 m/s crosswind from the south with light
+turbulence, the runway running east) is one campaign flight in exact lockstep
+(``companion sim --speed max --exact --start-at 10`` with the plan, which ends in a
+QGroundControl landing pattern; ground/campaign/flight_run.py), watched until the mission
+completes. Printed from the truth CSV (ground/campaign/landing_score.py): touchdown
+along (+ past) and across (+ right of) the landing point, vertical speed and bank at
+touchdown, the highest bounce, where the aircraft stopped, and whether the vehicle's last
+heartbeat said it was disarmed.
+Criteria (issue 24): |along| ≤ 30 m, |across| ≤ 3 m, sink ≤ 1.5 m/s, bounce ≤ 1 m,
+|bank| ≤ 10°, stopped on the runway, disarmed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from companion.control.mission.plan import checked_plan  # noqa: E402
+from companion.navigation.estimate_csv import read_estimate  # noqa: E402
+from ground.campaign.flight_run import FlightJob, fly_flight  # noqa: E402
+from ground.campaign.landing_score import LandingScore, landing_score_for_plan  # noqa: E402
+from ground.campaign.spec import SIM_CONFIG, Flight  # noqa: E402
+
+CONDITIONS = {"calm": ((0.0, 0.0, 0.0), "none"), "xwind 5 S + light": ((5.0, 0.0, 0.0), "light")}
+HERE_PLANS = Path(__file__).resolve().parent / "plans"
+START_AT_S = 10.0
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--aircraft", action="append")
+    ap.add_argument("--plan", action="append")
+    ap.add_argument("--calm-only", action="store_true")
+    args = ap.parse_args()
+    conditions = {"calm": CONDITIONS["calm"]} if args.calm_only else CONDITIONS
+    plans = [_plan(p) for p in (args.plan or ["land_east.plan"])]
+    print(
+        f"{'airframe':8} {'plan':10} {'condition':18} {'along':>6} {'across':>6} {'sink':>5} "
+        f"{'bounce':>6} {'bank':>5} {'stop@':>6} {'stop x':>6} {'stopped':7} {'runway':6} "
+        f"{'disarm':6} {'pass':5}"
+    )
+    for name in args.aircraft or ["c172p", "J3Cub"]:
+        for plan in plans:
+            for cond, (wind, turbulence) in conditions.items():
+                flight = Flight(str(plan), name, wind, turbulence, (), 1, str(SIM_CONFIG),
+                                False, 900.0, START_AT_S)  # fmt: skip
+                with tempfile.TemporaryDirectory() as tmp:
+                    row = fly_flight(FlightJob(flight, tmp, timeout_s=900.0))
+                    truth = Path(tmp) / flight.flight_id / "truth.csv"
+                    score = _score(truth, plan)
+                print(_row(name, plan.stem, cond, score, row), flush=True)
+
+
+def _plan(name: str) -> Path:
+    for candidate in (Path(name), HERE_PLANS / name):
+        if candidate.exists():
+            return candidate.resolve()
+    raise SystemExit(f"no plan {name}")
+
+
+def _score(truth: Path, plan: Path) -> LandingScore:
+    if not truth.exists():
+        return LandingScore(False)
+    return landing_score_for_plan(read_estimate(truth), checked_plan(plan)[0])
+
+
+def _row(name: str, plan: str, cond: str, s: LandingScore, row: dict) -> str:
+    disarmed = row.get("armed_at_end") is False
+    ok = s.passed() and disarmed
+    text = (
+        f"{name:8} {plan:10} {cond:18} {s.along_m:6.1f} {s.across_m:6.2f} {s.sink_m_s:5.2f} "
+        f"{s.bounce_m:6.2f} {s.bank_deg:5.1f} {s.stop_along_m:6.0f} {s.stop_across_m:6.2f} "
+        f"{s.stopped!s:7} {s.on_runway!s:6} {disarmed!s:6} {ok!s:5}"
+    )
+    if row["status"] != "ok":
+        text += f"  ({row['error']})"
+    return text
+
+
+if __name__ == "__main__":
+    main()

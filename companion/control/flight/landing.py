@@ -1,0 +1,280 @@
+"""Automatic fixed-wing landing: approach, glide slope, flare, rollout, stop.
+
+Pure: the aircraft's state and dt in, a demand out. The shape is the one ArduPlane and
+PX4 publish for their fixed-wing landings, written here from their descriptions:
+
+- **Approach**: the line from the previous waypoint through the touchdown point, at the
+  landing airspeed (``TECS_LAND_ARSPD``), down a straight glide path from the previous
+  waypoint's height. The path does not end at the touchdown point but where the flare
+  must begin for the flare to end there, so the aircraft touches down on the target
+  instead of floating past it.
+- **Flare**: below ``LAND_FLARE_ALT`` above the runway, or when the ground is less than
+  ``LAND_FLARE_SEC`` away at the present sink rate, the throttle is cut and pitch flies
+  an exponential flare: a sink-rate demand that falls with height towards ``TECS_LAND_SINK``
+  at the ground. Bank is limited to ``LEVEL_ROLL_LIMIT``; the crab is kept, so a
+  crosswind does not drift the aircraft off the centreline in the flare.
+- **Rollout**: on the wheels the rudder (and the steered wheel) holds the centreline,
+  the wings are held level, the throttle is idle (the brakes come on with it).
+- **Stopped**: slower than a walking pace for ``LAND_DISARMDELAY`` seconds: disarm.
+- **Go-around** (``abort()``): full climb power, climb straight out along the runway.
+
+Heights are above the touchdown point's altitude, from the navigator's altitude (which
+fuses the barometer and GPS).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from companion.control.laws.limits import clamp
+from companion.geodesy import wrap_pi
+from companion.params import ParamDecl
+
+Point = tuple[float, float]
+
+TOUCHDOWN_AGL_M = 0.4  # the wheels are on the runway below this (a sinking check guards it)
+STEER_LOOKAHEAD_M = 20.0
+STOPPED_SPEED = 0.8  # m/s: slower than this counts as stopped
+# The servo card has no brake channel: the simulator (as a pilot would) holds the brakes
+# while the throttle is closed (below 0.05). Just open, the wheels roll free.
+ROLL_FREE_THROTTLE = 0.06
+MIN_GLIDE = math.radians(1.5)  # a flatter path cannot be flown with the throttle at idle
+SINK_P = 0.12  # rad of pitch per m/s of sink-rate error in the flare
+SINK_I = 0.08  # rad per (m/s·s)
+
+
+LANDING_PARAMS = (
+    ParamDecl("LAND_FLARE_ALT", 3.0, 0.5, 20.0, "m", "landing: flare below this height"),
+    ParamDecl("LAND_FLARE_SEC", 2.0, 0.5, 10.0, "s", "landing: flare this long before ground"),
+    ParamDecl("LAND_PITCH_CD", 0.0, -500.0, 1500.0, "cdeg", "landing: least pitch in the flare"),
+    ParamDecl("LAND_DISARMDELAY", 3.0, 0.0, 127.0, "s", "landing: disarm this long after stop"),
+    ParamDecl("TECS_LAND_ARSPD", 28.0, 5.0, 100.0, "m/s", "landing: approach airspeed"),
+    ParamDecl("TECS_LAND_SINK", 0.4, 0.05, 2.0, "m/s", "landing: sink rate at touchdown"),
+    ParamDecl("TECS_LAND_PMAX", 10.0, 0.0, 30.0, "deg", "landing: most pitch in the flare"),
+    ParamDecl("LEVEL_ROLL_LIMIT", 5.0, 0.0, 45.0, "deg", "landing: most bank in the flare"),
+    ParamDecl("TECS_LAND_SPDWGT", 0.0, 0.0, 2.0, "", "landing: TECS speed weight on the approach "
+              "(0: pitch holds the glide path)"),
+    ParamDecl("LAND_BRAKE_SPD", 8.0, 0.0, 50.0, "m/s", "rollout: brake (throttle closed) below "
+              "this ground speed; above, the throttle is just open"),
+    ParamDecl("LAND_ROLL_ELEV", 0.0, 0.0, 1.0, "", "rollout: elevator held back (a tail "
+              "dragger pins its tail wheel); 0: the touchdown pitch is held"),
+    ParamDecl("LAND_STEER_P", 2.0, 0.0, 10.0, "", "rollout: rudder per radian of heading error"),
+    ParamDecl("LAND_FLAP_PERCNT", 0.0, 0.0, 100.0, "%", "landing: flaps on the approach"),
+    ParamDecl("RTL_AUTOLAND", 0.0, 0.0, 2.0, "", "Return lands at DO_LAND_START: 1 after "
+              "reaching home, 2 at once"),
+)  # fmt: skip
+
+
+class LandPhase(enum.IntEnum):
+    """Where in the landing the aircraft is."""
+
+    APPROACH = 1
+    FLARE = 2
+    ROLLOUT = 3
+    STOPPED = 4
+    GO_AROUND = 5
+
+
+@dataclass(frozen=True)
+class LandingDemand:
+    """What to fly now.
+
+    APPROACH and GO_AROUND: track ``line`` at ``alt_msl`` and ``speed`` with normal
+    energy control (``pitch`` and ``throttle`` are NaN). FLARE and ROLLOUT: ``pitch``,
+    ``throttle`` and the bank limit are given; ``rudder`` (NaN: the yaw damper) steers
+    on the ground.
+    """
+
+    phase: LandPhase
+    line: tuple[Point, Point]
+    alt_msl: float
+    speed: float
+    pitch: float = math.nan
+    throttle: float = math.nan
+    rudder: float = math.nan
+    elevator: float = math.nan  # ROLLOUT: held directly when given
+    roll_limit: float = math.nan
+    disarm: bool = False
+    flaps: float = 0.0
+    climb_ff: float = 0.0  # m/s: how fast the glide path descends under the aircraft
+
+
+@dataclass(frozen=True)
+class AircraftState:
+    """The navigator's view: local north/east position and velocity, MSL height."""
+
+    pos: Point
+    vel: Point
+    alt_msl: float
+    climb_rate: float  # m/s, + up
+    pitch: float
+    yaw: float
+    yaw_rate: float
+
+
+class Landing:
+    """One landing, from the previous waypoint ``start`` to the touchdown point."""
+
+    def __init__(
+        self, start: Point, start_alt_msl: float, touchdown: Point, land_alt_msl: float
+    ) -> None:
+        self.start, self.touchdown = start, touchdown
+        self.start_alt, self.land_alt = start_alt_msl, land_alt_msl
+        dn, de = touchdown[0] - start[0], touchdown[1] - start[1]
+        self.length = max(math.hypot(dn, de), 1.0)
+        self.heading = math.atan2(de, dn)
+        self.unit = (math.cos(self.heading), math.sin(self.heading))
+        self.phase = LandPhase.APPROACH
+        self._flare_integ = 0.0
+        self._flare_pitch = 0.0
+        self._stopped_s = 0.0
+        self._touchdown_pitch = 0.0
+        self._tau = 1.0
+
+    # -- geometry --------------------------------------------------------------------
+
+    def along(self, pos: Point) -> float:
+        """Metres past the touchdown point along the approach (negative before it)."""
+        return (pos[0] - self.touchdown[0]) * self.unit[0] + (
+            pos[1] - self.touchdown[1]
+        ) * self.unit[1]
+
+    def xtrack(self, pos: Point) -> float:
+        """Metres right of the centreline."""
+        dn, de = pos[0] - self.touchdown[0], pos[1] - self.touchdown[1]
+        return -dn * self.unit[1] + de * self.unit[0]
+
+    def point(self, along: float) -> Point:
+        """The centreline point ``along`` metres past the touchdown point."""
+        return (
+            self.touchdown[0] + along * self.unit[0],
+            self.touchdown[1] + along * self.unit[1],
+        )
+
+    def flare_distance(self, ground_speed: float, v: Mapping[str, float]) -> float:
+        """How far before touchdown the flare begins at this ground speed.
+
+        The exponential flare ḣ = -(s + h/τ) from height H at the glide's sink rate s0
+        has τ = H / (s0 - s) and lasts τ·ln(s0 / s); the glide's sink rate is the ground
+        speed times the slope, which itself depends on where the flare begins, so the
+        two are solved together by a few fixed-point steps.
+        """
+        h_f, s_t = v["LAND_FLARE_ALT"], max(v["TECS_LAND_SINK"], 0.05)
+        gs = max(ground_speed, 5.0)
+        dist = 0.0
+        for _ in range(4):
+            slope = self._slope(dist, h_f)
+            s0 = max(gs * slope, s_t * 1.5)
+            tau = h_f / (s0 - s_t)
+            dist = min(gs * tau * math.log(s0 / s_t), 0.5 * self.length)
+        return dist
+
+    def _slope(self, flare_dist: float, flare_alt: float) -> float:
+        drop = self.start_alt - self.land_alt - flare_alt
+        return max(drop / max(self.length - flare_dist, 1.0), math.tan(MIN_GLIDE))
+
+    def glide_alt(self, pos: Point, flare_dist: float, v: Mapping[str, float]) -> float:
+        """The glide path's height (MSL) abeam ``pos``."""
+        h_f = v["LAND_FLARE_ALT"]
+        to_flare = -self.along(pos) - flare_dist
+        alt = self.land_alt + h_f + to_flare * self._slope(flare_dist, h_f)
+        return min(alt, max(self.start_alt, self.land_alt + h_f))
+
+    # -- the phases ------------------------------------------------------------------
+
+    def abort(self) -> None:
+        """Go around: climb out along the runway (the caller decides what comes next)."""
+        if self.phase in (LandPhase.APPROACH, LandPhase.FLARE):
+            self.phase = LandPhase.GO_AROUND
+
+    def step(self, s: AircraftState, v: Mapping[str, float], dt: float) -> LandingDemand:
+        """The demand for this step; ``v`` holds the parameters by name."""
+        height = s.alt_msl - self.land_alt
+        ground_speed = math.hypot(*s.vel)
+        if self.phase == LandPhase.APPROACH and self._flare_due(height, s.climb_rate, v):
+            self.phase = LandPhase.FLARE
+            self._flare_pitch = s.pitch
+            self._flare_integ = 0.0
+            # The flare's time constant makes its first sink demand the sink rate now.
+            s_t = max(v["TECS_LAND_SINK"], 0.05)
+            self._tau = max(height, 0.5) / max(-s.climb_rate - s_t, 0.3)
+        # On the wheels: low and no longer sinking, or slower than anything that flies.
+        slow = ground_speed < 0.5 * v["TECS_LAND_ARSPD"]
+        if self.phase == LandPhase.FLARE and (
+            (height < TOUCHDOWN_AGL_M and s.climb_rate > -0.3) or slow
+        ):
+            self.phase = LandPhase.ROLLOUT
+            self._touchdown_pitch = s.pitch
+        if self.phase in (LandPhase.ROLLOUT, LandPhase.STOPPED):
+            return self._rollout(s, ground_speed, v, dt)
+        if self.phase == LandPhase.FLARE:
+            return self._flare(s, height, v, dt)
+        line = (self.start, self.point(1e4))
+        if self.phase == LandPhase.GO_AROUND:
+            alt = max(self.start_alt, self.land_alt + 30.0)
+            return LandingDemand(self.phase, line, alt, v["AIRSPEED_CRUISE"])
+        flare_dist = self.flare_distance(ground_speed, v)
+        alt = self.glide_alt(s.pos, flare_dist, v)
+        on_slope = alt < self.start_alt
+        speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
+        ff = -max(speed_along, 0.0) * self._slope(flare_dist, v["LAND_FLARE_ALT"]) if on_slope else 0.0
+        return LandingDemand(
+            self.phase, line, alt, v["TECS_LAND_ARSPD"], flaps=_flaps(v), climb_ff=ff
+        )
+
+    def _flare_due(self, height: float, climb_rate: float, v: Mapping[str, float]) -> bool:
+        sink = max(-climb_rate, 0.1)
+        return height < v["LAND_FLARE_ALT"] or height / sink < v["LAND_FLARE_SEC"]
+
+    def _flare(
+        self, s: AircraftState, height: float, v: Mapping[str, float], dt: float
+    ) -> LandingDemand:
+        s_t = max(v["TECS_LAND_SINK"], 0.05)
+        sink_dem = s_t + max(height, 0.0) / self._tau
+        error = -s.climb_rate - sink_dem  # + when sinking faster than wanted: pitch up
+        self._flare_integ = clamp(self._flare_integ + SINK_I * error * dt, -0.1, 0.25)
+        pitch_min = math.radians(v["LAND_PITCH_CD"] / 100.0)
+        pitch_max = math.radians(v["TECS_LAND_PMAX"])
+        pitch = self._flare_pitch + SINK_P * error + self._flare_integ
+        return LandingDemand(
+            self.phase,
+            (self.start, self.point(1e4)),
+            self.land_alt,
+            v["TECS_LAND_ARSPD"],
+            pitch=clamp(pitch, pitch_min, pitch_max),
+            throttle=0.0,
+            roll_limit=math.radians(v["LEVEL_ROLL_LIMIT"]),
+            flaps=_flaps(v),
+        )
+
+    def _rollout(
+        self, s: AircraftState, ground_speed: float, v: Mapping[str, float], dt: float
+    ) -> LandingDemand:
+        # Steer for a point ahead on the centreline, as on the take-off roll.
+        heading_dem = self.heading - math.atan2(self.xtrack(s.pos), STEER_LOOKAHEAD_M)
+        rudder = v["LAND_STEER_P"] * wrap_pi(heading_dem - s.yaw) - 0.3 * s.yaw_rate
+        self._stopped_s = self._stopped_s + dt if ground_speed < STOPPED_SPEED else 0.0
+        disarm = False
+        if self._stopped_s > 0.0:
+            self.phase = LandPhase.STOPPED
+            disarm = self._stopped_s >= v["LAND_DISARMDELAY"]
+        return LandingDemand(
+            self.phase,
+            (self.start, self.point(1e4)),
+            self.land_alt,
+            0.0,
+            pitch=self._touchdown_pitch,
+            throttle=0.0 if ground_speed < v["LAND_BRAKE_SPD"] else ROLL_FREE_THROTTLE,
+            rudder=clamp(rudder, -1.0, 1.0),
+            elevator=v["LAND_ROLL_ELEV"] if v["LAND_ROLL_ELEV"] > 0.0 else math.nan,
+            roll_limit=0.0,
+            disarm=disarm,
+            flaps=_flaps(v),
+        )
+
+
+def _flaps(v: Mapping[str, float]) -> float:
+    return clamp(v["LAND_FLAP_PERCNT"] / 100.0, 0.0, 1.0)

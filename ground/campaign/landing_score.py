@@ -1,0 +1,146 @@
+"""A landing judged from the simulator's truth: where and how hard it touched down.
+
+The truth file holds the centre of gravity's height above MSL; the aircraft resting on its
+wheels before the take-off gives the height that means "on the runway". Touchdown is the
+first time after the flight that the aircraft comes within ``TOUCH_M`` of that height;
+the runway is the landing's centreline (from the final approach point through the
+landing point) ``RUNWAY_HALF_WIDTH_M`` either side, from the landing point on.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from companion.control.mission.items import MissionItem
+from companion.geodesy import LocalFrame
+from mavlink_dialect import companion as d
+
+TOUCH_M = 0.25  # within this of the resting height: a wheel is on the runway
+AIRBORNE_M = 10.0  # the flight proper: higher than this above the runway
+RUNWAY_HALF_WIDTH_M = 15.0
+RUNWAY_LENGTH_M = 1500.0
+STOPPED_M_S = 0.5
+
+# The issue's criteria.
+MAX_ALONG_M, MAX_ACROSS_M, MAX_SINK_M_S, MAX_BOUNCE_M, MAX_BANK_DEG = 30.0, 3.0, 1.5, 1.0, 10.0
+
+
+@dataclass(frozen=True)
+class LandingScore:
+    """What a user would judge a landing by."""
+
+    landed: bool
+    along_m: float = math.nan  # touchdown past (+) or short of (-) the landing point
+    across_m: float = math.nan  # touchdown right (+) of the centreline
+    sink_m_s: float = math.nan  # vertical speed at touchdown
+    bounce_m: float = math.nan  # highest the wheels rose after touching
+    bank_deg: float = math.nan  # bank at touchdown
+    stop_along_m: float = math.nan  # where it stopped, along the runway from the point
+    stop_across_m: float = math.nan
+    stopped: bool = False
+    on_runway: bool = False
+
+    def passed(self) -> bool:
+        """Every criterion of the issue met (disarming is judged by the caller)."""
+        return (
+            self.landed
+            and abs(self.along_m) <= MAX_ALONG_M
+            and abs(self.across_m) <= MAX_ACROSS_M
+            and self.sink_m_s <= MAX_SINK_M_S
+            and self.bounce_m <= MAX_BOUNCE_M
+            and abs(self.bank_deg) <= MAX_BANK_DEG
+            and self.stopped
+            and self.on_runway
+        )
+
+    def as_row(self) -> dict[str, float | bool]:
+        return asdict(self)
+
+
+def landing_line(items: list[MissionItem]) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The last NAV_LAND's point and the point the approach to it starts from (lat, lon)."""
+    for k in range(len(items) - 1, 0, -1):
+        if items[k].command == d.MAV_CMD_NAV_LAND:
+            land = (items[k].x / 1e7, items[k].y / 1e7)
+            prev = next(
+                it for it in reversed(items[:k]) if it.x or it.y
+            )  # the final approach point
+            return (prev.x / 1e7, prev.y / 1e7), land
+    raise ValueError("the plan has no NAV_LAND")
+
+
+def score_landing(
+    truth: dict[str, np.ndarray],
+    approach: tuple[float, float],
+    land: tuple[float, float],
+    loiter_radius_m: float = 0.0,
+    clockwise: bool = True,
+) -> LandingScore:
+    """Score the landing in ``truth`` on the line ``approach`` → ``land`` (lat, lon).
+
+    When the approach point is a LOITER_TO_ALT centre, the line starts at its tangent
+    point: give the radius (and direction) to have it found.
+    """
+    frame = LocalFrame(*land)
+    n, e = frame.ne(truth["lat"], truth["lon"])
+    a = frame.ne(*approach)
+    if loiter_radius_m > 0.0:
+        a = _tangent_point(a, loiter_radius_m, clockwise)
+    heading = math.atan2(-a[1], -a[0])
+    u = (math.cos(heading), math.sin(heading))
+    along = n * u[0] + e * u[1]
+    across = -n * u[1] + e * u[0]
+    alt = truth["alt"]
+    rest = float(alt[0])
+    height = alt - rest
+    flying = np.nonzero(height > AIRBORNE_M)[0]
+    if flying.size == 0:
+        return LandingScore(False)
+    after = flying[-1] + np.nonzero(height[flying[-1] :] < TOUCH_M)[0]
+    if after.size == 0:
+        return LandingScore(False)
+    k = int(after[0])
+    speed = np.hypot(truth["vn"], truth["ve"])
+    end = len(alt) - 1
+    stopped = bool(speed[end] < STOPPED_M_S)
+    on_runway = bool(
+        abs(across[end]) <= RUNWAY_HALF_WIDTH_M and -50.0 <= along[end] <= RUNWAY_LENGTH_M
+    )
+    return LandingScore(
+        True,
+        float(along[k]),
+        float(across[k]),
+        float(np.max(truth["vd"][max(0, k - 5) : k + 1])),
+        float(np.max(height[k:]) - 0.0),
+        float(math.degrees(truth["roll"][k])),
+        float(along[end]),
+        float(across[end]),
+        stopped,
+        on_runway,
+    )
+
+
+def _tangent_point(
+    centre: tuple[float, float], radius: float, clockwise: bool
+) -> tuple[float, float]:
+    """Where a circle round ``centre`` is left straight for the origin (the land point)."""
+    dist = math.hypot(*centre)
+    if dist <= radius:
+        return centre
+    bearing = math.atan2(-centre[1], -centre[0])
+    beta = math.acos(radius / dist)
+    angle = bearing - beta if clockwise else bearing + beta
+    return (centre[0] + radius * math.cos(angle), centre[1] + radius * math.sin(angle))
+
+
+def landing_score_for_plan(truth: dict[str, np.ndarray], items: list[MissionItem]) -> LandingScore:
+    """``score_landing`` on the plan's last landing (its final approach as planned)."""
+    approach, land = landing_line(items)
+    final = next(it for it in reversed(items) if it.command != d.MAV_CMD_NAV_LAND and it.x)
+    radius, clockwise = 0.0, True
+    if final.command == d.MAV_CMD_NAV_LOITER_TO_ALT and final.param1 >= 0.5:
+        radius, clockwise = abs(final.param2), final.param2 >= 0
+    return score_landing(truth, approach, land, radius, clockwise)
