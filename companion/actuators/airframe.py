@@ -32,7 +32,8 @@ from typing import Any
 POSITION_MAX = 254  # 255 is the Mini SSC sync byte
 SERVO_IDS = range(8)
 AIRFRAMES_DIR = Path(__file__).resolve().parent.parent / "airframes"
-ONE_SIDED = frozenset({"throttle"})  # commands in [0, 1], safe at min
+ONE_SIDED = frozenset({"throttle", "brakes"})  # commands in [0, 1]
+SAFE_ON = frozenset({"brakes"})  # a stopped vehicle holds its wheel brakes
 
 
 class AirframeError(ValueError):
@@ -57,8 +58,8 @@ class ServoChannel:
 
     @property
     def safe(self) -> int:
-        """Where the channel goes when stopped: surfaces at trim, throttle off."""
-        return self.position(0.0)
+        """Where the channel goes when stopped: surfaces at trim, throttle off, brakes on."""
+        return self.position(1.0 if self.surface in SAFE_ON else 0.0)
 
     def position(self, command: float) -> int:
         """The servo position for a normalised command (clamped to the travel)."""

@@ -56,6 +56,7 @@ class ClosedLoop:
 
     def __post_init__(self) -> None:
         frame = load_airframe(self.airframe)
+        self.has_brakes = frame.channel("brakes") is not None
         speed = frame.control.get("AIRSPEED_CRUISE", frame.cruise_speed_m_s)
         self.flight = Flight(frame.jsbsim_model, PHYSICS_HZ, Home(), self.airborne_agl_m, speed)
         self.flight.set_wind(*self.wind_ned)
@@ -104,15 +105,16 @@ class ClosedLoop:
         s = self.flight.state()
         out = self.controller.step(self.nav(), self.status, s.t_s, self.sticks)
         self.reached += out.reached
-        self.flight.set_controls(
-            {
-                "aileron": out.aileron,
-                "elevator": out.elevator,
-                "rudder": out.rudder,
-                "throttle": out.throttle,
-                "flaps": out.flaps if math.isfinite(out.flaps) else 0.0,
-            }
-        )
+        controls = {
+            "aileron": out.aileron,
+            "elevator": out.elevator,
+            "rudder": out.rudder,
+            "throttle": out.throttle,
+            "flaps": out.flaps,
+        }
+        if self.has_brakes:
+            controls["brakes"] = out.brakes
+        self.flight.set_controls(controls)
         truth = (s.lat_deg, s.lon_deg, s.alt_msl_m, s.alt_agl_m, s.airspeed_m_s, s.roll, s.yaw)
         self.samples.append(Sample(s.t_s, *truth, out))
 

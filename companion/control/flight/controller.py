@@ -55,6 +55,7 @@ class ControlOutput:
     disarm: bool = False  # landed and stopped: the flight is over
     land_phase: int = 0  # LandPhase while landing, else 0
     flaps: float = 0.0  # 0 up .. 1 fully down
+    brakes: float = 1.0  # 0 off .. 1 full: held while parked
 
 
 class FlightController:
@@ -128,6 +129,7 @@ class FlightController:
         airspeed = self.wind.airspeed
         self._update_landed(nav, airspeed)
         out = ControlOutput(airspeed=airspeed, landed=bool(self.landed))
+        out.brakes = 1.0 if self.landed else 0.0
         mode = FlightMode(status.mode) if status.mode else FlightMode.LOITER
         if mode in PILOT_MODES and sticks is not None:
             self._mode_key = (int(mode), int(status.changes))
@@ -324,6 +326,7 @@ class FlightController:
         out.aileron, out.elevator = surfaces.aileron, surfaces.elevator
         out.rudder = demand.rudder
         out.throttle = demand.throttle
+        out.brakes = 0.0
         out.nav_roll, out.nav_pitch = demand.roll, demand.pitch
         out.target_bearing = to.heading
         out.xtrack = to.xtrack(pos)
@@ -348,7 +351,7 @@ class FlightController:
                               nav.yaw_rate_rad_s)  # fmt: skip
         dem = land.step(state, self.config, dt)
         out.land_phase = int(dem.phase)
-        out.flaps = dem.flaps
+        out.flaps, out.brakes = dem.flaps, dem.brakes
         if dem.phase in (LandPhase.APPROACH, LandPhase.GO_AROUND):
             line = Setpoint(Kind.LINE, dem.line[0], dem.line[1], dem.alt_msl, speed=dem.speed)
             if dem.phase == LandPhase.APPROACH:  # the glide path before the speed
@@ -429,7 +432,7 @@ class FlightController:
             dt,
         )
         out.aileron, out.elevator, out.rudder = surfaces.aileron, surfaces.elevator, surfaces.rudder
-        out.throttle = energy.throttle
+        out.throttle, out.brakes = energy.throttle, 0.0
         out.nav_roll, out.nav_pitch = roll_dem, energy.pitch
         out.target_bearing = lateral.target_bearing
         out.wp_dist = lateral.distance

@@ -38,10 +38,9 @@ Point = tuple[float, float]
 TOUCHDOWN_AGL_M = 0.4  # the wheels are on the runway below this (a sinking check guards it)
 STEER_LOOKAHEAD_M = 20.0
 STOPPED_SPEED = 0.8  # m/s: slower than this counts as stopped
-# The servo card has no brake channel: the simulator (as a pilot would) holds the brakes
-# while the throttle is closed (below 0.05). Just open, the wheels roll free.
-ROLL_FREE_THROTTLE = 0.06
+NOT_FLYING = 0.6  # below this fraction of the approach speed the wings cannot lift it
 MIN_GLIDE = math.radians(1.5)  # a flatter path cannot be flown with the throttle at idle
+AIM_LOW, AIM_HIGH = 0.6, 1.5  # the flare's sink demand may aim within these bounds
 SINK_P = 0.12  # rad of pitch per m/s of sink-rate error in the flare
 SINK_I = 0.08  # rad per (m/s·s)
 
@@ -57,11 +56,11 @@ LANDING_PARAMS = (
     ParamDecl("LEVEL_ROLL_LIMIT", 5.0, 0.0, 45.0, "deg", "landing: most bank in the flare"),
     ParamDecl("TECS_LAND_SPDWGT", 0.0, 0.0, 2.0, "", "landing: TECS speed weight on the approach "
               "(0: pitch holds the glide path)"),
-    ParamDecl("LAND_BRAKE_SPD", 8.0, 0.0, 50.0, "m/s", "rollout: brake (throttle closed) below "
-              "this ground speed; above, the throttle is just open"),
-    ParamDecl("LAND_ROLL_ELEV", 0.0, 0.0, 1.0, "", "rollout: elevator held back (a tail "
-              "dragger pins its tail wheel); 0: the touchdown pitch is held"),
-    ParamDecl("LAND_STEER_P", 2.0, 0.0, 10.0, "", "rollout: rudder per radian of heading error"),
+    ParamDecl("LAND_BRAKE", 0.5, 0.0, 1.0, "", "rollout: wheel brakes (fraction of full)"),
+    ParamDecl("LAND_BRAKE_SPD", 50.0, 0.0, 50.0, "m/s", "rollout: brake below this ground speed"),
+    ParamDecl("LAND_ROLL_ELEV", 0.0, 0.0, 1.0, "", "rollout: elevator held back once too slow "
+              "to fly (a tail dragger pins its tail wheel); 0: the touchdown pitch is held"),
+    ParamDecl("LAND_STEER_P", 8.0, 0.0, 10.0, "", "rollout: rudder per radian of heading error"),
     ParamDecl("LAND_FLAP_PERCNT", 0.0, 0.0, 100.0, "%", "landing: flaps on the approach"),
     ParamDecl("RTL_AUTOLAND", 0.0, 0.0, 2.0, "", "Return lands at DO_LAND_START: 1 after "
               "reaching home, 2 at once"),
@@ -96,6 +95,7 @@ class LandingDemand:
     throttle: float = math.nan
     rudder: float = math.nan
     elevator: float = math.nan  # ROLLOUT: held directly when given
+    brakes: float = 0.0  # 0 off .. 1 full
     roll_limit: float = math.nan
     disarm: bool = False
     flaps: float = 0.0
@@ -233,7 +233,13 @@ class Landing:
         self, s: AircraftState, height: float, v: Mapping[str, float], dt: float
     ) -> LandingDemand:
         s_t = max(v["TECS_LAND_SINK"], 0.05)
-        sink_dem = s_t + max(height, 0.0) / self._tau
+        nominal = s_t + max(height, 0.0) / self._tau
+        # Steer the touchdown onto the point: the sink rate that reaches the ground there,
+        # kept near the nominal flare's so the touchdown stays gentle either way.
+        speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
+        to_go = -self.along(s.pos) / max(speed_along, 1.0)
+        aim = max(height, 0.0) / to_go if to_go > 0.1 else math.inf
+        sink_dem = clamp(aim, AIM_LOW * nominal, nominal + AIM_HIGH * s_t)
         error = -s.climb_rate - sink_dem  # + when sinking faster than wanted: pitch up
         self._flare_integ = clamp(self._flare_integ + SINK_I * error * dt, -0.1, 0.25)
         pitch_min = math.radians(v["LAND_PITCH_CD"] / 100.0)
@@ -257,8 +263,10 @@ class Landing:
         heading_dem = self.heading - math.atan2(self.xtrack(s.pos), STEER_LOOKAHEAD_M)
         rudder = v["LAND_STEER_P"] * wrap_pi(heading_dem - s.yaw) - 0.3 * s.yaw_rate
         self._stopped_s = self._stopped_s + dt if ground_speed < STOPPED_SPEED else 0.0
+        slow = ground_speed < NOT_FLYING * v["TECS_LAND_ARSPD"]
+        stopped = self._stopped_s > 0.0
         disarm = False
-        if self._stopped_s > 0.0:
+        if stopped:
             self.phase = LandPhase.STOPPED
             disarm = self._stopped_s >= v["LAND_DISARMDELAY"]
         return LandingDemand(
@@ -267,9 +275,10 @@ class Landing:
             self.land_alt,
             0.0,
             pitch=self._touchdown_pitch,
-            throttle=0.0 if ground_speed < v["LAND_BRAKE_SPD"] else ROLL_FREE_THROTTLE,
+            throttle=0.0,
             rudder=clamp(rudder, -1.0, 1.0),
-            elevator=v["LAND_ROLL_ELEV"] if v["LAND_ROLL_ELEV"] > 0.0 else math.nan,
+            elevator=v["LAND_ROLL_ELEV"] if v["LAND_ROLL_ELEV"] > 0.0 and slow else math.nan,
+            brakes=v["LAND_BRAKE"] if ground_speed < v["LAND_BRAKE_SPD"] or stopped else 0.0,
             roll_limit=0.0,
             disarm=disarm,
             flaps=_flaps(v),

@@ -23,11 +23,14 @@ FRAME_BYTES = 3
 
 
 def surface_value(cmd: ActuatorCommand, surface: str) -> float:
-    """The command for a surface by name; ``flaps`` is aux[0]; other extras are not driven."""
+    """The command for a surface by name; ``flaps`` is aux[0], ``brakes`` aux[1]; other
+    extras are not driven."""
     if surface in ("aileron", "elevator", "rudder", "throttle"):
         return float(getattr(cmd, surface))
     if surface == "flaps":
         return float(cmd.aux[0])
+    if surface == "brakes":
+        return float(cmd.aux[1])
     return float("nan")
 
 

@@ -121,7 +121,7 @@ class FixedWingPlugin(Plugin):
         cmd.throttle = out.throttle
         for i in range(len(cmd.aux)):
             cmd.aux[i] = math.nan
-        cmd.aux[0] = out.flaps
+        cmd.aux[0], cmd.aux[1] = out.flaps, out.brakes
         self.surfaces.publish(cmd)
         if out.disarm and not self.disarm_sent:
             self._disarm(now_us, out, status)

@@ -23,7 +23,7 @@ from typing import Any
 
 FULL_TRAVEL = (0, 254)  # Mini SSC positions; 255 is the sync byte
 CENTRE = 127
-THROTTLES = frozenset({"throttle"})
+THROTTLES = frozenset({"throttle", "brakes"})  # one-sided: command 0 at the bottom
 
 
 @dataclass(frozen=True)

@@ -52,6 +52,7 @@ class Flight:
         self.fdm.set_dt(1.0 / rate_hz)
         self.home = home
         self.turbulence = False
+        self.brake_channel = False  # until a brakes servo is heard, idle means brakes
         self._initial_conditions(model, airborne_agl_m, speed_m_s)
 
     def _initial_conditions(
@@ -129,8 +130,13 @@ class Flight:
                 f["fcs/rudder-cmd-norm"] = -value  # JSBSim: + yaws left
             elif surface == "throttle":
                 f["fcs/throttle-cmd-norm"] = value
-                # A pilot holds the brakes at idle; the servo card has no brake channel.
-                brake = 1.0 if value < IDLE_THROTTLE else 0.0
+                if not self.brake_channel:
+                    # No brake servo: a pilot holds the brakes at idle.
+                    brake = 1.0 if value < IDLE_THROTTLE else 0.0
+                    f["fcs/left-brake-cmd-norm"] = f["fcs/right-brake-cmd-norm"] = brake
+            elif surface == "brakes":
+                self.brake_channel = True
+                brake = min(1.0, max(0.0, value))
                 f["fcs/left-brake-cmd-norm"] = f["fcs/right-brake-cmd-norm"] = brake
             elif surface == "flaps":
                 f["fcs/flap-cmd-norm"] = max(0.0, value)
