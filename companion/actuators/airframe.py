@@ -33,7 +33,9 @@ POSITION_MAX = 254  # 255 is the Mini SSC sync byte
 SERVO_IDS = range(8)
 AIRFRAMES_DIR = Path(__file__).resolve().parent.parent / "airframes"
 ONE_SIDED = frozenset({"throttle", "brakes"})  # commands in [0, 1]
-SAFE_ON = frozenset({"brakes"})  # a stopped vehicle holds its wheel brakes
+# A stopped vehicle holds its wheel brakes at the channel's trim (full unless the airframe
+# file says less: a light tail dragger noses over on full brakes in a crosswind).
+SAFE_ON = frozenset({"brakes"})
 
 
 class AirframeError(ValueError):
@@ -59,7 +61,7 @@ class ServoChannel:
     @property
     def safe(self) -> int:
         """Where the channel goes when stopped: surfaces at trim, throttle off, brakes on."""
-        return self.position(1.0 if self.surface in SAFE_ON else 0.0)
+        return self.trim if self.surface in SAFE_ON else self.position(0.0)
 
     def position(self, command: float) -> int:
         """The servo position for a normalised command (clamped to the travel)."""
@@ -155,6 +157,12 @@ def _control(path: Path, table: dict[str, Any]) -> dict[str, float]:
     return out
 
 
+def _default_trim(surface: str, spec: dict[str, Any]) -> int:
+    if surface in SAFE_ON:
+        return int(spec.get("max", POSITION_MAX))
+    return int(spec.get("min", 0)) if surface in ONE_SIDED else 127
+
+
 def _channel(path: Path, surface: str, spec: dict[str, Any]) -> ServoChannel:
     where = f"{path}: [channels.{surface}]"
     unknown = set(spec) - {"servo", "trim", "min", "max", "reversed"}
@@ -164,7 +172,7 @@ def _channel(path: Path, surface: str, spec: dict[str, Any]) -> ServoChannel:
         ch = ServoChannel(
             surface=surface,
             servo=int(spec["servo"]),
-            trim=int(spec.get("trim", 127 if surface not in ONE_SIDED else spec.get("min", 0))),
+            trim=int(spec.get("trim", _default_trim(surface, spec))),
             min=int(spec.get("min", 0)),
             max=int(spec.get("max", POSITION_MAX)),
             reversed=bool(spec.get("reversed", False)),

@@ -129,7 +129,7 @@ class FlightController:
         airspeed = self.wind.airspeed
         self._update_landed(nav, airspeed)
         out = ControlOutput(airspeed=airspeed, landed=bool(self.landed))
-        out.brakes = 1.0 if self.landed else 0.0
+        out.brakes = self.config["LAND_BRAKE"] if self.landed else 0.0
         mode = FlightMode(status.mode) if status.mode else FlightMode.LOITER
         if mode in PILOT_MODES and sticks is not None:
             self._mode_key = (int(mode), int(status.changes))

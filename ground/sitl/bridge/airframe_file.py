@@ -90,7 +90,10 @@ def read_airframe(name_or_path: str) -> SimAirframe:
 def _surface_servo(surface: str, spec: dict[str, Any]) -> SurfaceServo:
     bottom = int(spec.get("min", FULL_TRAVEL[0]))
     top = int(spec.get("max", FULL_TRAVEL[1]))
-    trim = bottom if surface in THROTTLES else int(spec.get("trim", CENTRE))
+    if surface == "brakes":  # held at trim (full unless less is given) until commanded
+        trim = int(spec.get("trim", top))
+    else:
+        trim = bottom if surface in THROTTLES else int(spec.get("trim", CENTRE))
     if not FULL_TRAVEL[0] <= bottom <= trim <= top <= FULL_TRAVEL[1]:
         raise ValueError(f"[channels.{surface}]: need 0 <= min <= trim <= max <= 254")
     return SurfaceServo(surface, bottom, trim, top, bool(spec.get("reversed", False)))

@@ -64,6 +64,9 @@ class SimBridge:
         )
         self.flight.set_wind(*opts.wind_ned)
         self.flight.set_turbulence(opts.turbulence)
+        for servo in self.airframe.servos.values():
+            if servo.surface == "brakes":  # held at their safe setting until commanded
+                self.flight.set_controls({"brakes": servo.command(servo.trim)})
         errors = SensorErrors(NoiseModel(scale=opts.noise_scale), MagneticField(), opts.seed)
         self.devices = EmulatedDevices(errors, opts.rates, opts.outages)
         self.failures = DeviceFailures(opts.seed)
