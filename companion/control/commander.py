@@ -50,9 +50,11 @@ MODE_COMMANDS = frozenset(
         CommandId.SET_HOME,
         CommandId.TAKEOFF,
         CommandId.ORBIT,
+        CommandId.GO_AROUND,
     }
 )
 NO_POINT = (math.nan, math.nan, math.nan)
+LANDING_PHASES = (1, 2)  # LandPhase APPROACH and FLARE: a go-around can still be flown
 
 
 class Commander:
@@ -68,6 +70,8 @@ class Commander:
         self.mission_first = 0
         self.changes = 0
         self.position: tuple[float, float, float] | None = None
+        self.go_arounds = 0
+        self.land_phase = 0  # the flight controller's, from its status
 
     def on_nav(self, nav: NavState) -> None:
         """Track the position; set home from the first fix while disarmed."""
@@ -106,6 +110,11 @@ class Commander:
             return self._takeoff(p[2])
         if kind == CommandId.SET_HOME:
             return self._set_home(p)
+        if kind == CommandId.GO_AROUND:
+            if self.land_phase not in LANDING_PHASES:
+                return Decision(CommandResult.DENIED, "Go around: not landing")
+            self.go_arounds += 1
+            return ACCEPTED
         return None
 
     def _go_to(self, kind: CommandId, p: list[float]) -> Decision:
@@ -189,6 +198,7 @@ class Commander:
         msg.target_lat_deg, msg.target_lon_deg, msg.target_alt_msl_m = self.target
         msg.target_radius_m = self.radius
         msg.mission_first, msg.changes = self.mission_first, self.changes
+        msg.go_arounds = self.go_arounds
         return msg
 
 

@@ -96,6 +96,7 @@ RULES: dict[int, tuple[Param, ...]] = {
         Param(2, "last item", 0, 65535, optional=True, whole=True),
     ),
     d.MAV_CMD_NAV_RETURN_TO_LAUNCH: (),
+    d.MAV_CMD_DO_GO_AROUND: (Param(1, "altitude", -MAX_ALT_M, MAX_ALT_M, optional=True),),
     d.MAV_CMD_DO_REPOSITION: (
         Param(1, "ground speed", -1, 1000, optional=True),
         Param(3, "loiter radius", -1e5, 1e5, optional=True),

@@ -27,6 +27,7 @@ class CommandId(enum.IntEnum):
     INJECT_FAILURE = 10  # param1..3 = MAVLink FAILURE_UNIT, FAILURE_TYPE, instance (simulator)
     TAKEOFF = 11  # param3 = alt_msl_m to climb to (NaN: the default height)
     ORBIT = 12  # param1..4 = lat_deg, lon_deg, alt_msl_m, radius_m (NaN: here / default)
+    GO_AROUND = 13  # abort the landing in progress: climb out and come round again
 
 
 class CommandResult(enum.IntEnum):
@@ -97,6 +98,7 @@ class VehicleStatus(Message):
         ("target_radius_m", ctypes.c_double),  # LOITER/ORBIT circle radius (NaN: default)
         ("mission_first", ctypes.c_int32),  # MISSION: the item to start from
         ("changes", ctypes.c_uint32),  # accepted mode commands since start (new target too)
+        ("go_arounds", ctypes.c_uint32),  # go-arounds ordered since start
     ]
 
 
@@ -131,6 +133,7 @@ class ControlStatus(Message):
         ("mission_seq", ctypes.c_int32),
         ("mission_state", ctypes.c_uint8),  # MissionState
         ("landed", ctypes.c_uint8),
+        ("land_phase", ctypes.c_uint8),  # LandPhase while landing, 0 otherwise
         ("reached_count", ctypes.c_uint32),
         ("last_reached", ctypes.c_int32),
     ]

@@ -8,9 +8,10 @@ plug-in runs it on the bus; tests and benchmarks run it against JSBSim directly.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
-from companion.control.flight.landing import AircraftState, Landing, LandingDemand, LandPhase
+from companion.control.flight.landing import Landing
+from companion.control.flight.landing_flight import LandingFlight
 from companion.control.flight.params import FlightConfig
 from companion.control.flight.pilot import PILOT_MODES, Sticks, fly_pilot
 from companion.control.flight.takeoff import Phase, RunwayTakeoff
@@ -58,7 +59,7 @@ class ControlOutput:
     brakes: float = 1.0  # 0 off .. 1 full: held while parked
 
 
-class FlightController:
+class FlightController(LandingFlight):
     """One aircraft's controller; ``step()`` once per navigation solution."""
 
     def __init__(self, config: FlightConfig, items: list[MissionItem] | None = None) -> None:
@@ -70,6 +71,8 @@ class FlightController:
         self.executor: MissionExecutor | None = None
         self.takeoff: RunwayTakeoff | None = None
         self.landing: Landing | None = None
+        self.go_arounds: int | None = None  # the commander's count when last seen
+        self.return_lands = False  # this Return ends in the mission's landing
         self.landed: bool | None = None
         self._last_t: float | None = None
         self._mode_key: tuple[int, int] | None = None
@@ -146,8 +149,11 @@ class FlightController:
             return self._fly_takeoff(setpoint, pos, nav, airspeed, dt, out)
         self.takeoff = None
         if setpoint.kind == Kind.LAND:
-            return self._fly_landing(setpoint, pos, nav, airspeed, dt, out)
+            out = self._fly_landing(setpoint, pos, nav, status, airspeed, dt, out)
+            self.go_arounds = status.go_arounds
+            return out
         self.landing = None
+        self.go_arounds = status.go_arounds
         return self._fly(setpoint, pos, vel, nav, airspeed, dt, out)
 
     def _fly_pilot(
@@ -218,6 +224,10 @@ class FlightController:
         self._mode_key = key
         if mode == FlightMode.MISSION:
             return self._mission(status, pos, nav, t_s, entered, out)
+        if mode == FlightMode.RTL and (not self.landed or self.landing is not None):
+            landing = self._return_landing(status, pos, nav, t_s, entered, out)
+            if landing is not None:
+                return landing
         if self.landed and mode != FlightMode.TAKEOFF:
             return None
         if entered or self._mode_setpoint is None:
@@ -331,74 +341,6 @@ class FlightController:
         out.target_bearing = to.heading
         out.xtrack = to.xtrack(pos)
         out.alt_error = setpoint.alt_msl - nav.alt_msl_m
-        return out
-
-    def _fly_landing(
-        self,
-        sp: Setpoint,
-        pos: tuple[float, float],
-        nav: NavState,
-        airspeed: float,
-        dt: float,
-        out: ControlOutput,
-    ) -> ControlOutput:
-        land = self.landing
-        if land is None or (land.start, land.touchdown, land.land_alt) != (sp.a, sp.b, sp.alt_msl):
-            from_alt = sp.from_alt if math.isfinite(sp.from_alt) else nav.alt_msl_m
-            land = self.landing = Landing(sp.a, from_alt, sp.b, sp.alt_msl)
-        vel = (nav.vn_m_s, nav.ve_m_s)
-        state = AircraftState(pos, vel, nav.alt_msl_m, -nav.vd_m_s, nav.pitch_rad, nav.yaw_rad,
-                              nav.yaw_rate_rad_s)  # fmt: skip
-        dem = land.step(state, self.config, dt)
-        out.land_phase = int(dem.phase)
-        out.flaps, out.brakes = dem.flaps, dem.brakes
-        if dem.phase in (LandPhase.APPROACH, LandPhase.GO_AROUND):
-            line = Setpoint(Kind.LINE, dem.line[0], dem.line[1], dem.alt_msl, speed=dem.speed)
-            if dem.phase == LandPhase.APPROACH:  # the glide path before the speed
-                self.tecs.gains = replace(self.config.tecs, speed_weight=self.config["TECS_LAND_SPDWGT"])
-            return self._fly(line, pos, vel, nav, airspeed, dt, out, dem.speed, dem.climb_ff)
-        if dem.disarm and self.executor is not None:
-            self.executor.land_complete()
-            out.mission_finished = True
-            out.reached += self.executor.drain_reached()
-        out.disarm = dem.disarm
-        return self._fly_attitude(dem, pos, vel, nav, airspeed, dt, out)
-
-    def _fly_attitude(
-        self,
-        dem: LandingDemand,
-        pos: tuple[float, float],
-        vel: tuple[float, float],
-        nav: NavState,
-        airspeed: float,
-        dt: float,
-        out: ControlOutput,
-    ) -> ControlOutput:
-        """The flare and the rollout: pitch and throttle given, bank limited, L1 on the
-        centreline for what bank is allowed."""
-        line = Setpoint(Kind.LINE, dem.line[0], dem.line[1], dem.alt_msl)
-        lateral = self._lateral(line, pos, vel, dt)
-        roll_dem = bank_for(lateral.lat_acc, min(dem.roll_limit, self.config.roll_limit))
-        flying = dem.phase == LandPhase.FLARE
-        surfaces = self.attitude.step(
-            roll_dem,
-            dem.pitch,
-            (nav.roll_rad, nav.pitch_rad),
-            (nav.roll_rate_rad_s, nav.pitch_rate_rad_s, nav.yaw_rate_rad_s),
-            max(airspeed, self.config["TKOFF_ROTATE_SPD"] * 0.5),
-            dt,
-            integrate=flying,
-        )
-        self.tecs.reset(dem.pitch)
-        out.aileron, out.elevator = surfaces.aileron, surfaces.elevator
-        if math.isfinite(dem.elevator):
-            out.elevator = dem.elevator
-        out.rudder = dem.rudder if math.isfinite(dem.rudder) else surfaces.rudder
-        out.throttle = dem.throttle
-        out.nav_roll, out.nav_pitch = roll_dem, dem.pitch
-        out.target_bearing = lateral.target_bearing
-        out.xtrack = lateral.xtrack
-        out.alt_error = dem.alt_msl - nav.alt_msl_m
         return out
 
     def _fly(

@@ -220,7 +220,8 @@ class Landing:
         alt = self.glide_alt(s.pos, flare_dist, v)
         on_slope = alt < self.start_alt
         speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
-        ff = -max(speed_along, 0.0) * self._slope(flare_dist, v["LAND_FLARE_ALT"]) if on_slope else 0.0
+        slope = self._slope(flare_dist, v["LAND_FLARE_ALT"])
+        ff = -max(speed_along, 0.0) * slope if on_slope else 0.0
         return LandingDemand(
             self.phase, line, alt, v["TECS_LAND_ARSPD"], flaps=_flaps(v), climb_ff=ff
         )

@@ -22,7 +22,7 @@ RELATIVE_FRAMES = frozenset(
 
 class ModeCommands:
     """DO_SET_MODE, DO_SET_STANDARD_MODE, SET_MODE, MISSION_START, RTL, DO_REPOSITION,
-    NAV_LOITER_UNLIM, DO_ORBIT, NAV_TAKEOFF and DO_SET_HOME."""
+    NAV_LOITER_UNLIM, DO_ORBIT, NAV_TAKEOFF, DO_SET_HOME and DO_GO_AROUND."""
 
     def __init__(self, port: VehiclePort, autopilot: int) -> None:
         self.port = port
@@ -39,6 +39,7 @@ class ModeCommands:
         service.register(d.MAV_CMD_DO_SET_HOME, self.set_home)
         service.register(d.MAV_CMD_DO_ORBIT, self.orbit)
         service.register(d.MAV_CMD_NAV_TAKEOFF, self.takeoff)
+        service.register(d.MAV_CMD_DO_GO_AROUND, self.go_around)
 
     def to_commander(self, command: CommandId, params: tuple[float, ...] = ()) -> Outcome:
         if not self.port.has_commander():
@@ -67,6 +68,9 @@ class ModeCommands:
     def mission_start(self, args: CommandArgs) -> Outcome:
         first, last = whole_or(args.params[0], 0), whole_or(args.params[1], -1)
         return self.to_commander(CommandId.MISSION_START, (float(first), float(last)))
+
+    def go_around(self, args: CommandArgs) -> Outcome:
+        return self.to_commander(CommandId.GO_AROUND)
 
     def rtl(self, args: CommandArgs) -> Outcome:
         return self.to_commander(CommandId.RETURN_TO_LAUNCH)

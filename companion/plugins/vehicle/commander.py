@@ -95,6 +95,8 @@ class CommanderPlugin(Plugin):
         self.live.poll()
         if d.MAV_MISSION_TYPE_FENCE in self.follower.follow(self.mission_changes.get()):
             self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
+        if (control := self.control.get()) is not None:
+            c.land_phase = int(control.land_phase) if control.fresh(now) else 0
         changed = self._commands() | self._mode_switch(now)
         if now >= self.next_failsafe_us or now < self.next_failsafe_us - FAILSAFE_PERIOD_US:
             self.next_failsafe_us = now + FAILSAFE_PERIOD_US

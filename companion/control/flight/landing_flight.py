@@ -1,0 +1,157 @@
+"""How the flight controller flies a landing: the glide by the energy controller, the flare
+and rollout by attitude, a go-around and its second approach, and Return ending in a
+landing (ArduPlane's ``RTL_AUTOLAND``).
+
+A mix-in of ``FlightController`` (companion/control/flight/controller.py), kept apart so
+each file stays one subject; the landing itself is ``Landing`` (landing.py).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+from companion.control.flight.landing import AircraftState, Landing, LandingDemand, LandPhase
+from companion.control.laws.l1_guidance import bank_for
+from companion.control.mission.executor import Kind, MissionExecutor, Setpoint
+from companion.control.mission.items import MissionItem
+from companion.messages import NavState, VehicleStatus
+from mavlink_dialect import companion as d
+
+if TYPE_CHECKING:
+    from companion.control.flight.controller import ControlOutput, FlightController
+
+GO_AROUND_MARGIN_M = 5.0  # this close to the go-around height: come round again
+
+
+def land_start(items: list[MissionItem]) -> int | None:
+    """The first DO_LAND_START's index (where a Return that lands joins the mission)."""
+    return next((k for k, it in enumerate(items) if it.command == d.MAV_CMD_DO_LAND_START), None)
+
+
+def approach_start(items: list[MissionItem], land_index: int) -> int:
+    """Where a second approach to the NAV_LAND at ``land_index`` begins: its DO_LAND_START,
+    else the positional item before it."""
+    for k in range(land_index - 1, -1, -1):
+        if items[k].command == d.MAV_CMD_DO_LAND_START:
+            return k
+    for k in range(land_index - 1, -1, -1):
+        if items[k].x or items[k].y:
+            return k
+    return land_index
+
+
+class LandingFlight:
+    """The landing half of the flight controller (see the module's docstring)."""
+
+    def _fly_landing(
+        self: FlightController,
+        sp: Setpoint,
+        pos: tuple[float, float],
+        nav: NavState,
+        status: VehicleStatus,
+        airspeed: float,
+        dt: float,
+        out: ControlOutput,
+    ) -> ControlOutput:
+        land = self.landing
+        if land is None or (land.start, land.touchdown, land.land_alt) != (sp.a, sp.b, sp.alt_msl):
+            from_alt = sp.from_alt if math.isfinite(sp.from_alt) else nav.alt_msl_m
+            land = self.landing = Landing(sp.a, from_alt, sp.b, sp.alt_msl)
+        if status.go_arounds != self.go_arounds:
+            land.abort()
+        vel = (nav.vn_m_s, nav.ve_m_s)
+        state = AircraftState(pos, vel, nav.alt_msl_m, -nav.vd_m_s, nav.pitch_rad, nav.yaw_rad,
+                              nav.yaw_rate_rad_s)  # fmt: skip
+        dem = land.step(state, self.config, dt)
+        out.land_phase = int(dem.phase)
+        out.flaps, out.brakes = dem.flaps, dem.brakes
+        if dem.phase == LandPhase.GO_AROUND and nav.alt_msl_m >= dem.alt_msl - GO_AROUND_MARGIN_M:
+            self._come_round(pos, nav.alt_msl_m)
+        if dem.phase in (LandPhase.APPROACH, LandPhase.GO_AROUND):
+            line = Setpoint(Kind.LINE, dem.line[0], dem.line[1], dem.alt_msl, speed=dem.speed)
+            if dem.phase == LandPhase.APPROACH:  # the glide path before the speed
+                weight = self.config["TECS_LAND_SPDWGT"]
+                self.tecs.gains = replace(self.config.tecs, speed_weight=weight)
+            return self._fly(line, pos, vel, nav, airspeed, dt, out, dem.speed, dem.climb_ff)
+        if dem.disarm and self.executor is not None:
+            self.executor.land_complete()
+            out.mission_finished = True
+            out.reached += self.executor.drain_reached()
+        out.disarm = dem.disarm
+        return self._fly_attitude(dem, pos, vel, nav, airspeed, dt, out)
+
+    def _come_round(self: FlightController, pos: tuple[float, float], alt: float) -> None:
+        """Climbed out after a go-around: fly the landing's approach again."""
+        ex = self.executor
+        if ex is not None:
+            ex.start(approach_start(ex.items, ex.current), pos, alt)
+        self.landing = None
+
+    def _fly_attitude(
+        self: FlightController,
+        dem: LandingDemand,
+        pos: tuple[float, float],
+        vel: tuple[float, float],
+        nav: NavState,
+        airspeed: float,
+        dt: float,
+        out: ControlOutput,
+    ) -> ControlOutput:
+        """The flare and the rollout: pitch and throttle given, bank limited, L1 on the
+        centreline for what bank is allowed."""
+        line = Setpoint(Kind.LINE, dem.line[0], dem.line[1], dem.alt_msl)
+        lateral = self._lateral(line, pos, vel, dt)
+        roll_dem = bank_for(lateral.lat_acc, min(dem.roll_limit, self.config.roll_limit))
+        flying = dem.phase == LandPhase.FLARE
+        surfaces = self.attitude.step(
+            roll_dem,
+            dem.pitch,
+            (nav.roll_rad, nav.pitch_rad),
+            (nav.roll_rate_rad_s, nav.pitch_rate_rad_s, nav.yaw_rate_rad_s),
+            max(airspeed, self.config["TKOFF_ROTATE_SPD"] * 0.5),
+            dt,
+            integrate=flying,
+        )
+        self.tecs.reset(dem.pitch)
+        out.aileron, out.elevator = surfaces.aileron, surfaces.elevator
+        if math.isfinite(dem.elevator):
+            out.elevator = dem.elevator
+        out.rudder = dem.rudder if math.isfinite(dem.rudder) else surfaces.rudder
+        out.throttle = dem.throttle
+        out.nav_roll, out.nav_pitch = roll_dem, dem.pitch
+        out.target_bearing = lateral.target_bearing
+        out.xtrack = lateral.xtrack
+        out.alt_error = dem.alt_msl - nav.alt_msl_m
+        return out
+
+    def _return_landing(
+        self: FlightController,
+        status: VehicleStatus,
+        pos: tuple[float, float],
+        nav: NavState,
+        t_s: float,
+        entered: bool,
+        out: ControlOutput,
+    ) -> Setpoint | None:
+        """Return with RTL_AUTOLAND: 2 joins the mission's DO_LAND_START at once, 1 once
+        home is reached (as ArduPlane); None when this Return does not land."""
+        first = land_start(self.items)
+        autoland = round(self.config["RTL_AUTOLAND"])
+        if first is None or autoland not in (1, 2):
+            return None
+        if entered:
+            self.return_lands = autoland == 2
+        if not self.return_lands:
+            home = (0.0, 0.0)
+            reach = max(self.config["WP_LOITER_RAD"], self._turn_radius()) * 1.5
+            if math.hypot(pos[0] - home[0], pos[1] - home[1]) > reach:
+                return None
+            self.return_lands = True
+        if entered or self.executor is None or self.executor.current < first:
+            assert self.frame is not None
+            ex = MissionExecutor(self.items, self.frame, self.home_alt, self.config.executor)
+            ex.start(first, pos, nav.alt_msl_m)
+            self.executor = ex
+        return self._mission(status, pos, nav, t_s, False, out)
