@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from companion.bus.namespace import cleanup_namespace
-from companion.control.mission.plan import load_plan
+from companion.control.mission.plan import PlanError, load_plan
 from ground.campaign.scoring import TrackScore, score_track
 from ground.campaign.spec import REPO, Flight
 
@@ -38,6 +38,7 @@ log = logging.getLogger(__name__)
 GCS_SYSID, GCS_COMPID = 255, 190
 TAIL_S = 1.0  # keep flying this long (wall) after completion: the loiter at home is in the truth
 FAILSAFE_PREFIXES = ("Failsafe", "Fence breached")
+DISARM_WAIT_S = 20.0  # wall: a landed vehicle's disarm heard within this after completion
 TIMING_INTERVAL_US = 20_000  # MISSION_CURRENT and ATTITUDE at 50 Hz (wall) to this station
 
 
@@ -167,7 +168,7 @@ def _fly(job: FlightJob, folder: Path, tl: Timeline) -> None:
         try:
             pilot = _Pilot(gcs, proc, time.monotonic() + job.timeout_s, tl, job.silent_s)
             pilot.endless_seq = endless_final_item(flight.plan)
-            pilot.fly(flight.start_at_s)
+            pilot.fly(flight.start_at_s, _lands(flight.plan))
         finally:
             _end(proc)
             gcs.close()
@@ -203,6 +204,14 @@ def endless_final_item(plan: str | Path) -> int | None:
     return None
 
 
+def _lands(plan: str) -> bool:
+    """Whether the plan ends in a landing (then the flight ends disarmed)."""
+    try:
+        return any(it.command == d.MAV_CMD_NAV_LAND for it in load_plan(plan).get(0, []))
+    except PlanError:
+        return False
+
+
 def _armed(msg: Any) -> bool:
     return (
         msg.get_type() == "HEARTBEAT"
@@ -223,7 +232,7 @@ class _Pilot:
         self.heard = time.monotonic()
         self.next_beat = 0.0
 
-    def fly(self, start_at_s: float | None) -> None:
+    def fly(self, start_at_s: float | None, lands: bool = False) -> None:
         """Arm and start (or, when the simulator starts the mission, see it armed)."""
         self._until(lambda m: m.get_type() == "HOME_POSITION", "the vehicle's home position")
         # The completion time is read off the telemetry: the faster it comes, the finer.
@@ -239,6 +248,8 @@ class _Pilot:
             self._until(_armed, "arming by the simulator")
             self.tl.start_ms = round(start_at_s * 1000)
         self._until(self._complete, "mission completion")
+        if lands:  # a landing ends with the vehicle disarming itself: wait to hear it
+            self._until(lambda m: self.tl.armed is False, "disarming", DISARM_WAIT_S, False)
         tail_end = time.monotonic() + TAIL_S
         while time.monotonic() < tail_end:
             self._next()

@@ -41,8 +41,8 @@ STOPPED_SPEED = 0.8  # m/s: slower than this counts as stopped
 NOT_FLYING = 0.6  # below this fraction of the approach speed the wings cannot lift it
 MIN_GLIDE = math.radians(1.5)  # a flatter path cannot be flown with the throttle at idle
 AIM_LOW, AIM_HIGH = 0.6, 1.5  # the flare's sink demand may aim within these bounds
-SINK_P = 0.12  # rad of pitch per m/s of sink-rate error in the flare
-SINK_I = 0.08  # rad per (m/s·s)
+SINK_P = 0.04  # rad of pitch per m/s of sink-rate error in the flare
+SINK_I = 0.05  # rad per (m/s·s)
 
 
 LANDING_PARAMS = (
@@ -130,6 +130,7 @@ class Landing:
         self.phase = LandPhase.APPROACH
         self._flare_integ = 0.0
         self._flare_pitch = 0.0
+        self._flare_sink = 0.0
         self._stopped_s = 0.0
         self._touchdown_pitch = 0.0
         self._tau = 1.0
@@ -197,6 +198,7 @@ class Landing:
         if self.phase == LandPhase.APPROACH and self._flare_due(height, s.climb_rate, v):
             self.phase = LandPhase.FLARE
             self._flare_pitch = s.pitch
+            self._flare_sink = -s.climb_rate
             self._flare_integ = 0.0
             # The flare's time constant makes its first sink demand the sink rate now.
             s_t = max(v["TECS_LAND_SINK"], 0.05)
@@ -245,7 +247,11 @@ class Landing:
         self._flare_integ = clamp(self._flare_integ + SINK_I * error * dt, -0.1, 0.25)
         pitch_min = math.radians(v["LAND_PITCH_CD"] / 100.0)
         pitch_max = math.radians(v["TECS_LAND_PMAX"])
-        pitch = self._flare_pitch + SINK_P * error + self._flare_integ
+        # The flight path the sink demand asks for, on top of the glide's pitch: the change
+        # of path angle is the pitch change to first order (the feedback does the rest).
+        speed = max(math.hypot(*s.vel), 5.0)
+        path_change = (self._flare_sink - sink_dem) / speed
+        pitch = self._flare_pitch + path_change + SINK_P * error + self._flare_integ
         return LandingDemand(
             self.phase,
             (self.start, self.point(1e4)),
