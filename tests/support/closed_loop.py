@@ -39,6 +39,7 @@ class Sample:
     roll: float
     yaw: float
     out: ControlOutput
+    vel_ned: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass
@@ -116,13 +117,15 @@ class ClosedLoop:
             controls["brakes"] = out.brakes
         self.flight.set_controls(controls)
         truth = (s.lat_deg, s.lon_deg, s.alt_msl_m, s.alt_agl_m, s.airspeed_m_s, s.roll, s.yaw)
-        self.samples.append(Sample(s.t_s, *truth, out))
+        self.samples.append(Sample(s.t_s, *truth, out, (s.vn, s.ve, s.vd)))
 
     def truth(self) -> dict[str, np.ndarray]:
         """The record as the columns of a truth file (those the scoring reads)."""
         cols = {"t": "t_s", "lat": "lat", "lon": "lon", "alt": "alt_msl", "roll": "roll"}
         out = {k: np.array([getattr(x, v) for x in self.samples]) for k, v in cols.items()}
         out["yaw"] = np.array([x.yaw for x in self.samples])
+        for k, name in enumerate(("vn", "ve", "vd")):
+            out[name] = np.array([x.vel_ned[k] for x in self.samples])
         return out
 
 

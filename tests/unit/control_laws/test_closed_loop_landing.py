@@ -1,0 +1,66 @@
+"""Landings flown by the control laws against JSBSim on the true state (closed_loop.py).
+
+The benchmark's plan (take off east, a loop, then QGroundControl's landing pattern back
+onto the runway) scored as the issue asks, from the simulator's state: touchdown within
+30 m along and 3 m across the landing point, at most 1.5 m/s down, no bounce over 1 m,
+wings within 10° of level, stopped on the runway, and the controller asking to disarm.
+A go-around ordered on the approach climbs away and the aircraft lands on its second
+approach.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from companion.control.flight.landing import LandPhase
+from companion.control.mission.plan import checked_plan
+from ground.campaign.landing_score import landing_score_for_plan
+from tests.support.closed_loop import ClosedLoop
+
+PLAN = Path(__file__).resolve().parents[3] / "benchmarks" / "plans" / "land_east.plan"
+CROSSWIND = (5.0, 0.0, 0.0)  # from the south, across the runway (which runs east)
+
+
+def _fly(loop: ClosedLoop, seconds: float) -> bool:
+    """Fly until the controller disarms (True) or ``seconds`` pass."""
+    while loop.flight.t_s < seconds:
+        loop.run(1.0)
+        if loop.samples[-1].out.disarm:
+            return True
+    return False
+
+
+@pytest.mark.parametrize(
+    ("airframe", "wind"),
+    [("c172p", (0.0, 0.0, 0.0)), ("J3Cub", CROSSWIND)],
+    ids=["c172p-calm", "J3Cub-crosswind"],
+)
+def test_the_landing_pattern_is_flown_to_a_stop_on_the_target(airframe: str, wind):  # type: ignore[no-untyped-def]
+    items = checked_plan(PLAN)[0]
+    loop = ClosedLoop(airframe, items, wind_ned=wind, turbulence="light" if any(wind) else "none")
+    assert _fly(loop, 600.0)
+    score = landing_score_for_plan(loop.truth(), items)
+    assert score.passed(), score
+
+
+def test_a_go_around_on_the_approach_climbs_away_and_the_second_approach_lands():
+    items = checked_plan(PLAN)[0]
+    loop = ClosedLoop("c172p", items)
+    while (
+        loop.flight.t_s < 600.0
+        and loop.samples[-1:]
+        and (
+            loop.samples[-1].out.land_phase != LandPhase.APPROACH or loop.samples[-1].alt_agl > 25.0
+        )
+        or not loop.samples
+    ):
+        loop.run(0.5)
+    low = loop.samples[-1].alt_agl
+    loop.status.go_arounds += 1  # the commander accepted MAV_CMD_DO_GO_AROUND
+    loop.run(30.0)
+    climbed = max(s.alt_agl for s in loop.samples[-1500:])
+    assert climbed > low + 15.0
+    assert _fly(loop, 900.0)
+    assert landing_score_for_plan(loop.truth(), items).passed()

@@ -1,0 +1,72 @@
+"""The landing law on its own (companion/control/flight/landing.py), stepped by hand.
+
+A glide path from the approach's first point down to the flare, a flare that cuts the
+throttle, a rollout that steers for the centreline and brakes, a disarm only once the
+aircraft has stood still for LAND_DISARMDELAY, and a go-around that climbs away.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from companion.control.flight.landing import AircraftState, Landing, LandPhase
+from companion.control.flight.params import CONTROL_PARAMS
+
+V = {p.name: p.default for p in CONTROL_PARAMS}
+START, TOUCHDOWN = (0.0, -500.0), (0.0, 300.0)  # an approach eastwards, 800 m long
+
+
+def _state(e: float, height: float, sink: float = 2.0, speed: float = 28.0, n: float = 0.0):
+    return AircraftState((n, e), (0.0, speed), 100.0 + height, -sink, 0.0, math.pi / 2, 0.0)
+
+
+def test_the_glide_path_runs_from_the_first_point_down_to_the_flare_before_the_target():
+    land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+    heights = []
+    for e in range(-500, 300, 50):
+        dem = land.step(_state(float(e), 40.0), V, 0.02)
+        assert dem.phase == LandPhase.APPROACH and math.isnan(dem.throttle)
+        assert dem.line[0] == START
+        assert dem.climb_ff < 0.0 or e == START[1]  # the path sinks under the aircraft
+        heights.append(dem.alt_msl - 100.0)
+    assert heights[0] == pytest.approx(50.0, abs=1.0)
+    assert all(b < a for a, b in zip(heights, heights[1:], strict=False))
+    flare_at = TOUCHDOWN[1] - land.flare_distance(28.0, V)
+    assert 0.0 < TOUCHDOWN[1] - flare_at < 200.0
+    dem = land.step(_state(flare_at - 1.0, 40.0), V, 0.02)
+    assert dem.alt_msl - 100.0 == pytest.approx(V["LAND_FLARE_ALT"], abs=0.3)
+
+
+def test_flare_cuts_the_throttle_then_the_rollout_steers_brakes_and_disarms_when_stopped():
+    land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+    dem = land.step(_state(200.0, 2.5), V, 0.02)  # below LAND_FLARE_ALT
+    assert dem.phase == LandPhase.FLARE and dem.throttle == 0.0
+    assert dem.roll_limit == pytest.approx(math.radians(V["LEVEL_ROLL_LIMIT"]))
+    dem = land.step(_state(260.0, 0.1, sink=0.1), V, 0.02)  # on the wheels
+    assert dem.phase == LandPhase.ROLLOUT and dem.throttle == 0.0
+    # Left of the centreline (north of an eastward runway): rudder to the right.
+    dem = land.step(_state(300.0, 0.0, sink=0.0, speed=20.0, n=5.0), V, 0.02)
+    assert dem.rudder > 0.0 and dem.brakes == V["LAND_BRAKE"] and not dem.disarm
+    t = 0.0
+    while t < V["LAND_DISARMDELAY"] - 0.1:
+        dem = land.step(_state(400.0, 0.0, sink=0.0, speed=0.0), V, 0.1)
+        t += 0.1
+        assert not dem.disarm
+    dem = land.step(_state(400.0, 0.0, sink=0.0, speed=0.0), V, 0.2)
+    assert dem.phase == LandPhase.STOPPED and dem.disarm
+
+
+def test_a_go_around_climbs_away_along_the_runway_and_cannot_start_on_the_ground():
+    land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+    land.step(_state(0.0, 20.0), V, 0.02)
+    land.abort()
+    dem = land.step(_state(10.0, 19.0), V, 0.02)
+    assert dem.phase == LandPhase.GO_AROUND and dem.alt_msl >= 150.0
+    assert math.isnan(dem.throttle) and dem.speed == V["AIRSPEED_CRUISE"]
+    rolled = Landing(START, 150.0, TOUCHDOWN, 100.0)
+    rolled.step(_state(250.0, 2.0), V, 0.02)
+    rolled.step(_state(280.0, 0.1, sink=0.0), V, 0.02)
+    rolled.abort()
+    assert rolled.phase == LandPhase.ROLLOUT

@@ -1,0 +1,104 @@
+"""Landing items: what QGroundControl's landing pattern uploads is taken and flown.
+
+The pattern (QGC's FixedWingLandingComplexItem) uploads DO_LAND_START, the camera stops
+asked for, the final approach (LOITER_TO_ALT with heading required and a tangent exit, or
+a waypoint) and NAV_LAND; a .plan file holding the pattern is expanded to the same items.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from companion.control.mission.executor import Kind
+from companion.control.mission.items import check_mission
+from companion.control.mission.plan import checked_plan
+from mavlink_dialect import companion as d
+from tests.unit.mission.executor_flying import HOME, HOME_ALT, dist, executor, item, on_circle
+
+LAND = (0.0, 300.0)
+CENTRE, RADIUS = (-250.0, -500.0), 250.0  # clockwise: leaves heading east for LAND
+
+
+def _pattern(loiter: bool = True, photos: bool = True) -> dict:
+    def ll(ne, z):  # type: ignore[no-untyped-def]
+        return [*HOME.latlon(*ne), z]
+
+    return {
+        "type": "ComplexItem", "complexItemType": "fwLandingPattern", "version": 2,
+        "altitudesAreRelative": True, "landCoordinate": ll(LAND, 0),
+        "landingApproachCoordinate": ll(CENTRE, 50), "loiterClockwise": True,
+        "loiterRadius": RADIUS, "stopTakingPhotos": photos, "stopTakingVideo": photos,
+        "useLoiterToAlt": loiter, "valueSetIsDistance": True,
+    }  # fmt: skip
+
+
+def _plan(tmp_path, pattern: dict):  # type: ignore[no-untyped-def]
+    takeoff = {"type": "SimpleItem", "command": 22, "frame": 3, "autoContinue": True,
+               "params": [15, 0, 0, None, *HOME.latlon(0.0, 600.0), 100]}  # fmt: skip
+    plan = {"fileType": "Plan", "mission": {"items": [takeoff, pattern]}}
+    path = tmp_path / "land.plan"
+    path.write_text(json.dumps(plan))
+    return checked_plan(path)[0]
+
+
+def test_a_landing_pattern_becomes_the_items_qgroundcontrol_uploads(tmp_path):
+    items = _plan(tmp_path, _pattern())
+    commands = [it.command for it in items]
+    assert commands == [
+        d.MAV_CMD_NAV_TAKEOFF,
+        d.MAV_CMD_DO_LAND_START,
+        d.MAV_CMD_IMAGE_STOP_CAPTURE,
+        d.MAV_CMD_VIDEO_STOP_CAPTURE,
+        d.MAV_CMD_NAV_LOITER_TO_ALT,
+        d.MAV_CMD_NAV_LAND,
+    ]
+    loiter, land = items[4], items[5]
+    assert (loiter.param1, loiter.param2, loiter.param4, loiter.z) == (1.0, RADIUS, 1.0, 50.0)
+    assert land.z == 0.0 and land.frame == loiter.frame == d.MAV_FRAME_GLOBAL_RELATIVE_ALT
+    assert HOME.ne(land.x / 1e7, land.y / 1e7) == pytest.approx(LAND, abs=0.05)
+    assert check_mission(items) == d.MAV_MISSION_ACCEPTED
+
+
+def test_a_pattern_without_loiter_ends_with_a_waypoint_then_the_landing(tmp_path):
+    items = _plan(tmp_path, _pattern(loiter=False, photos=False))
+    assert [it.command for it in items[1:]] == [
+        d.MAV_CMD_DO_LAND_START, d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_NAV_LAND,
+    ]  # fmt: skip
+    assert math.isnan(items[2].param4)
+
+
+def test_a_landing_without_a_place_to_land_is_refused():
+    here = item(0, d.MAV_CMD_NAV_LAND, None)  # lat = lon = 0: no runway to line up on
+    assert check_mission([here]) == d.MAV_MISSION_INVALID_PARAM5_X
+
+
+def test_loiter_to_alt_circles_down_then_leaves_on_the_tangent_to_the_runway():
+    items = [
+        item(0, d.MAV_CMD_DO_LAND_START),
+        item(1, d.MAV_CMD_NAV_LOITER_TO_ALT, CENTRE, z=50.0, p1=1.0, p2=RADIUS),
+        item(2, d.MAV_CMD_NAV_LAND, LAND, z=0.0),
+    ]
+    items[1] = items[1].__class__(**{**items[1].as_dict(), "param4": 1.0})
+    ex = executor(items, pos=(-250.0, -900.0), alt=HOME_ALT + 100.0)
+    sp = ex.step((-250.0, -900.0), HOME_ALT + 100.0, 0.0)
+    assert sp.kind == Kind.CIRCLE and sp.b == pytest.approx(CENTRE, abs=0.05)
+    # Round the circle clockwise, too high: it keeps circling.
+    for deg in range(0, 720, 10):
+        sp = ex.step(on_circle(CENTRE, RADIUS, deg), HOME_ALT + 100.0, 0.0)
+        assert sp.kind == Kind.CIRCLE
+    # At the height, it leaves where the circle's course points along the runway (east):
+    # the circle's northern point, and the approach runs from there through LAND.
+    left_at = None
+    for deg in range(0, 360, 5):
+        sp = ex.step(on_circle(CENTRE, RADIUS, deg), HOME_ALT + 50.0, 0.0)
+        if sp.kind == Kind.LAND:
+            left_at = deg
+            break
+    assert left_at is not None and left_at % 360 <= 30
+    assert sp.b == pytest.approx(LAND, abs=0.05) and sp.alt_msl == pytest.approx(HOME_ALT)
+    assert sp.a == pytest.approx((0.0, -500.0), abs=0.5)  # the planned tangent point
+    assert sp.from_alt == pytest.approx(HOME_ALT + 50.0)
+    assert dist(sp.a, sp.b) == pytest.approx(800.0, abs=0.5)
