@@ -23,6 +23,11 @@ PLAN = Path(__file__).resolve().parents[3] / "benchmarks" / "plans" / "land_east
 CROSSWIND = (5.0, 0.0, 0.0)  # from the south, across the runway (which runs east)
 
 
+def _low_on_approach(loop: ClosedLoop) -> bool:
+    last = loop.samples[-1]
+    return last.out.land_phase == LandPhase.APPROACH and last.alt_agl < 25.0
+
+
 def _fly(loop: ClosedLoop, seconds: float) -> bool:
     """Fly until the controller disarms (True) or ``seconds`` pass."""
     while loop.flight.t_s < seconds:
@@ -48,14 +53,8 @@ def test_the_landing_pattern_is_flown_to_a_stop_on_the_target(airframe: str, win
 def test_a_go_around_on_the_approach_climbs_away_and_the_second_approach_lands():
     items = checked_plan(PLAN)[0]
     loop = ClosedLoop("c172p", items)
-    while (
-        loop.flight.t_s < 600.0
-        and loop.samples[-1:]
-        and (
-            loop.samples[-1].out.land_phase != LandPhase.APPROACH or loop.samples[-1].alt_agl > 25.0
-        )
-        or not loop.samples
-    ):
+    loop.run(1.0)
+    while loop.flight.t_s < 600.0 and not _low_on_approach(loop):
         loop.run(0.5)
     low = loop.samples[-1].alt_agl
     loop.status.go_arounds += 1  # the commander accepted MAV_CMD_DO_GO_AROUND

@@ -7,6 +7,7 @@ aircraft has stood still for LAND_DISARMDELAY, and a go-around that climbs away.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
@@ -32,7 +33,7 @@ def test_the_glide_path_runs_from_the_first_point_down_to_the_flare_before_the_t
         assert dem.climb_ff < 0.0 or e == START[1]  # the path sinks under the aircraft
         heights.append(dem.alt_msl - 100.0)
     assert heights[0] == pytest.approx(50.0, abs=1.0)
-    assert all(b < a for a, b in zip(heights, heights[1:], strict=False))
+    assert all(b < a for a, b in itertools.pairwise(heights))
     flare_at = TOUCHDOWN[1] - land.flare_distance(28.0, V)
     assert 0.0 < TOUCHDOWN[1] - flare_at < 200.0
     dem = land.step(_state(flare_at - 1.0, 40.0), V, 0.02)
