@@ -35,7 +35,12 @@ from companion.params import ParamDecl
 
 Point = tuple[float, float]
 
-TOUCHDOWN_AGL_M = 0.4  # the wheels are on the runway below this (a sinking check guards it)
+# On the wheels: this low and no longer sinking for a moment. The flare sinks at least at
+# TECS_LAND_SINK until then, so a navigator a few decimetres out still touches down
+# gently instead of dropping the last of the height with the flare given up.
+TOUCHDOWN_AGL_M = 1.0
+TOUCHDOWN_CLIMB = -0.15  # m/s
+TOUCHDOWN_S = 0.3
 STEER_LOOKAHEAD_M = 20.0
 STOPPED_SPEED = 0.8  # m/s: slower than this counts as stopped
 NOT_FLYING = 0.6  # below this fraction of the approach speed the wings cannot lift it
@@ -131,6 +136,7 @@ class Landing:
         self._flare_integ = 0.0
         self._flare_pitch = 0.0
         self._flare_sink = 0.0
+        self._level_s = 0.0
         self._stopped_s = 0.0
         self._touchdown_pitch = 0.0
         self._tau = 1.0
@@ -205,9 +211,9 @@ class Landing:
             self._tau = max(height, 0.5) / max(-s.climb_rate - s_t, 0.3)
         # On the wheels: low and no longer sinking, or slower than anything that flies.
         slow = ground_speed < 0.5 * v["TECS_LAND_ARSPD"]
-        if self.phase == LandPhase.FLARE and (
-            (height < TOUCHDOWN_AGL_M and s.climb_rate > -0.3) or slow
-        ):
+        level = height < TOUCHDOWN_AGL_M and s.climb_rate > TOUCHDOWN_CLIMB
+        self._level_s = self._level_s + dt if level and self.phase == LandPhase.FLARE else 0.0
+        if self.phase == LandPhase.FLARE and (self._level_s >= TOUCHDOWN_S or slow):
             self.phase = LandPhase.ROLLOUT
             self._touchdown_pitch = s.pitch
         if self.phase in (LandPhase.ROLLOUT, LandPhase.STOPPED):

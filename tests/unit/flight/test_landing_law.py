@@ -45,7 +45,9 @@ def test_flare_cuts_the_throttle_then_the_rollout_steers_brakes_and_disarms_when
     dem = land.step(_state(200.0, 2.5), V, 0.02)  # below LAND_FLARE_ALT
     assert dem.phase == LandPhase.FLARE and dem.throttle == 0.0
     assert dem.roll_limit == pytest.approx(math.radians(V["LEVEL_ROLL_LIMIT"]))
-    dem = land.step(_state(260.0, 0.1, sink=0.1), V, 0.02)  # on the wheels
+    dem = land.step(_state(260.0, 0.1, sink=0.0), V, 0.02)  # on the wheels, a moment
+    assert dem.phase == LandPhase.FLARE
+    dem = land.step(_state(265.0, 0.1, sink=0.0), V, 0.4)
     assert dem.phase == LandPhase.ROLLOUT and dem.throttle == 0.0
     # Left of the centreline (north of an eastward runway): rudder to the right.
     dem = land.step(_state(300.0, 0.0, sink=0.0, speed=20.0, n=5.0), V, 0.02)
@@ -69,5 +71,6 @@ def test_a_go_around_climbs_away_along_the_runway_and_cannot_start_on_the_ground
     rolled = Landing(START, 150.0, TOUCHDOWN, 100.0)
     rolled.step(_state(250.0, 2.0), V, 0.02)
     rolled.step(_state(280.0, 0.1, sink=0.0), V, 0.02)
+    rolled.step(_state(285.0, 0.1, sink=0.0), V, 0.4)
     rolled.abort()
     assert rolled.phase == LandPhase.ROLLOUT
