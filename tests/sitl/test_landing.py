@@ -1,0 +1,92 @@
+"""A whole-vehicle landing in lockstep JSBSim, flown as a ground station would fly it.
+
+The benchmark's plan (take off east, a loop, QGroundControl's landing pattern back onto
+the runway) is uploaded item by item over MAVLink exactly as QGroundControl uploads the
+pattern (DO_LAND_START, camera stops, LOITER_TO_ALT, NAV_LAND); the aircraft is armed and
+the mission started. In a 5 m/s crosswind with light turbulence it lands on the target
+(within 30 m along and 3 m across), touches down at no more than 1.5 m/s with the wings
+within 10° of level and no bounce over 1 m, stops on the runway, and disarms itself.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import pytest
+
+from companion.control.mission.items import MissionItem
+from companion.control.mission.plan import checked_plan
+from companion.navigation.estimate_csv import read_estimate
+from ground.campaign.landing_score import landing_score_for_plan
+from mavlink_dialect import companion as d
+from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.sim.sim_run import finish, start_sim
+from tests.support.vehicle import REPO
+
+PLAN = REPO / "benchmarks" / "plans" / "land_east.plan"
+WALL_LIMIT_S = 600.0  # a hang guard only: the flight is judged by the simulator's truth
+
+
+def _upload(gcs: GroundStation, items: list[MissionItem]) -> None:
+    gcs.mav.mission_count_send(1, 1, len(items), d.MAV_MISSION_TYPE_MISSION)
+    for _ in items:
+        req = gcs.recv(["MISSION_REQUEST_INT", "MISSION_REQUEST"], 10)
+        it = items[req.seq]
+        gcs.mav.mission_item_int_send(
+            1, 1, it.seq, it.frame, it.command, 0, it.autocontinue, it.param1, it.param2,
+            it.param3, it.param4, it.x, it.y, it.z, d.MAV_MISSION_TYPE_MISSION,
+        )  # fmt: skip
+    assert gcs.recv("MISSION_ACK", 10).type == d.MAV_MISSION_ACCEPTED
+
+
+def _command_until_accepted(gcs: GroundStation, command: int, *params: float) -> None:
+    end = time.monotonic() + 60.0
+    while time.monotonic() < end:  # arming waits for the first GPS fix
+        gcs.heartbeat()
+        gcs.command(command, *params)
+        if gcs.ack(command, 10).result == d.MAV_RESULT_ACCEPTED:
+            return
+        time.sleep(0.5)
+    raise AssertionError(f"command {command} never accepted")
+
+
+def _fly(gcs: GroundStation) -> tuple[bool, bool]:
+    """(mission completed, disarmed afterwards) as the ground station saw them."""
+    completed = disarmed = False
+    end, beat = time.monotonic() + WALL_LIMIT_S, 0.0
+    while time.monotonic() < end and not (completed and disarmed):
+        if time.monotonic() > beat:
+            gcs.heartbeat()
+            beat = time.monotonic() + 1.0
+        msg = gcs.conn.recv_match(type=["MISSION_CURRENT", "HEARTBEAT"], blocking=True, timeout=1)
+        if msg is None or msg.get_srcSystem() != 1:
+            continue
+        if msg.get_type() == "MISSION_CURRENT":
+            completed |= msg.mission_state == d.MISSION_STATE_COMPLETE
+        elif completed:
+            disarmed = not msg.base_mode & d.MAV_MODE_FLAG_SAFETY_ARMED
+    return completed, disarmed
+
+
+@pytest.mark.timeout(900)
+def test_the_c172_lands_its_qgc_landing_pattern_in_a_crosswind_and_disarms(tmp_path: Path):
+    items = checked_plan(PLAN)[0]
+    port = free_udp_port()
+    proc, namespace, truth_path = start_sim(
+        tmp_path, f"udpin://127.0.0.1:{port}", "--aircraft", "c172p", "--wind", "5,0,0",
+        "--turbulence", "light", "--duration", "330",
+    )  # fmt: skip
+    gcs = GroundStation(port)
+    try:
+        gcs.connect()
+        _upload(gcs, items)
+        _command_until_accepted(gcs, d.MAV_CMD_COMPONENT_ARM_DISARM, 1.0)
+        _command_until_accepted(gcs, d.MAV_CMD_MISSION_START, 0.0)
+        completed, disarmed = _fly(gcs)
+    finally:
+        gcs.close()
+        out = finish(proc, namespace, WALL_LIMIT_S)
+    assert completed and disarmed, out[-3000:]
+    score = landing_score_for_plan(read_estimate(truth_path), items)
+    assert score.passed(), score
