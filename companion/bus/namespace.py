@@ -86,12 +86,24 @@ def cleanup_namespace(namespace: str) -> int:
     return _remove_prefixed_files(prefix_of(namespace))
 
 
+def _matching(base: Path, prefix: str) -> list[Path]:
+    """This namespace's paths under ``base``. Other namespaces' files come and go while the
+    directory is walked (other vehicles and tests clean up at the same time): a walk that
+    trips over one is started again."""
+    for _ in range(5):
+        try:
+            return list(base.rglob(f"{prefix}*"))
+        except FileNotFoundError:
+            continue
+    return []
+
+
 def _remove_prefixed_files(prefix: str) -> int:
     removed = 0
     for base in (SHM_DIR, IOX_DIR):
         if not base.exists():
             continue
-        for path in base.rglob(f"{prefix}*"):
+        for path in _matching(base, prefix):
             try:
                 if path.is_dir():
                     shutil.rmtree(path)
