@@ -18,7 +18,9 @@ from companion.control.mission.items import MissionItem
 from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
 
-TOUCH_M = 0.25  # within this of the resting height: a wheel is on the runway
+TOUCH_M = 0.6  # this close to the resting height and no longer sinking: on the wheels
+SETTLED_M_S = 0.15  # m/s down: no longer sinking
+SINK_WINDOW_S = 0.3  # the touchdown's vertical speed: the most in this time before it
 AIRBORNE_M = 10.0  # the flight proper: higher than this above the runway
 RUNWAY_HALF_WIDTH_M = 15.0
 RUNWAY_LENGTH_M = 1500.0
@@ -99,7 +101,11 @@ def score_landing(
     flying = np.nonzero(height > AIRBORNE_M)[0]
     if flying.size == 0:
         return LandingScore(False)
-    after = flying[-1] + np.nonzero(height[flying[-1] :] < TOUCH_M)[0]
+    # The wheels meet the runway where the descent stops close to it (a tail dragger on its
+    # main wheels sits higher than at rest, in its three-point attitude).
+    vd = truth["vd"]
+    low = (height < TOUCH_M) & (vd < SETTLED_M_S)
+    after = flying[-1] + np.nonzero(low[flying[-1] :])[0]
     if after.size == 0:
         return LandingScore(False)
     k = int(after[0])
@@ -113,8 +119,12 @@ def score_landing(
         True,
         float(along[k]),
         float(across[k]),
-        float(np.max(truth["vd"][max(0, k - 5) : k + 1])),
-        float(np.max(height[k:]) - 0.0),
+        float(
+            np.max(
+                vd[(truth["t"] >= truth["t"][k] - SINK_WINDOW_S) & (truth["t"] <= truth["t"][k])]
+            )
+        ),
+        float(np.max(height[k:]) - height[k]),
         float(math.degrees(truth["roll"][k])),
         float(along[end]),
         float(across[end]),

@@ -43,6 +43,10 @@ TOUCHDOWN_CLIMB = -0.15  # m/s
 TOUCHDOWN_S = 0.3
 STEER_LOOKAHEAD_M = 20.0
 STOPPED_SPEED = 0.8  # m/s: slower than this counts as stopped
+# On the wheels the nose is lowered this much from the touchdown attitude: the wing stops
+# lifting (a tricycle puts its nose wheel down, a tail dragger holds its main wheels on),
+# so a gust cannot lift the aircraft back off while it is still fast.
+WHEELS_DOWN_PITCH = math.radians(3.0)
 NOT_FLYING = 0.6  # below this fraction of the approach speed the wings cannot lift it
 MIN_GLIDE = math.radians(1.5)  # a flatter path cannot be flown with the throttle at idle
 AIM_LOW, AIM_HIGH = 0.6, 1.5  # the flare's sink demand may aim within these bounds
@@ -215,7 +219,7 @@ class Landing:
         self._level_s = self._level_s + dt if level and self.phase == LandPhase.FLARE else 0.0
         if self.phase == LandPhase.FLARE and (self._level_s >= TOUCHDOWN_S or slow):
             self.phase = LandPhase.ROLLOUT
-            self._touchdown_pitch = s.pitch
+            self._touchdown_pitch = s.pitch - WHEELS_DOWN_PITCH
         if self.phase in (LandPhase.ROLLOUT, LandPhase.STOPPED):
             return self._rollout(s, ground_speed, v, dt)
         if self.phase == LandPhase.FLARE:
