@@ -49,7 +49,9 @@ STOPPED_SPEED = 0.8  # m/s: slower than this counts as stopped
 WHEELS_DOWN_PITCH = math.radians(3.0)
 NOT_FLYING = 0.6  # below this fraction of the approach speed the wings cannot lift it
 MIN_GLIDE = math.radians(1.5)  # a flatter path cannot be flown with the throttle at idle
-AIM_LOW, AIM_HIGH = 0.6, 1.5  # the flare's sink demand may aim within these bounds
+# The flare's sink demand may aim for the point within these fractions of the nominal
+# flare's: more, and a flare that started early floats then drops onto the runway.
+AIM_LOW, AIM_HIGH = 0.75, 1.25
 SINK_P = 0.04  # rad of pitch per m/s of sink-rate error in the flare
 SINK_I = 0.05  # rad per (m/s·s)
 
@@ -252,7 +254,7 @@ class Landing:
         speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
         to_go = -self.along(s.pos) / max(speed_along, 1.0)
         aim = max(height, 0.0) / to_go if to_go > 0.1 else math.inf
-        sink_dem = clamp(aim, AIM_LOW * nominal, nominal + AIM_HIGH * s_t)
+        sink_dem = clamp(aim, AIM_LOW * nominal, AIM_HIGH * nominal)
         error = -s.climb_rate - sink_dem  # + when sinking faster than wanted: pitch up
         self._flare_integ = clamp(self._flare_integ + SINK_I * error * dt, -0.1, 0.25)
         pitch_min = math.radians(v["LAND_PITCH_CD"] / 100.0)
