@@ -16,6 +16,7 @@ import pytest
 
 from companion.control.flight.landing import LandPhase
 from companion.control.mission.plan import checked_plan
+from companion.messages import FlightMode
 from ground.campaign.landing_score import landing_score_for_plan
 from tests.support.closed_loop import ClosedLoop
 
@@ -63,3 +64,22 @@ def test_a_go_around_on_the_approach_climbs_away_and_the_second_approach_lands()
     assert climbed > low + 15.0
     assert _fly(loop, 900.0)
     assert landing_score_for_plan(loop.truth(), items).passed()
+
+
+def test_return_with_rtl_autoland_flies_the_missions_landing():
+    items = checked_plan(PLAN)[0]
+    loop = ClosedLoop("c172p", items, overrides={"RTL_AUTOLAND": 2.0})
+    loop.run(60.0)  # airborne, on the first leg
+    assert loop.samples[-1].alt_agl > 30.0
+    loop.set_mode(FlightMode.RTL)
+    assert _fly(loop, 600.0)
+    assert landing_score_for_plan(loop.truth(), items).passed()
+
+
+def test_return_without_rtl_autoland_circles_home_and_does_not_land():
+    items = checked_plan(PLAN)[0]
+    loop = ClosedLoop("c172p", items)
+    loop.run(60.0)
+    loop.set_mode(FlightMode.RTL)
+    assert not _fly(loop, 400.0)
+    assert min(s.alt_agl for s in loop.samples[-1000:]) > 50.0
