@@ -22,6 +22,7 @@ from mavlink_dialect import companion as d
 if TYPE_CHECKING:
     from companion.control.flight.controller import ControlOutput, FlightController
 
+FLARE_PITCH_GAIN = 2.5
 GO_AROUND_MARGIN_M = 5.0  # this close to the go-around height: come round again
 
 
@@ -105,6 +106,11 @@ class LandingFlight:
         lateral = self._lateral(line, pos, vel, dt)
         roll_dem = bank_for(lateral.lat_acc, min(dem.roll_limit, self.config.roll_limit))
         flying = dem.phase == LandPhase.FLARE
+        # The flare's pitch changes in a second or two, faster than cruise ever asks for:
+        # the pitch loop works harder while flaring (the gains return after).
+        gains = self.attitude.gains
+        if flying:
+            self.attitude.gains = replace(gains, pitch_p=gains.pitch_p * FLARE_PITCH_GAIN)
         surfaces = self.attitude.step(
             roll_dem,
             dem.pitch,
@@ -114,6 +120,7 @@ class LandingFlight:
             dt,
             integrate=flying,
         )
+        self.attitude.gains = gains
         self.tecs.reset(dem.pitch)
         out.aileron, out.elevator = surfaces.aileron, surfaces.elevator
         if math.isfinite(dem.elevator):
