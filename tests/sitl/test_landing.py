@@ -52,8 +52,8 @@ def _command_until_accepted(gcs: GroundStation, command: int, *params: float) ->
 
 
 def _fly(gcs: GroundStation) -> tuple[bool, bool]:
-    """(mission completed, disarmed afterwards) as the ground station saw them."""
-    completed = disarmed = False
+    """(mission completed, disarmed after having been armed) as the ground station saw them."""
+    completed = armed = disarmed = False
     end, beat = time.monotonic() + WALL_LIMIT_S, 0.0
     while time.monotonic() < end and not (completed and disarmed):
         if time.monotonic() > beat:
@@ -64,8 +64,10 @@ def _fly(gcs: GroundStation) -> tuple[bool, bool]:
             continue
         if msg.get_type() == "MISSION_CURRENT":
             completed |= msg.mission_state == d.MISSION_STATE_COMPLETE
-        elif completed:
-            disarmed = not msg.base_mode & d.MAV_MODE_FLAG_SAFETY_ARMED
+        elif msg.base_mode & d.MAV_MODE_FLAG_SAFETY_ARMED:
+            armed = True
+        else:
+            disarmed |= armed
     return completed, disarmed
 
 
@@ -75,7 +77,7 @@ def test_the_c172_lands_its_qgc_landing_pattern_in_a_crosswind_and_disarms(tmp_p
     port = free_udp_port()
     proc, namespace, truth_path = start_sim(
         tmp_path, f"udpin://127.0.0.1:{port}", "--aircraft", "c172p", "--wind", "5,0,0",
-        "--turbulence", "light", "--duration", "330",
+        "--turbulence", "light", "--duration", "600",
     )  # fmt: skip
     gcs = GroundStation(port)
     try:
