@@ -8,10 +8,10 @@ plug-in runs it on the bus; tests and benchmarks run it against JSBSim directly.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 from companion.control.flight.landing import Landing
 from companion.control.flight.landing_flight import LandingFlight
+from companion.control.flight.output import ControlOutput
 from companion.control.flight.params import FlightConfig
 from companion.control.flight.pilot import PILOT_MODES, Sticks, fly_pilot
 from companion.control.flight.takeoff import Phase, RunwayTakeoff
@@ -31,32 +31,6 @@ LANDED_SPEED = 8.0  # m/s: slower than this near the ground is "on the ground"
 # the airspeed a turn gains or loses.
 TURN_BANK_FRACTION = 0.7
 MAX_TURN_WIND = 15.0  # m/s: a wind estimate beyond this is not trusted to size turns
-
-
-@dataclass
-class ControlOutput:
-    """Surfaces (stick convention) and what the ground station is told."""
-
-    aileron: float = 0.0
-    elevator: float = 0.0
-    rudder: float = 0.0
-    throttle: float = 0.0
-    nav_roll: float = 0.0
-    nav_pitch: float = 0.0
-    target_bearing: float = 0.0
-    wp_dist: float = 0.0
-    alt_error: float = 0.0
-    aspd_error: float = 0.0
-    xtrack: float = 0.0
-    airspeed: float = 0.0
-    mission_seq: int = 0
-    mission_finished: bool = False
-    reached: list[int] = field(default_factory=list)
-    landed: bool = True
-    disarm: bool = False  # landed and stopped: the flight is over
-    land_phase: int = 0  # LandPhase while landing, else 0
-    flaps: float = 0.0  # 0 up .. 1 fully down
-    brakes: float = 1.0  # 0 off .. 1 full: held while parked
 
 
 class FlightController(LandingFlight):

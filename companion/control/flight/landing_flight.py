@@ -20,7 +20,8 @@ from companion.messages import NavState, VehicleStatus
 from mavlink_dialect import companion as d
 
 if TYPE_CHECKING:
-    from companion.control.flight.controller import ControlOutput, FlightController
+    from companion.control.flight.controller import FlightController
+    from companion.control.flight.output import ControlOutput
 
 FLARE_PITCH_GAIN = 2.5
 GO_AROUND_MARGIN_M = 5.0  # this close to the go-around height: come round again

@@ -1,0 +1,31 @@
+"""What the flight controller commands and what the ground station is told, per step."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass
+class ControlOutput:
+    """Surfaces (stick convention) and what the ground station is told."""
+
+    aileron: float = 0.0
+    elevator: float = 0.0
+    rudder: float = 0.0
+    throttle: float = 0.0
+    nav_roll: float = 0.0
+    nav_pitch: float = 0.0
+    target_bearing: float = 0.0
+    wp_dist: float = 0.0
+    alt_error: float = 0.0
+    aspd_error: float = 0.0
+    xtrack: float = 0.0
+    airspeed: float = 0.0
+    mission_seq: int = 0
+    mission_finished: bool = False
+    reached: list[int] = field(default_factory=list)
+    landed: bool = True
+    disarm: bool = False  # landed and stopped: the flight is over
+    land_phase: int = 0  # LandPhase while landing, else 0
+    flaps: float = 0.0  # 0 up .. 1 fully down
+    brakes: float = 1.0  # 0 off .. 1 full: held while parked
