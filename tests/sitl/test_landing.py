@@ -82,6 +82,8 @@ def test_the_c172_lands_its_qgc_landing_pattern_in_a_crosswind_and_disarms(tmp_p
     gcs = GroundStation(port)
     try:
         gcs.connect()
+        # Mission progress as often as QGroundControl asks for it while flying a plan.
+        gcs.command(d.MAV_CMD_SET_MESSAGE_INTERVAL, d.MAVLINK_MSG_ID_MISSION_CURRENT, 200_000)
         _upload(gcs, items)
         _command_until_accepted(gcs, d.MAV_CMD_COMPONENT_ARM_DISARM, 1.0)
         _command_until_accepted(gcs, d.MAV_CMD_MISSION_START, 0.0)
