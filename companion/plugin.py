@@ -79,6 +79,9 @@ class PluginContext:
     health: HealthCounters = field(default_factory=HealthCounters)
     # Every parameter declared by the config's plug-ins (what the parameter server serves).
     param_decls: tuple[ParamDecl, ...] = ()
+    # Every plug-in's validated settings by plug-in kind (the flight log records the
+    # navigator's, so a replay runs it as it flew).
+    plugins: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
 
 
 class Plugin(ABC):

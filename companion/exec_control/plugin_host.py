@@ -81,6 +81,7 @@ class PluginHost:
             clock=self.clock,
             vehicle=spec["vehicle"],
             param_decls=tuple(ParamDecl(**d) for d in spec.get("param_decls", [])),
+            plugins=spec.get("plugins", {}),
         )
 
     def _clock(self, kind: str) -> VehicleClock:

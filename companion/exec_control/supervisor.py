@@ -58,6 +58,7 @@ class Supervisor:
             "vehicle": cfg.vehicle,
             "log_level": log_level,
             "param_decls": decls,
+            "plugins": {spec.kind: spec.settings for spec in cfg.plugins},
         }
         self.children = [Child(spec, base) for spec in cfg.plugins]
         # A fork server started early (while the simulator loads) may be handed in.

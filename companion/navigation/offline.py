@@ -12,6 +12,7 @@ from typing import Protocol
 
 from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer, Message, NavState
 from companion.navigation.ins_ekf import InsEkf, InsEkfConfig
+from companion.navigation.sample_order import PublishGrid, SampleOrder
 
 
 class Navigator(Protocol):
@@ -100,3 +101,17 @@ def run_navigator(
         if t >= next_us:
             yield navigator.solution(t)
             next_us += period_us * max(1, (t - next_us) // period_us + 1)
+
+
+def run_as_plugin(
+    runner: InsEkfRunner, samples: Iterable[Message], rate_hz: float = 50.0
+) -> Iterator[NavState]:
+    """What ``nav.ins_ekf`` publishes given the samples in the order they reached it: the
+    plug-in's own ordering buffer and publication grid, so a log of its inputs replays to
+    its very states."""
+    order, grid = SampleOrder(), PublishGrid(rate_hz)
+    for sample in samples:
+        for ready in order.push((sample,)):
+            runner.feed(ready)
+            if grid.due(runner.nav.t_us, ready):
+                yield runner.nav.state()

@@ -18,6 +18,26 @@ from typing import Any
 
 from companion.messages import Imu
 
+# The order ``nav.ins_ekf`` drains its inputs in, which is the arrival order of aiding
+# samples of equal time read in one batch; a replay breaks such ties the same way.
+FEED_ORDER = ("sensors/imu", "sensors/gps", "sensors/mag", "sensors/compass", "sensors/baro")
+
+
+class PublishGrid:
+    """When the navigator publishes: after the first IMU sample at or past each tick of a
+    fixed grid of vehicle time, whatever batches the samples came in."""
+
+    def __init__(self, rate_hz: float) -> None:
+        self.period_us = round(1e6 / rate_hz)
+        self.next_us = 0
+
+    def due(self, t_us: int | None, sample: Any) -> bool:
+        """Whether to publish after feeding ``sample`` (the navigator now at ``t_us``)."""
+        if t_us is None or not isinstance(sample, Imu) or t_us < self.next_us:
+            return False
+        self.next_us = (t_us // self.period_us + 1) * self.period_us
+        return True
+
 
 class SampleOrder:
     """A time-ordering buffer in front of an IMU-driven navigator."""

@@ -35,19 +35,25 @@ def replay(
         Path | None, typer.Option(help="also draw the flight into this PNG (many: a directory)")
     ] = None,
     truth: Annotated[Path | None, typer.Option(help="truth CSV to draw beside it")] = None,
-    rate: Annotated[float, typer.Option(help="estimate rows per second of log time")] = 50.0,
+    rate: Annotated[
+        float | None,
+        typer.Option(
+            help="estimate rows per second of log time (default 50; an on-board log: the "
+            "rate its navigator published at)"
+        ),
+    ] = None,
     declination: Annotated[
         float | None,
         typer.Option(
             help="magnetic declination, degrees east (compass, magnetometer); "
-            "default: the World Magnetic Model's at the first fix"
+            "default: an on-board log's own setting, else the World Magnetic Model's"
         ),
     ] = None,
     gps_delay: Annotated[
         float | None,
         typer.Option(
             help="ins_ekf: seconds a fix reaches the navigator after it was measured (the nav "
-            "plug-in's gps_delay_s, 0.1 in companion sim); default: measured from the log"
+            "plug-in's gps_delay_s); default: an on-board log's own setting, else measured"
         ),
     ] = None,
     address: Annotated[
@@ -78,7 +84,7 @@ def replay(
 
 def _replay_one(
     log: Path, out_path: Path, navigator: str, plot: Path | None, truth: Path | None,
-    rate: float, declination: float | None, gps_delay: float | None = None,
+    rate: float | None, declination: float | None, gps_delay: float | None = None,
 ) -> None:  # fmt: skip
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
@@ -114,7 +120,7 @@ def _replay_one(
 
 
 def _replay_batch(
-    args: list[str], out_dir: Path, navigator: str, plot: Path | None, rate: float,
+    args: list[str], out_dir: Path, navigator: str, plot: Path | None, rate: float | None,
     declination: float | None, address: str | None, cpus: int | None,
 ) -> None:  # fmt: skip
     from ground.replay.batch import (
@@ -130,6 +136,7 @@ def _replay_batch(
     except LogsError as exc:
         err.print(f"[red]{exc}[/red]", highlight=False, soft_wrap=True)
         raise typer.Exit(EXIT_CONFIG) from None
+    rate = rate or 50.0
     rows = replay_logs(logs, out_dir, navigator, rate, declination, plot, address, cpus, err)
     out.print(summary_table(rows, f"{navigator} over {len(rows)} logs"))
     failed = sum(1 for r in rows if r.error)

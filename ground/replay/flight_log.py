@@ -24,6 +24,7 @@ from companion.flight_log import topic_name
 from companion.messages import Message, NavFlags, NavState
 from companion.messages.channels import CHANNELS
 from companion.navigation.estimate_csv import EstimateWriter
+from companion.navigation.sample_order import FEED_ORDER
 from companion.sensors.sensorlog import LogStats
 
 SENSOR_CHANNELS = ("sensors/imu", "sensors/gps", "sensors/mag", "sensors/baro", "sensors/compass")
@@ -77,14 +78,31 @@ def messages(ulog: ULog, channel: str) -> Iterator[Message]:
 
 
 def sensor_samples(ulog: ULog, stats: LogStats | None = None) -> Iterator[Message]:
-    """Every sensor sample of the log, oldest first (a channel's own order kept on ties)."""
+    """Every sensor sample of the log, oldest first; at equal times in the order the
+    navigator reads its inputs in (a channel's own order kept)."""
     stats = stats if stats is not None else LogStats()
     kinds = {c: c.split("/", 1)[1] for c in SENSOR_CHANNELS}
-    streams = [((m, kinds[c]) for m in messages(ulog, c)) for c in SENSOR_CHANNELS]
+    channels = sorted(SENSOR_CHANNELS, key=lambda c: FEED_ORDER.index(c))
+    streams = [((m, kinds[c]) for m in messages(ulog, c)) for c in channels]
     for msg, kind in heapq.merge(*streams, key=lambda item: item[0].t_us):
         stats.rows += 1
         stats.by_kind[kind] = stats.by_kind.get(kind, 0) + 1
         yield msg
+
+
+def navigator_settings(ulog: ULog) -> dict[str, float | None]:
+    """The settings the vehicle's navigator flew with (INFO ``nav.*``, as the logger
+    records them; NaN, "not set", as None); empty for a log without them."""
+    settings: dict[str, float | None] = {}
+    for key, value in ulog.msg_info_dict.items():
+        if not key.startswith("nav.") or key == "nav.plugin":
+            continue
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            continue  # a hostile or foreign log: the setting is left at its default
+        settings[key[4:]] = None if math.isnan(number) else number
+    return settings
 
 
 def sample_count(ulog: ULog) -> int:

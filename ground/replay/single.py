@@ -6,6 +6,7 @@ reads the log, shows progress, writes the estimate CSV and, on request, a plot.
 
 from __future__ import annotations
 
+import dataclasses
 import gc
 import math
 import time
@@ -20,6 +21,7 @@ from companion.navigation.offline import (
     NAVIGATORS,
     InsEkfRunner,
     Navigator,
+    run_as_plugin,
     run_navigator,
     true_headings,
 )
@@ -30,6 +32,7 @@ from ground.replay.flight_log import (
     flight_estimate,
     is_flight_log,
     load,
+    navigator_settings,
     sensor_samples,
 )
 
@@ -105,7 +108,7 @@ def replay_log(
     log: Path,
     navigator: str,
     out: Path,
-    rate_hz: float = 50.0,
+    rate_hz: float | None = None,
     declination_deg: float | None = None,
     progress: Callable[[int], None] | None = None,
     fixes: list[GpsFix] | None = None,
@@ -114,21 +117,63 @@ def replay_log(
     """Run the navigator over the log; write the estimate; return a summary and the states.
 
     ``gps_delay_s`` (ins_ekf): how late fixes arrive, as the nav plug-in's setting; None:
-    measured from the log."""
+    measured from the log. An on-board log runs ins_ekf as the plug-in did in flight: with
+    the settings it logged (the arguments given here override them), its sample order and
+    its publication grid (``rate_hz`` None: its own rate; otherwise 50 Hz)."""
     summary = ReplaySummary(log, navigator)
     stats = LogStats()
-    if navigator == "ins_ekf" and gps_delay_s is not None:
-        config = InsEkfConfig(declination_deg=declination_deg, gps_delay_s=gps_delay_s)
-        nav: Navigator = InsEkfRunner(config=config)
-    else:
-        nav = NAVIGATORS[navigator](declination_deg)
     if is_flight_log(log):
         ulog = load(log)
         summary.flown = flight_estimate(ulog)
-        source = sensor_samples(ulog, stats)
+        logged = navigator_settings(ulog)
+        solutions = _flight_solutions(
+            navigator, sensor_samples(ulog, stats), logged, rate_hz,
+            {"declination_deg": declination_deg, "gps_delay_s": gps_delay_s}, summary, fixes,
+        )  # fmt: skip
     else:
-        source = read_sensor_log(log, stats)
-    samples = _watch_gps(true_headings(source, declination_deg), summary, fixes)
+        if navigator == "ins_ekf" and gps_delay_s is not None:
+            config = InsEkfConfig(declination_deg=declination_deg, gps_delay_s=gps_delay_s)
+            nav: Navigator = InsEkfRunner(config=config)
+        else:
+            nav = NAVIGATORS[navigator](declination_deg)
+        samples = _watch_gps(true_headings(read_sensor_log(log, stats), declination_deg),
+                             summary, fixes)  # fmt: skip
+        solutions = run_navigator(nav, samples, rate_hz or 50.0)
+    states = _run(solutions, out, summary, stats, progress)
+    if is_flight_log(log):
+        summary.flight = compare(states, summary.flown)
+    return summary, states
+
+
+def _flight_solutions(
+    navigator: str,
+    source: Iterator[Message],
+    logged: dict[str, float | None],
+    rate_hz: float | None,
+    given: dict[str, float | None],
+    summary: ReplaySummary,
+    fixes: list[GpsFix] | None,
+) -> Iterator[NavState]:
+    """An on-board log's samples are the bus's, as the navigator took them (compass
+    headings already true): no conversion, the flight's settings unless overridden."""
+    settings = {**logged, **{k: v for k, v in given.items() if v is not None}}
+    samples = _watch_gps(source, summary, fixes)
+    if navigator != "ins_ekf":
+        nav = NAVIGATORS[navigator](settings.get("declination_deg"))
+        return run_navigator(nav, samples, rate_hz or 50.0)
+    names = {f.name for f in dataclasses.fields(InsEkfConfig)}
+    config = InsEkfConfig(**{k: v for k, v in settings.items() if k in names})  # type: ignore[arg-type]
+    rate = rate_hz or settings.get("publish_hz") or 50.0
+    return run_as_plugin(InsEkfRunner(config=config), samples, rate)
+
+
+def _run(
+    solutions: Iterator[NavState],
+    out: Path,
+    summary: ReplaySummary,
+    stats: LogStats,
+    progress: Callable[[int], None] | None,
+) -> list[NavState]:
     writer = EstimateWriter(out)
     states: list[NavState] = []
     started = time.perf_counter()
@@ -137,7 +182,7 @@ def replay_log(
     gc_was_enabled = gc.isenabled()
     gc.disable()
     try:
-        for state in run_navigator(nav, samples, rate_hz):
+        for state in solutions:
             states.append(state)
             if state.flags & _POSITION_VALID:
                 writer.add(state.t_us / 1e6, state.roll_rad, state.pitch_rad, state.yaw_rad,
@@ -154,9 +199,7 @@ def replay_log(
         progress(stats.rows - summary.rows)
     summary.wall_seconds = time.perf_counter() - started
     _summarise(summary, stats, writer.rows, states)
-    if is_flight_log(log):
-        summary.flight = compare(states, summary.flown)
-    return summary, states
+    return states
 
 
 def _summarise(summary: ReplaySummary, stats: LogStats, rows: int, states: list[NavState]) -> None:

@@ -118,6 +118,9 @@ def vehicle_config(req: SimRequest, opts: BridgeOptions, devices: dict[str, str]
     for spec in cfg.plugins:
         if spec.kind == "link.mavlink" and req.links:
             spec.settings["endpoints"] = list(req.links)
+        if spec.kind == "system.logger" and opts.exact:
+            # One file from boot: a replay then sees every sample the navigator saw.
+            spec.settings.update(from_boot=True, split=False)
     if req.state_dir:
         cfg.vehicle["state_dir"] = req.state_dir
     if req.sysid is not None:

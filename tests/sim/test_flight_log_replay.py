@@ -1,5 +1,5 @@
-"""A mission flown in lockstep SITL leaves an on-board ULog that is on one time base and
-that ``companion replay`` re-runs, landing near the estimate the vehicle made in flight."""
+"""A mission flown in exact lockstep SITL leaves an on-board ULog, from boot, on one time
+base, that ``companion replay`` re-runs to the very estimate the vehicle made in flight."""
 
 from __future__ import annotations
 
@@ -12,7 +12,8 @@ from pyulog import ULog
 
 from companion.messages import NavFlags
 from companion.navigation.estimate_csv import read_estimate
-from ground.replay.flight_log import SENSOR_CHANNELS
+from ground.replay.flight_log import SENSOR_CHANNELS, flight_estimate, load
+from ground.replay.single import replay_log
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
 from tests.support.vehicle import REPO
@@ -26,10 +27,11 @@ def test_a_flown_ulog_replays_near_the_flight_estimate(tmp_path):
     port = free_udp_port()
     proc, namespace, _ = start_sim(
         tmp_path, f"udpout://127.0.0.1:{port}", "--plan", str(REPO / "qgc_plans/square.plan"),
-        "--duration", f"{DURATION_S:g}", "--start-at", f"{START_AT_S:g}",
+        "--duration", f"{DURATION_S:g}", "--start-at", f"{START_AT_S:g}", "--exact",
     )  # fmt: skip
     finish(proc, namespace, 240)
-    (flight,) = (tmp_path / "state" / "logs").glob("*_armed.ulg")
+    # --exact: one file from start-up, through the arming, to the end.
+    (flight,) = (tmp_path / "state" / "logs").glob("*.ulg")
 
     ulog = ULog(str(flight))
     # Simulation time throughout: no stamp from the host's clock, none after the end.
@@ -49,11 +51,11 @@ def test_a_flown_ulog_replays_near_the_flight_estimate(tmp_path):
     assert "against the estimate made in flight" in said, said
     figures = {k: float(v) for k, v in re.findall(r"(\w+) RMS ([0-9.]+)", said)}
     line = said
-    # Quiet runs see 0.3 m, 0.6 m, 0.2° and 0.7°; a navigator starved of CPU in flight lags.
-    assert figures["horizontal"] < 5.0 and figures["altitude"] < 3.0, line
-    assert figures["tilt"] < 1.5 and figures["yaw"] < 3.0, line
+    assert figures["horizontal"] < 1e-3 and figures["altitude"] < 1e-3, line
+    assert figures["tilt"] < 1e-3 and figures["yaw"] < 1e-3, line
     replayed = read_estimate(estimate)
     assert replayed["t"][-1] == pytest.approx(DURATION_S, abs=0.5)
+    _assert_replays_to_rounding(flight, tmp_path / "again.csv")
 
     # The same flight as CSV for the older tools: every sensor sample, and the estimate.
     sensors, flown = tmp_path / "sensors.csv", tmp_path / "flown.csv"
@@ -71,3 +73,24 @@ def test_a_flown_ulog_replays_near_the_flight_estimate(tmp_path):
     nav = ulog.get_dataset("nav_state").data
     valid = int((nav["flags"] & int(NavFlags.POSITION_VALID) != 0).sum())
     assert len(in_flight["t"]) == valid > 20 * (DURATION_S - 10)
+
+
+def _assert_replays_to_rounding(flight, out) -> None:
+    """Every solution the vehicle published, at its own time, as the replay computes it."""
+    _, states = replay_log(flight, "ins_ekf", out)
+    replayed = {s.t_us: s for s in states}
+    flown = flight_estimate(load(flight))
+    assert len(flown) > 40 * (DURATION_S - 5)
+    worst = dict.fromkeys(
+        ("lat_deg", "lon_deg", "alt_msl_m", "roll_rad", "pitch_rad", "yaw_rad"), 0.0
+    )
+    for logged in flown:
+        again = replayed.get(logged.t_us)
+        assert again is not None, f"no replayed solution at {logged.t_us} us"
+        assert again.flags == logged.flags, logged.t_us
+        for name in worst:
+            worst[name] = max(worst[name], abs(getattr(again, name) - getattr(logged, name)))
+    print("largest differences, replay vs flight:", worst)
+    assert worst["lat_deg"] <= 1e-9 and worst["lon_deg"] <= 1e-9, worst
+    assert worst["alt_msl_m"] <= 1e-6, worst
+    assert max(worst["roll_rad"], worst["pitch_rad"], worst["yaw_rad"]) <= 1e-9, worst

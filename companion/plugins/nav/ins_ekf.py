@@ -11,10 +11,9 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from companion.messages import Imu
 from companion.navigation.ins_ekf import InsEkfConfig
 from companion.navigation.offline import InsEkfRunner
-from companion.navigation.sample_order import SampleOrder
+from companion.navigation.sample_order import FEED_ORDER, PublishGrid, SampleOrder
 from companion.plugin import Plugin, PluginContext, Setting
 
 WAIT_S = 0.5
@@ -62,11 +61,10 @@ class InsEkfPlugin(Plugin):
             gyro_noise=s["gyro_noise"],
         )
         self.runner = InsEkfRunner(config=config)
-        self.readers = [ctx.bus.queue_reader(c) for c in (*self.inputs, *self.optional_inputs)]
+        self.readers = [ctx.bus.queue_reader(c) for c in FEED_ORDER]
         self.waiter = ctx.bus.waiter(self.readers)
         self.out = ctx.bus.writer("nav/state")
-        self.period_us = round(1e6 / s["publish_hz"])
-        self.next_us = 0
+        self.grid = PublishGrid(s["publish_hz"])
         self.order = SampleOrder()
 
     def step(self) -> None:
@@ -77,12 +75,9 @@ class InsEkfPlugin(Plugin):
         nav = self.runner.nav
         for sample in samples:
             self.runner.feed(sample)
-            # On a fixed grid of vehicle time, whatever batches the samples came in, so a
-            # lockstep simulation sees the same states at the same times every run.
-            t = nav.t_us
-            if t is not None and isinstance(sample, Imu) and t >= self.next_us:
+            # A lockstep simulation sees the same states at the same times every run.
+            if self.grid.due(nav.t_us, sample):
                 self.out.publish(nav.state())
-                self.next_us = (t // self.period_us + 1) * self.period_us
         self.ctx.health.ok(len(samples))
         self.ctx.health.frames_bad = nav.gps_rejected + nav.heading_rejected
 

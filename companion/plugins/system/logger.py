@@ -52,7 +52,22 @@ IDLE_PERIOD_S = 0.25
 # The channels that wake the logger at once (rare, and worth their exact order); the rest
 # is drained when it wakes on its own: waking for every 100 Hz sample would cost more CPU
 # than writing them.
+# The navigator plug-ins whose settings the log keeps.
+NAVIGATORS = ("nav.ins_ekf", "nav.gps_compass")
 _WAKERS = ("system/health", "vehicle/statustext", "link/commands", "params/changes")
+
+
+def navigator_info(plugins: Mapping[str, Mapping[str, Any]]) -> dict[str, str]:
+    """INFO fields ``nav.<setting>`` from the navigator's settings, as exact decimal text
+    (ULog's float is single precision): ``companion replay`` runs the navigator with them."""
+    for kind in NAVIGATORS:
+        if kind in plugins:
+            info = {"nav.plugin": kind}
+            for key, value in plugins[kind].items():
+                if isinstance(value, int | float) and not isinstance(value, bool):
+                    info[f"nav.{key}"] = repr(float(value))
+            return info
+    return {}
 
 
 class LoggerPlugin(Plugin):
@@ -61,6 +76,9 @@ class LoggerPlugin(Plugin):
     settings = {
         "channels": Setting(list, DEFAULT_CHANNELS, "bus channels to record"),
         "from_boot": Setting(bool, False, "also log while disarmed (from start-up)"),
+        "split": Setting(
+            bool, True, "a new file at each arming and disarming (false: one from start-up)"
+        ),
         "budget_mb": Setting(float, 1000.0, "disk space for logs; oldest removed", min=0.01),
         "flush_s": Setting(float, 1.0, "wall seconds between fsyncs", min=0.05, max=1.0),
         "period_s": Setting(float, 0.02, "wall seconds between reads of the queues", min=0.001),
@@ -103,6 +121,7 @@ class LoggerPlugin(Plugin):
             # The airframe's name: a file (as ``companion sim`` gives) by its stem.
             "airframe": Path(s["airframe"]).stem if s["airframe"] else "",
             "sys_id": int(ctx.vehicle.get("sysid", 1)),
+            **navigator_info(ctx.plugins),
         }
         self.armed = False
         self.file: BinaryIO | None = None
@@ -167,6 +186,8 @@ class LoggerPlugin(Plugin):
         if armed == self.armed:
             return
         self.armed = armed
+        if self.file is not None and not self.ctx.settings["split"]:
+            return
         self._close()
         if armed:
             self._open("armed")
