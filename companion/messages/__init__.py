@@ -37,6 +37,7 @@ from companion.messages.sensors import (
 )
 from companion.messages.simulation import SimClock, SimTruth
 from companion.messages.system import (
+    LogProgress,
     ParamChange,
     PluginHealth,
     PluginState,
@@ -65,6 +66,7 @@ __all__ = [
     "GpsFixType",
     "Imu",
     "LinkStatus",
+    "LogProgress",
     "Magnetometer",
     "Message",
     "MissionChanged",

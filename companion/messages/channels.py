@@ -13,7 +13,7 @@ from companion.messages.navigation import NavState
 from companion.messages.pilot import PilotInput
 from companion.messages.sensors import Baro, Battery, Compass, GpsFix, Imu, Magnetometer
 from companion.messages.simulation import SimClock, SimTruth
-from companion.messages.system import ParamChange, PluginStats, SystemHealth
+from companion.messages.system import LogProgress, ParamChange, PluginStats, SystemHealth
 
 
 @dataclass(frozen=True)
@@ -53,6 +53,7 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("link/command_acks", CommandAck, "queue", 16, "command outcomes"),
     Channel("system/plugin_stats", PluginStats, "queue", 64, "per-plug-in counters", True),
     Channel("system/health", SystemHealth, "latest", doc="the health table"),
+    Channel("system/logged", LogProgress, "latest", doc="how far the flight log has written"),
     Channel("params/changes", ParamChange, "queue", 32, "parameters set from the ground"),
     Channel("link/status", LinkStatus, "latest", doc="ground-station heartbeats heard"),
     Channel("mission/changed", MissionChanged, "latest", doc="stored mission lists changed"),

@@ -86,3 +86,12 @@ class ParamChange(Message):
         ("value", ctypes.c_double),
         ("name", ctypes.c_char * 17),
     ]
+
+
+class LogProgress(Message):
+    """How far the flight log has written. Producer: ``system.logger`` with ``in_step``.
+    Consumer: the simulator bridge, whose exact lockstep waits for it (no sample lost)."""
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),  # the newest IMU sample written (all before it drained)
+    ]

@@ -119,7 +119,8 @@ def sample_count(ulog: ULog) -> int:
 @dataclass
 class FlightComparison:
     """How far a replay's estimate is from the one the vehicle made in flight, at the
-    replay's solution times (the flight's newest estimate at or before each)."""
+    flight's logged solution times (the replay's newest solution at or before each: the
+    very same instant when the replay runs on the navigator's grid)."""
 
     compared: int = 0  # solutions with a valid position in both
     horizontal_rms_m: float = math.nan
@@ -145,7 +146,9 @@ def compare(replayed: list[NavState], flown: list[NavState]) -> FlightComparison
     result = FlightComparison()
     if not replayed or not flown:
         return result
-    a, b = _table(replayed), _table(flown)
+    # The flight's log may miss some of its solutions (``nav/state`` keeps only the newest):
+    # each logged one is compared, none is stood in for by an older one.
+    a, b = _table(flown), _table(replayed)
     index = np.searchsorted(b["t_us"], a["t_us"], side="right") - 1
     use = (index >= 0) & a["valid"]
     index = np.clip(index, 0, None)

@@ -120,7 +120,7 @@ def vehicle_config(req: SimRequest, opts: BridgeOptions, devices: dict[str, str]
             spec.settings["endpoints"] = list(req.links)
         if spec.kind == "system.logger" and opts.exact:
             # One file from boot: a replay then sees every sample the navigator saw.
-            spec.settings.update(from_boot=True, split=False)
+            spec.settings.update(from_boot=True, split=False, in_step=True)
     if req.state_dir:
         cfg.vehicle["state_dir"] = req.state_dir
     if req.sysid is not None:

@@ -21,6 +21,7 @@ from typing import Any, BinaryIO
 
 from companion import __version__
 from companion.flight_log import LogDirectory, ULogWriter, hold, topic_name
+from companion.messages import LogProgress
 from companion.messages.channels import CHANNELS
 from companion.params.store import ParamStore
 from companion.plugin import Plugin, PluginContext, Ports, Setting
@@ -79,6 +80,9 @@ class LoggerPlugin(Plugin):
         "split": Setting(
             bool, True, "a new file at each arming and disarming (false: one from start-up)"
         ),
+        "in_step": Setting(
+            bool, False, "wake on every sample and say how far it wrote (exact lockstep waits)"
+        ),
         "budget_mb": Setting(float, 1000.0, "disk space for logs; oldest removed", min=0.01),
         "flush_s": Setting(float, 1.0, "wall seconds between fsyncs", min=0.05, max=1.0),
         "period_s": Setting(float, 0.02, "wall seconds between reads of the queues", min=0.001),
@@ -90,7 +94,10 @@ class LoggerPlugin(Plugin):
 
     @classmethod
     def ports(cls, settings: Mapping[str, Any]) -> Ports:
-        return Ports(optional_inputs=tuple(dict.fromkeys([*settings["channels"], "system/health"])))
+        inputs = tuple(dict.fromkeys([*settings["channels"], "system/health"]))
+        return Ports(
+            optional_inputs=inputs, outputs=("system/logged",) if settings["in_step"] else ()
+        )
 
     @classmethod
     def validate(cls, settings: Mapping[str, Any]) -> list[str]:
@@ -110,7 +117,10 @@ class LoggerPlugin(Plugin):
         self.readers = {name: ctx.bus.reader(name) for name in names}
         # Its own reader: the one in ``readers`` hands every table to the log.
         self.health = ctx.bus.latest_reader("system/health")
-        self.waiter = ctx.bus.waiter([r for n, r in self.readers.items() if n in _WAKERS])
+        wakers = [r for n, r in self.readers.items() if s["in_step"] or n in _WAKERS]
+        self.waiter = ctx.bus.waiter(wakers)
+        self.progress = ctx.bus.writer("system/logged") if s["in_step"] else None
+        self.written_us = -1
         self.depths = {n: CHANNELS[n].depth for n in names}
         self.period_s = s["period_s"]
         self.topics = [(name, topic_name(name), CHANNELS[name].type) for name in names]
@@ -163,6 +173,8 @@ class LoggerPlugin(Plugin):
             total += count
         self._adapt(fill, total)
         self._count_losses()
+        if self.progress is not None and self.writer is not None:
+            self.progress.publish(LogProgress(t_us=self.written_us))
         if self.file is not None and time.monotonic() >= self.next_flush:
             self._flush()
 
@@ -206,6 +218,8 @@ class LoggerPlugin(Plugin):
             self.recent.append((name, msg))
             return
         self.writer.data(topic_name(name), msg)
+        if name == "sensors/imu":
+            self.written_us = max(self.written_us, int(msg.t_us))
         if name == "vehicle/statustext":
             self.writer.log_string(msg.t_us, msg.severity, msg.text.decode(errors="replace"))
         self.ctx.health.ok()

@@ -92,6 +92,7 @@ class SimBridge:
         self.nav_sync: FlightSync | None = None
         self.navigated: FlightSync | None = None
         self.samples: SampleSync | None = None
+        self.logged: FlightSync | None = None
         if lockstep:
             self._keep_in_step(round(1e6 / opts.sync_hz), exact)
         self.commands = VehicleCommands(
@@ -120,6 +121,9 @@ class SimBridge:
             }
             every = [r for by_channel in readers.values() for r in by_channel.values()]
             self.samples = SampleSync(readers, self.bus.waiter(every))
+            # The flight log's reader, a period behind at most, so its queues never overflow.
+            logged = self.bus.latest_reader("system/logged")
+            self.logged = FlightSync(period_us, logged, self.bus.waiter([logged]), 1, "t_us", True)
 
     def device_paths(self) -> dict[str, str]:
         """Device name → the pty path the vehicle's driver opens."""
@@ -157,7 +161,7 @@ class SimBridge:
     def stop(self) -> None:
         """Ask the loop to end after the current frame (also ends any wait for the vehicle)."""
         self.stopping = True
-        for waiting in (self.sync, self.nav_sync, self.navigated, self.samples):
+        for waiting in (self.sync, self.nav_sync, self.navigated, self.samples, self.logged):
             if waiting is not None:
                 waiting.cancelled = True
 
@@ -199,6 +203,8 @@ class SimBridge:
             self.nav_sync.wait(t_us)
         if self.sync is not None:
             self.sync.wait(t_us)
+        if self.logged is not None:
+            self.logged.wait(t_us)
         self._apply_servos()
 
     def _publish_truth(self, s: TrueState, t_us: int) -> None:
