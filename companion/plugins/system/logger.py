@@ -2,9 +2,12 @@
 
 Records the configured bus channels, with their ``t_us``, in PX4's ULog format
 (``companion.flight_log``): one file per arming in ``<state_dir>/logs/`` (and, with
-``from_boot``, one from start-up to the first arming and between flights). It is just
-another reader: producers never wait for it, and what a full queue made it lose is counted
-in its ``dropped`` health counter and as a logged warning. The file is flushed and fsynced
+``from_boot``, one from start-up to the first arming and between flights; with ``split``
+off, one file from start-up to the end). INFO ``nav.*`` keeps the navigator's settings for
+``companion replay``. It is just another reader: producers never wait for it (only exact
+lockstep simulation, told by ``system/logged`` with ``in_step``, waits for it), and what
+a full queue made it lose is counted in its ``dropped`` health counter and as a logged
+warning. The file is flushed and fsynced
 at least once a (wall) second, so a power cut loses at most that much and leaves a file
 pyulog reads up to its last complete message. Past ``budget_mb`` the oldest logs go.
 """
