@@ -4,10 +4,12 @@ Each driver is its own process, so a GPS fix can reach the navigator before the 
 of the same instant. The INS must be predicted to a time before an aiding measurement of
 that time is fused, or the fix corrects the state of an earlier instant; and the result
 would depend on which process the scheduler ran first. So aiding samples (GPS, heading,
-barometer) wait until an IMU sample at or past their time has arrived; at equal times the
-IMU sample goes first. A navigator whose IMU has gone quiet still gets its aiding samples once
-newer ones have come ``max_hold_us`` later (sample times only: a replayed log's times
-need not be the vehicle clock's).
+barometer) wait until an IMU sample past their time has arrived: at equal times the IMU
+sample goes first, and the aiding samples of one instant, whichever process delivered its
+own first, are fed together in a fixed order of kinds (fusing a magnetometer before or after
+a compass gives different numbers). A navigator whose IMU has gone quiet still gets its
+aiding samples once newer ones have come ``max_hold_us`` later (sample times only: a
+replayed log's times need not be the vehicle clock's).
 """
 
 from __future__ import annotations
@@ -16,7 +18,10 @@ import heapq
 from collections.abc import Iterable
 from typing import Any
 
-from companion.messages import Imu
+from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
+
+# Aiding samples of one instant are fed in this order (then any other kind), not as they came.
+_KIND_RANK = {GpsFix: 0, Magnetometer: 1, Compass: 2, Baro: 3}
 
 # The order ``nav.ins_ekf`` drains its inputs in, which is the arrival order of aiding
 # samples of equal time read in one batch; a replay breaks such ties the same way.
@@ -46,7 +51,7 @@ class SampleOrder:
         self.max_hold_us = max_hold_us
         self.horizon_us: int | None = None  # the newest IMU time seen
         self.newest_us: int | None = None  # the newest time of any sample
-        self._held: list[tuple[int, int, Any]] = []  # (t_us, arrival, sample)
+        self._held: list[tuple[int, int, int, Any]] = []  # (time key, kind, arrival, sample)
         self._arrival = 0
 
     def push(self, samples: Iterable[Any]) -> list[Any]:
@@ -59,15 +64,18 @@ class SampleOrder:
             if self.newest_us is None or t > self.newest_us:
                 self.newest_us = t
             self._arrival += 1
-            # IMU before aiding at equal times, then arrival order: a total order.
-            heapq.heappush(self._held, (2 * t + (0 if is_imu else 1), self._arrival, sample))
+            # IMU before aiding at equal times, then the kind, then arrival: a total order.
+            key = 2 * t + (0 if is_imu else 1)
+            rank = -1 if is_imu else _KIND_RANK.get(type(sample), len(_KIND_RANK))
+            heapq.heappush(self._held, (key, rank, self._arrival, sample))
         ready = []
         horizon = self.horizon_us if self.horizon_us is not None else -1
         stale_before = (self.newest_us or 0) - self.max_hold_us
         while self._held:
-            key, _, sample = self._held[0]
-            t = key // 2
-            if t > horizon and t > stale_before:
+            key = self._held[0][0]
+            # An IMU sample goes at the horizon; aiding samples only once it is past them,
+            # when every sample of their instant is known to have come (lockstep) or late.
+            if key > 2 * horizon and key // 2 > stale_before:
                 break
-            ready.append(heapq.heappop(self._held)[2])
+            ready.append(heapq.heappop(self._held)[3])
         return ready

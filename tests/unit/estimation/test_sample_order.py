@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from companion.messages import Baro, GpsFix, Imu
+from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
 from companion.navigation.sample_order import SampleOrder
 
 
@@ -28,6 +28,25 @@ def test_the_result_does_not_depend_on_how_the_samples_were_batched():
     assert piecewise == one_batch
     assert one_batch == [("Imu", 0), ("Baro", 5_000), ("Imu", 10_000), ("GpsFix", 10_000),
                          ("Baro", 15_000), ("Imu", 20_000)]  # fmt: skip
+
+
+def test_aiding_samples_of_one_instant_go_in_the_same_order_whichever_process_came_first():
+    # Each driver is its own process: at 10 ms the compass may reach the navigator before
+    # or after the IMU's magnetometer, and before or after the IMU sample itself.
+    def fed(arrivals: list[list]) -> list[tuple[str, int]]:
+        order, out = SampleOrder(), []
+        for batch in arrivals:
+            out += _kinds(order.push(batch))
+        return out
+
+    imu0, imu1, imu2 = Imu(t_us=0), Imu(t_us=10_000), Imu(t_us=20_000)
+    mag, compass = Magnetometer(t_us=10_000), Compass(t_us=10_000)
+    mag_first = fed([[imu0], [imu1, mag], [compass], [imu2]])
+    compass_first = fed([[imu0], [compass], [imu1], [mag], [imu2]])
+    together = fed([[imu0], [imu1, compass, mag, imu2]])
+    assert mag_first == compass_first == together
+    assert mag_first == [("Imu", 0), ("Imu", 10_000), ("Magnetometer", 10_000),
+                         ("Compass", 10_000), ("Imu", 20_000)]  # fmt: skip
 
 
 def test_aiding_flows_on_when_the_imu_goes_quiet():
