@@ -7,9 +7,11 @@ import logging
 import math
 import time
 from collections.abc import Callable
+from typing import Any
 
+from companion.bus.channels import Reader
 from companion.bus.node import BusNode
-from companion.messages import SimClock, SimTruth
+from companion.messages import SimClock, SimTruth, channel
 from ground.simulation.sensor_errors import MagneticField, NoiseModel, SensorErrors
 from ground.simulation.true_state import TrueState
 from ground.sitl.bridge.airframe_file import read_airframe
@@ -39,6 +41,9 @@ DEVICE_CHANNELS = {
     "imu": ("sensors/imu", "sensors/mag", "sensors/baro"),
     "compass": ("sensors/compass",),
     "gps": ("sensors/gps",),
+    # A Latest channel: the controller and the commander read the sticks' newest frame, so
+    # that frame must be this one's, not the one the receiver process had got to.
+    "rc": ("sensors/rc",),
 }
 STANDARD_PRESSURE_KPA = 101.325
 FAST_LAG_PERIODS = 1  # fast lockstep: how many nav/state periods the vehicle may trail
@@ -116,7 +121,7 @@ class SimBridge:
             self.nav_sync = FlightSync(period_us, nav, self.bus.waiter([nav]), lag, "t_us", True)
         if exact:
             readers = {
-                device: {c: self.bus.queue_reader(c) for c in channels}
+                device: {c: self._sample_reader(c) for c in channels}
                 for device, channels in DEVICE_CHANNELS.items()
             }
             every = [r for by_channel in readers.values() for r in by_channel.values()]
@@ -124,6 +129,11 @@ class SimBridge:
             # The flight log's reader, a period behind at most, so its queues never overflow.
             logged = self.bus.latest_reader("system/logged")
             self.logged = FlightSync(period_us, logged, self.bus.waiter([logged]), 1, "t_us", True)
+
+    def _sample_reader(self, name: str) -> Reader[Any]:
+        if channel(name).pattern == "latest":
+            return self.bus.latest_reader(name)
+        return self.bus.queue_reader(name)
 
     def device_paths(self) -> dict[str, str]:
         """Device name → the pty path the vehicle's driver opens."""
@@ -193,7 +203,9 @@ class SimBridge:
             self.ports[name].write(data)
             written.add(name)
         if self.samples is not None:  # sleeps on the bus: the pty check after is quick
-            self.samples.wait(written - self.failures.garbled(), t_us)
+            # A device whose driver stopped reading (or never ran) is not waited for.
+            live = {n for n in written if self.lockstep.waiting_for.get(n, True)}
+            self.samples.wait(live - self.failures.garbled(), t_us)
         if self.pacer is not None:
             self.pacer.wait(s.t_s)
         else:
