@@ -65,6 +65,8 @@ class MiniSscOutput(Plugin):
         self.airframe: Airframe = load_airframe(ctx.settings["airframe"])
         self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"])
         self.per_second = minissc.frames_per_second(ctx.settings["baud"])
+        # The reader before the writer: the controller takes this writer as the sign that
+        # its commands are heard (control.fixed_wing waits for it before its first one).
         self.commands = ctx.bus.queue_reader("control/actuators")
         self.waiter = ctx.bus.waiter([self.commands])
         self.out = ctx.bus.writer("actuators/servos")

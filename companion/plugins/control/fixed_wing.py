@@ -12,6 +12,7 @@ change them in flight (they arrive on ``params/changes``).
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -37,6 +38,7 @@ from mavlink_dialect import companion as d
 
 WAIT_S = 0.5
 STATUS_WAIT_S = 5.0  # the commander's last status, once, when this process starts
+OUTPUT_WAIT_S = 5.0  # ... and the servo output's process, started with this one, listening
 STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item is reached)
 
 
@@ -53,6 +55,7 @@ class FixedWingPlugin(Plugin):
         "mission/changed",
         "sensors/rc",
         "link/manual_control",
+        "actuators/servos",
     )
     outputs = ("control/actuators", "control/status", "link/commands")
 
@@ -85,6 +88,8 @@ class FixedWingPlugin(Plugin):
         self.rc = bus.latest_reader("sensors/rc")
         self.joystick = bus.latest_reader("link/manual_control")
         self.surfaces = bus.writer("control/actuators")
+        self.servo_answers = bus.latest_reader("actuators/servos")
+        self.output_waited = False
         self.status_out = bus.writer("control/status")
         # Landed and stopped: the controller disarms as a pilot would (execution control
         # stops the flight group, servos safe).
@@ -113,6 +118,7 @@ class FixedWingPlugin(Plugin):
         # (Take-off, say) is waited for, not guessed, or the first commands would depend on
         # which process the scheduler ran first. Without a commander: loiter, armed.
         status = self.status_in.first(STATUS_WAIT_S) or self.default_status
+        self._await_output()
         # The receiver first: a safety pilot's sticks win over the ground station's joystick.
         sticks = pilot_sticks(nav.t_us, self.rc.get(), self.joystick.get())
         out = self.controller.step(nav, status, nav.t_us / 1e6, sticks)
@@ -139,6 +145,21 @@ class FixedWingPlugin(Plugin):
         self.ctx.log.info("landed and stopped: disarming")
         self.commands.publish(VehicleCommand(t_us=now_us, command=int(CommandId.STOP)))
         self.disarm_sent = True
+
+    def _await_output(self) -> None:
+        """Once: wait until the servo output plug-in listens before the first command.
+
+        START starts both processes at once; a command sent before the servo output made
+        its reader is lost (control/actuators is a Queue), so the first surfaces would go
+        out one navigation step later or not at all, as the scheduler ran the two. The
+        servo plug-in makes its writer on actuators/servos after its reader.
+        """
+        if self.output_waited:
+            return
+        self.output_waited = True
+        deadline = time.monotonic() + OUTPUT_WAIT_S
+        while self.servo_answers.writers() == 0 and time.monotonic() < deadline:
+            time.sleep(0.002)
 
     def _status(self, now_us: int, out: ControlOutput, status: VehicleStatus) -> ControlStatus:
         msg = ControlStatus(t_us=now_us)
