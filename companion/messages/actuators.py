@@ -36,4 +36,7 @@ class ServoOutput(Message):
         # The t_us of the ActuatorCommand these positions answer (-1: none, e.g. safe on
         # stale input); written after the bytes, so a lockstep simulator can wait for it.
         ("command_t_us", ctypes.c_int64),
+        # Bytes written to the card since the plug-in started, these included: a pty hands
+        # them to the simulator a moment after the write returns, which waits for them all.
+        ("bytes_out", ctypes.c_uint64),
     ]

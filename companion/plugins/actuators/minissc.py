@@ -147,6 +147,7 @@ class MiniSscOutput(Plugin):
 
     def _publish(self, command_t_us: int) -> None:
         msg = ServoOutput(t_us=self.ctx.clock.now_us(), command_t_us=command_t_us)
+        msg.bytes_out = self.port.bytes_out
         for servo, position in self.sent.items():
             msg.position[servo] = position
             msg.pulse_us[servo] = minissc.pulse_us(position)

@@ -47,6 +47,8 @@ DEVICE_CHANNELS = {
 }
 STANDARD_PRESSURE_KPA = 101.325
 FAST_LAG_PERIODS = 1  # fast lockstep: how many nav/state periods the vehicle may trail
+SERVO_BYTES_WAIT_S = 1.0  # exact: longest wait for servo bytes an answer says were written
+POLL_S = 50e-6
 
 
 def pressure_kpa(alt_msl_m: float) -> float:
@@ -83,6 +85,7 @@ class SimBridge:
         self.pending: list[tuple[float, int, str, bytes]] = []  # (release, order, port, data)
         self.order = 0
         self.servo_card = MiniSscReader()
+        self.servo_bytes_in = 0
         self.pacer = RealTime(opts.speed) if opts.speed else None
         lockstep = self.pacer is None and opts.sync_hz > 0
         exact = lockstep and opts.exact
@@ -239,8 +242,27 @@ class SimBridge:
             )
         )
 
+    def _servo_bytes(self) -> bytes:
+        """What the servo plug-in wrote; exact lockstep takes every byte its answer counts.
+
+        The kernel hands a pty's bytes to the other side a moment after the write returns,
+        so one read may miss the end of what was written just before the answer.
+        """
+        data = self.ports["servos"].read()
+        self.servo_bytes_in += len(data)
+        answer = self.sync.answers.get() if self.samples is not None and self.sync else None
+        if answer is None or answer.bytes_out <= self.servo_bytes_in:
+            return data
+        deadline = time.monotonic() + SERVO_BYTES_WAIT_S
+        chunks = [data]
+        while answer.bytes_out > self.servo_bytes_in and time.monotonic() < deadline:
+            time.sleep(POLL_S)
+            chunks.append(chunk := self.ports["servos"].read())
+            self.servo_bytes_in += len(chunk)
+        return b"".join(chunks)
+
     def _apply_servos(self) -> None:
-        commands = self.servo_card.read(self.ports["servos"].read())
+        commands = self.servo_card.read(self._servo_bytes())
         if not commands:
             return
         controls = {}
