@@ -107,12 +107,9 @@ def test_a_small_campaign_scores_each_flight_and_survives_hung_ones(tmp_path):
                     (), 3, sim_toml, False, 900.0, 10.0)  # fmt: skip
     alone = fly_flight(FlightJob(flight, str(tmp_path / "alone"), timeout_s=300.0))
     assert alone["flight_id"] == calm["flight_id"]
-    # The same flight flown alone scores as it did inside the busy campaign. Not to the last
-    # digit yet: the arming race is fixed (test_exact_lockstep is byte-exact again), but one
-    # stressed suite run in three still saw the truth of this flight part from the campaign's
-    # at 14.75 s (4.75 s after the start, in the take-off roll): a second timing dependence.
+    # The same flight flown alone scores as it did inside the busy campaign, to the last digit.
     for key in ("xtrack_rms_m", "xtrack_p95_m", "alt_rms_m", "airspeed_rms_m_s", "samples"):
-        assert float(alone[key]) == pytest.approx(float(calm[key]), rel=0.05), key
+        assert float(alone[key]) == float(calm[key]), key
     # Completion is seen in the telemetry, which flows in wall time: to its resolution.
     assert abs(alone["time_to_complete_s"] - float(calm["time_to_complete_s"])) < 2.0
 
