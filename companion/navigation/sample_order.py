@@ -23,8 +23,8 @@ from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
 # Aiding samples of one instant are fed in this order (then any other kind), not as they came.
 _KIND_RANK = {GpsFix: 0, Magnetometer: 1, Compass: 2, Baro: 3}
 
-# The order ``nav.ins_ekf`` drains its inputs in, which is the arrival order of aiding
-# samples of equal time read in one batch; a replay breaks such ties the same way.
+# The channels in the order ``nav.ins_ekf`` feeds aiding samples of one instant (the
+# IMU first, then ``_KIND_RANK``); a replay breaks such ties the same way.
 FEED_ORDER = ("sensors/imu", "sensors/gps", "sensors/mag", "sensors/compass", "sensors/baro")
 
 

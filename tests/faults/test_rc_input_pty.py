@@ -22,7 +22,7 @@ def pulses(roll: int = 1500, throttle: int = 1100, switch: int = 1100) -> list[i
     return ch
 
 
-@pytest.mark.timeout(90)
+@pytest.mark.timeout(240)
 def test_sticks_switch_and_failsafe_through_garbage(vehicle_factory, tmp_path):
     device = tmp_path / "ttyRC"
     pty = Pty(device)
@@ -40,7 +40,7 @@ def test_sticks_switch_and_failsafe_through_garbage(vehicle_factory, tmp_path):
         got = sticks.get()
         return got is not None and got.roll == pytest.approx(roll, abs=0.01)
 
-    wait_for(lambda: seen(1.0), 15, "full right roll")
+    wait_for(lambda: seen(1.0), 60, "full right roll")  # a minute, as on a busy machine
     got = sticks.get()
     assert got.throttle == pytest.approx(0.5, abs=0.01) and got.mode_switch == 0
     assert got.usable() and got.channels_us[0] == 1900 and got.channel_count == 18
@@ -50,10 +50,10 @@ def test_sticks_switch_and_failsafe_through_garbage(vehicle_factory, tmp_path):
         send(frame(pulses(switch=1900)) * 2)
         return any(s.mode_switch == 5 for s in switch.take(0.2))
 
-    wait_for(moved, 10, "the switch moved to position 6")
+    wait_for(moved, 30, "the switch moved to position 6")
     send(frame(pulses(throttle=900), flags=0x08) * 2)  # the receiver's failsafe
     failsafe = PilotFlags.FAILSAFE | PilotFlags.THROTTLE_LOW
-    wait_for(lambda: (s := sticks.get()) is not None and s.flags == failsafe, 10, "failsafe")
-    wait_for(lambda: vehicle.row("rc").frames_bad >= 1, 5, "the garbage counted")
+    wait_for(lambda: (s := sticks.get()) is not None and s.flags == failsafe, 30, "failsafe")
+    wait_for(lambda: vehicle.row("rc").frames_bad >= 1, 30, "the garbage counted")
     assert vehicle.row("rc").restarts == 0
     pty.vanish()
