@@ -24,8 +24,11 @@ class BatteryModel:
     """One pack; ``step`` advances it by ``dt_s`` at a throttle in [0, 1]."""
 
     cells: int = 3
-    capacity_mah: float = 2200.0
-    internal_ohm: float = 0.045  # whole pack
+    # Sized for the missions flown here (tens of minutes): at full throttle 30 A sags a
+    # 2200 mAh pack (0.045 ohm) under BATT_LOW_VOLT after a minute and a half of climbing,
+    # which sent every longer simulated flight home on a battery failsafe.
+    capacity_mah: float = 10000.0
+    internal_ohm: float = 0.012  # whole pack
     idle_a: float = 0.6  # the avionics, servos and companion computer
     full_a: float = 30.0
     used_mah: float = 0.0

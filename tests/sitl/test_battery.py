@@ -91,7 +91,8 @@ def test_battery_and_sensors_are_shown_true_and_low_battery_returns_home(tmp_pat
 
         station.fly_mission()
         station.until(lambda: station.amps() > 5.0, 120, "the motor drawing current")
-        station.until(lambda: station.battery.current_consumed > 10, 120, "charge used")
+        # Over 1 % of the pack, so the whole-percent figure QGC shows has moved.
+        station.until(lambda: station.battery.current_consumed > 110, 120, "charge used")
         assert station.battery.battery_remaining < 100
 
         station.conn.mav.param_set_send(1, 1, b"SYS_FAILURE_EN", 1, d.MAV_PARAM_TYPE_REAL32)
@@ -105,7 +106,7 @@ def test_battery_and_sensors_are_shown_true_and_low_battery_returns_home(tmp_pat
         station.until(lambda: station.healthy(battery_bit), 60, "the battery healthy again")
 
         # Low when less than this is left: a few mAh from now at cruise current.
-        left = 2200 - station.battery.current_consumed - 5
+        left = 10000 - station.battery.current_consumed - 5  # BATT_CAPACITY's default
         station.conn.mav.param_set_send(1, 1, b"BATT_LOW_MAH", left, d.MAV_PARAM_TYPE_REAL32)
         station.until(lambda: station.said("battery low"), 120, "told the battery is low")
         station.until(lambda: station.in_mode(FlightMode.RTL), 10, "returning home")

@@ -24,7 +24,7 @@ from companion.sensors.battery_monitor import (
 )
 
 BATTERY_PARAMS = (
-    ParamDecl("BATT_CAPACITY", 2200.0, 0.0, 100_000.0, "mAh", "Pack capacity (0: unknown)"),
+    ParamDecl("BATT_CAPACITY", 10000.0, 0.0, 100_000.0, "mAh", "Pack capacity (0: unknown)"),
     ParamDecl("BATT_LOW_VOLT", 10.5, 0.0, 100.0, "V", "Low-battery voltage (0: off)"),
     ParamDecl("BATT_CRT_VOLT", 9.9, 0.0, 100.0, "V", "Critical-battery voltage (0: off)"),
     ParamDecl("BATT_LOW_MAH", 0.0, 0.0, 100_000.0, "mAh", "Low when less is left (0: off)"),
