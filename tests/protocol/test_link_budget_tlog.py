@@ -10,6 +10,7 @@ from pymavlink.dialects.v20 import common as m
 from companion.link.link_budget import LinkBudget
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.support.configs import link_vehicle
+from tests.support.vehicle import wait_for
 
 
 def start(vehicle_factory, query: str, tmp_path) -> GroundStation:
@@ -65,12 +66,22 @@ def test_tlog_records_both_directions_readable_by_pymavlink(vehicle_factory, tmp
     gcs = start(vehicle_factory, f"?tlog={tlog}", tmp_path)
     gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AUTOPILOT_VERSION)
     gcs.ack(m.MAV_CMD_REQUEST_MESSAGE)
-    time.sleep(1.5)
-    log = mavutil.mavlink_connection(str(tlog))
-    types = {}
-    while (msg := log.recv_msg()) is not None:
-        key = (msg.get_type(), msg.get_srcSystem())
-        types[key] = types.get(key, 0) + 1
+
+    # Read until the log holds the exchange and half a second of telemetry: on a busy
+    # machine the link process may take longer than that to write it.
+    def recorded() -> dict[tuple[str, int], int]:
+        log = mavutil.mavlink_connection(str(tlog))
+        types: dict[tuple[str, int], int] = {}
+        while (msg := log.recv_msg()) is not None:
+            key = (msg.get_type(), msg.get_srcSystem())
+            types[key] = types.get(key, 0) + 1
+        log.close()
+        return types
+
+    def complete(t: dict[tuple[str, int], int]) -> bool:
+        return t.get(("ATTITUDE", 1), 0) >= 5 and ("COMMAND_ACK", 1) in t
+
+    types = wait_for(lambda: t if complete(t := recorded()) else None, 60, "the exchange")
     assert types.get(("HEARTBEAT", 1), 0) >= 1, "the vehicle's own heartbeats"
     assert types.get(("HEARTBEAT", 255), 0) >= 1, "the ground station's heartbeats"
     assert types.get(("COMMAND_LONG", 255)) == 1 and types.get(("COMMAND_ACK", 1)) == 1

@@ -183,7 +183,9 @@ def test_mavsdk_flight_modes_start_mission_return_and_go_to(vehicle_factory, tmp
     port = free_udp_port()
     vehicle = vehicle_factory(client_vehicle(f"udpout://127.0.0.1:{port}", tmp_path))
     status = vehicle.bus.latest_reader("vehicle/status")
-    wait_for(status.get, 20, "the commander up")
+    wait_for(status.get, 60, "the commander up")
+    # Return needs home, from the navigator's first solution: later on a busy machine.
+    wait_for(lambda: status.get().home_valid, 60, "home from the first solution")
     seen = asyncio.run(_mode_session(port, status))
     assert seen["initial"] == FlightMode.HOLD  # a fixed wing without a pilot circles
     assert seen["mission"] == FlightMode.MISSION
