@@ -67,6 +67,9 @@ class MissionService:
         self.uploads: dict[int, _Upload] = {}
         self.current = 0
         self.on_change: Callable[[int], None] = lambda mission_type: None
+        # The stored mission was flown to its end: MISSION_CURRENT says so after the flight
+        # controller stops (landed and disarmed), as PX4's does, until the mission changes.
+        self.completed = False
         self.refused = 0
 
     def _ack(self, peer: Peer, result: int, mission_type: int) -> Outgoing:
@@ -104,7 +107,7 @@ class MissionService:
             return self._send_item(msg.seq, mission_type, peer, legacy=kind == "MISSION_REQUEST")
         if kind == "MISSION_CLEAR_ALL":
             self.store.replace(mission_type, [])
-            self.on_change(mission_type)
+            self._changed(mission_type)
             return [self._ack(peer, d.MAV_MISSION_ACCEPTED, mission_type)]
         if kind == "MISSION_SET_CURRENT":
             return self._set_current(msg.seq)
@@ -122,7 +125,7 @@ class MissionService:
         if count == 0:
             self.uploads.pop(mission_type, None)
             self.store.replace(mission_type, [])
-            self.on_change(mission_type)
+            self._changed(mission_type)
             return [self._ack(peer, d.MAV_MISSION_ACCEPTED, mission_type)]
         upload = self.uploads[mission_type] = _Upload(peer, mission_type, count)
         return [self._request(upload, now_s)]
@@ -147,7 +150,7 @@ class MissionService:
         if result == d.MAV_MISSION_ACCEPTED:
             self.store.replace(mission_type, upload.items)
             self.current = 0 if mission_type == 0 else self.current
-            self.on_change(mission_type)
+            self._changed(mission_type)
         else:
             self.refused += 1
             log.warning("mission upload refused: %s", d.enums["MAV_MISSION_RESULT"][result].name)
@@ -181,8 +184,13 @@ class MissionService:
     def _set_current(self, seq: int) -> list[Outgoing]:
         if 0 <= seq < len(self.store.items[0]):
             self.current = seq
-            self.on_change(0)
+            self._changed(0)
         return [Outgoing(self.mission_current(), None)]
+
+    def _changed(self, mission_type: int) -> None:
+        if mission_type == 0:
+            self.completed = False
+        self.on_change(mission_type)
 
     def mission_current(self) -> Any:
         return mission_current_message(self.mav, self.current, len(self.store.items[0]))

@@ -57,6 +57,7 @@ class Snapshot:
     home_alt_m: float = math.nan
     mission_seq: int = 0
     mission_total: int = 0
+    mission_completed: bool = False  # flown to its end since it was stored
     home: tuple[float, float, float] | None = None  # lat_deg, lon_deg, alt_msl_m
     health_cursor: int = 0  # PLUGIN_HEALTH sends one row at a time, round the table
     prearm_ok: bool | None = None  # the pre-arm checks pass (None: not judged yet)
@@ -213,7 +214,7 @@ def _extended_sys_state(mav: Any, s: Snapshot) -> Any:
 
 
 def _mission_current(mav: Any, s: Snapshot) -> Any:
-    return mission_current(mav, s.mission_seq, s.mission_total, s.control)
+    return mission_current(mav, s.mission_seq, s.mission_total, s.control, s.mission_completed)
 
 
 def _home_position(mav: Any, s: Snapshot) -> Any:

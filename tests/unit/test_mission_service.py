@@ -6,6 +6,7 @@ import pytest
 
 from companion.control.mission.store import MissionStore
 from companion.link.codec import new_encoder, new_parser
+from companion.link.flight_messages import mission_current
 from companion.link.mission_service import MAX_RETRIES, MissionService
 from companion.link.service import Peer
 from mavlink_dialect import companion as d
@@ -121,3 +122,22 @@ def test_set_current_reports_mission_current(bench):
 def test_torn_mission_file_starts_empty(tmp_path):
     (tmp_path / "mission.json").write_text('[{"seq": 0, "fra')
     assert MissionStore(tmp_path).items[0] == []
+
+
+def test_a_flown_mission_stays_complete_after_the_controller_stops_until_it_changes(bench):
+    """QGroundControl shows "mission complete" after the landing and disarm, as with PX4."""
+    bench.upload([bench.item(i) for i in range(3)])
+    service = bench.service
+
+    def state() -> tuple[int, int]:
+        msg = mission_current(bench.vehicle, service.current, 3, None, service.completed)
+        return msg.seq, msg.mission_state
+
+    assert state() == (0, d.MISSION_STATE_NOT_STARTED)
+    service.completed = True  # the link saw the controller report the end of the mission
+    assert state() == (2, d.MISSION_STATE_COMPLETE)
+    bench.send(bench.gcs.mission_set_current_encode(1, 1, 1))  # fly it again from item 1
+    assert state() == (1, d.MISSION_STATE_NOT_STARTED)
+    service.completed = True
+    bench.upload([bench.item(i) for i in range(3)])  # a new plan is not flown yet
+    assert state() == (0, d.MISSION_STATE_NOT_STARTED)

@@ -46,7 +46,14 @@ from companion.link.signing import key_from
 from companion.link.statustext import StatusTexts
 from companion.link.telemetry import Snapshot
 from companion.link.timesync import TimesyncService
-from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChange, VehicleCommand
+from companion.messages import (
+    ControlStatus,
+    FlightMode,
+    LinkStatus,
+    MissionState,
+    ParamChange,
+    VehicleCommand,
+)
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 
@@ -278,6 +285,7 @@ class MavlinkLink(Plugin):
             s.prearm_ok = armed or not checks or not self.prearm_failures()
         s.mission_seq = self.missions.current
         s.mission_total = len(self.missions.store.items[0])
+        s.mission_completed = self.missions.completed
         s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
         s.unix_us = time.time_ns() // 1000
         self._mode_changes(s)
@@ -295,6 +303,8 @@ class MavlinkLink(Plugin):
             msg = self.mav.mission_item_reached_encode(control.last_reached)
             self.router.send([Outgoing(msg, None)], time.monotonic())
         self.reached_count = control.reached_count
+        if control.mission_state != MissionState.NOT_STARTED:
+            self.missions.completed = control.mission_state == MissionState.COMPLETE
         return control
 
     def _mode_changes(self, s: Snapshot) -> None:
