@@ -17,6 +17,7 @@ from typing import Any
 from companion.control.mission.items import MISSION_TYPES, MissionItem, check_mission
 from companion.control.mission.store import MissionStore
 from companion.link.service import Outgoing, Peer
+from companion.messages import MissionState
 from mavlink_dialect import companion as d
 
 log = logging.getLogger(__name__)
@@ -186,6 +187,11 @@ class MissionService:
             self.current = seq
             self._changed(0)
         return [Outgoing(self.mission_current(), None)]
+
+    def follow(self, mission_state: int) -> None:
+        """The flight controller's MissionState of the stored mission, while it runs."""
+        if mission_state != MissionState.NOT_STARTED:
+            self.completed = mission_state == MissionState.COMPLETE
 
     def _changed(self, mission_type: int) -> None:
         if mission_type == 0:

@@ -9,6 +9,7 @@ from companion.link.codec import new_encoder, new_parser
 from companion.link.flight_messages import mission_current
 from companion.link.mission_service import MAX_RETRIES, MissionService
 from companion.link.service import Peer
+from companion.messages import MissionState
 from mavlink_dialect import companion as d
 
 GCS = Peer(255, 190, 0)
@@ -134,10 +135,10 @@ def test_a_flown_mission_stays_complete_after_the_controller_stops_until_it_chan
         return msg.seq, msg.mission_state
 
     assert state() == (0, d.MISSION_STATE_NOT_STARTED)
-    service.completed = True  # the link saw the controller report the end of the mission
+    service.follow(MissionState.COMPLETE)  # the controller reported the end of the mission
     assert state() == (2, d.MISSION_STATE_COMPLETE)
     bench.send(bench.gcs.mission_set_current_encode(1, 1, 1))  # fly it again from item 1
     assert state() == (1, d.MISSION_STATE_NOT_STARTED)
-    service.completed = True
+    service.follow(MissionState.COMPLETE)
     bench.upload([bench.item(i) for i in range(3)])  # a new plan is not flown yet
     assert state() == (0, d.MISSION_STATE_NOT_STARTED)

@@ -46,14 +46,7 @@ from companion.link.signing import key_from
 from companion.link.statustext import StatusTexts
 from companion.link.telemetry import Snapshot
 from companion.link.timesync import TimesyncService
-from companion.messages import (
-    ControlStatus,
-    FlightMode,
-    LinkStatus,
-    MissionState,
-    ParamChange,
-    VehicleCommand,
-)
+from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChange, VehicleCommand
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 
@@ -303,8 +296,7 @@ class MavlinkLink(Plugin):
             msg = self.mav.mission_item_reached_encode(control.last_reached)
             self.router.send([Outgoing(msg, None)], time.monotonic())
         self.reached_count = control.reached_count
-        if control.mission_state != MissionState.NOT_STARTED:
-            self.missions.completed = control.mission_state == MissionState.COMPLETE
+        self.missions.follow(control.mission_state)
         return control
 
     def _mode_changes(self, s: Snapshot) -> None:
