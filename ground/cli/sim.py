@@ -108,6 +108,9 @@ def sim(
         typer.Option(help="MAVLink endpoint URL, repeatable (default udpout 14550 and 14540)"),
     ] = None,
     airborne: Annotated[bool, typer.Option(help="start in the air at cruise speed")] = False,
+    airborne_bank: Annotated[
+        float, typer.Option(min=-80, max=80, help="with --airborne: start banked (deg)")
+    ] = 0.0,
     wind: Annotated[str, typer.Option(help="steady wind N,E,D m/s (blowing towards)")] = "0,0,0",
     turbulence: Annotated[str, typer.Option(help="none, light, moderate, severe")] = "none",
     gps_outage: Annotated[
@@ -132,6 +135,14 @@ def sim(
         ),
     ] = None,
     noise: Annotated[float, typer.Option(help="sensor noise scale (0: perfect)")] = 1.0,
+    sensor_defects: Annotated[
+        bool,
+        typer.Option(
+            "--sensor-defects/--quiet-mount",
+            help="an airframe's magnetometer iron, motor field and vibration, or none",
+        ),
+    ] = True,
+    imu_hz: Annotated[float, typer.Option(min=5, max=400, help="IMU output rate")] = 100.0,
     truth: Annotated[Path | None, typer.Option(help="write the true state CSV here")] = None,
     pilot: Annotated[
         Path | None,
@@ -169,6 +180,7 @@ def sim(
     require_ground_extra("sim", "jsbsim")
     from companion.bus.namespace import default_namespace
     from companion.exec_control.config import ConfigError
+    from ground.sitl.bridge.device_streams import DeviceRates
     from ground.sitl.bridge.options import BridgeOptions
     from ground.sitl.fleet import GCS_LINK, FleetRequest
     from ground.sitl.session import SimRequest, run_sim
@@ -181,6 +193,8 @@ def sim(
             airframe=aircraft, home=_home(home), airborne=airborne, speed=_speed(speed),
             wind_ned=_triple(wind), turbulence=turbulence,
             outages=[_outage(o) for o in gps_outage or []], noise_scale=noise, seed=seed,
+            sensor_defects=sensor_defects, airborne_bank_deg=airborne_bank,
+            rates=DeviceRates(imu_hz=imu_hz),
             exact=exact, start_at_s=start_at,
             duration_s=duration, truth_path=str(truth) if truth else None,
             pilot_path=str(pilot) if pilot else None,

@@ -133,7 +133,10 @@ def shared_args(req: FleetRequest) -> list[str]:
         "--log-level", req.log_level,
     ]  # fmt: skip
     if o.airborne:
-        args.append("--airborne")
+        args += ["--airborne", "--airborne-bank", _number(o.airborne_bank_deg)]
+    if not o.sensor_defects:
+        args.append("--quiet-mount")
+    args += ["--imu-hz", _number(o.rates.imu_hz)]
     if o.duration_s is not None:
         args += ["--duration", _number(o.duration_s)]
     for outage in o.outages:

@@ -41,7 +41,8 @@ def state(t_s: float, yaw_deg: float = 30.0) -> TrueState:
 
 def perfect_devices(outages=()) -> EmulatedDevices:
     errors = SensorErrors(NoiseModel(scale=0.0), FIELD, seed=3)
-    return EmulatedDevices(errors, DeviceRates(gps_latency_s=0.0), list(outages))
+    rates = DeviceRates(gps_latency_s=0.0, gps_latency_jitter_s=0.0)
+    return EmulatedDevices(errors, rates, list(outages))
 
 
 def lines(devices: EmulatedDevices, t_s: float, kind: str) -> list[bytes]:

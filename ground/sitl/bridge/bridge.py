@@ -68,14 +68,16 @@ class SimBridge:
             opts.home,
             opts.airborne_agl_m if opts.airborne else None,
             opts.airborne_speed_m_s or self.airframe.cruise_speed_m_s,
+            opts.airborne_bank_deg,
         )
         self.flight.set_wind(*opts.wind_ned)
         self.flight.set_turbulence(opts.turbulence)
         for servo in self.airframe.servos.values():
             if servo.surface == "brakes":  # held at their safe setting until commanded
                 self.flight.set_controls({"brakes": servo.command(servo.trim)})
-        errors = SensorErrors(NoiseModel(scale=opts.noise_scale), MagneticField(), opts.seed)
-        self.devices = EmulatedDevices(errors, opts.rates, opts.outages)
+        noise = NoiseModel.installed if opts.sensor_defects else NoiseModel
+        errors = SensorErrors(noise(scale=opts.noise_scale), MagneticField(), opts.seed)
+        self.devices = EmulatedDevices(errors, opts.rates, opts.outages, opts.seed)
         self.failures = DeviceFailures(opts.seed)
         pilot = load_pilot(opts.pilot_path) if opts.pilot_path else None
         self.receiver = EmulatedReceiver(pilot, opts.rates.rc_hz)

@@ -13,6 +13,7 @@ import datetime as dt
 import math
 from dataclasses import dataclass
 
+import numpy as np
 import pynmea2
 
 from ground.simulation.battery import BatteryModel
@@ -127,7 +128,10 @@ class DeviceRates:
     imu_hz: float = 100.0
     compass_hz: float = 20.0
     gps_hz: float = 5.0
-    gps_latency_s: float = 0.1
+    # A receiver sends its fix a computation after the epoch it describes, and not always
+    # equally late: each epoch's latency is drawn uniformly within ± the jitter.
+    gps_latency_s: float = 0.12
+    gps_latency_jitter_s: float = 0.03
     rc_hz: float = 50.0  # SBUS receivers send every 7-20 ms
     battery_hz: float = 10.0
 
@@ -135,8 +139,14 @@ class DeviceRates:
 class EmulatedDevices:
     """Decides, frame by frame, which device says what and when it reaches the wire."""
 
-    def __init__(self, errors: SensorErrors, rates: DeviceRates, outages: list[Outage]) -> None:
+    def __init__(
+        self, errors: SensorErrors, rates: DeviceRates, outages: list[Outage], seed: int = 0
+    ) -> None:
+        if not 0.0 <= rates.gps_latency_jitter_s <= rates.gps_latency_s:
+            raise ValueError("the GPS latency jitter must lie between 0 and the latency")
         self.errors, self.rates, self.outages = errors, rates, outages
+        # Its own stream, so the latency draws leave the sensors' errors as they were.
+        self.latency_rng = np.random.default_rng([seed, 1])
         self.next_s = {"imu": 0.0, "compass": 0.0, "gps": 0.0, "battery": 0.0}
         self.last_imu_s = 0.0
         self.last_gps_s = 0.0
@@ -155,17 +165,24 @@ class EmulatedDevices:
             out.append(("battery", t, sentence))
             self.next_s["battery"] += 1.0 / self.rates.battery_hz
         if t + 1e-9 >= self.next_s["imu"]:
-            sample = self.errors.imu(s, t - self.last_imu_s, pressure_kpa)
+            sample = self.errors.imu(s, t - self.last_imu_s, pressure_kpa, throttle)
             out.append(("imu", t, vnimu_sentence(sample)))
             self.last_imu_s = t
             self.next_s["imu"] += 1.0 / self.rates.imu_hz
         if t + 1e-9 >= self.next_s["compass"]:
-            out.append(("compass", t, os3000_sentence(*self.errors.compass(s), 25.0)))
+            compass = self.errors.compass(s, throttle)
+            out.append(("compass", t, os3000_sentence(*compass, 25.0)))
             self.next_s["compass"] += 1.0 / self.rates.compass_hz
         if t + 1e-9 >= self.next_s["gps"]:
-            out.append(("gps", t + self.rates.gps_latency_s, self._gps(s)))
+            out.append(("gps", t + self._gps_latency_s(), self._gps(s)))
             self.next_s["gps"] += 1.0 / self.rates.gps_hz
         return out
+
+    def _gps_latency_s(self) -> float:
+        jitter = self.rates.gps_latency_jitter_s
+        if jitter == 0.0:
+            return self.rates.gps_latency_s
+        return self.rates.gps_latency_s + float(self.latency_rng.uniform(-jitter, jitter))
 
     def _drain_battery(self, t_s: float, throttle: float) -> None:
         dt = 0.0 if self.last_battery_s is None else t_s - self.last_battery_s

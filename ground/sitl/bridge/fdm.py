@@ -44,6 +44,7 @@ class Flight:
         home: Home,
         airborne_agl_m: float | None = None,
         speed_m_s: float = 0.0,
+        bank_deg: float = 0.0,
     ) -> None:
         self.fdm = jsbsim.FGFDMExec(None)
         self.fdm.set_debug_level(0)
@@ -54,6 +55,8 @@ class Flight:
         self.turbulence = False
         self.brake_channel = False  # until a brakes servo is heard, idle means brakes
         self._initial_conditions(model, airborne_agl_m, speed_m_s)
+        if airborne_agl_m and bank_deg:
+            self._bank(bank_deg)
 
     def _initial_conditions(
         self, model: str, airborne_agl_m: float | None, speed_m_s: float
@@ -78,6 +81,15 @@ class Flight:
                 log.warning("%s cannot trim at %.1f m/s: starting untrimmed", model, speed_m_s)
         else:
             self.set_controls({"throttle": 0.0})
+
+    def _bank(self, bank_deg: float) -> None:
+        """Roll the trimmed aircraft into a bank: its controls stay trimmed for level flight,
+        so it starts as a real one handed over in a turn, dropping its nose."""
+        f = self.fdm
+        alpha, theta = f["aero/alpha-deg"], f["attitude/theta-deg"]
+        f["ic/phi-deg"], f["ic/theta-deg"], f["ic/alpha-deg"] = bank_deg, theta, alpha
+        if not f.run_ic():
+            raise RuntimeError("JSBSim refused the banked initial conditions")
 
     def _rest_on_gear(self) -> None:
         """Start at the height and pitch the aircraft rests at on its wheels.

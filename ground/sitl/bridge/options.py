@@ -19,6 +19,7 @@ class BridgeOptions:
     airborne: bool = False
     airborne_agl_m: float = 300.0
     airborne_speed_m_s: float | None = None  # None: the airframe's cruise speed
+    airborne_bank_deg: float = 0.0  # right wing down; trimmed level, then rolled into it
     speed: float | None = None  # real-time factor; None: lockstep, as fast as consumed
     physics_hz: float = 100.0
     exact: bool = False  # lockstep also with the control loop (companion sim --exact)
@@ -29,6 +30,7 @@ class BridgeOptions:
     outages: list[Outage] = field(default_factory=list)
     rates: DeviceRates = field(default_factory=DeviceRates)
     noise_scale: float = 1.0
+    sensor_defects: bool = True  # iron, motor field, vibration (NoiseModel.installed)
     seed: int = 1
     duration_s: float | None = None
     truth_path: str | None = None
@@ -40,6 +42,8 @@ class BridgeOptions:
     def __post_init__(self) -> None:
         if self.turbulence not in TURBULENCE:
             raise ValueError(f"turbulence must be one of {', '.join(TURBULENCE)}")
+        if not -80.0 <= self.airborne_bank_deg <= 80.0:
+            raise ValueError("the airborne start's bank must lie within ±80°")
         if self.speed is not None and self.speed <= 0:
             raise ValueError("speed must be positive (or None for lockstep)")
 
