@@ -23,13 +23,7 @@ from companion.link.codec import dialect as d
 from companion.link.codec import new_encoder
 from companion.link.command_service import CommandService
 from companion.link.commands import register_commands
-from companion.link.endpoints import (
-    SCHEMES,
-    Endpoint,
-    EndpointError,
-    open_endpoint,
-    split_options,
-)
+from companion.link.endpoints import SCHEMES, Endpoint, EndpointError, open_endpoint, split_options
 from companion.link.gcs_watch import GcsWatch
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
