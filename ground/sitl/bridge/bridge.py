@@ -56,6 +56,13 @@ def pressure_kpa(alt_msl_m: float) -> float:
     return STANDARD_PRESSURE_KPA * (1.0 - 2.25577e-5 * alt_msl_m) ** 5.25588
 
 
+def _devices(opts: BridgeOptions) -> EmulatedDevices:
+    """The emulated devices, as installed in an airframe unless told otherwise."""
+    noise = NoiseModel.installed if opts.sensor_defects else NoiseModel
+    errors = SensorErrors(noise(scale=opts.noise_scale), MagneticField(), opts.seed)
+    return EmulatedDevices(errors, opts.rates, opts.outages, opts.seed)
+
+
 class SimBridge:
     """One simulated aircraft with its devices on ptys."""
 
@@ -75,9 +82,7 @@ class SimBridge:
         for servo in self.airframe.servos.values():
             if servo.surface == "brakes":  # held at their safe setting until commanded
                 self.flight.set_controls({"brakes": servo.command(servo.trim)})
-        noise = NoiseModel.installed if opts.sensor_defects else NoiseModel
-        errors = SensorErrors(noise(scale=opts.noise_scale), MagneticField(), opts.seed)
-        self.devices = EmulatedDevices(errors, opts.rates, opts.outages, opts.seed)
+        self.devices = _devices(opts)
         self.failures = DeviceFailures(opts.seed)
         pilot = load_pilot(opts.pilot_path) if opts.pilot_path else None
         self.receiver = EmulatedReceiver(pilot, opts.rates.rc_hz)
