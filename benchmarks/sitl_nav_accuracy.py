@@ -49,6 +49,8 @@ CASES = {
     "installed 25 Hz": [*MISSION, "--imu-hz", "25"],
     "wind": [*MISSION, "--wind", "5,0,0", "--turbulence", "light"],
     "airborne bank 45": [*AIRBORNE, "--airborne-bank", "45"],
+    "airborne bank 45 quiet": [*AIRBORNE, "--airborne-bank", "45", "--quiet-mount"],
+    "airborne level": AIRBORNE,
 }
 SETTLE_S = 10.0
 EARTH_RADIUS_M = 6378137.0

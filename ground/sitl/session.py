@@ -260,6 +260,8 @@ def run_sim(req: SimRequest, opts: BridgeOptions, log_level: str = "INFO") -> in
     # Lockstep, fast or exact, keeps in step with the navigator's grid (fast: a period
     # behind at most, so a late vehicle process holds the simulation instead of losing data).
     sync_hz = nav_grid_hz(req.config) if opts.speed is None else 0.0
+    # An IMU slower than the grid: the navigator publishes at each of its samples instead.
+    sync_hz = min(sync_hz, opts.rates.imu_hz)
     if opts.exact and not sync_hz:
         log.warning("--exact: only lockstep (--speed max) with nav.ins_ekf can follow control")
     opts = dataclasses.replace(opts, hold=True, sync_hz=sync_hz)
