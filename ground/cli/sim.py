@@ -135,13 +135,10 @@ def sim(
         ),
     ] = None,
     noise: Annotated[float, typer.Option(help="sensor noise scale (0: perfect)")] = 1.0,
-    sensor_defects: Annotated[
-        bool,
-        typer.Option(
-            "--sensor-defects/--quiet-mount",
-            help="an airframe's magnetometer iron, motor field and vibration, or none",
-        ),
-    ] = True,
+    mount: Annotated[
+        str,
+        typer.Option(help="the sensors' airframe defects: quiet (none), calibrated, uncalibrated"),
+    ] = "quiet",
     imu_hz: Annotated[float, typer.Option(min=5, max=400, help="IMU output rate")] = 100.0,
     truth: Annotated[Path | None, typer.Option(help="write the true state CSV here")] = None,
     pilot: Annotated[
@@ -193,7 +190,7 @@ def sim(
             airframe=aircraft, home=_home(home), airborne=airborne, speed=_speed(speed),
             wind_ned=_triple(wind), turbulence=turbulence,
             outages=[_outage(o) for o in gps_outage or []], noise_scale=noise, seed=seed,
-            sensor_defects=sensor_defects, airborne_bank_deg=airborne_bank,
+            mount=mount, airborne_bank_deg=airborne_bank,
             rates=DeviceRates(imu_hz=imu_hz),
             exact=exact, start_at_s=start_at,
             duration_s=duration, truth_path=str(truth) if truth else None,

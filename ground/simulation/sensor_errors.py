@@ -37,9 +37,9 @@ class NoiseModel:
     gps_white_m: float = 0.3
     gps_velocity_m_s: float = 0.1
     # What a real airframe adds (all off here: the VN-100 on a quiet mount; ``installed``
-    # gives an airframe's). Magnetometer: a body-fixed offset (hard iron, a poor calibration
-    # or a steel part), per-axis gains (soft iron) and the motor current's field, in
-    # proportion to throttle; real logs show ±30-70° of heading error from these.
+    # gives an airframe's, calibrated or not). Magnetometer: a body-fixed offset (hard
+    # iron, a poor calibration or a steel part), per-axis gains (soft iron) and the motor
+    # current's field, in proportion to throttle; real logs show ±30-70° of heading error.
     mag_hard_iron_gauss: tuple[float, float, float] = (0.0, 0.0, 0.0)
     mag_soft_iron: tuple[float, float, float] = (1.0, 1.0, 1.0)
     mag_throttle_gauss: tuple[float, float, float] = (0.0, 0.0, 0.0)  # at full throttle
@@ -49,20 +49,26 @@ class NoiseModel:
     vibration_hz: float = 87.0
 
     @classmethod
-    def installed(cls, scale: float = 1.0) -> NoiseModel:
-        """The same sensors as installed in a small airframe after a ground calibration.
+    def installed(cls, scale: float = 1.0, calibrated: bool = True) -> NoiseModel:
+        """The same sensors as installed in a small airframe.
 
-        What is left is what a field calibration leaves: a hard-iron residual of about a
-        tenth of Melbourne's 0.21 G horizontal field (a heading error of up to 7° that turns
-        with the heading), 2-4 % soft iron, the motor's field (5° more at full throttle and a
-        field strength that swings with it) and propeller vibration the IMU's own filter
-        does not take out entirely.
+        Calibrated: what a good ground calibration and motor compensation (ArduPilot's
+        COMPASS_MOT) leave: a hard-iron residue of 8 mG, 1 % soft iron, a fifth of the
+        motor's field; about 2° of heading error that turns with the heading. Uncalibrated:
+        a tenth of Melbourne's 0.21 G horizontal field as hard iron (up to 7° that turns with
+        the heading), 2-4 % soft iron, the motor's whole field (5° more at full throttle and
+        a field strength that swings with it). Both: propeller vibration the IMU's own
+        filter does not take out entirely.
         """
+        if calibrated:
+            iron, gains, motor = (0.006, -0.005, 0.004), (1.01, 0.99, 1.01), (0.0025, 0.002, -0.004)
+        else:
+            iron, gains, motor = (0.02, -0.015, 0.01), (1.04, 0.97, 1.02), (0.012, 0.01, -0.02)
         return cls(
             scale=scale,
-            mag_hard_iron_gauss=(0.02, -0.015, 0.01),
-            mag_soft_iron=(1.04, 0.97, 1.02),
-            mag_throttle_gauss=(0.012, 0.01, -0.02),
+            mag_hard_iron_gauss=iron,
+            mag_soft_iron=gains,
+            mag_throttle_gauss=motor,
             accel_vibration_m_s2=0.5,
             gyro_vibration_rad_s=0.01,
         )

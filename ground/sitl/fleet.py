@@ -134,9 +134,7 @@ def shared_args(req: FleetRequest) -> list[str]:
     ]  # fmt: skip
     if o.airborne:
         args += ["--airborne", "--airborne-bank", _number(o.airborne_bank_deg)]
-    if not o.sensor_defects:
-        args.append("--quiet-mount")
-    args += ["--imu-hz", _number(o.rates.imu_hz)]
+    args += ["--mount", o.mount, "--imu-hz", _number(o.rates.imu_hz)]
     if o.duration_s is not None:
         args += ["--duration", _number(o.duration_s)]
     for outage in o.outages:

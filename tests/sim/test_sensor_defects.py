@@ -1,6 +1,6 @@
-"""The simulator's sensors as installed in an airframe (on by default in ``companion sim``):
-the iron and the motor's field turn the magnetometer and the compass, the GPS's latency
-varies epoch to epoch, and an airborne start can begin in a bank."""
+"""The simulator's sensors as installed in an airframe (``companion sim --mount``): the iron
+and the motor's field turn the magnetometer and the compass, a calibration leaves a little
+of it; the GPS's latency varies epoch to epoch; an airborne start can begin in a bank."""
 
 from __future__ import annotations
 
@@ -29,8 +29,8 @@ def level(yaw_deg: float, t_s: float = 0.0) -> TrueState:
     )  # fmt: skip
 
 
-def installed(scale: float = 1.0) -> SensorErrors:
-    return SensorErrors(NoiseModel.installed(scale), FIELD, seed=3)
+def installed(scale: float = 1.0, calibrated: bool = False) -> SensorErrors:
+    return SensorErrors(NoiseModel.installed(scale, calibrated), FIELD, seed=3)
 
 
 def compass_heading(errors: SensorErrors, yaw_deg: float, throttle: float) -> float:
@@ -52,6 +52,15 @@ def test_the_installed_compass_errs_by_heading_as_a_calibrated_airframe_does():
     # Hard iron: an error that turns with the heading, a few degrees, never tens of them.
     assert 3.0 < max(abs(e) for e in errors) < 12.0
     assert max(errors) - min(errors) > 5.0
+
+
+def test_a_calibration_leaves_a_few_degrees_that_still_turn_with_the_heading():
+    def worst(errors: SensorErrors) -> float:
+        return max(
+            abs(heading_error(compass_heading(errors, yaw, 1.0), yaw)) for yaw in range(0, 360, 30)
+        )
+
+    assert 1.0 < worst(installed(calibrated=True)) < 4.0 < worst(installed())
 
 
 def test_the_motor_turns_the_heading_and_swings_the_field_with_throttle():
@@ -110,3 +119,5 @@ def test_an_airborne_start_in_a_bank_begins_banked_at_speed_and_height():
     assert start["velocities/vc-kts"] * 0.514444 == pytest.approx(55.0, abs=1.0)
     with pytest.raises(ValueError, match="bank"):
         BridgeOptions(airborne=True, airborne_bank_deg=95.0)
+    with pytest.raises(ValueError, match="mount"):
+        BridgeOptions(mount="bolted")

@@ -58,8 +58,11 @@ def pressure_kpa(alt_msl_m: float) -> float:
 
 def _devices(opts: BridgeOptions) -> EmulatedDevices:
     """The emulated devices, as installed in an airframe unless told otherwise."""
-    noise = NoiseModel.installed if opts.sensor_defects else NoiseModel
-    errors = SensorErrors(noise(scale=opts.noise_scale), MagneticField(), opts.seed)
+    if opts.mount == "quiet":
+        noise = NoiseModel(scale=opts.noise_scale)
+    else:
+        noise = NoiseModel.installed(opts.noise_scale, calibrated=opts.mount == "calibrated")
+    errors = SensorErrors(noise, MagneticField(), opts.seed)
     return EmulatedDevices(errors, opts.rates, opts.outages, opts.seed)
 
 

@@ -9,6 +9,10 @@ from dataclasses import dataclass, field
 from ground.sitl.bridge.device_streams import DeviceRates, Outage
 from ground.sitl.bridge.fdm import TURBULENCE, Home
 
+# How the sensors sit in the airframe (ground/simulation/sensor_errors.py NoiseModel):
+# no defects, the residue of a good calibration, or the iron and motor field as they are.
+MOUNTS = ("quiet", "calibrated", "uncalibrated")
+
 
 @dataclass
 class BridgeOptions:
@@ -30,7 +34,7 @@ class BridgeOptions:
     outages: list[Outage] = field(default_factory=list)
     rates: DeviceRates = field(default_factory=DeviceRates)
     noise_scale: float = 1.0
-    sensor_defects: bool = True  # iron, motor field, vibration (NoiseModel.installed)
+    mount: str = "quiet"  # the sensors' airframe defects: one of MOUNTS
     seed: int = 1
     duration_s: float | None = None
     truth_path: str | None = None
@@ -42,6 +46,8 @@ class BridgeOptions:
     def __post_init__(self) -> None:
         if self.turbulence not in TURBULENCE:
             raise ValueError(f"turbulence must be one of {', '.join(TURBULENCE)}")
+        if self.mount not in MOUNTS:
+            raise ValueError(f"mount must be one of {', '.join(MOUNTS)}")
         if not -80.0 <= self.airborne_bank_deg <= 80.0:
             raise ValueError("the airborne start's bank must lie within ±80°")
         if self.speed is not None and self.speed <= 0:
