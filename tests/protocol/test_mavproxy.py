@@ -91,10 +91,13 @@ def test_mavproxy_param_fetch_wp_load_and_arm(vehicle_factory, tmp_path):
         # MAVProxy asks MAVLink FTP for @PARAM/param.pck first (ArduPilot's packed list);
         # the vehicle's FTP has no such file and says so, and MAVProxy uses the protocol.
         wait_for(lambda: any(said in x for x in mavproxy.lines), 30, "param fetch")
+        # The flight group starts before the acknowledgement has crossed back to MAVProxy.
+        acked = "COMPONENT_ARM_DISARM: ACCEPTED"
+        wait_for(lambda: any(acked in x for x in mavproxy.lines), 30, "the arm acknowledged")
     finally:
         output = mavproxy.close()
     assert said in output
-    assert "COMPONENT_ARM_DISARM: ACCEPTED" in output
+    assert "COMPONENT_ARM_DISARM: ACCEPTED" in output, output
     assert len(json.loads(mission.read_text())) == 3
 
 
