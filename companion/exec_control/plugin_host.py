@@ -97,6 +97,8 @@ class PluginHost:
         msg.name = self.spec["name"].encode()[: NAME_LEN - 1]
         health = self.ctx.health
         msg.frames_ok, msg.frames_bad = health.frames_ok, health.frames_bad
+        # The plug-in's own losses (bytes, frames) plus its bus readers' overflows, added
+        # here only: a plug-in must not add its readers' losses to health.dropped itself.
         msg.dropped = health.dropped + self.bus.total_lost()
         msg.refused = health.refused
         msg.step_p50_us = self.timer.percentile(0.5)

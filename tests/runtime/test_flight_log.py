@@ -152,3 +152,41 @@ def test_a_simulated_vehicle_logs_on_one_time_base(vehicle_factory, tmp_path):
         stamps = [int(t) for t in data.data["timestamp"]]
         assert all(first_us <= t <= t_us for t in stamps if t), (data.name, stamps[:3])
     assert {d.name for d in ulog.data_list} >= {"system_health", "sensors_imu"}
+
+
+def test_lost_samples_are_counted_once_and_marked_in_the_log(vehicle_factory, tmp_path):
+    """Bursts larger than the IMU queue: the samples the logger lost are its status row's
+    ``dropped`` (once, not twice) and leave ULog dropouts and a warning where they were."""
+    state = tmp_path / "state"
+    vehicle = vehicle_factory(
+        vehicle_config(
+            "lossy",
+            plugin("logger", "system.logger", from_boot=True, flush_s=0.2, period_s=0.1),
+            plugin("imu", "tests.support.plugins:Burst", size=2000, bursts=3),
+            state_dir=state,
+        )
+    )
+    logs = state / "logs"
+    wait_for(lambda: len(imu_ax(read_log(logs))) >= 64, 30, "a burst in the log")
+
+    def missing() -> int:
+        ax = imu_ax(read_log(logs))  # numbered from 1: the gaps are what was lost
+        return int(ax[-1] - ax[0] + 1) - len(ax) if ax else -1
+
+    # All three bursts written and counted (the row comes once a second).
+    wait_for(
+        lambda: (
+            (r := vehicle.row("logger")) is not None and r.dropped > 0 and r.dropped == missing()
+        ),
+        30,
+        "the status row's dropped count equal to the samples missing from the log",
+    )
+    vehicle.stop()
+    ulog = read_log(logs)
+    assert ulog is not None
+    ax = imu_ax(ulog)
+    assert ax[-1] == 3 * 2000  # the last sample of the last burst is there
+    assert ulog.dropouts and all(d.duration >= 0 for d in ulog.dropouts)
+    warnings = [m.message for m in ulog.logged_messages if "logger lost" in m.message]
+    counted = sum(int(text.split()[2]) for text in warnings)
+    assert counted == int(ax[-1] - ax[0] + 1) - len(ax)

@@ -146,3 +146,34 @@ class PublishOnce(Plugin):
     def step(self) -> None:
         with self.ctx.bus.idle:
             self._pace.wait(0.1)
+
+
+class Burst(Plugin):
+    """A pretend IMU that sends ``size`` numbered samples at once, ``bursts`` times, 0.5 s
+    apart, then nothing: more than a reader's queue holds, so a slower reader loses some."""
+
+    settings = {
+        "size": Setting(int, 1000, "samples in one burst", min=1),
+        "bursts": Setting(int, 3, "bursts before it falls silent", min=0),
+    }
+    outputs = ("sensors/imu",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.writer = ctx.bus.writer("sensors/imu")
+        self.count = 0
+        self.left = ctx.settings["bursts"]
+        self._pace = threading.Event()
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:
+            self._pace.wait(0.5)
+        if self.left <= 0:
+            return
+        self.left -= 1
+        for _ in range(self.ctx.settings["size"]):
+            self.count += 1
+            # Microseconds apart, so the gap a loss leaves is as long as it is in samples.
+            self.writer.publish(Imu(t_us=self.ctx.clock.now_us(), ax_m_s2=float(self.count)))
+        self.ctx.health.ok()
+

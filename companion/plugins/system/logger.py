@@ -6,8 +6,9 @@ Records the configured bus channels, with their ``t_us``, in PX4's ULog format
 off, one file from start-up to the end). INFO ``nav.*`` keeps the navigator's settings for
 ``companion replay``. It is just another reader: producers never wait for it (only exact
 lockstep simulation, told by ``system/logged`` with ``in_step``, waits for it), and what
-a full queue made it lose is counted in its ``dropped`` health counter and as a logged
-warning. The file is flushed and fsynced
+a full queue made it lose is counted once, in its ``dropped`` health counter (the plug-in
+host adds every bus reader's losses), and in the log as a dropout and a warning where the
+gap is. The file is flushed and fsynced
 at least once a (wall) second, so a power cut loses at most that much and leaves a file
 pyulog reads up to its last complete message. Past ``budget_mb`` the oldest logs go.
 """
@@ -20,7 +21,7 @@ import time
 from collections import deque
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import TYPE_CHECKING, Any, BinaryIO
 
 from companion import __version__
 from companion.flight_log import LogDirectory, ULogWriter, hold, topic_name
@@ -28,6 +29,9 @@ from companion.messages import LogProgress
 from companion.messages.channels import CHANNELS
 from companion.params.store import ParamStore
 from companion.plugin import Plugin, PluginContext, Ports, Setting
+
+if TYPE_CHECKING:
+    from companion.bus.channels import Reader
 
 DEFAULT_CHANNELS = [
     "sensors/imu",
@@ -140,7 +144,7 @@ class LoggerPlugin(Plugin):
         self.file: BinaryIO | None = None
         self.writer: ULogWriter | None = None
         self.path: Path | None = None
-        self.lost = 0
+        self.last_us: dict[str, int] = {}  # each channel's last sample, to time a gap
         # What came before the arming was seen (the health table lags the first samples).
         self.recent: deque[tuple[str, Any]] = deque(maxlen=s["prearm_samples"])
         self.next_flush = 0.0
@@ -168,18 +172,38 @@ class LoggerPlugin(Plugin):
         self._follow_arming()
         fill, total = 0.0, 0
         for name, reader in self.readers.items():
-            count = 0
-            for msg in reader.drain():
-                self._record(name, msg)
-                count += 1
+            count = self._drain(name, reader)
             fill = max(fill, count / self.depths[name])
             total += count
         self._adapt(fill, total)
-        self._count_losses()
         if self.progress is not None and self.writer is not None:
             self.progress.publish(LogProgress(t_us=self.written_us))
         if self.file is not None and time.monotonic() >= self.next_flush:
             self._flush()
+
+    def _drain(self, name: str, reader: Reader[Any]) -> int:
+        """Record what waits on one channel; the number of samples."""
+        count = 0
+        lost = reader.lost
+        for msg in reader.drain():
+            # The reader finds a loss on the first sample after the gap: mark it there.
+            if reader.lost > lost:
+                self._mark_loss(name, reader.lost - lost, msg)
+                lost = reader.lost
+            self._record(name, msg)
+            count += 1
+        return count
+
+    def _mark_loss(self, name: str, lost: int, msg: Any) -> None:
+        """A ULog dropout (Flight Review shows the gap) and a warning, before the first
+        sample after the gap. Not added to ``health.dropped``: the plug-in host already adds
+        every bus reader's losses to the status row."""
+        gap_us = int(msg.t_us) - self.last_us.get(name, int(msg.t_us))
+        if self.writer is None:
+            return
+        self.writer.dropout(gap_us // 1000)
+        text = f"logger lost {lost} samples of {name} (reader fell behind)"
+        self.writer.log_string(int(msg.t_us), 4, text)
 
     def _adapt(self, fill: float, count: int) -> None:
         """Read more often while a queue comes back over half full (a lockstep simulation
@@ -210,6 +234,7 @@ class LoggerPlugin(Plugin):
             self._open("disarmed")
 
     def _record(self, name: str, msg: Any) -> None:
+        self.last_us[name] = int(msg.t_us)
         if name == "params/changes":
             value = float(msg.value)
             key = msg.name.decode(errors="replace")
@@ -226,15 +251,6 @@ class LoggerPlugin(Plugin):
         if name == "vehicle/statustext":
             self.writer.log_string(msg.t_us, msg.severity, msg.text.decode(errors="replace"))
         self.ctx.health.ok()
-
-    def _count_losses(self) -> None:
-        lost = self.ctx.bus.total_lost()
-        if lost > self.lost:
-            self.ctx.health.dropped += lost - self.lost
-            if self.writer is not None:
-                text = f"logger lost {lost - self.lost} samples (reader fell behind)"
-                self.writer.log_string(self.ctx.clock.now_us(), 4, text)
-            self.lost = lost
 
     def _open(self, label: str) -> None:
         self.path = self.logs.new_path(label)
