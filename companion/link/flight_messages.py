@@ -9,6 +9,8 @@ from typing import Any
 from companion.link.codec import dialect as d
 from companion.messages import ControlStatus, MissionState
 
+LANDING_PHASES = (1, 2, 3)  # the controller's LandPhase APPROACH, FLARE and ROLLOUT
+
 
 def _deg(rad: float) -> float:
     return math.degrees(rad) if math.isfinite(rad) else 0.0
@@ -50,9 +52,20 @@ def mission_current(
 
 
 def landed_state(c: ControlStatus | None) -> int | None:
-    """MAV_LANDED_STATE from the controller, or None when it is not running."""
+    """MAV_LANDED_STATE from the controller, or None when it is not running.
+
+    TAKEOFF from the start of the take-off roll until the take-off height; LANDING on the
+    approach, in the flare and on the rollout until the aircraft has stopped (a go-around
+    is IN_AIR). QGroundControl offers its "Land Abort" for a fixed wing only in LANDING
+    (Vehicle::_handleExtendedSysState sets ``landing``, GuidedActionsController.qml
+    ``_fixedWingOnApproach``), and counts TAKEOFF and LANDING as flying.
+    """
     if c is None:
         return None
+    if c.takeoff_phase:
+        return d.MAV_LANDED_STATE_TAKEOFF
+    if c.land_phase in LANDING_PHASES:
+        return d.MAV_LANDED_STATE_LANDING
     return d.MAV_LANDED_STATE_ON_GROUND if c.landed else d.MAV_LANDED_STATE_IN_AIR
 
 

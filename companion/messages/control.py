@@ -113,8 +113,9 @@ class MissionState(enum.IntEnum):
 class ControlStatus(Message):
     """What the flight controller is doing. Producer: control.fixed_wing. Consumer: link.
 
-    Feeds NAV_CONTROLLER_OUTPUT, MISSION_CURRENT and MISSION_ITEM_REACHED (sent when
-    ``reached_count`` grows).
+    Feeds NAV_CONTROLLER_OUTPUT, MISSION_CURRENT, MISSION_ITEM_REACHED (sent when
+    ``reached_count`` grows) and EXTENDED_SYS_STATE's landed state (from ``landed``,
+    ``takeoff_phase`` and ``land_phase``).
     """
 
     _fields_ = [
@@ -134,6 +135,7 @@ class ControlStatus(Message):
         ("mission_state", ctypes.c_uint8),  # MissionState
         ("landed", ctypes.c_uint8),
         ("land_phase", ctypes.c_uint8),  # LandPhase while landing, 0 otherwise
+        ("takeoff_phase", ctypes.c_uint8),  # take-off Phase from the roll to the height, else 0
         ("reached_count", ctypes.c_uint32),
         ("last_reached", ctypes.c_int32),
     ]

@@ -17,7 +17,9 @@ decides when each is shown (Land never, for a fixed wing). What each action send
   the vehicle's present altitude AMSL (COMMAND_INT because AUTOPILOT_VERSION says so);
 - Orbit: FirmwarePlugin::guidedModeOrbit, COMMAND_INT DO_ORBIT (radius, NaN, NaN, NaN,
   lat, lon, altitude AMSL) in MAV_FRAME_GLOBAL;
-- Return: guidedModeRTL, the "Return" mode, validated by the heartbeat.
+- Return: guidedModeRTL, the "Return" mode, validated by the heartbeat;
+- Land Abort (shown for a fixed wing only while EXTENDED_SYS_STATE says LANDING):
+  Vehicle::abortLanding(50), COMMAND_LONG DO_GO_AROUND with param1 = 50 (the altitude).
 QGroundControl 5 also asks AVAILABLE_MODES (src/Vehicle/StandardModes.cc, all at once with
 param2 = 0) and names modes PX4 does not know from it.
 """
@@ -34,7 +36,7 @@ from companion.control.modes import BY_MODE
 from companion.messages import FlightMode
 from mavlink_dialect import companion as m
 from tests.protocol.mav_client import GroundStation, free_udp_port
-from tests.support.configs import client_vehicle
+from tests.support.configs import FAKE_APPROACH, client_vehicle, plugin
 from tests.support.plugins import FakeNav
 from tests.support.vehicle import REPO, wait_for
 
@@ -212,3 +214,23 @@ def test_parameters_qgroundcontrols_px4_setup_pages_read_are_there(qgc):
     # They describe the vehicle: a write does not change them.
     gcs.mav.param_set_send(1, 1, b"COM_RC_IN_MODE", 1.0, m.MAV_PARAM_TYPE_REAL32)
     assert gcs.recv("PARAM_VALUE", 5.0, param_id="COM_RC_IN_MODE").param_value == 4.0
+
+
+def test_land_abort_on_the_approach_as_qgroundcontrol_sends_it(vehicle_factory, tmp_path):
+    """A stand-in controller on the approach: QGroundControl sees LANDING (so it offers
+    Land Abort), and its DO_GO_AROUND is accepted and passed on as a go-around."""
+    port = free_udp_port()
+    extra = (plugin("approach", FAKE_APPROACH),)
+    vehicle = vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path, extra))
+    gcs = GroundStation(port)
+    try:
+        gcs.connect()
+        status = vehicle.bus.latest_reader("vehicle/status")
+        wait_for(status.get, 15, "the commander's first status")
+        landing = m.MAV_LANDED_STATE_LANDING
+        gcs.recv("EXTENDED_SYS_STATE", 5.0, landed_state=landing)
+        gcs.command(m.MAV_CMD_DO_GO_AROUND, 50.0)
+        assert gcs.ack(m.MAV_CMD_DO_GO_AROUND).result == m.MAV_RESULT_ACCEPTED
+        settled(status, lambda s: s.go_arounds == 1, "the go-around passed on")
+    finally:
+        gcs.close()

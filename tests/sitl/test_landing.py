@@ -5,7 +5,8 @@ the runway) is uploaded item by item over MAVLink exactly as QGroundControl uplo
 pattern (DO_LAND_START, camera stops, LOITER_TO_ALT, NAV_LAND); the aircraft is armed and
 the mission started. In a 5 m/s crosswind with light turbulence it lands on the target
 (within 30 m along and 3 m across), touches down at no more than 1.5 m/s with the wings
-within 10° of level and no bounce over 1 m, stops on the runway, and disarms itself.
+within 10° of level and no bounce over 1 m, stops on the runway, and disarms itself;
+the ground station sees the landed state go TAKEOFF, IN_AIR, LANDING, ON_GROUND.
 """
 
 from __future__ import annotations
@@ -51,24 +52,30 @@ def _command_until_accepted(gcs: GroundStation, command: int, *params: float) ->
     raise AssertionError(f"command {command} never accepted")
 
 
-def _fly(gcs: GroundStation) -> tuple[bool, bool]:
-    """(mission completed, disarmed after having been armed) as the ground station saw them."""
+def _fly(gcs: GroundStation) -> tuple[bool, bool, list[int]]:
+    """(mission completed, disarmed after having been armed, the landed states in turn) as
+    the ground station saw them."""
     completed = armed = disarmed = False
+    states: list[int] = []
     end, beat = time.monotonic() + WALL_LIMIT_S, 0.0
     while time.monotonic() < end and not (completed and disarmed):
         if time.monotonic() > beat:
             gcs.heartbeat()
             beat = time.monotonic() + 1.0
-        msg = gcs.conn.recv_match(type=["MISSION_CURRENT", "HEARTBEAT"], blocking=True, timeout=1)
+        kinds = ["MISSION_CURRENT", "HEARTBEAT", "EXTENDED_SYS_STATE"]
+        msg = gcs.conn.recv_match(type=kinds, blocking=True, timeout=1)
         if msg is None or msg.get_srcSystem() != 1:
             continue
-        if msg.get_type() == "MISSION_CURRENT":
+        if msg.get_type() == "EXTENDED_SYS_STATE":
+            if not states or states[-1] != msg.landed_state:
+                states.append(msg.landed_state)
+        elif msg.get_type() == "MISSION_CURRENT":
             completed |= msg.mission_state == d.MISSION_STATE_COMPLETE
         elif msg.base_mode & d.MAV_MODE_FLAG_SAFETY_ARMED:
             armed = True
         else:
             disarmed |= armed
-    return completed, disarmed
+    return completed, disarmed, states
 
 
 @pytest.mark.timeout(900)
@@ -84,13 +91,18 @@ def test_the_c172_lands_its_qgc_landing_pattern_in_a_crosswind_and_disarms(tmp_p
         gcs.connect()
         # Mission progress as often as QGroundControl asks for it while flying a plan.
         gcs.command(d.MAV_CMD_SET_MESSAGE_INTERVAL, d.MAVLINK_MSG_ID_MISSION_CURRENT, 200_000)
+        gcs.command(d.MAV_CMD_SET_MESSAGE_INTERVAL, d.MAVLINK_MSG_ID_EXTENDED_SYS_STATE, 200_000)
         _upload(gcs, items)
         _command_until_accepted(gcs, d.MAV_CMD_COMPONENT_ARM_DISARM, 1.0)
         _command_until_accepted(gcs, d.MAV_CMD_MISSION_START, 0.0)
-        completed, disarmed = _fly(gcs)
+        completed, disarmed, states = _fly(gcs)
     finally:
         gcs.close()
         out = finish(proc, namespace, WALL_LIMIT_S)
     assert completed and disarmed, out[-3000:]
+    # What QGroundControl's Fly view goes by (Land Abort only while LANDING): the take-off
+    # from the roll to its height, the flight, the landing to the stop, on the ground.
+    flown = [d.MAV_LANDED_STATE_TAKEOFF, d.MAV_LANDED_STATE_IN_AIR, d.MAV_LANDED_STATE_LANDING]
+    assert states[states.index(flown[0]) :][:4] == [*flown, d.MAV_LANDED_STATE_ON_GROUND], states
     score = landing_score_for_plan(read_estimate(truth_path), items)
     assert score.passed(), score

@@ -23,6 +23,7 @@ FAKE_NAV = "tests.support.plugins:FakeNav"
 FAKE_GPS = "tests.support.plugins:FakeGps"
 CRASH_AFTER = "tests.support.plugins:CrashAfter"
 PUBLISH_ONCE = "tests.support.plugins:PublishOnce"
+FAKE_APPROACH = "tests.support.plugins:FakeApproach"
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import threading
 
-from companion.messages import GpsFix, Imu, NavFlags, NavState
+from companion.messages import ControlStatus, GpsFix, Imu, NavFlags, NavState
 from companion.plugin import Plugin, PluginContext, Setting
 
 
@@ -177,3 +177,20 @@ class Burst(Plugin):
             self.writer.publish(Imu(t_us=self.ctx.clock.now_us(), ax_m_s2=float(self.count)))
         self.ctx.health.ok()
 
+
+class FakeApproach(Plugin):
+    """A flight controller stand-in on a landing approach: its status ten times a second,
+    in the air, LandPhase APPROACH (1)."""
+
+    outputs = ("control/status",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.status = ctx.bus.writer("control/status")
+        self._pace = threading.Event()
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:
+            self._pace.wait(0.1)
+        self.status.publish(ControlStatus(t_us=self.ctx.clock.now_us(), landed=0, land_phase=1))
+        self.ctx.health.ok()

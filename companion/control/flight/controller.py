@@ -291,6 +291,7 @@ class FlightController(LandingFlight):
             self.attitude.reset()
         to = self.takeoff
         demand = to.step(pos, nav.alt_msl_m, nav.yaw_rad, nav.yaw_rate_rad_s, airspeed, self.config)
+        out.takeoff_phase = int(demand.phase)
         if demand.phase == Phase.CLIMB_OUT:
             # Climb straight out along the runway with normal energy control.
             far = to.centreline_point(1e5)

@@ -178,6 +178,6 @@ class FixedWingPlugin(Plugin):
         else:
             msg.mission_state = MissionState.NOT_STARTED
         msg.landed = int(out.landed)
-        msg.land_phase = out.land_phase
+        msg.land_phase, msg.takeoff_phase = out.land_phase, out.takeoff_phase
         msg.reached_count, msg.last_reached = self.reached_count, self.last_reached
         return msg

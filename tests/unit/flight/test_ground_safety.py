@@ -71,6 +71,12 @@ def test_take_off_opens_the_throttle():
     assert max(o.throttle for o in _outputs(_controller(), FlightMode.TAKEOFF)) > 0.5
 
 
+def test_the_take_off_roll_is_reported_as_a_take_off_and_nothing_else_is():
+    """The ground station's landed state (TAKEOFF) comes from this, from the first step."""
+    assert all(o.takeoff_phase == 1 for o in _outputs(_controller(), FlightMode.TAKEOFF))
+    assert all(o.takeoff_phase == 0 for o in _outputs(_controller(), FlightMode.LOITER))
+
+
 def test_a_navigator_drifting_upwards_on_the_runway_does_not_make_it_fly():
     controller = _controller()
     outs = []
