@@ -20,6 +20,10 @@ if TYPE_CHECKING:
 
 # Sample age beyond which a sensor is reported unhealthy (vehicle-clock microseconds).
 STALE_US = {"imu": 500_000, "mag": 1_000_000, "baro": 1_000_000, "gps": 2_000_000}
+# A receiver sends a frame every 7-20 ms; silence this long is a lost radio (PX4's
+# COM_RC_LOSS_T is 0.5 s, ArduPlane's short failsafe 1.5 s). The failsafe action waits
+# for FS_LONG_TIMEOUT; the sensor list says at once that the radio is gone.
+RC_STALE_US = 1_000_000
 BATTERY_STALE_US = 2_000_000
 UNKNOWN_CELL_MV = 65535
 CHARGE_STATE = {
@@ -55,6 +59,10 @@ def sensor_bits(s: Snapshot) -> tuple[int, int]:
         usable = limit != "gps" or sample.fix_type >= 3
         if usable and fresh(sample, s.now_us, STALE_US[limit]):
             healthy |= bits
+    if s.rc is not None:  # a receiver has been heard (the joystick is not a sensor)
+        present |= d.MAV_SYS_STATUS_SENSOR_RC_RECEIVER
+        if fresh(s.rc, s.now_us, RC_STALE_US) and s.rc.usable():
+            healthy |= d.MAV_SYS_STATUS_SENSOR_RC_RECEIVER
     if s.battery is not None:
         present |= d.MAV_SYS_STATUS_SENSOR_BATTERY
         if fresh(s.battery, s.now_us, BATTERY_STALE_US) and s.battery.level == BatteryLevel.OK:

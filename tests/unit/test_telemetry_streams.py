@@ -99,3 +99,29 @@ def test_battery_status_reports_the_pack_and_its_charge_state():
     sys_status = STREAMS[d.MAVLINK_MSG_ID_SYS_STATUS].build(mav, snap)
     assert not sys_status.onboard_control_sensors_health & d.MAV_SYS_STATUS_SENSOR_BATTERY
     assert STREAMS[d.MAVLINK_MSG_ID_BATTERY_STATUS].build(mav, Snapshot()) is None
+
+
+def test_sys_status_lists_the_rc_receiver_healthy_while_its_radio_is_heard():
+    from companion.messages import PilotFlags, PilotInput
+    from mavlink_dialect import companion as d
+
+    mav = new_encoder(1)
+    rc_bit = d.MAV_SYS_STATUS_SENSOR_RC_RECEIVER
+    sys_status = STREAMS[d.MAVLINK_MSG_ID_SYS_STATUS]
+    no_receiver = sys_status.build(mav, Snapshot(now_us=10_000_000))
+    assert no_receiver.onboard_control_sensors_present & rc_bit == 0
+    snap = Snapshot(now_us=10_000_000, rc=PilotInput(t_us=9_950_000, throttle=0.5))
+    heard = sys_status.build(mav, snap)
+    assert heard.onboard_control_sensors_present & rc_bit
+    assert heard.onboard_control_sensors_enabled & rc_bit
+    assert heard.onboard_control_sensors_health & rc_bit
+    for flags in (PilotFlags.FAILSAFE, PilotFlags.THROTTLE_LOW):  # the receiver's failsafe
+        snap.rc = PilotInput(t_us=9_950_000, flags=int(flags))
+        failsafe = sys_status.build(mav, snap)
+        assert failsafe.onboard_control_sensors_present & rc_bit
+        assert failsafe.onboard_control_sensors_health & rc_bit == 0
+    snap.rc = PilotInput(t_us=9_950_000, throttle=0.5)
+    snap.now_us = 11_500_000  # the receiver silent for 1.55 s
+    silent = sys_status.build(mav, snap)
+    assert silent.onboard_control_sensors_present & rc_bit
+    assert silent.onboard_control_sensors_health & rc_bit == 0
