@@ -16,6 +16,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from companion.control.inputs import position_usable
 from companion.control.mission.items import MAX_ALT_M
 from companion.control.modes import INITIAL_MODE
 from companion.messages import (
@@ -72,14 +73,23 @@ class Commander:
         self.position: tuple[float, float, float] | None = None
         self.go_arounds = 0
         self.land_phase = 0  # the flight controller's, from its status
+        self.rejected_nav = 0  # solutions whose "valid" position was not a place
 
-    def on_nav(self, nav: NavState) -> None:
-        """Track the position; set home from the first fix while disarmed."""
+    def on_nav(self, nav: NavState) -> bool:
+        """Track the position; set home from the first fix while disarmed.
+
+        False (and counted in ``rejected_nav``) when the solution says its position is
+        valid but it is not a place on Earth: it is neither home nor judged by failsafes.
+        """
         if not nav.flags & NavFlags.POSITION_VALID:
-            return
+            return True
+        if not position_usable(nav):
+            self.rejected_nav += 1
+            return False
         self.position = (nav.lat_deg, nav.lon_deg, nav.alt_msl_m)
         if self.home is None:  # armed before the first fix: home is where that fix is
             self.home = self.position
+        return True
 
     def on_armed(self, armed: bool) -> None:
         """Arming sets home where the aircraft is (the place it will return to)."""

@@ -8,6 +8,7 @@ plug-in runs it on the bus; tests and benchmarks run it against JSBSim directly.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from companion.control.flight.landing import Landing
 from companion.control.flight.landing_flight import LandingFlight
@@ -15,6 +16,7 @@ from companion.control.flight.output import ControlOutput
 from companion.control.flight.params import FlightConfig
 from companion.control.flight.pilot import PILOT_MODES, Sticks, fly_pilot
 from companion.control.flight.takeoff import Phase, RunwayTakeoff
+from companion.control.inputs import nav_usable, status_usable, sticks_usable
 from companion.control.laws.attitude import AttitudeController
 from companion.control.laws.l1_guidance import L1Guidance, LateralDemand, bank_for
 from companion.control.laws.tecs import Tecs
@@ -48,6 +50,8 @@ class FlightController(LandingFlight):
         self.go_arounds: int | None = None  # the commander's count when last seen
         self.return_lands = False  # this Return ends in the mission's landing
         self.landed: bool | None = None
+        self.rejected = 0  # steps whose inputs were not usable (last good output kept)
+        self._last_out = ControlOutput()
         self._last_t: float | None = None
         self._mode_key: tuple[int, int] | None = None
         self._mode_setpoint: Setpoint | None = None
@@ -91,11 +95,22 @@ class FlightController(LandingFlight):
         self, nav: NavState, status: VehicleStatus, t_s: float, sticks: Sticks | None = None
     ) -> ControlOutput:
         """Surface commands for this navigation solution (and the pilot's ``sticks``, which
-        fly Manual and Stabilized when given)."""
-        dt = 0.0 if self._last_t is None else max(0.0, min(t_s - self._last_t, 0.2))
-        self._last_t = t_s
+        fly Manual and Stabilized when given). Unusable inputs (``control.inputs``) are
+        counted in ``rejected`` and the last good output kept: the laws never see them."""
         if not status.home_valid and (self.landed is None or self.landed):
             return ControlOutput()  # no home yet: nothing to fly from or back to
+        usable = math.isfinite(t_s) and nav_usable(nav) and status_usable(status)
+        if not (usable and sticks_usable(sticks)):
+            self.rejected += 1
+            return replace(self._last_out, reached=[], disarm=False)
+        self._last_out = self._step(nav, status, t_s, sticks)
+        return self._last_out
+
+    def _step(
+        self, nav: NavState, status: VehicleStatus, t_s: float, sticks: Sticks | None
+    ) -> ControlOutput:
+        dt = 0.0 if self._last_t is None else max(0.0, min(t_s - self._last_t, 0.2))
+        self._last_t = t_s
         frame = self._ensure_frame(nav, status)
         pos = frame.ne(nav.lat_deg, nav.lon_deg)
         vel = (nav.vn_m_s, nav.ve_m_s)

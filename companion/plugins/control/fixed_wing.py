@@ -95,6 +95,7 @@ class FixedWingPlugin(Plugin):
         # stops the flight group, servos safe).
         self.commands = bus.writer("link/commands")
         self.disarm_sent = False
+        self.refusing = False  # the last step's inputs were not usable
         self.reached_count = 0
         self.last_reached = -1
         self.next_status_us = 0
@@ -121,7 +122,9 @@ class FixedWingPlugin(Plugin):
         self._await_output()
         # The receiver first: a safety pilot's sticks win over the ground station's joystick.
         sticks = pilot_sticks(nav.t_us, self.rc.get(), self.joystick.get())
+        rejected = self.controller.rejected
         out = self.controller.step(nav, status, nav.t_us / 1e6, sticks)
+        self._count(self.controller.rejected > rejected, nav.t_us)
         cmd = ActuatorCommand(t_us=nav.t_us, armed=1)
         cmd.aileron, cmd.elevator, cmd.rudder = out.aileron, out.elevator, out.rudder
         cmd.throttle = out.throttle
@@ -131,13 +134,23 @@ class FixedWingPlugin(Plugin):
         self.surfaces.publish(cmd)
         if out.disarm and not self.disarm_sent:
             self._disarm(now_us, out, status)
-        self.ctx.health.ok()
         if out.reached:
             self.reached_count += len(out.reached)
             self.last_reached = out.reached[-1]
         if out.reached or now_us >= self.next_status_us:
             self.status_out.publish(self._status(now_us, out, status))
             self.next_status_us = now_us + STATUS_PERIOD_US
+
+    def _count(self, refused: bool, t_us: int) -> None:
+        """Count the step; an unusable solution or status is said once per stretch of them."""
+        if not refused:
+            self.ctx.health.ok()
+            self.refusing = False
+            return
+        if not self.refusing:
+            self.ctx.log.warning("unusable navigation or status at t=%d us: output held", t_us)
+        self.ctx.health.refused += 1
+        self.refusing = True
 
     def _disarm(self, now_us: int, out: ControlOutput, status: VehicleStatus) -> None:
         # The ground station hears the mission complete before the controller stops.

@@ -82,14 +82,14 @@ class CommanderPlugin(Plugin):
         self.texts = bus.writer("vehicle/statustext")
         self.next_status_us = 0
         self.next_failsafe_us = 0
+        self.nav_seen: Any = None  # the last solution read, usable or not
+        self.nav_good: Any = None  # the last usable one
 
     def step(self) -> None:
         self.waiter.wait(WAIT_S)
         c = self.commander
         now = self.ctx.clock.now_us()
-        nav = self.nav.get()
-        if nav is not None:
-            c.on_nav(nav)
+        nav = self._nav()
         if (health := self.health.get()) is not None:
             c.on_armed(bool(health.flight_running))
         self.live.poll()
@@ -105,6 +105,21 @@ class CommanderPlugin(Plugin):
             self.out.publish(c.status(now))
             self.next_status_us = now + STATUS_PERIOD_US
             self.ctx.health.ok()
+
+    def _nav(self) -> Any:
+        """The newest usable navigation solution: one whose position is not a place is
+        counted and ignored (not home, not judged by the failsafes), as if never sent."""
+        nav = self.nav.get()
+        if nav is None or nav is self.nav_seen:
+            return self.nav_good
+        self.nav_seen = nav
+        if self.commander.on_nav(nav):
+            self.nav_good = nav
+        else:
+            if self.ctx.health.refused == 0:
+                self.ctx.log.warning("navigation position not a place: ignored (counted)")
+            self.ctx.health.refused += 1
+        return self.nav_good
 
     def _commands(self) -> bool:
         changed = False

@@ -1,0 +1,92 @@
+"""What the commander and the flight controller accept from the bus before they use it.
+
+Pure: a message in, whether it is usable out. The link validates what comes from a
+ground station, but the bus also carries what a navigator, a replay or a buggy plug-in
+publishes; one infinite heading reaches ``cos`` in the wind estimator, one NaN roll
+becomes NaN surface commands. A solution that fails here is not flown from (the
+controller keeps its last good output) and not taken as home (the commander ignores it),
+and each is counted. NaN is refused where the laws read a number; in a target it means
+"not given", as the commander publishes it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from companion.control.mission.items import MAX_ALT_M
+from companion.messages import FlightMode, NavState, VehicleStatus
+
+if TYPE_CHECKING:
+    from companion.control.flight.pilot import Sticks
+
+# Beyond these a value is a broken input, not a state the aircraft can be in: an IMU
+# saturates near 35 rad/s (2000 °/s), and no airframe here flies at 500 m/s.
+MAX_ANGLE_RAD = 2 * math.pi  # attitude angles are published in [-π, π]; some slack
+MAX_RATE_RAD_S = 40.0
+MAX_SPEED_M_S = 500.0
+MAX_RADIUS_M = 10_000.0  # as the commander's limit on an orbit
+KNOWN_MODES = frozenset(int(m) for m in FlightMode)
+NAV_ANGLES = ("roll_rad", "pitch_rad", "yaw_rad")
+NAV_RATES = ("roll_rate_rad_s", "pitch_rate_rad_s", "yaw_rate_rad_s")
+NAV_SPEEDS = ("vn_m_s", "ve_m_s", "vd_m_s")
+
+
+def _within(value: float, limit: float) -> bool:
+    """Finite and no larger than ``limit`` either way (NaN and infinity fail)."""
+    return abs(value) <= limit
+
+
+def place_usable(lat_deg: float, lon_deg: float, alt_msl_m: float) -> bool:
+    """A place on Earth at a sane height (every coordinate given)."""
+    return _within(lat_deg, 90.0) and _within(lon_deg, 180.0) and _within(alt_msl_m, MAX_ALT_M)
+
+
+def position_usable(nav: NavState) -> bool:
+    """The solution's position, which the commander takes as home and judges the fence by."""
+    return place_usable(nav.lat_deg, nav.lon_deg, nav.alt_msl_m)
+
+
+def nav_usable(nav: NavState) -> bool:
+    """Every field the control laws read is finite and within what an aircraft can be."""
+    return (
+        position_usable(nav)
+        and all(_within(getattr(nav, f), MAX_ANGLE_RAD) for f in NAV_ANGLES)
+        and all(_within(getattr(nav, f), MAX_RATE_RAD_S) for f in NAV_RATES)
+        and all(_within(getattr(nav, f), MAX_SPEED_M_S) for f in NAV_SPEEDS)
+    )
+
+
+def _target_usable(status: VehicleStatus) -> bool:
+    """NaN means "not given" (each coordinate alone); anything else must be a place."""
+    lat, lon, alt = status.target_lat_deg, status.target_lon_deg, status.target_alt_msl_m
+    radius = status.target_radius_m
+    return (
+        (math.isnan(lat) or _within(lat, 90.0))
+        and (math.isnan(lon) or _within(lon, 180.0))
+        and (math.isnan(alt) or _within(alt, MAX_ALT_M))
+        and (math.isnan(radius) or _within(radius, MAX_RADIUS_M))
+    )
+
+
+def status_usable(status: VehicleStatus) -> bool:
+    """A known mode, a home that is a place (when it is said to be valid), a target that
+    is a place or not given."""
+    if status.mode and status.mode not in KNOWN_MODES:
+        return False
+    home = (status.home_lat_deg, status.home_lon_deg, status.home_alt_msl_m)
+    if status.home_valid and not place_usable(*home):
+        return False
+    return _target_usable(status)
+
+
+def sticks_usable(sticks: Sticks | None) -> bool:
+    """No sticks, or sticks within their travel (roll, pitch, yaw ±1, throttle 0..1)."""
+    if sticks is None:
+        return True
+    return (
+        _within(sticks.roll, 1.0)
+        and _within(sticks.pitch, 1.0)
+        and _within(sticks.yaw, 1.0)
+        and 0.0 <= sticks.throttle <= 1.0
+    )
