@@ -1,10 +1,14 @@
-"""The directory of flight logs: numbered files, the oldest removed past a disk budget."""
+"""The directory of flight logs: numbered files, the oldest removed past a disk budget.
+
+A log being started lives under a hidden partial name (``.NNNN_label.ulg.part``, which no
+listing shows) until its header is on disk; ``publish`` then renames it into view."""
 
 from __future__ import annotations
 
 import contextlib
 import fcntl
 import logging
+import os
 import re
 from pathlib import Path
 from typing import BinaryIO
@@ -12,6 +16,7 @@ from typing import BinaryIO
 log = logging.getLogger(__name__)
 
 _NAME = re.compile(r"^(\d{4,})_[A-Za-z0-9_-]*\.ulg$")
+PARTIAL_SUFFIX = ".part"
 
 
 class LogDirectory:
@@ -35,6 +40,32 @@ class LogDirectory:
         number = max(numbers, default=0) + 1
         safe = re.sub(r"[^A-Za-z0-9_-]", "_", label)
         return self.path / f"{number:04d}_{safe}.ulg"
+
+    def partial_path(self, path: Path) -> Path:
+        """The hidden name ``path`` is written under until ``publish``."""
+        return path.with_name(f".{path.name}{PARTIAL_SUFFIX}")
+
+    def publish(self, partial: Path, path: Path) -> None:
+        """Rename a partial log into view, durably (the directory is fsynced too)."""
+        os.rename(partial, path)
+        fd = os.open(self.path, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+    def remove_partial(self) -> list[Path]:
+        """Remove partial logs nobody writes (cut off before their header was on disk)."""
+        if not self.path.is_dir():
+            return []
+        removed = []
+        for path in self.path.glob(f".*.ulg{PARTIAL_SUFFIX}"):
+            if being_written(path):
+                continue
+            with contextlib.suppress(OSError):
+                path.unlink()
+                removed.append(path)
+        return removed
 
     def prune(self, keep: Path | None = None) -> list[Path]:
         """Remove the oldest logs (never ``keep``, the one being written) while the directory

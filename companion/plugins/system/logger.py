@@ -8,23 +8,22 @@ off, one file from start-up to the end). INFO ``nav.*`` keeps the navigator's se
 lockstep simulation, told by ``system/logged`` with ``in_step``, waits for it), and what
 a full queue made it lose is counted once, in its ``dropped`` health counter (the plug-in
 host adds every bus reader's losses), and in the log as a dropout and a warning where the
-gap is. The file is flushed and fsynced
-at least once a (wall) second, so a power cut loses at most that much and leaves a file
-pyulog reads up to its last complete message. Past ``budget_mb`` the oldest logs go.
+gap is. The file is flushed and fsynced at least once a (wall) second, so a power cut
+loses at most that much and leaves a file pyulog reads up to its last complete message; a
+file appears only once its header is on disk. At each flush the oldest logs past
+``budget_mb`` go, and a file past ``file_mb`` goes on in a new one (``LogRecorder``).
 """
 
 from __future__ import annotations
 
-import contextlib
-import os
 import time
 from collections import deque
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, BinaryIO
+from typing import TYPE_CHECKING, Any
 
 from companion import __version__
-from companion.flight_log import LogDirectory, ULogWriter, hold, topic_name
+from companion.flight_log import LogDirectory, LogRecorder, ULogWriter, topic_name
 from companion.messages import LogProgress
 from companion.messages.channels import CHANNELS
 from companion.params.store import ParamStore
@@ -91,6 +90,9 @@ class LoggerPlugin(Plugin):
             bool, False, "wake on every sample and say how far it wrote (exact lockstep waits)"
         ),
         "budget_mb": Setting(float, 1000.0, "disk space for logs; oldest removed", min=0.01),
+        "file_mb": Setting(
+            float, 100.0, "a log goes on in a new file past this size (at most budget/2)", min=0.01
+        ),
         "flush_s": Setting(float, 1.0, "wall seconds between fsyncs", min=0.05, max=1.0),
         "period_s": Setting(float, 0.02, "wall seconds between reads of the queues", min=0.001),
         "prearm_samples": Setting(
@@ -118,7 +120,6 @@ class LoggerPlugin(Plugin):
         super().init(ctx)
         s = ctx.settings
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
-        self.logs = LogDirectory(state_dir / "logs", int(s["budget_mb"] * 1e6))
         self.params = ParamStore(ctx.param_decls, state_dir / "params.json").values
         names = list(dict.fromkeys(s["channels"]))
         self.readers = {name: ctx.bus.reader(name) for name in names}
@@ -130,8 +131,7 @@ class LoggerPlugin(Plugin):
         self.written_us = -1
         self.depths = {n: CHANNELS[n].depth for n in names}
         self.period_s = s["period_s"]
-        self.topics = [(name, topic_name(name), CHANNELS[name].type) for name in names]
-        self.info = {
+        info = {
             "sys_name": "companion",
             "ver_sw": __version__,
             "vehicle_name": str(ctx.vehicle.get("name", "")),
@@ -141,9 +141,11 @@ class LoggerPlugin(Plugin):
             **navigator_info(ctx.plugins),
         }
         self.armed = False
-        self.file: BinaryIO | None = None
-        self.writer: ULogWriter | None = None
-        self.path: Path | None = None
+        # A file is at most half the budget, so the one before it survives the pruning.
+        max_bytes = int(min(s["file_mb"], s["budget_mb"] / 2) * 1e6)
+        logs = LogDirectory(state_dir / "logs", int(s["budget_mb"] * 1e6))
+        topics = [(topic_name(name), CHANNELS[name].type) for name in names]
+        self.recorder = LogRecorder(logs, topics, info, self.params, max_bytes)
         self.last_us: dict[str, int] = {}  # each channel's last sample, to time a gap
         # What came before the arming was seen (the health table lags the first samples).
         self.recent: deque[tuple[str, Any]] = deque(maxlen=s["prearm_samples"])
@@ -158,15 +160,14 @@ class LoggerPlugin(Plugin):
         except OSError as exc:
             # A full or failing card: stop this file (what reached it stays readable) and
             # carry on reading, so nothing upstream notices; the next arming tries again.
-            self.ctx.log.error("flight log %s: %s; logging stopped", self.path, exc)
+            self.ctx.log.error("flight log %s: %s; logging stopped", self.recorder.path, exc)
             self.ctx.health.bad()
-            self._abandon()
+            self.recorder.abandon()
 
-    def _abandon(self) -> None:
-        if self.file is not None:
-            with contextlib.suppress(OSError):
-                self.file.close()
-        self.file = self.writer = None
+    @property
+    def writer(self) -> ULogWriter | None:
+        """The open log's writer (the recorder swaps it when a file is full)."""
+        return self.recorder.writer
 
     def _work(self) -> None:
         self._follow_arming()
@@ -178,7 +179,7 @@ class LoggerPlugin(Plugin):
         self._adapt(fill, total)
         if self.progress is not None and self.writer is not None:
             self.progress.publish(LogProgress(t_us=self.written_us))
-        if self.file is not None and time.monotonic() >= self.next_flush:
+        if self.recorder.is_open and time.monotonic() >= self.next_flush:
             self._flush()
 
     def _drain(self, name: str, reader: Reader[Any]) -> int:
@@ -225,7 +226,7 @@ class LoggerPlugin(Plugin):
         if armed == self.armed:
             return
         self.armed = armed
-        if self.file is not None and not self.ctx.settings["split"]:
+        if self.recorder.is_open and not self.ctx.settings["split"]:
             return
         self._close()
         if armed:
@@ -253,35 +254,18 @@ class LoggerPlugin(Plugin):
         self.ctx.health.ok()
 
     def _open(self, label: str) -> None:
-        self.path = self.logs.new_path(label)
-        self.file = open(self.path, "wb", buffering=256 * 1024)  # noqa: SIM115 - kept open
-        hold(self.file)  # LOG_ERASE leaves it alone while it is written
-        topics = [(topic, kind) for _, topic, kind in self.topics]
-        self.writer = ULogWriter(self.file, self.ctx.clock.now_us(), topics, self.info, self.params)
-        self._flush()  # the definitions are on disk before any data
+        self.recorder.open(label, self.ctx.clock.now_us())
+        self.next_flush = time.monotonic() + self.ctx.settings["flush_s"]
         for name, msg in self.recent:
             self._record(name, msg)
         self.recent.clear()
-        for path in self.logs.prune(keep=self.path):
-            self.ctx.log.info("removed old log %s (over the disk budget)", path.name)
-        self.ctx.log.info("logging to %s", self.path)
 
     def _flush(self) -> None:
-        assert self.file is not None and self.writer is not None
-        self.writer.sync()
-        self.file.flush()
-        os.fsync(self.file.fileno())
+        self.recorder.flush(self.ctx.clock.now_us())
         self.next_flush = time.monotonic() + self.ctx.settings["flush_s"]
 
     def _close(self) -> None:
-        if self.file is None:
-            return
-        self._flush()
-        self.file.close()
-        self.ctx.log.info("closed %s", self.path)
-        self.file = self.writer = None
-        if self.path is not None:
-            self.logs.prune(keep=self.path)
+        self.recorder.close()
 
     def close(self) -> None:
         self._close()
