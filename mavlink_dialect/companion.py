@@ -11112,31 +11112,33 @@ class MAVLink_timesync_message(MAVLink_message):
 
     id = MAVLINK_MSG_ID_TIMESYNC
     msgname = "TIMESYNC"
-    fieldnames = ["tc1", "ts1"]
-    ordered_fieldnames = ["tc1", "ts1"]
-    fieldtypes = ["int64_t", "int64_t"]
+    fieldnames = ["tc1", "ts1", "target_system", "target_component"]
+    ordered_fieldnames = ["tc1", "ts1", "target_system", "target_component"]
+    fieldtypes = ["int64_t", "int64_t", "uint8_t", "uint8_t"]
     fielddisplays_by_name: Dict[str, str] = {}
     fieldenums_by_name: Dict[str, str] = {}
     fieldunits_by_name: Dict[str, str] = {"tc1": "ns", "ts1": "ns"}
-    native_format = bytearray(b"<qq")
-    orders = [0, 1]
-    lengths = [1, 1]
-    array_lengths = [0, 0]
+    native_format = bytearray(b"<qqBB")
+    orders = [0, 1, 2, 3]
+    lengths = [1, 1, 1, 1]
+    array_lengths = [0, 0, 0, 0]
     crc_extra = 34
-    unpacker = struct.Struct("<qq")
+    unpacker = struct.Struct("<qqBB")
     instance_field = None
     instance_offset = -1
 
-    def __init__(self, tc1: int, ts1: int):
+    def __init__(self, tc1: int, ts1: int, target_system: int = 0, target_component: int = 0):
         MAVLink_message.__init__(self, MAVLink_timesync_message.id, MAVLink_timesync_message.msgname)
         self._fieldnames = MAVLink_timesync_message.fieldnames
         self._instance_field = MAVLink_timesync_message.instance_field
         self._instance_offset = MAVLink_timesync_message.instance_offset
         self.tc1 = tc1
         self.ts1 = ts1
+        self.target_system = target_system
+        self.target_component = target_component
 
     def pack(self, mav: "MAVLink", force_mavlink1: bool = False) -> bytes:
-        return self._pack(mav, self.crc_extra, self.unpacker.pack(self.tc1, self.ts1), force_mavlink1=force_mavlink1)
+        return self._pack(mav, self.crc_extra, self.unpacker.pack(self.tc1, self.ts1, self.target_system, self.target_component), force_mavlink1=force_mavlink1)
 
 
 # Define name on the class for backwards compatibility (it is now msgname).
@@ -21537,7 +21539,7 @@ class MAVLink(object):
         """
         self.send(self.file_transfer_protocol_encode(target_network, target_system, target_component, payload), force_mavlink1=force_mavlink1)
 
-    def timesync_encode(self, tc1: int, ts1: int) -> MAVLink_timesync_message:
+    def timesync_encode(self, tc1: int, ts1: int, target_system: int = 0, target_component: int = 0) -> MAVLink_timesync_message:
         """
         Time synchronization message.         The message is used for both
         timesync requests and responses.         The request is sent
@@ -21562,11 +21564,13 @@ class MAVLink(object):
 
         tc1                       : Time sync timestamp 1. Syncing: 0. Responding: Timestamp of responding component. [ns] (type:int64_t)
         ts1                       : Time sync timestamp 2. Timestamp of syncing component (mirrored in response). [ns] (type:int64_t)
+        target_system             : Target system id. Request: 0 (broadcast) or id of specific system. Response must contain system id of the requesting component. (type:uint8_t)
+        target_component          : Target component id. Request: 0 (broadcast) or id of specific component. Response must contain component id of the requesting component. (type:uint8_t)
 
         """
-        return MAVLink_timesync_message(tc1, ts1)
+        return MAVLink_timesync_message(tc1, ts1, target_system, target_component)
 
-    def timesync_send(self, tc1: int, ts1: int, force_mavlink1: bool = False) -> None:
+    def timesync_send(self, tc1: int, ts1: int, target_system: int = 0, target_component: int = 0, force_mavlink1: bool = False) -> None:
         """
         Time synchronization message.         The message is used for both
         timesync requests and responses.         The request is sent
@@ -21591,9 +21595,11 @@ class MAVLink(object):
 
         tc1                       : Time sync timestamp 1. Syncing: 0. Responding: Timestamp of responding component. [ns] (type:int64_t)
         ts1                       : Time sync timestamp 2. Timestamp of syncing component (mirrored in response). [ns] (type:int64_t)
+        target_system             : Target system id. Request: 0 (broadcast) or id of specific system. Response must contain system id of the requesting component. (type:uint8_t)
+        target_component          : Target component id. Request: 0 (broadcast) or id of specific component. Response must contain component id of the requesting component. (type:uint8_t)
 
         """
-        self.send(self.timesync_encode(tc1, ts1), force_mavlink1=force_mavlink1)
+        self.send(self.timesync_encode(tc1, ts1, target_system, target_component), force_mavlink1=force_mavlink1)
 
     def camera_trigger_encode(self, time_usec: int, seq: int) -> MAVLink_camera_trigger_message:
         """

@@ -96,6 +96,7 @@ class LogTransferService:
         self.tokens = 0.0
         self.last_s: float | None = None
         self.refused = 0
+        self.rejected_target = 0  # for another component of this system
         self.bytes_sent = 0
         self.erased = 0
 
@@ -109,6 +110,7 @@ class LogTransferService:
 
     def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
         if not self._for_us(msg):
+            self.rejected_target += 1
             return []
         kind = msg.get_type()
         if kind == "LOG_REQUEST_LIST":

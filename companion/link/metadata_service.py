@@ -29,6 +29,7 @@ class MetadataService:
         self.compid = compid
         self.metadata = metadata_files(decls)
         self.ftp = FtpServer(self.metadata.files)
+        self.rejected_target = 0  # for another component of this system
 
     @property
     def refused(self) -> int:
@@ -48,6 +49,7 @@ class MetadataService:
             0,
             self.compid,
         ):
+            self.rejected_target += 1
             return []
         replies = self.ftp.handle(bytes(msg.payload))
         return [

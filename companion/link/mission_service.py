@@ -72,6 +72,7 @@ class MissionService:
         # controller stops (landed and disarmed), as PX4's does, until the mission changes.
         self.completed = False
         self.refused = 0
+        self.rejected_target = 0  # for another component of this system
 
     def _ack(self, peer: Peer, result: int, mission_type: int) -> Outgoing:
         msg = self.mav.mission_ack_encode(peer.sysid, peer.compid, result, mission_type)
@@ -87,6 +88,7 @@ class MissionService:
     def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
         # Broadcasts count too: MAVProxy addresses sysid 0 until it has heard a heartbeat.
         if msg.target_system not in (0, self.sysid) or msg.target_component not in (0, self.compid):
+            self.rejected_target += 1
             return []
         mission_type = getattr(msg, "mission_type", 0)
         if mission_type not in MISSION_TYPES:

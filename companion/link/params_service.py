@@ -46,6 +46,7 @@ class ParamsService:
         self.on_change: Callable[[str, float], None] = lambda name, value: None
         self._queue: deque[tuple[int, Peer | None]] = deque()
         self.refused = 0
+        self.rejected_target = 0  # for another component of this system
 
     def _for_us(self, msg: Any) -> bool:
         targets = (0, self.sysid)  # broadcasts included, as for missions
@@ -59,6 +60,7 @@ class ParamsService:
 
     def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
         if not self._for_us(msg):
+            self.rejected_target += 1
             return []
         kind = msg.get_type()
         if kind == "PARAM_REQUEST_LIST":

@@ -6,6 +6,7 @@ send out. The link plug-in owns the transports and the bus and dispatches by mes
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -40,3 +41,10 @@ class Service(Protocol):
     def tick(self, now_s: float) -> list[Outgoing]:
         """Timeouts, retries and paced streaming."""
         ...
+
+
+def refused_count(services: Iterable[object]) -> int:
+    """Well-formed input the services refused: by its rules (``refused``) or because it was
+    addressed to another component of this system (``rejected_target``). Another system's
+    traffic never reaches them: the router forwards it."""
+    return sum(getattr(s, "refused", 0) + getattr(s, "rejected_target", 0) for s in services)

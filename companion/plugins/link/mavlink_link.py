@@ -35,7 +35,7 @@ from companion.link.mode_messages import current_mode, heartbeat_mode
 from companion.link.params_service import ParamsService
 from companion.link.px4_compat import PX4_SETUP_PARAMS
 from companion.link.refusal_texts import RefusalTexts
-from companion.link.service import Outgoing
+from companion.link.service import Outgoing, refused_count
 from companion.link.signing import key_from
 from companion.link.statustext import StatusTexts
 from companion.link.telemetry import Snapshot
@@ -151,8 +151,10 @@ class MavlinkLink(Plugin):
         self.next_link_status_s = 0.0
         self.next_prearm_s = 0.0
         self.reached_count = 0
-        timesync = TimesyncService(self.mav, lambda: ctx.clock.now_us() * 1000)
-        services = [self.identity, self.commands, timesync]
+        self.timesync = TimesyncService(
+            self.mav, lambda: ctx.clock.now_us() * 1000, sysid, ctx.settings["compid"]
+        )
+        services = [self.identity, self.commands, self.timesync]
         secret = ctx.settings["signing_key"]
         key = key_from(secret) if secret else None
         self.refusal_text = RefusalTexts(self.statustext, time.monotonic)
@@ -339,7 +341,8 @@ class MavlinkLink(Plugin):
         counts = self.router.counters
         self.ctx.health.frames_ok, self.ctx.health.frames_bad = counts.ok, counts.bad
         parts = self.commands, self._params_service, self.missions, self.manual, self.metadata
-        self.ctx.health.refused = sum(p.refused for p in (*parts, self.log_transfer))
+        services = (*parts, self.log_transfer, self.timesync)
+        self.ctx.health.refused = refused_count(services)
 
     def has_commander(self) -> bool:
         """Whether the vehicle runs a commander to answer mode commands."""
