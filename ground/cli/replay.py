@@ -88,11 +88,14 @@ def _replay_one(
 ) -> None:  # fmt: skip
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
+    from ground.replay.flight_log import is_flight_log
     from ground.replay.single import count_rows, replay_log
 
     if not log.is_file():
         err.print(f"[red]{log}: no such file[/red]", highlight=False, soft_wrap=True)
         raise typer.Exit(EXIT_CONFIG)
+    if is_flight_log(log):  # a CSV sensor log replays on an on-board install; a ULog not
+        require_ground_extra("replay FLIGHT.ulg", "pyulog")
     fixes: list = []
     percent = TextColumn("{task.percentage:>3.0f}%")
     columns = (TextColumn("{task.description}"), BarColumn(), percent, TimeRemainingColumn())

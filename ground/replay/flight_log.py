@@ -4,6 +4,9 @@ vehicle made in flight, read with pyulog.
 The samples come back as the very bus messages the drivers published (every field, at
 the precision it was logged), merged in time order; ``nav/state`` is what the vehicle's
 navigator said, for comparing a replay with the flight.
+
+pyulog (the ``ground`` extra) is imported only when a ULog is read: ``companion replay`` of
+a CSV sensor log imports this module too, and works on an on-board install without it.
 """
 
 from __future__ import annotations
@@ -14,11 +17,9 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from pyulog import ULog
-from pyulog.exceptions import ULogException
 
 from companion.flight_log import topic_name
 from companion.messages import Message, NavFlags, NavState
@@ -31,6 +32,9 @@ SENSOR_CHANNELS = ("sensors/imu", "sensors/gps", "sensors/mag", "sensors/baro", 
 NAV_CHANNEL = "nav/state"
 EARTH_RADIUS_M = 6_371_000.0
 
+if TYPE_CHECKING:
+    from pyulog import ULog
+
 
 def is_flight_log(path: Path) -> bool:
     """Whether replay should read the file as an on-board ULog (by its name)."""
@@ -39,6 +43,9 @@ def is_flight_log(path: Path) -> bool:
 
 def load(path: Path) -> ULog:
     """The log with only what replay uses parsed."""
+    from pyulog import ULog
+    from pyulog.exceptions import ULogException
+
     try:
         return ULog(str(path), [topic_name(c) for c in (*SENSOR_CHANNELS, NAV_CHANNEL)])
     except (OSError, ValueError, IndexError, KeyError, ULogException) as exc:

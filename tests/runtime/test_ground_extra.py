@@ -11,6 +11,8 @@ from tests.support.vehicle import REPO
 # Run the real command line with the ground extra's libraries made unimportable, as they
 # are in an on-board install (pip install . without [ground]).
 BLOCKED = "import sys\nfor m in {blocked!r}: sys.modules[m] = None\n"
+# Every library of the ground extra (pyproject.toml's [ground]).
+GROUND = ["jsbsim", "ray", "matplotlib", "pyulog"]
 RUN_CLI = "from companion.cli import main\nsys.argv = ['companion', *{args!r}]\nmain()\n"
 
 
@@ -45,3 +47,22 @@ def test_the_vehicle_commands_work_without_the_ground_extra(tmp_path) -> None:
     done = run_without(["jsbsim", "ray"], "graph", "--config", str(config))
     assert done.returncode == 0, done.stderr
     assert "nav/state" in done.stdout
+
+
+def test_replay_of_a_csv_log_works_without_the_ground_extra(tmp_path) -> None:
+    log, estimate = tmp_path / "s.csv", tmp_path / "e.csv"
+    lines = ["t,kind,ax,ay,az,gx,gy,gz,lat,lon,alt_m,vn,ve,vd,fix,hdop,mx,my,mz,baro_alt_m"]
+    lines += [f"{i * 0.02:.2f},imu,0,0,-9.81,0,0,0,,,,,,,,,,,," for i in range(100)]
+    log.write_text("\n".join(lines) + "\n")
+    done = run_without(GROUND, "replay", str(log), "--out", str(estimate))
+    assert done.returncode == 0, done.stderr
+    assert estimate.read_text().startswith("t,")
+
+
+def test_replay_of_a_flight_log_names_the_extra_to_install(tmp_path) -> None:
+    flight = tmp_path / "0001_armed.ulg"
+    flight.write_bytes(b"ULog")
+    done = run_without(GROUND, "replay", str(flight), "--out", str(tmp_path / "e.csv"))
+    assert done.returncode == 2
+    assert "companion replay FLIGHT.ulg needs pyulog" in done.stderr
+    assert "companion[ground]" in done.stderr
