@@ -13,41 +13,12 @@ import time
 import pytest
 
 from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.support.configs import FAKE_GPS, FAKE_NAV, link, plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
 
 m = pytest.importorskip("mavlink_dialect.companion")
 
-VEHICLE = """
-[vehicle]
-name = "prearm"
-state_dir = "{state}"
-
-[[plugins]]
-name = "link"
-plugin = "link.mavlink"
-settings = {{ endpoints = ["udpin://127.0.0.1:{port}"] }}
-
-[[plugins]]
-name = "nav"
-plugin = "tests.support.plugins:FakeNav"
-settings = {{ aligning = {aligning} }}
-
-[[plugins]]
-name = "gps"
-plugin = "tests.support.plugins:FakeGps"
-settings = {{ fix_type = {fix_type} }}
-
-[[plugins]]
-name = "commander"
-plugin = "vehicle.commander"
-
-[[plugins]]
-name = "servos"
-plugin = "actuators.minissc"
-group = "flight"
-settings = {{ device = "{servo}", airframe = "c172p" }}
-"""
 ARM = m.MAV_CMD_COMPONENT_ARM_DISARM
 
 
@@ -57,10 +28,17 @@ def _vehicle(vehicle_factory, tmp_path, servo: str, aligning=False, fix_type=3, 
     state.mkdir(exist_ok=True)
     if checks is not None:  # as a bench user would have stored it
         (state / "params.json").write_text(json.dumps({"ARMING_CHECK": checks}))
-    text = VEHICLE.format(
-        state=state, port=port, aligning=str(aligning).lower(), fix_type=fix_type, servo=servo
+    vehicle = vehicle_factory(
+        vehicle_config(
+            "prearm",
+            link(f"udpin://127.0.0.1:{port}"),
+            plugin("nav", FAKE_NAV, aligning=aligning),
+            plugin("gps", FAKE_GPS, fix_type=fix_type),
+            plugin("commander", "vehicle.commander"),
+            plugin("servos", "actuators.minissc", group="flight", device=servo, airframe="c172p"),
+            state_dir=state,
+        )
     )
-    vehicle = vehicle_factory(text)
     gcs = GroundStation(port)
     gcs.connect()
     wait_for(lambda: vehicle.row("gps").pid and vehicle.row("nav").pid, 60, "sensors running")
