@@ -234,3 +234,21 @@ def test_land_abort_on_the_approach_as_qgroundcontrol_sends_it(vehicle_factory, 
         settled(status, lambda s: s.go_arounds == 1, "the go-around passed on")
     finally:
         gcs.close()
+
+
+def test_qgc44_modes_this_plane_does_not_fly_are_refused_with_a_reason(qgc):
+    """QGroundControl 4.4's PX4 plug-in lists Acro, Rattitude, Altitude and Position for a
+    fixed wing from its own fixed table (5 lists the vehicle's AVAILABLE_MODES): picked,
+    each is refused with a STATUSTEXT that names it, and the mode stays as it was."""
+    gcs, status, _ = qgc
+    before = status.get().mode
+    for main, name in ((2, "Altitude"), (3, "Position"), (5, "Acro"), (8, "Rattitude")):
+        gcs.command(m.MAV_CMD_DO_SET_MODE, m.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, main << 16)
+        got = {}
+        while len(got) < 2:  # the reason and the ack, in whichever order they come
+            msg = gcs.recv(["STATUSTEXT", "COMMAND_ACK"], 3.0)
+            got[msg.get_type()] = msg
+        assert got["STATUSTEXT"].id == 0  # one message, not chunks
+        assert got["STATUSTEXT"].text.startswith(f"{name}: not flown here")
+        assert got["COMMAND_ACK"].result == m.MAV_RESULT_DENIED
+    assert status.get().mode == before
