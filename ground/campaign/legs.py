@@ -17,7 +17,8 @@ import numpy as np
 from companion.actuators.airframe import load_airframe
 from companion.control.flight.controller import TURN_BANK_FRACTION
 from companion.control.flight.params import control_params
-from companion.control.mission.executor import MAX_LEAD_TURN_DEG, RELATIVE_FRAMES
+from companion.control.laws.fillet import corner_arc
+from companion.control.mission.executor import RELATIVE_FRAMES
 from companion.control.mission.items import MissionItem
 from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import LocalFrame
@@ -104,9 +105,8 @@ def plan_legs(
         turn = _turn(before[0], a, b) if before is not None and before[2] else math.nan
         lead = 0.0
         if after is not None:
-            out_turn = min(abs(_turn(a, b, after[0])), MAX_LEAD_TURN_DEG)
-            lead = turn_radius * math.tan(math.radians(out_turn) / 2.0)
-            lead = min(lead, math.dist(a, b) / 2, math.dist(b, after[0]) / 2)
+            out_turn = math.radians(_turn(a, b, after[0]))
+            lead = corner_arc(out_turn, turn_radius, math.dist(a, b), math.dist(b, after[0]))[0]
         legs.append(Leg(a, b, there[1], turn, lead, before is None or not before[2]))
     return legs
 

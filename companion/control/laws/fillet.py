@@ -14,6 +14,13 @@ import math
 from dataclasses import dataclass
 
 MIN_TURN_RAD = math.radians(3.0)  # below this a corner is flown as a straight line
+MAX_TURN_RAD = math.radians(175.0)  # beyond this (a reversal) L1 turns from the switch point
+# A corner sharper than 135° flown at the planned radius would begin its arc far back along
+# the leg (3.3 radii before a 146° corner): it is flown tighter instead, its arc starting no
+# earlier than a 135° one's, down to this fraction of the planned radius. Planned at 70 % of
+# the bank limit, 0.7 of the radius asks for tan(bank) 1/0.7 times larger: 41° of a 45° limit.
+SHARP_LEAD_TAN = math.tan(math.radians(135.0) / 2.0)
+SHARP_RADIUS_SCALE = 0.7
 
 
 @dataclass(frozen=True)
@@ -27,6 +34,24 @@ class Fillet:
     centre: tuple[float, float]
     radius: float
     clockwise: bool  # a right turn
+
+
+def corner_arc(turn_rad: float, radius: float, l_in: float, l_out: float) -> tuple[float, float]:
+    """Lead (distance from the corner to either tangent point) and radius of the arc that
+    turns through ``turn_rad`` between legs ``l_in`` and ``l_out`` long, planned at ``radius``.
+
+    The mission executor switches legs at this lead and guidance flies this arc: one
+    geometry for both, or the aircraft reaches the arc's start already past it.
+    """
+    half_tan = math.tan(abs(turn_rad) / 2.0)
+    if half_tan <= 0.0 or radius <= 0.0:
+        return 0.0, radius
+    if abs(turn_rad) > MAX_TURN_RAD:  # no arc: switch legs as early as for a 135° corner
+        return min(radius * SHARP_LEAD_TAN, 0.5 * l_in, 0.5 * l_out), radius
+    radius *= max(SHARP_RADIUS_SCALE, min(1.0, SHARP_LEAD_TAN / half_tan))
+    # Short legs leave no room for the whole arc: a tighter one, flown at the bank limit.
+    lead = min(radius * half_tan, 0.5 * l_in, 0.5 * l_out)
+    return lead, lead / half_tan
 
 
 def fillet(
@@ -43,11 +68,9 @@ def fillet(
     turn = math.atan2(
         u_in[0] * u_out[1] - u_in[1] * u_out[0], u_in[0] * u_out[0] + u_in[1] * u_out[1]
     )
-    if abs(turn) < MIN_TURN_RAD or abs(turn) > math.radians(175.0):
+    if abs(turn) < MIN_TURN_RAD or abs(turn) > MAX_TURN_RAD:
         return None
-    # Short legs leave no room for the whole arc: a tighter one, flown at the bank limit.
-    lead = min(radius * math.tan(abs(turn) / 2.0), 0.5 * l_in, 0.5 * l_out)
-    radius = lead / math.tan(abs(turn) / 2.0)
+    lead, radius = corner_arc(turn, radius, l_in, l_out)
     sign = 1.0 if turn > 0 else -1.0
     right = (-u_out[1] * sign, u_out[0] * sign)  # towards the centre
     t_out = (corner[0] + u_out[0] * lead, corner[1] + u_out[1] * lead)

@@ -15,6 +15,7 @@ import enum
 import math
 from dataclasses import dataclass, field
 
+from companion.control.laws.fillet import MIN_TURN_RAD, corner_arc
 from companion.control.mission.items import CAMERA_STOPS, MissionItem
 from companion.geodesy import LocalFrame, wrap_pi
 from mavlink_dialect import companion as d
@@ -22,9 +23,6 @@ from mavlink_dialect import companion as d
 RELATIVE_FRAMES = (d.MAV_FRAME_GLOBAL_RELATIVE_ALT, d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT)
 ON_CIRCLE = 0.25  # within this fraction of the radius the aircraft counts as circling
 TAKEOFF_MARGIN_M = 5.0
-# Sharper turns (towards a reversal) start no earlier than a 135° one: their arc would
-# begin far back along the leg.
-MAX_LEAD_TURN_DEG = 135.0
 MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
 
 
@@ -223,9 +221,10 @@ class MissionExecutor:
             return 0.0
         leg_in = math.atan2(b[1] - a[1], b[0] - a[0])
         leg_out = math.atan2(nxt[1] - b[1], nxt[0] - b[0])
-        turn = min(abs(wrap_pi(leg_out - leg_in)), math.radians(MAX_LEAD_TURN_DEG))
-        lead = self._turn_radius * math.tan(turn / 2.0)
-        return min(lead, 0.5 * _distance(a, b), 0.5 * _distance(b, nxt))
+        turn = wrap_pi(leg_out - leg_in)
+        if abs(turn) < MIN_TURN_RAD:
+            return 0.0
+        return corner_arc(turn, self._turn_radius, _distance(a, b), _distance(b, nxt))[0]
 
     def _next_point(self, here: tuple[float, float]) -> tuple[float, float] | None:
         """Where the leg after the current waypoint goes (None when it is not a leg)."""
