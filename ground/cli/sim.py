@@ -98,6 +98,26 @@ def _run_fleet(req) -> int:
     return fleet.run()
 
 
+def _run_one(req, opts, log_level: str, logs_dir: Path, truth: Path | None) -> int:
+    """One vehicle; then where its flight logs are (copied beside the truth CSV)."""
+    from companion.exec_control.config import ConfigError
+    from ground.sitl.run_logs import keep_beside, log_names, new_logs
+    from ground.sitl.session import run_sim
+
+    before = log_names(logs_dir)
+    try:
+        code = run_sim(req, opts, log_level)
+    except ConfigError as exc:
+        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
+        raise typer.Exit(EXIT_CONFIG) from None
+    logs = new_logs(logs_dir, before)
+    for path in logs:
+        err.print(f"flight log: {path}", highlight=False, soft_wrap=True)
+    for path in keep_beside(truth, logs) if truth is not None else []:
+        err.print(f"flight log copied to {path}", highlight=False, soft_wrap=True)
+    return code
+
+
 @app.command()
 def sim(
     aircraft: Annotated[str, typer.Option(help="airframe: c172p, J3Cub, or a TOML path")] = "c172p",
@@ -176,11 +196,10 @@ def sim(
     """
     require_ground_extra("sim", "jsbsim")
     from companion.bus.namespace import default_namespace
-    from companion.exec_control.config import ConfigError
     from ground.sitl.bridge.device_streams import DeviceRates
     from ground.sitl.bridge.options import BridgeOptions
     from ground.sitl.fleet import GCS_LINK, FleetRequest
-    from ground.sitl.session import SimRequest, run_sim
+    from ground.sitl.session import SimRequest
 
     setup_logging(log_level)
     lists = plan_or_exit(plan) if plan is not None else None
@@ -212,9 +231,5 @@ def sim(
             plan=plan, log_level=log_level,
         )))  # fmt: skip
     req = SimRequest(config, _single_links(link, api_port_base), state_dir, lists, sysid)
-    try:
-        code = run_sim(req, opts, log_level)
-    except ConfigError as exc:
-        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
-        raise typer.Exit(EXIT_CONFIG) from None
-    raise typer.Exit(code)
+    logs_dir = Path(state_dir or vehicle["state_dir"]).expanduser() / "logs"
+    raise typer.Exit(_run_one(req, opts, log_level, logs_dir, truth))

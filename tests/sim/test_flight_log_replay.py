@@ -29,9 +29,12 @@ def test_a_flown_ulog_replays_near_the_flight_estimate(tmp_path):
         tmp_path, f"udpout://127.0.0.1:{port}", "--plan", str(REPO / "qgc_plans/square.plan"),
         "--duration", f"{DURATION_S:g}", "--start-at", f"{START_AT_S:g}", "--exact",
     )  # fmt: skip
-    finish(proc, namespace, 240)
+    out = finish(proc, namespace, 240)
     # --exact: one file from start-up, through the arming, to the end.
     (flight,) = (tmp_path / "state" / "logs").glob("*.ulg")
+    # The run says where it is, and keeps a copy beside the truth CSV.
+    assert f"flight log: {flight}" in out
+    assert (tmp_path / "truth.ulg").read_bytes() == flight.read_bytes()
 
     ulog = ULog(str(flight))
     # Simulation time throughout: no stamp from the host's clock, none after the end.
