@@ -79,7 +79,7 @@ def test_sixty_seconds_airborne_in_lockstep(tmp_path):
         k = min(k, len(t) - 1)
         error = horizontal_m(lat[k], lon[k], msg.lat / 1e7, msg.lon / 1e7)
         assert error < 15.0, (msg.time_boot_ms, error)
-    assert "lockstep stalls 0" in out
+    assert "lockstep stalls 0" in out, [line for line in out.splitlines() if "stalls" in line]
 
 
 @pytest.mark.timeout(240)
