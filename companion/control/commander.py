@@ -3,8 +3,9 @@
 Pure: commands and navigation in, decisions and a ``VehicleStatus`` out. The
 ``vehicle.commander`` plug-in wraps it; the link reports what it decides.
 Rules (as PX4 and ArduPilot have them): MISSION needs a stored mission; RTL needs a home;
-GUIDED and LOITER need a position (or a given point); LAND is refused (no automatic
-landing yet); home is the first valid position, and is set again at arming.
+GUIDED and LOITER need a position (or a given point); LAND (PX4's Land, which a fixed
+wing flies as the mission's landing from its DO_LAND_START) needs a stored mission with a
+DO_LAND_START; home is the first valid position, and is set again at arming.
 A reposition without a point (QGroundControl's Pause and Change altitude, PX4's
 DO_REPOSITION with NaN latitude/longitude) keeps the point being flown to, or circles here,
 at the altitude given (or the present one).
@@ -59,10 +60,14 @@ LANDING_PHASES = (1, 2)  # LandPhase APPROACH and FLARE: a go-around can still b
 
 
 class Commander:
-    """Mode state machine; ``mission_count`` says how many mission items are stored."""
+    """Mode state machine; ``mission_count`` says how many mission items are stored and
+    ``mission_lands`` whether the stored mission has a DO_LAND_START."""
 
-    def __init__(self, mission_count: Callable[[], int]) -> None:
+    def __init__(
+        self, mission_count: Callable[[], int], mission_lands: Callable[[], bool] = lambda: False
+    ) -> None:
         self.mission_count = mission_count
+        self.mission_lands = mission_lands
         self.mode = INITIAL_MODE
         self.armed = False
         self.home: tuple[float, float, float] | None = None
@@ -160,8 +165,8 @@ class Commander:
     def _enter(
         self, mode: FlightMode, point: tuple[float, ...] | None = None, radius: float = math.nan
     ) -> Decision:
-        if mode == FlightMode.LAND:
-            return Decision(CommandResult.DENIED, "Land: no automatic landing on this vehicle")
+        if mode == FlightMode.LAND and not self.mission_lands():
+            return Decision(CommandResult.DENIED, "Land: the mission has no DO_LAND_START")
         if mode == FlightMode.MISSION and self.mission_count() == 0:
             return Decision(CommandResult.DENIED, "Mission: no mission stored")
         if mode == FlightMode.RTL and self.home is None:

@@ -81,7 +81,8 @@ MODES: tuple[ModeInfo, ...] = (
              _NONE, _STAB | d.MAV_MODE_FLAG_GUIDED_ENABLED),
     ModeInfo(FlightMode.TAKEOFF, "Takeoff", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_TAKEOFF), 13,
              d.MAV_STANDARD_MODE_TAKEOFF, _STAB | _AUTO),
-    # Listed so every tool can name it, but not offered (no automatic landing yet).
+    # Listed so every tool can name it, not offered in a mode list: it lands only a stored
+    # mission that has a DO_LAND_START (from there, at once), and is refused otherwise.
     ModeInfo(FlightMode.LAND, "Land", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_LAND), 26,
              d.MAV_STANDARD_MODE_LAND, _STAB | _AUTO, user_selectable=False),
 )  # fmt: skip

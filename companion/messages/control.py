@@ -78,7 +78,7 @@ class FlightMode(enum.IntEnum):
     RTL = 5  # fly home and circle there
     GUIDED = 6  # fly to a commanded point and circle there
     TAKEOFF = 7  # climb out from the runway and circle at the take-off height
-    LAND = 8  # named and numbered for the ground tools; refused until landing exists
+    LAND = 8  # fly the mission's landing from its DO_LAND_START (refused without one)
 
 
 class VehicleStatus(Message):

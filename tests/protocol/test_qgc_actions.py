@@ -178,7 +178,8 @@ def test_start_mission_then_every_in_flight_action(qgc):
     shown(gcs, FlightMode.RTL)
     assert set_mode(gcs, FlightMode.MISSION) == m.MAV_RESULT_ACCEPTED
     shown(gcs, FlightMode.MISSION)
-    # Land is never offered for a fixed wing; asked anyway, it is refused with a reason.
+    # Land is never offered for a fixed wing; asked anyway, it lands the mission's landing
+    # from its DO_LAND_START, and this plan (the square) has none: refused with a reason.
     assert set_mode(gcs, FlightMode.LAND) == m.MAV_RESULT_DENIED
     assert "Land" in gcs.recv("STATUSTEXT", 3.0).text
     assert status.get().mode == FlightMode.MISSION

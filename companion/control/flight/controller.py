@@ -213,8 +213,8 @@ class FlightController(LandingFlight):
         self._mode_key = key
         if mode == FlightMode.MISSION:
             return self._mission(status, pos, nav, t_s, entered, out)
-        if mode == FlightMode.RTL and (not self.landed or self.landing is not None):
-            landing = self._return_landing(status, pos, nav, t_s, entered, out)
+        if mode in (FlightMode.RTL, FlightMode.LAND) and (not self.landed or self.landing):
+            landing = self._mode_landing(mode, status, pos, nav, t_s, entered, out)
             if landing is not None:
                 return landing
         if self.landed and mode != FlightMode.TAKEOFF:

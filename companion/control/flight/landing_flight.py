@@ -16,7 +16,7 @@ from companion.control.flight.landing import AircraftState, Landing, LandingDema
 from companion.control.laws.l1_guidance import bank_for
 from companion.control.mission.executor import Kind, MissionExecutor, Setpoint
 from companion.control.mission.items import MissionItem
-from companion.messages import NavState, VehicleStatus
+from companion.messages import FlightMode, NavState, VehicleStatus
 from mavlink_dialect import companion as d
 
 if TYPE_CHECKING:
@@ -134,8 +134,9 @@ class LandingFlight:
         out.alt_error = dem.alt_msl - nav.alt_msl_m
         return out
 
-    def _return_landing(
+    def _mode_landing(
         self: FlightController,
+        mode: FlightMode,
         status: VehicleStatus,
         pos: tuple[float, float],
         nav: NavState,
@@ -143,10 +144,11 @@ class LandingFlight:
         entered: bool,
         out: ControlOutput,
     ) -> Setpoint | None:
-        """Return with RTL_AUTOLAND: 2 joins the mission's DO_LAND_START at once, 1 once
-        home is reached (as ArduPlane); None when this Return does not land."""
+        """The mission's landing from its first DO_LAND_START, None when not landing now.
+        Land (PX4's Land, as a fixed wing flies it): at once. Return with RTL_AUTOLAND: 2
+        at once, 1 once home is reached (as ArduPlane)."""
         first = land_start(self.items)
-        autoland = round(self.config["RTL_AUTOLAND"])
+        autoland = 2 if mode == FlightMode.LAND else round(self.config["RTL_AUTOLAND"])
         if first is None or autoland not in (1, 2):
             return None
         if entered:

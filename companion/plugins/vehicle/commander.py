@@ -18,6 +18,7 @@ from typing import Any
 from companion.control.battery_failsafe import BATTERY_FS_PARAMS, BatteryFailsafe
 from companion.control.commander import MODE_COMMANDS, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
+from companion.control.flight.landing_flight import land_start
 from companion.control.mission.fence import Fence
 from companion.control.mission.store import MissionStore, StoreFollower
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch
@@ -56,7 +57,10 @@ class CommanderPlugin(Plugin):
         self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
         # The link stores missions in its own process and says so on mission/changed.
         self.follower = StoreFollower(self.store)
-        self.commander = Commander(lambda: len(self.store.items[d.MAV_MISSION_TYPE_MISSION]))
+        self.commander = Commander(
+            lambda: len(self.store.items[d.MAV_MISSION_TYPE_MISSION]),
+            lambda: land_start(self.store.items[d.MAV_MISSION_TYPE_MISSION]) is not None,
+        )
         self.live = LiveParams(ctx.bus, self.params, state_dir)
         self.failsafes = Failsafes(self.live.values)
         self.pilot = PilotWatch(self.live.values)
