@@ -20,6 +20,10 @@ from companion.geodesy import wrap_pi
 MIN_SPEED = 1.0  # below this the ground course is meaningless
 XTRACK_I_CAPTURE_RAD = math.radians(5.0)
 XTRACK_I_MAX_RAD = 0.1
+# Far off the line the capture angle is held at 45° (as ArduPlane's L1 holds it): steeper,
+# the aircraft arrives at the line nearly square to it, faster than its roll can undo, and
+# overshoots by tens of metres (a 100 m capture came back 87 m on the other side).
+MAX_CAPTURE_SIN = math.sin(math.radians(45.0))
 # The wings take about this long to level: leave the arc that much before its end.
 ROLL_OUT_S = 1.0
 
@@ -124,7 +128,7 @@ class L1Guidance:
             # Far behind the start of the line: fly to its start first.
             return self._towards(vel, speed, l1, (-from_a[0], -from_a[1]), xtrack, bearing_b)
         eta_track = math.atan2(_cross(vel, u), _dot(vel, u))
-        eta_capture = -math.asin(max(-1.0, min(1.0, xtrack / l1)))
+        eta_capture = -math.asin(max(-MAX_CAPTURE_SIN, min(MAX_CAPTURE_SIN, xtrack / l1)))
         if abs(eta_capture) < XTRACK_I_CAPTURE_RAD:  # only once the line is captured
             self.integ += eta_capture * self.xtrack_i * dt
             self.integ = max(-XTRACK_I_MAX_RAD, min(XTRACK_I_MAX_RAD, self.integ))

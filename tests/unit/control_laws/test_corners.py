@@ -125,10 +125,12 @@ def test_in_a_5_m_s_wind_the_corners_still_end_on_the_new_leg(airframe: str):
         assert straight_worst(legs[k], a, b) < 1.0
 
 
-def test_without_the_arc_a_right_angle_overshoots_the_new_leg():
+def test_the_arc_ends_on_the_new_leg_closer_than_l1_alone():
     """What the arc is for: L1 alone starts turning one L1 distance from the new line."""
-    guidance, aircraft, radius = setup("c172p")
-    legs = fly_legs(guidance, aircraft, SQUARE, radius, arcs=False)
-    rows = cross_track(legs[1], SQUARE[1], SQUARE[2])
-    overshoot = max(-x for _, x in rows)  # the square turns right: overshoot is to the left
-    assert overshoot > 10.0
+    overshoot = {}
+    for arcs in (False, True):
+        guidance, aircraft, radius = setup("c172p")
+        legs = fly_legs(guidance, aircraft, SQUARE, radius, arcs=arcs)
+        rows = cross_track(legs[1], SQUARE[1], SQUARE[2])
+        overshoot[arcs] = max(-x for _, x in rows)  # the square turns right: overshoot is left
+    assert overshoot[True] < 1.0 and overshoot[True] < overshoot[False]

@@ -124,10 +124,11 @@ def test_demand_grows_with_the_offset_until_it_saturates():
     guidance = L1Guidance()
     accs = [-guidance.line((500.0, e), vel_on(0.0), A, B).lat_acc for e in (5, 20, 60, 120)]
     assert accs == sorted(accs) and accs[0] > 0.0
-    # Far off, the intercept saturates at 90° to the track: a turn at the full L1 rate.
+    # Far off, the intercept is held at 45° to the track (as ArduPlane holds it).
     far = guidance.line((500.0, 5_000.0), vel_on(0.0), A, B)
     l1 = guidance.l1_distance(V)
-    assert far.lat_acc == pytest.approx(-4 * guidance.damping**2 * V * V / l1, rel=1e-6)
+    expected = -4 * guidance.damping**2 * V * V / l1 * math.sin(math.radians(45.0))
+    assert far.lat_acc == pytest.approx(expected, rel=1e-6)
 
 
 def test_far_behind_the_start_aims_at_the_start():
