@@ -8,8 +8,9 @@ values their rules refuse; tests/support/hostile.py) goes to a UDP endpoint as f
 the vehicle answers (at most WINDOW commands unanswered), another to a 57600-baud serial
 endpoint at the wire's pace, until --frames have gone out on UDP. Printed: frames sent
 and commands answered per endpoint, restarts of every plug-in (must be 0), ATTITUDE rate
-before, during and after (must hold), and the stored mission and parameters' checksums
-before and after (must match).
+before, during and after (must hold; the socket is drained before each window, so
+datagrams queued while nothing read are not counted), and the stored mission's and the
+parameters' checksums, each before and after (must match).
 """
 
 from __future__ import annotations
@@ -54,11 +55,18 @@ def raw_pty() -> tuple[int, str]:
     return master, os.ttyname(slave)
 
 
-def state_digest(state: Path) -> str:
+def state_digest(state: Path, missions: bool) -> str:
+    """The stored missions' files (``missions``) or every other stored file (parameters)."""
     h = hashlib.sha256()
     for p in sorted(q for q in state.rglob("*") if q.is_file() and q.suffix != ".tmp"):
-        h.update(p.name.encode() + p.read_bytes())
+        if ("mission" in str(p.relative_to(state))) == missions:
+            h.update(p.name.encode() + p.read_bytes())
     return h.hexdigest()[:16]
+
+
+def digests(state: Path) -> tuple[str, str]:
+    """(missions, parameters)."""
+    return state_digest(state, True), state_digest(state, False)
 
 
 def restarts(namespace: str) -> dict[str, int]:
@@ -92,7 +100,12 @@ class UdpStation:
                 self.seen[msg.get_type()] += 1
                 self.acks += msg.get_type() == "COMMAND_ACK"
 
+    def drain(self) -> None:
+        """Read what queued while nobody read, so a rate counts only its own window."""
+        self.read()
+
     def attitude_rate(self, seconds: float) -> float:
+        self.drain()
         before, end = self.seen["ATTITUDE"], time.monotonic() + seconds
         while time.monotonic() < end:
             self.read(0.05)
@@ -192,9 +205,10 @@ def main() -> None:
         station.connect()
         station.send(station.mav.param_set_encode(1, 1, b"SR_GPS", 3.0, 9).pack(station.mav))
         time.sleep(3.0)  # the parameter file and the mission are on disk
-        digest_before, rate_before = state_digest(tmp / "state"), station.attitude_rate(5.0)
+        digest_before, rate_before = digests(tmp / "state"), station.attitude_rate(5.0)
         serial = SerialFuzzer(master, args.seed + 1)
         serial.start()
+        station.drain()
         attitudes_before = station.seen["ATTITUDE"]
         commands, seconds = fuzz_udp(station, args.frames, args.seed)
         rate_during = (station.seen["ATTITUDE"] - attitudes_before) / seconds
@@ -205,9 +219,10 @@ def main() -> None:
         report(args.frames, commands, station, serial, seconds, namespace)
         print(f"ATTITUDE on UDP: {rate_before:.1f} Hz before, {rate_during:.1f} during, "
               f"{rate_after:.1f} after")  # fmt: skip
-        after = state_digest(tmp / "state")
-        same = "match" if after == digest_before else "DIFFER"
-        print(f"mission and parameters: {digest_before} before, {after} after: {same}")
+        after = digests(tmp / "state")
+        for name, was, now in zip(("mission", "parameters"), digest_before, after, strict=True):
+            same = "match" if now == was else "DIFFER"
+            print(f"{name} checksum: {was} before, {now} after: {same}")
     finally:
         sim.terminate()
         sim.wait(timeout=30)

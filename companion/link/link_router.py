@@ -32,6 +32,16 @@ class LinkCounters:
     stream_errors: int = 0  # telemetry samples that could not be encoded
 
 
+def _target_system(msg: Any) -> int:
+    """The system a message is addressed to (0: every one). MANUAL_CONTROL names it
+    ``target``; read as a broadcast, a joystick flood on one link was forwarded onto every
+    other, and crowded a 57600-baud radio's telemetry off."""
+    target = getattr(msg, "target_system", None)
+    if target is None and msg.get_type() == "MANUAL_CONTROL":
+        target = msg.target
+    return target or 0
+
+
 class LinkRouter:
     """Routing and dispatch for all endpoints of the link."""
 
@@ -103,7 +113,7 @@ class LinkRouter:
         if sysid == self.mav.srcSystem:
             return  # our own traffic looped back by another router
         self.routes.setdefault(sysid, set()).add(index)
-        target = getattr(msg, "target_system", 0)
+        target = _target_system(msg)
         if target not in (0, self.mav.srcSystem):
             self.counters.foreign += 1
             self._forward(msg, index, self.routes.get(target))

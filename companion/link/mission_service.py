@@ -113,7 +113,7 @@ class MissionService:
             self._changed(mission_type)
             return [self._ack(peer, d.MAV_MISSION_ACCEPTED, mission_type)]
         if kind == "MISSION_SET_CURRENT":
-            return self._set_current(msg.seq)
+            return self._set_current(msg.seq, peer)
         return []  # MISSION_ACK closing a download: nothing to do
 
     def _start_upload(
@@ -184,11 +184,15 @@ class MissionService:
             )
         return [Outgoing(msg, peer)]
 
-    def _set_current(self, seq: int) -> list[Outgoing]:
+    def _set_current(self, seq: int, peer: Peer) -> list[Outgoing]:
         if 0 <= seq < len(self.store.items[0]):
             self.current = seq
             self._changed(0)
-        return [Outgoing(self.mission_current(), None)]
+            return [Outgoing(self.mission_current(), None)]  # news for every ground station
+        # No such item: the unchanged item to the sender only, as a refused PARAM_SET is
+        # answered; a flood of them on one link must not crowd telemetry off the others.
+        self.refused += 1
+        return [Outgoing(self.mission_current(), peer)]
 
     def follow(self, mission_state: int) -> None:
         """The flight controller's MissionState of the stored mission, while it runs."""

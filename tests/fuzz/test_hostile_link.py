@@ -8,15 +8,44 @@ import time
 from collections import Counter
 from pathlib import Path
 
+from companion.link.command_service import CommandService
+from companion.link.gcs_watch import GcsWatch
+from companion.link.log_transfer import LogTransferService
+from companion.link.manual_control import ManualControlService
+from companion.link.metadata_service import MetadataService
+from companion.link.mission_service import MissionService
+from companion.link.params_service import ParamsService
+from companion.link.timesync import TimesyncService
 from companion.messages import PluginState
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import GroundStation, free_udp_port, upload_mission
 from tests.support.configs import client_vehicle
-from tests.support.hostile import HostileStream
+from tests.support.hostile import HOSTILE_TYPES, HostileStream
 from tests.support.vehicle import wait_for
 
 FRAMES = 6000
 BURST = 40  # frames sent between reads of what came back
+
+
+SERVICES = (
+    CommandService, GcsWatch, LogTransferService, ManualControlService, MetadataService,
+    MissionService, ParamsService, TimesyncService,
+)  # fmt: skip
+BY_DESIGN = {"LOG_ERASE", "MISSION_CLEAR_ALL"}  # they change the vehicle: never sent
+
+
+def test_the_stream_carries_every_message_the_link_accepts_but_erase_and_clear():
+    accepted = set().union(*(service.handles for service in SERVICES))
+    assert accepted - BY_DESIGN == HOSTILE_TYPES
+    parser, stream = d.MAVLink(None), HostileStream(seed=3)
+    parser.robust_parsing = True
+    kinds: Counter[str] = Counter()
+    for _ in range(20_000):
+        frame = stream.frame()
+        if frame.kind == "hostile":
+            kinds.update(msg.get_type() for msg in parser.parse_buffer(frame.data) or [])
+    assert set(kinds) == HOSTILE_TYPES
+    assert not BY_DESIGN & set(kinds)
 
 
 def state_digest(state: Path) -> dict[str, str]:

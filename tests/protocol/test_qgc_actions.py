@@ -27,12 +27,14 @@ param2 = 0) and names modes PX4 does not know from it.
 from __future__ import annotations
 
 import math
+import time
 
 import pytest
 
 from companion.control.mission.plan import checked_plan
 from companion.control.mission.store import MissionStore
 from companion.control.modes import BY_MODE
+from companion.link.refusal_texts import REFUSAL_TEXT_PERIOD_S
 from companion.messages import FlightMode
 from mavlink_dialect import companion as m
 from tests.protocol.mav_client import GroundStation, free_udp_port
@@ -252,4 +254,5 @@ def test_qgc44_modes_this_plane_does_not_fly_are_refused_with_a_reason(qgc):
         assert got["STATUSTEXT"].id == 0  # one message, not chunks
         assert got["STATUSTEXT"].text.startswith(f"{name}: not flown here")
         assert got["COMMAND_ACK"].result == m.MAV_RESULT_DENIED
+        time.sleep(REFUSAL_TEXT_PERIOD_S)  # refusal texts are paced; an operator is slower
     assert status.get().mode == before

@@ -3,9 +3,13 @@
 Four kinds of frame, mixed: random bytes; valid frames with one byte changed (a CRC-16
 always catches a one-byte change, so none of them can act); valid frames cut short; and
 valid, well-addressed frames whose values break a rule (NaN, infinity, out of range) in
-every message the vehicle accepts. None of them may change the vehicle: commands that
-could (arming, mode changes, reboot) always carry at least one value their rule refuses,
-missions are never cleared or completed, and parameters only get values they refuse.
+every message the vehicle accepts (HOSTILE_TYPES). None of them may change the vehicle:
+commands that could (arming, mode changes, reboot) always carry at least one value their
+rule refuses, as does the old SET_MODE message; missions are never cleared (no
+MISSION_CLEAR_ALL, no MISSION_COUNT of 0) or completed, MISSION_SET_CURRENT names no item
+of theirs, parameters only get values they refuse, log data is asked beyond every log's end
+and never erased (no LOG_ERASE), and the joystick's axes are out of range. Requests that
+only read go to this component, to every one (0) or to another (counted as refused).
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ import random
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from companion.control.modes import decode_set_mode
 from companion.link.command_rules import RULES, Param
 from companion.link.command_service import SET_MODE_MESSAGE
 from mavlink_dialect import companion as d
@@ -23,6 +28,19 @@ BAD_FLOATS = (math.nan, math.inf, -math.inf, 3.4e38, -3.4e38)
 # A parameter name that exists, with values every declaration refuses.
 PARAM_NAMES = ("SR_ATTITUDE", "SR_POSITION", "SYS_FAILURE_EN", "NOT_A_PARAM", "")
 CHECKED_COMMANDS = sorted(c for c, rules in RULES.items() if rules and c != SET_MODE_MESSAGE)
+# Every message type the link accepts except LOG_ERASE and MISSION_CLEAR_ALL, which change
+# the vehicle by design (tests check this list against the link's services).
+HOSTILE_TYPES = frozenset(
+    {
+        "COMMAND_LONG", "COMMAND_INT", "SET_MODE", "PARAM_SET", "PARAM_REQUEST_LIST",
+        "PARAM_REQUEST_READ", "MISSION_COUNT", "MISSION_ITEM_INT", "MISSION_ITEM",
+        "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_REQUEST_LIST", "MISSION_SET_CURRENT",
+        "MISSION_ACK", "TIMESYNC", "HEARTBEAT", "MANUAL_CONTROL", "FILE_TRANSFER_PROTOCOL",
+        "LOG_REQUEST_LIST", "LOG_REQUEST_DATA", "LOG_REQUEST_END",
+    }
+)  # fmt: skip
+FTP_OPCODES = (0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 128, 129, 255)
+AXIS_LIMIT = 1000  # MANUAL_CONTROL's x, y, r: beyond ±1000 (and not 32767, "unused") refused
 
 
 @dataclass
@@ -50,6 +68,11 @@ class HostileStream:
             self._mission_item,
             self._mission_count,
             self._small_requests,
+            self._mission_requests,
+            self._set_mode,
+            self._manual_control,
+            self._ftp,
+            self._log_requests,
         ]
 
     def frame(self) -> HostileFrame:
@@ -117,6 +140,11 @@ class HostileStream:
         cmd = self.rng.choice((d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_DO_JUMP, d.MAV_CMD_NAV_LAND))
         p = [self._bad(), self._any(), self._any(), self._bad()]
         x, y = self.rng.randint(-(2**31), 2**31 - 1), self.rng.randint(-(2**31), 2**31 - 1)
+        if self.rng.random() < 0.3:  # the old MISSION_ITEM, degrees as floats
+            lat, lon = self._any(), self._any()
+            z = self._bad()
+            msg = self.mav.mission_item_encode(self.sysid, 1, seq, 3, cmd, 0, 1, *p, lat, lon, z)
+            return msg, None
         msg = self.mav.mission_item_int_encode(
             self.sysid, 1, seq, 6, cmd, 0, 1, *p, x, y, self._bad(), 0
         )
@@ -129,14 +157,76 @@ class HostileStream:
         count = self.rng.randint(1, 65535)
         return self.mav.mission_count_encode(self.sysid, 1, count, mission_type), None
 
+    def _component(self) -> int:
+        """This component mostly; every component (0) or another one now and then."""
+        return self.rng.choice((1, 1, 1, 0, self.rng.randint(2, 255)))
+
     def _small_requests(self) -> tuple[object, int | None]:
-        pick = self.rng.randrange(4)
-        if pick == 0:
-            return self.mav.timesync_encode(self.rng.randint(-(2**63), 2**63 - 1), 0), None
+        pick, comp = self.rng.randrange(5), self._component()
+        if pick == 0:  # a request (tc1 0) or somebody's reply, to anyone
+            tc1 = self.rng.choice((0, self.rng.randint(-(2**63), 2**63 - 1)))
+            ts1 = self.rng.randint(-(2**63), 2**63 - 1)
+            return self.mav.timesync_encode(tc1, ts1, self.sysid, comp), None
         if pick == 1:
             index = self.rng.randint(-32768, 32767)
-            return self.mav.param_request_read_encode(self.sysid, 1, b"", index), None
+            name = self.rng.choice(PARAM_NAMES).encode()
+            return self.mav.param_request_read_encode(self.sysid, comp, name, index), None
+        if pick == 2 and self.rng.random() < 0.1:  # the whole list: rarely, it is long
+            return self.mav.param_request_list_encode(self.sysid, comp), None
         if pick == 2:
-            seq = self.rng.randint(0, 65535)
-            return self.mav.mission_request_int_encode(self.sysid, 1, seq, 0), None
-        return self.mav.heartbeat_encode(6, 8, self.rng.randint(0, 255), 0, 4), None
+            return self.mav.heartbeat_encode(6, 8, self.rng.randint(0, 255), 0, 4), None
+        seq = self.rng.randint(0, 65535)
+        if pick == 3:
+            return self.mav.mission_request_int_encode(self.sysid, comp, seq, 0), None
+        return self.mav.mission_request_encode(self.sysid, comp, seq, 0), None
+
+    def _mission_requests(self) -> tuple[object, int | None]:
+        pick, comp = self.rng.randrange(3), self._component()
+        mission_type = self.rng.choice((0, 1, 2, 7, 255))
+        if pick == 0:
+            return self.mav.mission_request_list_encode(self.sysid, comp, mission_type), None
+        if pick == 1:  # no mission here has this many items: the current one stays
+            seq = self.rng.randint(1000, 65535)
+            return self.mav.mission_set_current_encode(self.sysid, comp, seq), None
+        result = self.rng.randint(0, 255)
+        return self.mav.mission_ack_encode(self.sysid, comp, result, mission_type), None
+
+    def _set_mode(self) -> tuple[object, int | None]:
+        """The old SET_MODE message with a mode no encoding names (answered DENIED)."""
+        while True:
+            base, custom = self.rng.randint(0, 255), self.rng.randint(0, 2**32 - 1)
+            if decode_set_mode(base, custom) is None:
+                msg = self.mav.set_mode_encode(self.sysid, base, custom)
+                return msg, SET_MODE_MESSAGE
+
+    def _axis_out_of_range(self) -> int:
+        return self.rng.choice((-1, 1)) * self.rng.randint(AXIS_LIMIT + 1, 32766)
+
+    def _manual_control(self) -> tuple[object, int | None]:
+        """The joystick with at least one axis out of range (refused, never flown)."""
+        axes = [self.rng.randint(-32768, 32767) for _ in range(4)]  # x, y, z, r
+        axes[self.rng.choice((0, 1, 3))] = self._axis_out_of_range()
+        buttons = self.rng.randint(0, 65535)
+        return self.mav.manual_control_encode(self.sysid, *axes, buttons), None
+
+    def _ftp(self) -> tuple[object, int | None]:
+        """A FILE_TRANSFER_PROTOCOL payload: random, or a real opcode with random fields
+        (the server is read-only)."""
+        payload = bytearray(self.rng.randbytes(251))
+        if self.rng.random() < 0.7:
+            payload[3] = self.rng.choice(FTP_OPCODES)
+            payload[4] = self.rng.choice((0, 1, 239, 240, 255))  # data size
+        network = self.rng.choice((0, 0, 0, self.rng.randint(1, 255)))
+        comp = self._component()
+        return self.mav.file_transfer_protocol_encode(network, self.sysid, comp, payload), None
+
+    def _log_requests(self) -> tuple[object, int | None]:
+        pick, comp = self.rng.randrange(3), self._component()
+        if pick == 0:
+            start, end = self.rng.randint(0, 65535), self.rng.randint(0, 65535)
+            return self.mav.log_request_list_encode(self.sysid, comp, start, end), None
+        if pick == 1:  # beyond the end of any log (or none at all): refused, nothing sent
+            log_id = self.rng.randint(0, 65535)
+            ofs, count = self.rng.randint(2**31, 2**32 - 1), self.rng.randint(0, 2**32 - 1)
+            return self.mav.log_request_data_encode(self.sysid, comp, log_id, ofs, count), None
+        return self.mav.log_request_end_encode(self.sysid, comp), None

@@ -120,6 +120,16 @@ def test_set_current_reports_mission_current(bench):
     assert (current.seq, current.total) == (2, 4)
 
 
+def test_set_current_beyond_the_mission_is_refused_and_answered_to_the_sender_only(bench):
+    bench.upload([bench.item(i) for i in range(4)])
+    (decoded,) = bench.parser.parse_buffer(
+        bench.gcs.mission_set_current_encode(1, 1, 9).pack(bench.gcs)
+    )
+    (answer,) = bench.service.handle(decoded, GCS, 0.0)
+    assert answer.to == GCS and answer.msg.seq == 0  # unchanged, and not broadcast
+    assert bench.service.refused == 1
+
+
 def test_torn_mission_file_starts_empty(tmp_path):
     (tmp_path / "mission.json").write_text('[{"seq": 0, "fra')
     assert MissionStore(tmp_path).items[0] == []

@@ -37,8 +37,10 @@ class ModeCommands:
     def __init__(self, port: VehiclePort, autopilot: int) -> None:
         self.port = port
         self.px4 = autopilot == d.MAV_AUTOPILOT_PX4
+        self.service: CommandService | None = None
 
     def register(self, service: CommandService) -> None:
+        self.service = service
         service.register(d.MAV_CMD_DO_SET_MODE, self.do_set_mode)
         service.register(d.MAV_CMD_DO_SET_STANDARD_MODE, self.set_standard_mode)
         service.register(SET_MODE_MESSAGE, self.set_mode_message)
@@ -57,10 +59,19 @@ class ModeCommands:
         seq = self.port.publish_command(command, params)
         return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)
 
+    def _refuse(self, text: str) -> None:
+        """A refusal like a broken rule's: counted, and said at most a few times a second
+        (a flood of SET_MODE had told every link some 500 STATUSTEXT a second)."""
+        if self.service is None:
+            self.port.statustext(text)
+            return
+        self.service.refused += 1
+        self.service.on_refusal(text)
+
     def set_mode(self, mode: FlightMode | None, what: str, custom: int = 0) -> Outcome:
         if mode is None:
             main = (custom >> 16) & 0xFF if custom >= 1 << 16 else -1
-            self.port.statustext(PX4_NOT_FLOWN.get(main, f"{what}: unknown mode"))
+            self._refuse(PX4_NOT_FLOWN.get(main, f"{what}: unknown mode"))
             return Outcome(d.MAV_RESULT_DENIED)
         return self.to_commander(CommandId.SET_MODE, (float(mode),))
 

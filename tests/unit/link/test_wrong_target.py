@@ -11,6 +11,7 @@ from companion.control.mission.store import MissionStore
 from companion.flight_log import LogDirectory
 from companion.link.codec import new_encoder
 from companion.link.command_service import CommandService
+from companion.link.link_router import _target_system
 from companion.link.log_transfer import LogTransferService
 from companion.link.metadata_service import MetadataService
 from companion.link.mission_service import MissionService
@@ -71,3 +72,11 @@ def test_timesync_answers_a_broadcast_and_its_own_component_addressed_to_the_req
     assert timesync.handle(gcs.timesync_encode(0, 123, 1, 2), GCS, 0.0) == []
     assert timesync.rejected_target == 1
     assert timesync.handle(gcs.timesync_encode(7, 123, 1, 1), GCS, 0.0) == []  # a reply
+
+
+def test_a_joystick_for_this_vehicle_is_not_forwarded_as_a_broadcast():
+    gcs = new_encoder(255, 190)
+    assert _target_system(gcs.manual_control_encode(1, 0, 0, 500, 0, 0)) == 1
+    assert _target_system(gcs.manual_control_encode(0, 0, 0, 500, 0, 0)) == 0
+    assert _target_system(gcs.heartbeat_encode(6, 8, 0, 0, 4)) == 0
+    assert _target_system(gcs.param_request_list_encode(3, 1)) == 3
