@@ -1,6 +1,6 @@
 """Pre-arm checks: what must hold before the aircraft may be armed, as ArduPilot and PX4 ask.
 
-Pure: the newest navigation solution, GPS fix and IMU sample (with their own time stamps),
+Pure: the newest navigation solution and sensor samples (with their own time stamps),
 the vehicle time, the mode and the stored lists in; the reasons arming is refused out,
 each worded for a ``PreArm: ...`` STATUSTEXT. The link refuses the arm command with them
 (MAV_RESULT_DENIED) and shows the result in SYS_STATUS; the supervisor adds the checks that
@@ -15,7 +15,16 @@ from dataclasses import dataclass, field
 
 from companion.control.mission.fence import Fence
 from companion.control.mission.items import MissionItem, check_mission
-from companion.messages import FlightMode, GpsFix, Imu, NavFlags, NavState
+from companion.messages import (
+    Baro,
+    Compass,
+    FlightMode,
+    GpsFix,
+    Imu,
+    Magnetometer,
+    NavFlags,
+    NavState,
+)
 from companion.params import ParamDecl
 from mavlink_dialect import companion as d
 
@@ -37,6 +46,11 @@ class Readiness:
     nav: NavState | None = None
     gps: GpsFix | None = None
     imu: Imu | None = None
+    # None: the vehicle has no such sensor (or it has never spoken), which is no failure;
+    # the navigator says whether it can fly without it.
+    mag: Magnetometer | None = None
+    compass: Compass | None = None
+    baro: Baro | None = None
     mode: FlightMode = FlightMode.LOITER
     mission: list[MissionItem] = field(default_factory=list)
     fence: list[MissionItem] = field(default_factory=list)
@@ -69,9 +83,14 @@ def _gps(r: Readiness, params: dict[str, float]) -> list[str]:
 
 
 def _fresh(r: Readiness, params: dict[str, float]) -> list[str]:
+    """Every sensor the vehicle has, fresh: one that stopped is not flown on."""
     stale_us = params["ARMING_STALE_S"] * 1e6
     found = []
-    for name, sample in (("navigation", r.nav), ("GPS", r.gps), ("IMU", r.imu)):
+    samples = (
+        ("navigation", r.nav), ("GPS", r.gps), ("IMU", r.imu), ("magnetometer", r.mag),
+        ("compass", r.compass), ("barometer", r.baro),
+    )  # fmt: skip
+    for name, sample in samples:
         if sample is not None and r.now_us - int(sample.t_us) > stale_us:
             found.append(f"{name} not fresh")
     return found

@@ -27,6 +27,7 @@ from companion.exec_control.registry import load
 from companion.exec_control.zygote import READY_TIMEOUT_S, ForkServer, become_subreaper
 from companion.messages import (
     NAME_LEN,
+    REASON_LEN,
     CommandAck,
     CommandId,
     CommandResult,
@@ -234,5 +235,5 @@ class Supervisor:
         ack = CommandAck(t_us=self.clock.now_us(), seq=cmd.seq, command=cmd.command)
         ack.result = int(result)
         ack.source = b"exec_control"[: NAME_LEN - 1]
-        ack.reason = self.reason.encode()[:47]
+        ack.reason = self.reason.encode()[:REASON_LEN]  # whole: the field fits a PreArm text
         return ack

@@ -13,6 +13,7 @@ from companion.messages.actuators import ActuatorCommand, ServoOutput
 from companion.messages.base import MAX_PLUGINS, NAME_LEN, NAN, Message
 from companion.messages.channels import CHANNELS, Channel, channel
 from companion.messages.control import (
+    REASON_LEN,
     CommandAck,
     CommandId,
     CommandResult,
@@ -51,6 +52,7 @@ __all__ = [
     "NAME_LEN",
     "NAN",
     "RC_MAX_CHANNELS",
+    "REASON_LEN",
     "ActuatorCommand",
     "Baro",
     "Battery",

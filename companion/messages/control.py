@@ -7,6 +7,10 @@ import enum
 
 from companion.messages.base import NAME_LEN, Message
 
+# A refusal's reason, whole: "PreArm: servo device: [Errno 2] No such file or directory:
+# '/dev/...'" runs past 100 bytes; the link sends a long one as STATUSTEXT chunks.
+REASON_LEN = 200
+
 
 class CommandId(enum.IntEnum):
     """Vehicle commands carried on ``link/commands``.
@@ -64,7 +68,7 @@ class CommandAck(Message):
         ("command", ctypes.c_uint16),
         ("result", ctypes.c_uint8),  # CommandResult
         ("source", ctypes.c_char * NAME_LEN),  # who answered
-        ("reason", ctypes.c_char * 48),  # why it was refused (told to the ground station)
+        ("reason", ctypes.c_char * REASON_LEN),  # why it was refused (told to the ground station)
     ]
 
 

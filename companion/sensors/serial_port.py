@@ -50,7 +50,10 @@ def open_problem(url: str, baud: int) -> str | None:
     try:
         serial.serial_for_url(path, baudrate=rate, timeout=0).close()
     except _PORT_ERRORS as exc:
-        return str(getattr(exc, "strerror", None) or exc)
+        text = str(getattr(exc, "strerror", None) or exc)
+        # pyserial names the port twice ("could not open port P: [Errno 2] ...: 'P'"): once
+        # is enough for a STATUSTEXT the operator reads.
+        return text.removeprefix(f"could not open port {path}: ")
     return None
 
 

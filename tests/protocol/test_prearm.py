@@ -49,11 +49,12 @@ def _vehicle(vehicle_factory, tmp_path, servo: str, aligning=False, fix_type=3, 
 
 
 def _arm(gcs: GroundStation, *params: float) -> tuple[int, list[str]]:
-    """The arm command's result and the PreArm texts that came with it."""
+    """The arm command's result and the PreArm texts that came with it (a long one put
+    together from its STATUSTEXT chunks, as QGroundControl does)."""
     while gcs.conn.recv_match(type="STATUSTEXT", blocking=False) is not None:
         pass
     gcs.command(ARM, 1, *params)
-    result, texts = None, []
+    result, texts, chunked = None, [], {}
     deadline = time.monotonic() + 10
     while time.monotonic() < deadline:
         msg = gcs.conn.recv_match(type=["COMMAND_ACK", "STATUSTEXT"], blocking=True, timeout=1.0)
@@ -61,11 +62,14 @@ def _arm(gcs: GroundStation, *params: float) -> tuple[int, list[str]]:
             if result is not None:
                 break  # a quiet second after the ack: every text has come
             continue
-        if msg.get_type() == "STATUSTEXT":
+        if msg.get_type() == "STATUSTEXT" and msg.id:
+            chunked.setdefault(msg.id, []).append((msg.chunk_seq, msg.text))
+        elif msg.get_type() == "STATUSTEXT":
             texts.append(msg.text)
         elif msg.command == ARM:
             result = msg.result
     assert result is not None, "no COMMAND_ACK for the arm command"
+    texts += ["".join(text for _, text in sorted(parts)) for parts in chunked.values()]
     return result, [t for t in texts if t.startswith("PreArm: ")]
 
 
@@ -110,7 +114,10 @@ def test_missing_servo_device_is_refused(vehicle_factory, tmp_path):
     wait_for(lambda: _ready_bit(gcs), 10, "SYS_STATUS says ready (the servo is checked on arming)")
     result, texts = _arm(gcs)
     assert result == m.MAV_RESULT_DENIED
-    assert any(t.startswith("PreArm: servo device") for t in texts), texts
+    # Whole, well past the 48 bytes an ack once carried: the error and the device.
+    whole = [t for t in texts if t.startswith("PreArm: servo device: ")]
+    assert whole and whole[0].startswith("PreArm: servo device: [Errno 2] No such file"), texts
+    assert whole[0].endswith("no-such-tty'") and len(whole[0]) > 100, texts
     assert vehicle.row("servos").pid == 0
     gcs.close()
 

@@ -5,7 +5,16 @@ from __future__ import annotations
 from companion.control.mission.items import MissionItem
 from companion.control.mission.plan import load_plan
 from companion.control.prearm import PREARM_PARAMS, Readiness, failures
-from companion.messages import FlightMode, GpsFix, Imu, NavFlags, NavState
+from companion.messages import (
+    Baro,
+    Compass,
+    FlightMode,
+    GpsFix,
+    Imu,
+    Magnetometer,
+    NavFlags,
+    NavState,
+)
 from mavlink_dialect import companion as d
 from tests.support.vehicle import REPO
 
@@ -40,6 +49,22 @@ def test_each_unready_state_gives_its_reason():
     poor = GpsFix(t_us=NOW, fix_type=3, eph_m=12.0)
     assert failures(_ready(gps=poor), PARAMS) == ["GPS: accuracy 12.0 m, need 5 m"]
     assert failures(_ready(imu=Imu(t_us=NOW - 3_000_000)), PARAMS) == ["IMU not fresh"]
+
+
+def test_every_sensor_the_vehicle_has_must_be_fresh_and_one_it_lacks_is_no_failure():
+    fresh, stale = NOW - 50_000, NOW - 3_000_000
+    sensors = {"mag": Magnetometer, "compass": Compass, "baro": Baro}
+    names = {"mag": "magnetometer", "compass": "compass", "baro": "barometer"}
+    for key, kind in sensors.items():
+        assert failures(_ready(**{key: kind(t_us=fresh)}), PARAMS) == []
+        assert failures(_ready(**{key: kind(t_us=stale)}), PARAMS) == [f"{names[key]} not fresh"]
+    assert failures(_ready(mag=None, compass=None, baro=None), PARAMS) == []  # none fitted
+    all_stale = {key: kind(t_us=stale) for key, kind in sensors.items()}
+    assert failures(_ready(**all_stale), PARAMS) == [
+        "magnetometer not fresh",
+        "compass not fresh",
+        "barometer not fresh",
+    ]
 
 
 def test_mission_mode_needs_a_valid_mission_and_a_fence_must_be_valid():

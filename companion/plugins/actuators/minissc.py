@@ -58,7 +58,7 @@ class MiniSscOutput(Plugin):
     @classmethod
     def prearm(cls, settings: Mapping[str, Any]) -> list[str]:
         problem = open_problem(settings["device"], settings["baud"])
-        return [] if problem is None else [f"servo device: {problem}"[:38]]
+        return [] if problem is None else [f"servo device: {problem}"]
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)

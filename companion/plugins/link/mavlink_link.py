@@ -365,6 +365,7 @@ class MavlinkLink(Plugin):
         items = self.missions.store.items
         r = Readiness(
             now_us=self.ctx.clock.now_us(), nav=snap.nav, gps=snap.gps, imu=snap.imu, mode=mode,
+            mag=snap.mag, compass=snap.compass, baro=snap.baro,
             mission=items[d.MAV_MISSION_TYPE_MISSION], fence=items[d.MAV_MISSION_TYPE_FENCE],
         )  # fmt: skip
         return failures(r, self.store.values)

@@ -22,7 +22,14 @@ from companion.control.flight.landing_flight import land_start
 from companion.control.mission.fence import Fence
 from companion.control.mission.store import MissionStore, StoreFollower
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch
-from companion.messages import NAME_LEN, CommandAck, FlightMode, NavFlags, StatusText
+from companion.messages import (
+    NAME_LEN,
+    REASON_LEN,
+    CommandAck,
+    FlightMode,
+    NavFlags,
+    StatusText,
+)
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
 from mavlink_dialect import companion as d
@@ -136,7 +143,7 @@ class CommanderPlugin(Plugin):
             ack = CommandAck(t_us=self.ctx.clock.now_us(), seq=cmd.seq, command=cmd.command)
             ack.result = int(decision.result)
             ack.source = self.ctx.name.encode()[: NAME_LEN - 1]
-            ack.reason = decision.reason.encode()[:47]
+            ack.reason = decision.reason.encode()[:REASON_LEN]
             self.acks.publish(ack)
             if decision.reason:
                 self.ctx.log.info("refused: %s", decision.reason)
