@@ -37,6 +37,22 @@ def _within(value: float, limit: float) -> bool:
     return abs(value) <= limit
 
 
+def _rate_usable(value: float) -> bool:
+    """A body rate within an IMU's range, or NaN: not measured (gps_compass has no gyro)."""
+    return math.isnan(value) or _within(value, MAX_RATE_RAD_S)
+
+
+def rates_or_zero(nav: NavState) -> NavState:
+    """``nav`` with unmeasured (NaN) body rates as zero: the loops fly without damping terms."""
+    if not any(math.isnan(getattr(nav, f)) for f in NAV_RATES):
+        return nav
+    copy = NavState.from_buffer_copy(nav)
+    for f in NAV_RATES:
+        if math.isnan(getattr(copy, f)):
+            setattr(copy, f, 0.0)
+    return copy
+
+
 def place_usable(lat_deg: float, lon_deg: float, alt_msl_m: float) -> bool:
     """A place on Earth at a sane height (every coordinate given)."""
     return _within(lat_deg, 90.0) and _within(lon_deg, 180.0) and _within(alt_msl_m, MAX_ALT_M)
@@ -52,7 +68,7 @@ def nav_usable(nav: NavState) -> bool:
     return (
         position_usable(nav)
         and all(_within(getattr(nav, f), MAX_ANGLE_RAD) for f in NAV_ANGLES)
-        and all(_within(getattr(nav, f), MAX_RATE_RAD_S) for f in NAV_RATES)
+        and all(_rate_usable(getattr(nav, f)) for f in NAV_RATES)
         and all(_within(getattr(nav, f), MAX_SPEED_M_S) for f in NAV_SPEEDS)
     )
 

@@ -143,6 +143,17 @@ def test_an_infinite_heading_or_a_nan_roll_keeps_the_last_good_output():
     assert controller.rejected == 3
 
 
+def test_a_navigator_without_body_rates_is_flown_without_damping():
+    """gps_compass has no gyro and publishes NaN rates: "not measured", not a broken input."""
+    controller = _controller()
+    for i in range(5):
+        nav = _good_nav(i)
+        nav.roll_rate_rad_s = nav.pitch_rate_rad_s = nav.yaw_rate_rad_s = math.nan
+        out = controller.step(nav, _good_status(4), i * 0.02)
+        _assert_within_travel(out)
+    assert controller.rejected == 0
+
+
 @FAST
 @given(navs=st.lists(st.tuples(NAV_CHANGES, st.booleans(), st.booleans()), min_size=1, max_size=20))
 def test_the_commander_never_takes_what_is_not_a_place_as_home(navs):

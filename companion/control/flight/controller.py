@@ -16,7 +16,7 @@ from companion.control.flight.output import ControlOutput
 from companion.control.flight.params import FlightConfig
 from companion.control.flight.pilot import PILOT_MODES, Sticks, fly_pilot
 from companion.control.flight.takeoff import Phase, RunwayTakeoff
-from companion.control.inputs import nav_usable, status_usable, sticks_usable
+from companion.control.inputs import nav_usable, rates_or_zero, status_usable, sticks_usable
 from companion.control.laws.attitude import AttitudeController
 from companion.control.laws.l1_guidance import L1Guidance, LateralDemand, bank_for
 from companion.control.laws.tecs import Tecs
@@ -103,7 +103,7 @@ class FlightController(LandingFlight):
         if not (usable and sticks_usable(sticks)):
             self.rejected += 1
             return replace(self._last_out, reached=[], disarm=False)
-        self._last_out = self._step(nav, status, t_s, sticks)
+        self._last_out = self._step(rates_or_zero(nav), status, t_s, sticks)
         return self._last_out
 
     def _step(
