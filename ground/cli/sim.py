@@ -157,8 +157,11 @@ def sim(
     noise: Annotated[float, typer.Option(help="sensor noise scale (0: perfect)")] = 1.0,
     mount: Annotated[
         str,
-        typer.Option(help="the sensors' airframe defects: quiet (none), calibrated, uncalibrated"),
-    ] = "quiet",
+        typer.Option(
+            help="the sensors' airframe defects: calibrated (a good compass calibration's "
+            "residue, about 2 degrees), uncalibrated, quiet (none)"
+        ),
+    ] = "calibrated",
     imu_hz: Annotated[float, typer.Option(min=5, max=400, help="IMU output rate")] = 100.0,
     truth: Annotated[Path | None, typer.Option(help="write the true state CSV here")] = None,
     pilot: Annotated[

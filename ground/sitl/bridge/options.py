@@ -34,7 +34,7 @@ class BridgeOptions:
     outages: list[Outage] = field(default_factory=list)
     rates: DeviceRates = field(default_factory=DeviceRates)
     noise_scale: float = 1.0
-    mount: str = "quiet"  # the sensors' airframe defects: one of MOUNTS
+    mount: str = "calibrated"  # the sensors' airframe defects: one of MOUNTS
     seed: int = 1
     duration_s: float | None = None
     truth_path: str | None = None
