@@ -3,7 +3,7 @@
 ``udpout://HOST:PORT`` sends to a ground station (and hears its replies on the same
 socket), ``udpin://HOST:PORT`` listens and answers whoever speaks, ``tcpin://HOST:PORT``
 accepts TCP clients, ``serial:///dev/ttyUSB0:57600`` is a radio modem. Endpoints move
-bytes only; framing, CRC and signing are pymavlink's, one parser per remote.
+bytes only; framing is companion.link.codec's (one parser per remote), CRC and signing pymavlink's.
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ import struct
 from dataclasses import dataclass
 from typing import Any
 
-from companion.link.codec import discard_partial, new_encoder, new_parser
+from companion.link.codec import StreamParser, new_encoder, new_parser
 from companion.link.endpoints import Endpoint, Remote, UdpOut, default_budget
 from companion.link.link_budget import LinkBudget
 from companion.link.service import Outgoing, Peer, Service
@@ -26,7 +26,7 @@ log = logging.getLogger(__name__)
 @dataclass
 class LinkCounters:
     ok: int = 0  # frames decoded
-    bad: int = 0  # CRC failures, truncated frames, garbage
+    bad: int = 0  # rejections: CRC failures, truncated frames, garbage, refused signatures
     forwarded: int = 0
     foreign: int = 0  # addressed to another system
     stream_errors: int = 0  # telemetry samples that could not be encoded
@@ -55,7 +55,7 @@ class LinkRouter:
         self.mav = mav
         self.endpoints = endpoints
         self.services = list(services)
-        self.parsers: dict[tuple[int, Remote], Any] = {}
+        self.parsers: dict[tuple[int, Remote], StreamParser] = {}
         self.routes: dict[int, set[int]] = {}  # sysid → endpoint indexes it was heard on
         self.schedules = [StreamSchedule() for _ in endpoints]
         self.budgets = [LinkBudget(default_budget(e)) for e in endpoints]
@@ -87,22 +87,15 @@ class LinkRouter:
             parser = self.parsers.get((index, remote))
             if parser is None:
                 parser = self.parsers[(index, remote)] = new_parser()
-                configure_parser(parser, self.signing, endpoint.options.signing)
-            try:
-                messages = parser.parse_buffer(data) or []
-            except Exception:  # pymavlink raises on some malformed input even when robust
-                self.counters.bad += 1
-                discard_partial(parser)
-                continue
-            if isinstance(endpoint, UdpOut) and discard_partial(parser):
-                self.counters.bad += 1
+                configure_parser(parser.mav, self.signing, endpoint.options.signing)
+            rejected = parser.counters.rejected
+            # A datagram holds whole frames: one cut short at its end never completes.
+            messages = parser.parse_buffer(data, final=isinstance(endpoint, UdpOut))
+            self.counters.bad += parser.counters.rejected - rejected
             for msg in messages:
                 self._route(msg, index, now_s)
 
     def _route(self, msg: Any, index: int, now_s: float) -> None:
-        if msg.get_type() == "BAD_DATA":
-            self.counters.bad += 1
-            return
         self.counters.ok += 1
         tlog = self.tlogs[index]
         if tlog is not None:

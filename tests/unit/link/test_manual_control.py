@@ -18,7 +18,8 @@ def wire(x: int, y: int, z: int, r: int, target: int = 1):
     """The message as it arrives: packed by QGroundControl's sysid, parsed by the vehicle."""
     gcs = new_encoder(255, 190)
     data = gcs.manual_control_encode(target, x, y, z, r, 0).pack(gcs)
-    return new_parser().parse_char(data)
+    (msg,) = new_parser().parse_buffer(data)
+    return msg
 
 
 def service() -> tuple[ManualControlService, list[PilotInput], list[str]]:
