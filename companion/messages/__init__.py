@@ -35,6 +35,7 @@ from companion.messages.sensors import (
     GpsFixType,
     Imu,
     Magnetometer,
+    RangeReading,
 )
 from companion.messages.simulation import SimClock, SimTruth
 from companion.messages.system import (
@@ -82,6 +83,7 @@ __all__ = [
     "PluginHealth",
     "PluginState",
     "PluginStats",
+    "RangeReading",
     "ServoOutput",
     "SimClock",
     "SimTruth",

@@ -11,7 +11,15 @@ from companion.messages.control import CommandAck, ControlStatus, VehicleCommand
 from companion.messages.link import LinkStatus, MissionChanged, StatusText
 from companion.messages.navigation import NavState
 from companion.messages.pilot import PilotInput
-from companion.messages.sensors import Baro, Battery, Compass, GpsFix, Imu, Magnetometer
+from companion.messages.sensors import (
+    Baro,
+    Battery,
+    Compass,
+    GpsFix,
+    Imu,
+    Magnetometer,
+    RangeReading,
+)
 from companion.messages.simulation import SimClock, SimTruth
 from companion.messages.system import LogProgress, ParamChange, PluginStats, SystemHealth
 
@@ -38,6 +46,7 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("sensors/gps", GpsFix, "queue", 8, "GPS fixes"),
     Channel("sensors/compass", Compass, "queue", 32, "digital compass attitude"),
     Channel("sensors/baro", Baro, "queue", 32, "barometric altitude"),
+    Channel("sensors/range", RangeReading, "latest", doc="downward rangefinder's reading"),
     Channel("sensors/rc", PilotInput, "latest", doc="the RC receiver's newest frame"),
     Channel("sensors/rc_switch", PilotInput, "queue", 8, "frames where the mode switch moved"),
     Channel("link/manual_control", PilotInput, "latest", doc="the ground station's joystick"),

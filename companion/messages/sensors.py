@@ -131,3 +131,21 @@ class Battery(Message):
         ("remaining", ctypes.c_double),  # 0..1 of BATT_CAPACITY; NaN when capacity is 0
         ("level", ctypes.c_uint8),  # BatteryLevel
     ]
+
+
+class RangeReading(Message):
+    """A downward rangefinder's reading: distance along its beam to the ground.
+
+    Producer: sensors.rangefinder. Consumers: control.fixed_wing (the landing's height
+    above the runway), link (DISTANCE_SENSOR, SYS_STATUS), logger.
+    """
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),  # when the device measured it
+        ("distance_m", ctypes.c_double),  # along the beam (body down); -1 when none
+        ("min_distance_m", ctypes.c_double),  # the range it measures (RNGFND1_MIN/MAX)
+        ("max_distance_m", ctypes.c_double),
+        ("ground_clearance_m", ctypes.c_double),  # reading on the wheels (RNGFND1_GNDCLR)
+        ("signal_quality", ctypes.c_uint8),  # MAVLink's: 0 unknown, 1 invalid, 2-100 %
+        ("valid", ctypes.c_uint8),  # 1: in range with enough signal
+    ]

@@ -37,6 +37,11 @@ class LineFramer:
         self._discarding = False  # inside the tail of an over-long line
         self._in_run = False  # the last bytes outside a sentence were garbage
 
+    @property
+    def rejected(self) -> int:
+        """Over-long lines and runs of garbage: what a driver counts as bad frames."""
+        return self.counters.overlong + self.counters.garbage_runs
+
     def feed(self, data: bytes) -> list[bytes]:
         """The sentences completed by this chunk, in order."""
         out: list[bytes] = []

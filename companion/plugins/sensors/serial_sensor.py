@@ -1,8 +1,8 @@
-"""What every line-based serial sensor plug-in does: read, frame, decode, publish, count.
+"""What every serial sensor plug-in does: read, frame, decode, publish, count.
 
 A subclass names its decoder (``make_decoder``) and what a reading becomes on the bus
-(``publish``); the port, the line framing, the time stamp and the health counters are
-here, once.
+(``publish``); the port, the framing (text lines unless ``make_framer`` says otherwise, as
+a binary protocol does), the time stamp and the health counters are here, once.
 """
 
 from __future__ import annotations
@@ -25,6 +25,19 @@ class DecoderCounters(Protocol):
     ok: int
     bad_checksum: int
     garbage: int
+
+
+class Framer(Protocol):
+    """Cuts a byte stream into the device's sentences or frames."""
+
+    @property
+    def rejected(self) -> int:
+        """How many stretches of bytes it has refused as not a sentence or frame."""
+        ...
+
+    def feed(self, data: bytes) -> list[bytes]:
+        """The whole sentences or frames completed by ``data``."""
+        ...
 
 
 class SentenceDecoder(Protocol[ReadingT_co]):
@@ -56,8 +69,12 @@ class SerialSensor(Plugin, Generic[ReadingT]):
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
         self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"])
-        self.framer = LineFramer()
+        self.framer = self.make_framer()
         self.decoder = self.make_decoder(ctx.settings)
+
+    def make_framer(self) -> Framer:
+        """The device's framing: ``$``-sentences ending at CR or LF unless overridden."""
+        return LineFramer()
 
     @abstractmethod
     def make_decoder(self, settings: Mapping[str, Any]) -> SentenceDecoder[ReadingT]:
@@ -74,9 +91,9 @@ class SerialSensor(Plugin, Generic[ReadingT]):
             reading = self.decoder.decode(sentence, t_us)
             if reading is not None:
                 self.publish(reading, t_us)
-        c, f = self.decoder.counters, self.framer.counters
+        c = self.decoder.counters
         self.ctx.health.frames_ok = c.ok
-        self.ctx.health.frames_bad = c.bad_checksum + c.garbage + f.overlong + f.garbage_runs
+        self.ctx.health.frames_bad = c.bad_checksum + c.garbage + self.framer.rejected
 
     def close(self) -> None:
         self.port.close()
