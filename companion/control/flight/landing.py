@@ -19,7 +19,9 @@ PX4 publish for their fixed-wing landings, written here from their descriptions:
 - **Go-around** (``abort()``): full climb power, climb straight out along the runway.
 
 Heights are above the touchdown point's altitude, from the navigator's altitude (which
-fuses the barometer and GPS).
+fuses the barometer and GPS); the flare (when to begin it, its sink demand, the touchdown)
+takes the rangefinder's height instead whenever the state carries one
+(``range_height.py``: valid, fresh, wings near level), as ArduPlane's ``RNGFND_LANDING``.
 """
 
 from __future__ import annotations
@@ -75,6 +77,8 @@ LANDING_PARAMS = (
     ParamDecl("LAND_FLAP_PERCNT", 0.0, 0.0, 100.0, "%", "landing: flaps on the approach"),
     ParamDecl("RTL_AUTOLAND", 0.0, 0.0, 2.0, "", "Return lands at DO_LAND_START: 1 after "
               "reaching home, 2 at once"),
+    ParamDecl("RNGFND_LANDING", 1.0, 0.0, 1.0, "", "landing: flare on the rangefinder's "
+              "height when it has a fresh valid reading (no effect without one)"),
 )  # fmt: skip
 
 
@@ -124,6 +128,7 @@ class AircraftState:
     pitch: float
     yaw: float
     yaw_rate: float
+    range_height: float = math.nan  # m above the ground by the rangefinder; NaN: none usable
 
 
 class Landing:
@@ -205,7 +210,7 @@ class Landing:
 
     def step(self, s: AircraftState, v: Mapping[str, float], dt: float) -> LandingDemand:
         """The demand for this step; ``v`` holds the parameters by name."""
-        height = s.alt_msl - self.land_alt
+        height = s.range_height if math.isfinite(s.range_height) else s.alt_msl - self.land_alt
         ground_speed = math.hypot(*s.vel)
         if self.phase == LandPhase.APPROACH and self._flare_due(height, s.climb_rate, v):
             self.phase = LandPhase.FLARE

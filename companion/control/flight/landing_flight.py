@@ -13,10 +13,11 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from companion.control.flight.landing import AircraftState, Landing, LandingDemand, LandPhase
+from companion.control.flight.range_height import range_height
 from companion.control.laws.l1_guidance import bank_for
 from companion.control.mission.executor import Kind, MissionExecutor, Setpoint
 from companion.control.mission.items import MissionItem
-from companion.messages import FlightMode, NavState, VehicleStatus
+from companion.messages import FlightMode, NavState, RangeReading, VehicleStatus
 from mavlink_dialect import companion as d
 
 if TYPE_CHECKING:
@@ -47,6 +48,10 @@ def approach_start(items: list[MissionItem], land_index: int) -> int:
 class LandingFlight:
     """The landing half of the flight controller (see the module's docstring)."""
 
+    # The rangefinder's newest reading, set by whoever steps the controller (None: none).
+    range_reading: RangeReading | None = None
+    range_steps = 0  # landing steps that flew on the rangefinder's height
+
     def _fly_landing(
         self: FlightController,
         sp: Setpoint,
@@ -64,8 +69,11 @@ class LandingFlight:
         if status.go_arounds != self.go_arounds:
             land.abort()
         vel = (nav.vn_m_s, nav.ve_m_s)
+        agl = range_height(self.range_reading, nav.t_us, nav.roll_rad, nav.pitch_rad,
+                           self.config["RNGFND_LANDING"])  # fmt: skip
+        self.range_steps += math.isfinite(agl)
         state = AircraftState(pos, vel, nav.alt_msl_m, -nav.vd_m_s, nav.pitch_rad, nav.yaw_rad,
-                              nav.yaw_rate_rad_s)  # fmt: skip
+                              nav.yaw_rate_rad_s, agl)  # fmt: skip
         dem = land.step(state, self.config, dt)
         out.land_phase = int(dem.phase)
         out.flaps, out.brakes = dem.flaps, dem.brakes

@@ -6,7 +6,8 @@ normalised surface commands out on ``control/actuators`` (the servo plug-in turn
 into bytes),
 and guidance and mission progress on ``control/status`` for the link. Every gain, limit
 and speed is a parameter: the airframe file gives the defaults, the ground station may
-change them in flight (they arrive on ``params/changes``).
+change them in flight (they arrive on ``params/changes``). A landing flares on the
+rangefinder's height (``sensors/range``) when it has a usable one (``range_height.py``).
 """
 
 from __future__ import annotations
@@ -56,6 +57,7 @@ class FixedWingPlugin(Plugin):
         "sensors/rc",
         "link/manual_control",
         "actuators/servos",
+        "sensors/range",
     )
     outputs = ("control/actuators", "control/status", "link/commands")
 
@@ -87,6 +89,8 @@ class FixedWingPlugin(Plugin):
         self.mission_changes = bus.latest_reader("mission/changed")
         self.rc = bus.latest_reader("sensors/rc")
         self.joystick = bus.latest_reader("link/manual_control")
+        self.range = bus.latest_reader("sensors/range")
+        self.range_said = False  # the log says once when a landing flies on the range
         self.surfaces = bus.writer("control/actuators")
         self.servo_answers = bus.latest_reader("actuators/servos")
         self.output_waited = False
@@ -123,7 +127,11 @@ class FixedWingPlugin(Plugin):
         # The receiver first: a safety pilot's sticks win over the ground station's joystick.
         sticks = pilot_sticks(nav.t_us, self.rc.get(), self.joystick.get())
         rejected = self.controller.rejected
+        self.controller.range_reading = self.range.get()
         out = self.controller.step(nav, status, nav.t_us / 1e6, sticks)
+        if self.controller.range_steps and not self.range_said:
+            self.ctx.log.info("landing: flaring on the rangefinder's height")
+            self.range_said = True
         self._count(self.controller.rejected > rejected, nav.t_us)
         cmd = ActuatorCommand(t_us=nav.t_us, armed=1)
         cmd.aileron, cmd.elevator, cmd.rudder = out.aileron, out.elevator, out.rudder
@@ -155,7 +163,10 @@ class FixedWingPlugin(Plugin):
     def _disarm(self, now_us: int, out: ControlOutput, status: VehicleStatus) -> None:
         # The ground station hears the mission complete before the controller stops.
         self.status_out.publish(self._status(now_us, out, status))
-        self.ctx.log.info("landed and stopped: disarming")
+        self.ctx.log.info(
+            "landed and stopped: disarming (%d landing steps on the rangefinder's height)",
+            self.controller.range_steps,
+        )
         self.commands.publish(VehicleCommand(t_us=now_us, command=int(CommandId.STOP)))
         self.disarm_sent = True
 
