@@ -1,5 +1,5 @@
-"""SYS_STATUS and BATTERY_STATUS: which sensors the vehicle has, whether each is healthy,
-and its battery, as QGroundControl's sensor list and battery indicator show them.
+"""SYS_STATUS, BATTERY_STATUS and DISTANCE_SENSOR: which sensors the vehicle has, whether
+each is healthy, its battery and its rangefinder, as QGroundControl shows them.
 
 A sensor is present (and enabled) once it has published since boot, and healthy while its
 newest sample is recent by the samples' own time stamps against the vehicle clock (never
@@ -25,6 +25,9 @@ STALE_US = {"imu": 500_000, "mag": 1_000_000, "baro": 1_000_000, "gps": 2_000_00
 # for FS_LONG_TIMEOUT; the sensor list says at once that the radio is gone.
 RC_STALE_US = 1_000_000
 BATTERY_STALE_US = 2_000_000
+# A TFmini sends 100 frames a second. Out of range (high above the ground) is healthy:
+# only a silent device is not.
+RANGE_STALE_US = 500_000
 UNKNOWN_CELL_MV = 65535
 CHARGE_STATE = {
     BatteryLevel.OK: d.MAV_BATTERY_CHARGE_STATE_OK,
@@ -67,6 +70,10 @@ def sensor_bits(s: Snapshot) -> tuple[int, int]:
         present |= d.MAV_SYS_STATUS_SENSOR_BATTERY
         if fresh(s.battery, s.now_us, BATTERY_STALE_US) and s.battery.level == BatteryLevel.OK:
             healthy |= d.MAV_SYS_STATUS_SENSOR_BATTERY
+    if s.rangefinder is not None:
+        present |= d.MAV_SYS_STATUS_SENSOR_LASER_POSITION
+        if fresh(s.rangefinder, s.now_us, RANGE_STALE_US):
+            healthy |= d.MAV_SYS_STATUS_SENSOR_LASER_POSITION
     if s.nav is not None:
         present |= d.MAV_SYS_STATUS_AHRS
         if s.nav.flags & NavFlags.ATTITUDE_VALID:
@@ -131,4 +138,26 @@ def battery_status(mav: Any, s: Snapshot) -> Any:
         left,
         0,  # time remaining: not provided
         state,
+    )
+
+
+def distance_sensor(mav: Any, s: Snapshot) -> Any:
+    """The downward lidar (id 0, pointing down); out of range reads one past its maximum,
+    with signal quality 1 (invalid), as MAVLink asks. None without a rangefinder."""
+    r = s.rangefinder
+    if r is None:
+        return None
+    low = _scaled(r.min_distance_m, 100, 0, 65534, 0)
+    high = _scaled(r.max_distance_m, 100, 0, 65534, 0)
+    now = _scaled(r.distance_m, 100, 0, 65535, high + 1) if r.valid else high + 1
+    return mav.distance_sensor_encode(
+        s.time_boot_ms,
+        low,
+        high,
+        now,
+        d.MAV_DISTANCE_SENSOR_LASER,
+        0,
+        d.MAV_SENSOR_ROTATION_PITCH_270,
+        255,  # covariance unknown
+        signal_quality=r.signal_quality,
     )

@@ -15,7 +15,12 @@ from companion.link import flight_messages
 from companion.link.codec import dialect as d
 from companion.link.flight_messages import landed_state, mission_current, nav_controller_output
 from companion.link.mode_messages import available_modes_monitor, current_mode
-from companion.link.system_messages import battery_status, sensor_bits, sys_status
+from companion.link.system_messages import (
+    battery_status,
+    distance_sensor,
+    sensor_bits,
+    sys_status,
+)
 from companion.messages import (
     Baro,
     Battery,
@@ -27,6 +32,7 @@ from companion.messages import (
     NavFlags,
     NavState,
     PilotInput,
+    RangeReading,
     ServoOutput,
     SystemHealth,
     VehicleStatus,
@@ -52,6 +58,7 @@ class Snapshot:
     health: SystemHealth | None = None
     servos: ServoOutput | None = None
     rc: PilotInput | None = None  # the RC receiver's newest frame
+    rangefinder: RangeReading | None = None  # the downward lidar's newest reading
     status: VehicleStatus | None = None
     control: ControlStatus | None = None  # None while the flight controller is not running
     home_alt_m: float = math.nan
@@ -294,6 +301,7 @@ STREAMS: dict[int, Stream] = {
         Stream("VFR_HUD", d.MAVLINK_MSG_ID_VFR_HUD, 4.0, _vfr_hud),
         Stream("SYS_STATUS", d.MAVLINK_MSG_ID_SYS_STATUS, 1.0, sys_status),
         Stream("BATTERY_STATUS", d.MAVLINK_MSG_ID_BATTERY_STATUS, 0.5, battery_status),
+        Stream("DISTANCE_SENSOR", d.MAVLINK_MSG_ID_DISTANCE_SENSOR, 2.0, distance_sensor),
         Stream("SYSTEM_TIME", d.MAVLINK_MSG_ID_SYSTEM_TIME, 0.5, _system_time),
         Stream("SERVO_OUTPUT_RAW", d.MAVLINK_MSG_ID_SERVO_OUTPUT_RAW, 2.0, _servo_output),
         Stream("RC_CHANNELS", d.MAVLINK_MSG_ID_RC_CHANNELS, 2.0, flight_messages.rc_channels),

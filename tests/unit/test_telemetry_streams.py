@@ -7,7 +7,15 @@ from hypothesis import strategies as st
 
 from companion.link.codec import new_encoder, new_parser
 from companion.link.telemetry import STREAMS, Snapshot
-from companion.messages import Battery, ControlStatus, GpsFix, Imu, NavFlags, NavState
+from companion.messages import (
+    Battery,
+    ControlStatus,
+    GpsFix,
+    Imu,
+    NavFlags,
+    NavState,
+    RangeReading,
+)
 
 floats = st.floats(allow_nan=True, allow_infinity=True, width=64)
 
@@ -25,6 +33,9 @@ def test_every_stream_encodes_whatever_the_sensors_say(ax, gz, roll, lat, vn, al
     snap = Snapshot(time_boot_ms=5, nav=nav, imu=Imu(t_us=1, ax_m_s2=ax, gz_rad_s=gz), gps=gps)
     snap.control = ControlStatus(t_us=1, airspeed_m_s=speed, throttle=roll)
     snap.battery = Battery(t_us=1, voltage_v=alt, current_a=vn, consumed_mah=lat, remaining=ax)
+    snap.rangefinder = RangeReading(
+        t_us=1, distance_m=alt, min_distance_m=ax, max_distance_m=gz, valid=1, signal_quality=50
+    )
     for stream in STREAMS.values():
         msg = stream.build(mav, snap)  # must not raise, whatever the values
         if msg is not None:
@@ -125,3 +136,34 @@ def test_sys_status_lists_the_rc_receiver_healthy_while_its_radio_is_heard():
     silent = sys_status.build(mav, snap)
     assert silent.onboard_control_sensors_present & rc_bit
     assert silent.onboard_control_sensors_health & rc_bit == 0
+
+
+def test_the_rangefinder_is_listed_healthy_while_heard_and_sent_as_distance_sensor():
+    from mavlink_dialect import companion as d
+
+    mav = new_encoder(1)
+    bit = d.MAV_SYS_STATUS_SENSOR_LASER_POSITION
+    sys_status, distance = (
+        STREAMS[d.MAVLINK_MSG_ID_SYS_STATUS],
+        STREAMS[d.MAVLINK_MSG_ID_DISTANCE_SENSOR],
+    )
+    assert (
+        sys_status.build(mav, Snapshot(now_us=10_000_000)).onboard_control_sensors_present & bit
+        == 0
+    )
+    assert distance.build(mav, Snapshot()) is None
+    reading = RangeReading(
+        t_us=9_990_000, distance_m=3.45, min_distance_m=0.1, max_distance_m=12.0,
+        ground_clearance_m=0.1, signal_quality=80, valid=1,
+    )  # fmt: skip
+    snap = Snapshot(now_us=10_000_000, rangefinder=reading)
+    heard = sys_status.build(mav, snap)
+    assert heard.onboard_control_sensors_present & heard.onboard_control_sensors_health & bit
+    msg = distance.build(mav, snap)
+    assert (msg.current_distance, msg.min_distance, msg.max_distance) == (345, 10, 1200)
+    assert msg.orientation == d.MAV_SENSOR_ROTATION_PITCH_270 and msg.signal_quality == 80
+    reading.valid, reading.signal_quality = 0, 1  # high above the ground: still healthy
+    assert sys_status.build(mav, snap).onboard_control_sensors_health & bit
+    assert distance.build(mav, snap).current_distance == 1201
+    snap.now_us = 10_600_000  # silent for 0.61 s
+    assert sys_status.build(mav, snap).onboard_control_sensors_health & bit == 0

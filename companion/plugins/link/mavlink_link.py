@@ -99,6 +99,7 @@ class MavlinkLink(Plugin):
         "sensors/compass",
         "sensors/baro",
         "sensors/battery",
+        "sensors/range",
         "actuators/servos",
         "vehicle/status",
         "system/health",
@@ -182,7 +183,8 @@ class MavlinkLink(Plugin):
     def _readers(bus: Any) -> dict[str, Any]:  # queues are drained to their newest sample
         latest = {"nav": "nav/state", "health": "system/health", "servos": "actuators/servos",
                   "status": "vehicle/status", "control": "control/status",
-                  "rc": "sensors/rc", "battery": "sensors/battery"}  # fmt: skip
+                  "rc": "sensors/rc", "battery": "sensors/battery",
+                  "rangefinder": "sensors/range"}  # fmt: skip
         readers = {key: bus.latest_reader(name) for key, name in latest.items()}
         for key in ("gps", "imu", "mag", "compass", "baro"):
             readers[key] = bus.queue_reader(f"sensors/{key}")
@@ -256,13 +258,11 @@ class MavlinkLink(Plugin):
         s, r = self.snapshot, self.readers
         s.nav, s.health, s.servos = r["nav"].get(), r["health"].get(), r["servos"].get()
         s.status, s.rc, s.battery = r["status"].get(), r["rc"].get(), r["battery"].get()
+        s.rangefinder = r["rangefinder"].get()
         s.control = self._fresh_control()
         s.now_us = self.ctx.clock.now_us()
         for key in ("gps", "imu", "mag", "compass", "baro"):
-            latest = None
-            for latest in r[key].drain():  # noqa: B007 - only the newest matters here
-                pass
-            if latest is not None:
+            for latest in r[key].drain():  # the newest is left in the snapshot
                 setattr(s, key, latest)
         if s.status is not None and s.status.home_valid:  # home is the commander's alone
             s.home = (s.status.home_lat_deg, s.status.home_lon_deg, s.status.home_alt_msl_m)
