@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 import signal
 from pathlib import Path
 
+import pytest
 from pyulog import ULog
 from pyulog.exceptions import ULogException
 
@@ -57,14 +59,43 @@ def kill_everything(vehicle: Vehicle) -> None:
     vehicle.proc.wait(timeout=10)
 
 
-def test_an_armed_flight_is_logged_and_readable_after_kill_9(vehicle_factory, tmp_path):
+class PublishedImu:
+    """The IMU samples published on the bus, as the test's own reader sees them, each
+    with the sensor time elapsed since the first (a replay that loops starts its stamps
+    again from the log's first one at once: no time passes at the wrap)."""
+
+    def __init__(self, vehicle: Vehicle) -> None:
+        assert vehicle.bus is not None
+        self.reader = vehicle.bus.queue_reader("sensors/imu")
+        self.ax: list[float] = []
+        self.elapsed_us: list[int] = []
+        self.last_us: int | None = None
+
+    def read(self) -> int:
+        for msg in self.reader.drain():
+            step = 0 if self.last_us is None else max(int(msg.t_us) - self.last_us, 0)
+            self.elapsed_us.append((self.elapsed_us[-1] if self.elapsed_us else 0) + step)
+            self.last_us = int(msg.t_us)
+            self.ax.append(float(msg.ax_m_s2))
+        assert self.reader.lost == 0, "the test's reader fell behind"
+        return len(self.ax)
+
+
+# The promise: a power cut loses at most the last flush interval (1 s by default) of
+# samples. The margin is the logger's read period (20 ms) and the scheduling of a busy
+# machine between the drain it last flushed and the flush itself.
+MARGIN_S = 0.3
+
+
+@pytest.mark.parametrize("flush_s", [0.2, 1.0])
+def test_an_armed_flight_is_logged_and_readable_after_kill_9(vehicle_factory, tmp_path, flush_s):
     sensor_log = tmp_path / "flight.csv"
     make_sensor_log(sensor_log)
     state = tmp_path / "state"
     vehicle = vehicle_factory(
         vehicle_config(
             "logged",
-            plugin("logger", "system.logger", flush_s=0.2, airframe="x8"),
+            plugin("logger", "system.logger", flush_s=flush_s, airframe="x8"),
             # In the flight group: it plays (in a loop) once armed, as sensors would fly.
             plugin("replay", "sensors.replay", group="flight", file=sensor_log, loop=True),
             state_dir=state,
@@ -72,12 +103,16 @@ def test_an_armed_flight_is_logged_and_readable_after_kill_9(vehicle_factory, tm
     )
     # Armed only once the logger reads (its first step done), so it sees the first sample.
     wait_for(lambda: (r := vehicle.row("logger")) is not None and r.step_p50_us > 0, 30, "logger")
+    published = PublishedImu(vehicle)  # from before the arming: every sample the replay plays
     vehicle.bus.writer("link/commands").publish(
         VehicleCommand(t_us=0, seq=1, command=int(CommandId.START))
     )
     logs = state / "logs"
     # The samples reach the disk while the vehicle runs: more than one pass of the log.
-    wait_for(lambda: len(imu_ax(read_log(logs))) > ROWS + 10, 30, "a log on disk")
+    wait_for(
+        lambda: published.read() and len(imu_ax(read_log(logs))) > ROWS + 10, 30, "a log on disk"
+    )
+    published.read()  # the newest sample published just before the cut
     kill_everything(vehicle)
 
     files = sorted(logs.glob("*.ulg"))
@@ -86,6 +121,13 @@ def test_an_armed_flight_is_logged_and_readable_after_kill_9(vehicle_factory, tm
     ax = imu_ax(ulog)
     assert len(ax) > ROWS + 10
     assert ax == [float(i % ROWS) for i in range(len(ax))]  # in order, none lost or repeated
+    # The cut lost at most the last flush interval: the newest sample on disk is the one
+    # published that much sensor time before the newest the bus carried.
+    on_disk = min(len(ax), len(published.ax))  # the cut may come after a newer one
+    assert published.ax[:on_disk] == ax[:on_disk]
+    lost_s = (published.elapsed_us[-1] - published.elapsed_us[on_disk - 1]) / 1e6
+    logging.getLogger(__name__).info("kill -9 lost %.3f s of IMU samples", lost_s)
+    assert lost_s <= flush_s + MARGIN_S, (lost_s, len(published.ax), len(ax))
     assert ulog is not None
     assert ulog.msg_info_dict["vehicle_name"] == "logged"
     assert ulog.msg_info_dict["sys_name"] == "companion"
