@@ -6,11 +6,13 @@ pattern (DO_LAND_START, camera stops, LOITER_TO_ALT, NAV_LAND); the aircraft is 
 the mission started. In a 5 m/s crosswind with light turbulence it lands on the target
 (within 30 m along and 3 m across), touches down at no more than 1.5 m/s with the wings
 within 10° of level and no bounce over 1 m, stops on the runway, and disarms itself;
-the ground station sees the landed state go TAKEOFF, IN_AIR, LANDING, ON_GROUND.
+the ground station sees the landed state go TAKEOFF, IN_AIR, LANDING, ON_GROUND; the
+flare flies on the simulated TFmini's height.
 """
 
 from __future__ import annotations
 
+import re
 import time
 from pathlib import Path
 
@@ -106,3 +108,6 @@ def test_the_c172_lands_its_qgc_landing_pattern_in_a_crosswind_and_disarms(tmp_p
     assert states[states.index(flown[0]) :][:4] == [*flown, d.MAV_LANDED_STATE_ON_GROUND], states
     score = landing_score_for_plan(read_estimate(truth_path), items)
     assert score.passed(), score
+    # The simulated TFmini was in range: the flare flew on its height, not the navigator's.
+    used = re.search(r"disarming \((\d+) landing steps on the rangefinder's height\)", out)
+    assert used is not None and int(used.group(1)) > 0, out[-3000:]

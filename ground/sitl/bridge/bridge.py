@@ -35,7 +35,7 @@ from ground.sitl.bridge.vehicle_commands import VehicleCommands
 
 log = logging.getLogger(__name__)
 
-SENSORS = ("gps", "compass", "imu", "rc")
+SENSORS = ("gps", "compass", "imu", "rc", "range")
 # What the vehicle's driver of each emulated device publishes (the sim config's drivers).
 DEVICE_CHANNELS = {
     "imu": ("sensors/imu", "sensors/mag", "sensors/baro"),
@@ -44,6 +44,7 @@ DEVICE_CHANNELS = {
     # A Latest channel: the controller and the commander read the sticks' newest frame, so
     # that frame must be this one's, not the one the receiver process had got to.
     "rc": ("sensors/rc",),
+    "range": ("sensors/range",),  # the landing's flare steers by it
 }
 STANDARD_PRESSURE_KPA = 101.325
 FAST_LAG_PERIODS = 1  # fast lockstep: how many nav/state periods the vehicle may trail
@@ -86,6 +87,7 @@ class SimBridge:
             if servo.surface == "brakes":  # held at their safe setting until commanded
                 self.flight.set_controls({"brakes": servo.command(servo.trim)})
         self.devices = _devices(opts)
+        self.devices.rest_agl_m = self.flight.rest_agl_m
         self.failures = DeviceFailures(opts.seed)
         pilot = load_pilot(opts.pilot_path) if opts.pilot_path else None
         self.receiver = EmulatedReceiver(pilot, opts.rates.rc_hz)

@@ -1,5 +1,5 @@
 """The emulated devices' bytes: NMEA GPS, the OS-3000 ``$C`` sentence, VectorNav ``$VNIMU``,
-and the battery monitor's ``$PCBAT``.
+the battery monitor's ``$PCBAT`` and a Benewake TFmini-S lidar's 9-byte frame.
 
 Each device turns the true state (through ``SensorErrors``) into the exact text the real
 part sends, at its own rate. NMEA is rendered by pynmea2 and the other sentences are
@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import datetime as dt
 import math
+import struct
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,6 +24,11 @@ from ground.simulation.true_state import TrueState
 KNOT_M_S = 0.514444
 _VNIMU_FORMAT = "VNIMU," + ",".join(["%+.4f"] * 9) + ",%+.1f,%+.3f"
 UTC_EPOCH = dt.datetime(2026, 1, 1, tzinfo=dt.UTC)  # simulation time 0
+# The lidar looks straight down from under the fuselage, reading this on the wheels (as
+# ArduPilot's default RNGFND1_GNDCLR), and measures 0.1-12 m as a TFmini-S does indoors.
+LIDAR_CLEARANCE_M = 0.1
+LIDAR_RANGE_M = (0.1, 12.0)
+LIDAR_NOISE_M = 0.02
 
 
 def _ddmm(value: float, positive: str, negative: str, width: int) -> tuple[str, str]:
@@ -109,6 +115,26 @@ def battery_sentence(voltage_v: float, current_a: float) -> bytes:
     return checked(f"PCBAT,{round(voltage_v * 1000)},{round(current_a * 1000)}")
 
 
+def tfmini_frame(dist_cm: int, strength: int, temp_c: float = 25.0) -> bytes:
+    """A TFmini-S frame as its manual draws it: 0x59 0x59, distance (cm), strength and
+    temperature (raw = (°C + 256) * 8) as little-endian uint16, then the low byte of the
+    sum of those eight bytes. A distance of -1 (0xFFFF) is the device's "no reading"."""
+    temp_raw = round((temp_c + 256.0) * 8.0)
+    body = struct.pack("<BBHHH", 0x59, 0x59, dist_cm & 0xFFFF, strength, temp_raw)
+    return body + struct.pack("<B", sum(body) & 0xFF)
+
+
+def lidar_reading(height_m: float, roll: float, pitch: float, noise_m: float) -> tuple[int, int]:
+    """(distance cm, strength) a downward lidar at ``height_m`` over flat ground reads:
+    along its tilted beam, weaker with distance; beyond its range -1 and a weak return."""
+    tilt = math.cos(roll) * math.cos(pitch)
+    distance = height_m / tilt + noise_m if tilt > 0.1 else math.inf
+    lo, hi = LIDAR_RANGE_M
+    if not lo <= distance <= hi:
+        return -1, 20
+    return round(distance * 100.0), round(3000.0 / (1.0 + distance))
+
+
 @dataclass
 class Outage:
     """A window of simulation time with no GPS fix."""
@@ -134,6 +160,7 @@ class DeviceRates:
     gps_latency_jitter_s: float = 0.03
     rc_hz: float = 50.0  # SBUS receivers send every 7-20 ms
     battery_hz: float = 10.0
+    range_hz: float = 100.0  # a TFmini's default frame rate
 
 
 class EmulatedDevices:
@@ -147,11 +174,13 @@ class EmulatedDevices:
         self.errors, self.rates, self.outages = errors, rates, outages
         # Its own stream, so the latency draws leave the sensors' errors as they were.
         self.latency_rng = np.random.default_rng([seed, 1])
-        self.next_s = {"imu": 0.0, "compass": 0.0, "gps": 0.0, "battery": 0.0}
+        self.next_s = {"imu": 0.0, "compass": 0.0, "gps": 0.0, "battery": 0.0, "range": 0.0}
         self.last_imu_s = 0.0
         self.last_gps_s = 0.0
         self.battery = BatteryModel()
         self.last_battery_s: float | None = None
+        self.lidar_rng = np.random.default_rng([seed, 2])  # apart, as the latency's
+        self.rest_agl_m = 0.0  # the truth's height above ground standing on the wheels
 
     def due(
         self, s: TrueState, pressure_kpa: float, throttle: float = 0.0
@@ -176,6 +205,11 @@ class EmulatedDevices:
         if t + 1e-9 >= self.next_s["gps"]:
             out.append(("gps", t + self._gps_latency_s(), self._gps(s)))
             self.next_s["gps"] += 1.0 / self.rates.gps_hz
+        if t + 1e-9 >= self.next_s["range"]:
+            height = s.alt_agl_m - self.rest_agl_m + LIDAR_CLEARANCE_M
+            noise = float(self.lidar_rng.normal(0.0, LIDAR_NOISE_M))
+            out.append(("range", t, tfmini_frame(*lidar_reading(height, s.roll, s.pitch, noise))))
+            self.next_s["range"] += 1.0 / self.rates.range_hz
         return out
 
     def _gps_latency_s(self) -> float:

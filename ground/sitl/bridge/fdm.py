@@ -54,6 +54,7 @@ class Flight:
         self.home = home
         self.turbulence = False
         self.brake_channel = False  # until a brakes servo is heard, idle means brakes
+        self.rest_agl_m = 0.0  # the reference point's height on the wheels (0: not known)
         self._initial_conditions(model, airborne_agl_m, speed_m_s)
         if airborne_agl_m and bank_deg:
             self._bank(bank_deg)
@@ -105,6 +106,7 @@ class Flight:
         for _ in range(round(SETTLE_S / f.get_delta_t())):
             f.run()
         rest_agl_ft, rest_pitch_deg = f["position/h-agl-ft"], f["attitude/theta-deg"]
+        self.rest_agl_m = rest_agl_ft * FT
         h = self.home
         f["ic/lat-geod-deg"], f["ic/long-gc-deg"] = h.lat_deg, h.lon_deg
         f["ic/psi-true-deg"] = h.heading_deg
