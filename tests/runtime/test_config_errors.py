@@ -149,7 +149,7 @@ def test_an_unknown_simulated_device_is_named(tmp_path):
 
 
 def test_the_shipped_sim_config_loads_with_the_bridge_devices():
-    devices = ("gps", "compass", "imu", "rc", "battery", "servos")  # the bridge's ptys
+    devices = ("gps", "compass", "imu", "rc", "range", "battery", "servos")  # the bridge's ptys
     refs = {n: f"/dev/pts/{i}" for i, n in enumerate(devices)}
     cfg = load_config(REPO / "companion/configs/sim.toml", sim_refs={**refs, "airframe": "J3Cub"})
     check_topology(cfg)
