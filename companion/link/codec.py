@@ -3,19 +3,31 @@ the parser that finds its frames in a byte stream however much garbage surrounds
 
 from __future__ import annotations
 
+import hashlib
+import hmac
 import re
 from dataclasses import dataclass
 from typing import Any
 
 from mavlink_dialect import companion as dialect
 
-__all__ = ["ParserCounters", "StreamParser", "dialect", "new_encoder", "new_parser"]
+__all__ = [
+    "ParserCounters",
+    "SigningMAVLink",
+    "StreamParser",
+    "dialect",
+    "new_encoder",
+    "new_parser",
+    "signature_verdict",
+]
 
 V1, V2 = dialect.PROTOCOL_MARKER_V1, dialect.PROTOCOL_MARKER_V2
 HEADER_LEN = {V1: dialect.HEADER_LEN_V1, V2: dialect.HEADER_LEN_V2}  # start byte included
 SIGNED = dialect.MAVLINK_IFLAG_SIGNED
 SIGNATURE_LEN = dialect.MAVLINK_SIGNATURE_BLOCK_LEN
 CRC_LEN = 2
+SIGNED_PART = -6  # a signature covers the frame up to its own 6 bytes (timestamp included)
+ONE_MINUTE = 6_000_000  # in signing units (10 µs): how far behind ours a timestamp may be
 _START = re.compile(b"[\xfd\xfe]")
 # A header must name a message we know and a payload no longer than that message's:
 # msgid → (CRC extra, longest payload). An unknown id cannot be checksummed (its CRC extra
@@ -44,13 +56,56 @@ class ParserCounters:
     bad_crc: int = 0  # checksum failed: a corrupted frame, or a start byte in garbage
     bad_header: int = 0  # unknown message id, a payload longer than the message, bad flags
     truncated: int = 0  # still incomplete where its datagram ended
-    refused: int = 0  # good checksum, refused all the same: signature, unpacking
+    bad_signature: int = 0  # signed, but not with our key (or unsigned where it must be)
+    replayed: int = 0  # well signed, but not newer than its stream's last, or a minute stale
+    refused: int = 0  # good checksum, refused all the same: unpacking
     garbage: int = 0  # runs of bytes before any start byte
     dropped_bytes: int = 0  # every byte outside an accepted or refused frame
 
     @property
     def rejected(self) -> int:
-        return self.bad_crc + self.bad_header + self.truncated + self.refused + self.garbage
+        refused = self.bad_signature + self.replayed + self.refused
+        return self.bad_crc + self.bad_header + self.truncated + refused + self.garbage
+
+
+class SigningMAVLink(dialect.MAVLink):
+    """pymavlink's decoder with the signature check in the order the spec and the C library
+    use. pymavlink's own ``check_signature`` stores a frame's timestamp as its stream's
+    newest before it compares the signature, so one forged frame with a far-future
+    timestamp on a real (sysid, compid, link id) made the real sender's frames replays
+    from then on. ``verdict`` says why the last signed frame was refused ("" if it was not).
+    """
+
+    verdict = ""
+
+    def check_signature(self, msgbuf: bytearray, sysid: int, compid: int) -> bool:
+        self.verdict = signature_verdict(self.signing, bytes(msgbuf), sysid, compid)
+        return not self.verdict
+
+
+def signature_verdict(signing: Any, frame: bytes, sysid: int, compid: int) -> str:
+    """Check a signed frame against ``signing`` (pymavlink's MAVLinkSigning: key, our
+    timestamp, the newest timestamp per stream) and record it only if it passes:
+    "bad_signature", "replayed", or "" (accepted; its stream and our timestamp moved on).
+
+    The spec's accept rules: the signature is sha256(key + frame up to it) cut to 6 bytes;
+    a stream, (sysid, compid, link id), must never repeat or go back; and no timestamp
+    may be more than a minute behind ours, which follows the newest accepted one. The
+    spec sets no bound ahead, and after the signature check none is needed: only a key
+    holder can move a stream or our timestamp on.
+    """
+    digest = hashlib.sha256(signing.secret_key + frame[:SIGNED_PART]).digest()
+    if not hmac.compare_digest(digest[:6], frame[SIGNED_PART:]):
+        return "bad_signature"
+    link_id = frame[-SIGNATURE_LEN]
+    timestamp = int.from_bytes(frame[-SIGNATURE_LEN + 1 : SIGNED_PART], "little")
+    stream = (link_id, sysid, compid)
+    last = signing.stream_timestamps.get(stream)
+    if (last is not None and timestamp <= last) or timestamp + ONE_MINUTE < signing.timestamp:
+        return "replayed"
+    signing.stream_timestamps[stream] = timestamp
+    signing.timestamp = max(signing.timestamp, timestamp)
+    return ""
 
 
 class StreamParser:
@@ -63,11 +118,12 @@ class StreamParser:
     header or checksum costs only its start byte: the search goes on from the next byte, so
     a real frame among the bytes it claimed is still found. A plausible header still waits
     for the bytes it claims, as the C parser does. pymavlink decodes, checksums and checks
-    signatures (``self.mav``, where companion.link.signing sets the key and policy).
+    signatures (``self.mav``, where companion.link.signing sets the key and policy), the
+    last with our own check (SigningMAVLink).
     """
 
     def __init__(self) -> None:
-        self.mav = dialect.MAVLink(None)
+        self.mav = SigningMAVLink(None)
         self.counters = ParserCounters()
         self._buf = bytearray()
         self._base = 0  # stream offset of _buf[0]
@@ -111,17 +167,19 @@ class StreamParser:
 
     def _take(self, frame: bytearray, pos: int, out: list[Any]) -> int:
         """Decode one candidate frame at ``pos``; returns the bytes it used up."""
+        self.mav.verdict, unsigned = "", False
         try:
             msg = self.mav.decode(frame)
-        except Exception:  # MAVError mostly, but pymavlink is third-party input handling
-            msg = None
+        except Exception as exc:  # MAVError mostly, but pymavlink is third-party input handling
+            msg, unsigned = None, str(exc) == "Invalid signature"  # unsigned where it must not be
         if msg is not None:
             out.append(msg)
             self.counters.frames += 1
             self._claim_end = -1
             return len(frame)
         if _checksum_ok(frame):  # a real frame, refused whole: signature, payload
-            self.counters.refused += 1
+            reason = self.mav.verdict or ("bad_signature" if unsigned else "refused")
+            setattr(self.counters, reason, getattr(self.counters, reason) + 1)
             self._claim_end = -1
             return len(frame)
         self._reject(pos, len(frame), 1, "bad_crc")

@@ -27,6 +27,8 @@ log = logging.getLogger(__name__)
 class LinkCounters:
     ok: int = 0  # frames decoded
     bad: int = 0  # rejections: CRC failures, truncated frames, garbage, refused signatures
+    bad_signature: int = 0  # of those: not signed with our key where it had to be
+    replayed: int = 0  # and: well signed but not newer than its stream's last (or stale)
     forwarded: int = 0
     foreign: int = 0  # addressed to another system
     stream_errors: int = 0  # telemetry samples that could not be encoded
@@ -88,10 +90,13 @@ class LinkRouter:
             if parser is None:
                 parser = self.parsers[(index, remote)] = new_parser()
                 configure_parser(parser.mav, self.signing, endpoint.options.signing)
-            rejected = parser.counters.rejected
+            c = parser.counters
+            before = c.rejected, c.bad_signature, c.replayed
             # A datagram holds whole frames: one cut short at its end never completes.
             messages = parser.parse_buffer(data, final=isinstance(endpoint, UdpOut))
-            self.counters.bad += parser.counters.rejected - rejected
+            self.counters.bad += c.rejected - before[0]
+            self.counters.bad_signature += c.bad_signature - before[1]
+            self.counters.replayed += c.replayed - before[2]
             for msg in messages:
                 self._route(msg, index, now_s)
 

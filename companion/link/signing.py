@@ -5,8 +5,10 @@ unsigned traffic is accepted (MAVSDK cannot sign). ``required``: commands, param
 writes and mission writes must carry a valid signature; unsigned or wrongly signed ones
 are rejected and counted, and a replayed frame (an old timestamp on its stream) is
 rejected too. Heartbeats and read requests stay accepted so a ground station without the
-key still sees the aircraft. pymavlink does the cryptography; all parsers share one
-signing state, so a replay cannot slip in through a new remote address.
+key still sees the aircraft. pymavlink frames and signs; incoming signatures are checked
+by companion.link.codec (SigningMAVLink), which, unlike pymavlink, lets only a verified
+frame move a stream's timestamp on. All parsers share one signing state, so a replay
+cannot slip in through a new remote address.
 """
 
 from __future__ import annotations
