@@ -46,7 +46,9 @@ class GroundStation:
                 return msg
         raise AssertionError("no HEARTBEAT from the vehicle")
 
-    def recv(self, type_: str | list[str], timeout_s: float = 5.0, **match: Any) -> Any:
+    # A busy machine can hold the vehicle's answer back for seconds: the waits are generous,
+    # and a test that passes never waits them out.
+    def recv(self, type_: str | list[str], timeout_s: float = 15.0, **match: Any) -> Any:
         deadline = time.monotonic() + timeout_s
         while time.monotonic() < deadline:
             msg = self.conn.recv_match(type=type_, blocking=True, timeout=0.2)
@@ -60,7 +62,7 @@ class GroundStation:
         values = [*params, 0, 0, 0, 0, 0, 0, 0][:7]
         self.mav.command_long_send(target[0], target[1], command, confirmation, *values)
 
-    def ack(self, command: int, timeout_s: float = 5.0) -> Any:
+    def ack(self, command: int, timeout_s: float = 15.0) -> Any:
         return self.recv("COMMAND_ACK", timeout_s, command=command)
 
     def close(self) -> None:

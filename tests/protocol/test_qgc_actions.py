@@ -71,7 +71,7 @@ def set_mode(gcs: GroundStation, mode: FlightMode) -> int:
 
 def shown(gcs: GroundStation, mode: FlightMode) -> None:
     """_setFlightModeAndValidate: QGroundControl waits for the heartbeat to show the mode."""
-    gcs.recv("HEARTBEAT", 5.0, custom_mode=BY_MODE[mode].px4)
+    gcs.recv("HEARTBEAT", 15.0, custom_mode=BY_MODE[mode].px4)
 
 
 def arm(gcs: GroundStation, on: bool, force: bool = False) -> int:
@@ -88,7 +88,7 @@ def wait_armable(gcs: GroundStation, status) -> None:
 
 def settled(status, check, what: str):
     """The commander's status once it shows ``check`` (it is published just after the ack)."""
-    wait_for(lambda: check(status.get()), 5, what)
+    wait_for(lambda: check(status.get()), 15, what)
     return status.get()
 
 
