@@ -63,9 +63,10 @@ class BatteryStation(Station):
                 if not self.modes or self.modes[-1] != self.mode:
                     self.modes.append(self.mode)
 
-    def healthy(self, bit: int) -> bool:
+    def healthy(self, bits: int) -> bool:
+        """Every one of ``bits`` healthy (not just any of them)."""
         s = self.sys_status
-        return s is not None and bool(s.onboard_control_sensors_health & bit)
+        return s is not None and s.onboard_control_sensors_health & bits == bits
 
     def amps(self) -> float:
         return -1.0 if self.battery is None else self.battery.current_battery / 100
