@@ -13,7 +13,10 @@ class RecordingVehicle:
 
     snapshot: Snapshot = field(default_factory=Snapshot)
     commander: bool = True
-    params: dict[str, float] = field(default_factory=lambda: {"SYS_FAILURE_EN": 0.0})
+    # The defaults of the parameters the command groups read, as the link declares them.
+    params: dict[str, float] = field(
+        default_factory=lambda: {"SYS_FAILURE_EN": 0.0, "ARMING_CHECK": 1.0}
+    )
     simulated: bool = True
     published: list[tuple[int, tuple[float, ...]]] = field(default_factory=list)
     texts: list[str] = field(default_factory=list)
