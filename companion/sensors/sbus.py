@@ -16,6 +16,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from companion.sensors.frame_scan import FixedFrameScanner
+
 FRAME_LEN = 25
 HEADER = 0x0F
 END_BYTES = frozenset({0x00, 0x04, 0x14, 0x24, 0x34})
@@ -47,15 +49,6 @@ class SbusFrame:
         return [raw_to_us(raw) for raw in self.channels] + digital
 
 
-@dataclass
-class SbusCounters:
-    """What the decoder accepted and skipped."""
-
-    ok: int = 0
-    bad_frames: int = 0  # a header whose flag bits or end byte were wrong
-    garbage_bytes: int = 0  # bytes skipped while looking for a header
-
-
 def decode_frame(frame: bytes) -> SbusFrame | None:
     """One 25-byte frame, or None when it is not one."""
     if len(frame) != FRAME_LEN or frame[0] != HEADER:
@@ -78,32 +71,9 @@ class SbusDecoder:
     """Finds frames in a byte stream, whatever arrives in between."""
 
     def __init__(self) -> None:
-        self.counters = SbusCounters()
-        self._buf = bytearray()
+        self._scan = FixedFrameScanner(bytes([HEADER]), FRAME_LEN, decode_frame)
+        self.counters = self._scan.counters
 
     def feed(self, data: bytes) -> list[SbusFrame]:
         """The frames completed by ``data``."""
-        buf = self._buf
-        buf += data
-        frames: list[SbusFrame] = []
-        while True:
-            start = buf.find(HEADER)
-            if start < 0:
-                self.counters.garbage_bytes += len(buf)
-                buf.clear()
-                break
-            if start:
-                self.counters.garbage_bytes += start
-                del buf[:start]
-            if len(buf) < FRAME_LEN:
-                break
-            frame = decode_frame(bytes(buf[:FRAME_LEN]))
-            if frame is None:
-                # Not a frame: the 0x0F was data; look again from the next byte.
-                self.counters.bad_frames += 1
-                del buf[:1]
-                continue
-            self.counters.ok += 1
-            frames.append(frame)
-            del buf[:FRAME_LEN]
-        return frames
+        return self._scan.feed(data)

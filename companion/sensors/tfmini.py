@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from companion.sensors.frame_scan import FixedFrameScanner
+
 FRAME_LEN = 9
 HEADER = b"\x59\x59"
 ERROR_DIST_CM = 0x8000  # and above: the TFmini-S's negative error codes as uint16
@@ -32,55 +34,26 @@ def checksum(first_eight: bytes) -> int:
     return sum(first_eight) & 0xFF
 
 
-@dataclass
-class TfminiFramerCounters:
-    """What the framer has handed out and skipped."""
-
-    frames: int = 0
-    bad_checksum: int = 0  # a header whose frame did not add up
-    garbage_bytes: int = 0  # bytes skipped while looking for a header
+def _checked(frame: bytes) -> bytes | None:
+    return frame if checksum(frame[:8]) == frame[8] else None
 
 
 class TfminiFramer:
-    """Finds checked 9-byte frames in a byte stream, whatever arrives in between."""
+    """Finds checked 9-byte frames in a byte stream, whatever arrives in between (a
+    strength of 0x5959 looks like a header: a frame that does not add up costs one byte)."""
 
     def __init__(self) -> None:
-        self.counters = TfminiFramerCounters()
-        self._buf = bytearray()
+        self._scan = FixedFrameScanner(HEADER, FRAME_LEN, _checked)
+        self.counters = self._scan.counters
 
     @property
     def rejected(self) -> int:
         """Frames refused by their checksum (garbage bytes are counted apart)."""
-        return self.counters.bad_checksum
+        return self.counters.bad_frames
 
     def feed(self, data: bytes) -> list[bytes]:
         """The whole frames completed by ``data``, their checksums right."""
-        buf = self._buf
-        buf += data
-        frames: list[bytes] = []
-        while True:
-            start = buf.find(HEADER)
-            if start < 0:
-                # Keep a trailing 0x59: it may be the first half of the next header.
-                keep = 1 if buf.endswith(HEADER[:1]) else 0
-                self.counters.garbage_bytes += len(buf) - keep
-                del buf[: len(buf) - keep]
-                break
-            if start:
-                self.counters.garbage_bytes += start
-                del buf[:start]
-            if len(buf) < FRAME_LEN:
-                break
-            frame = bytes(buf[:FRAME_LEN])
-            if checksum(frame[:8]) != frame[8]:
-                # The header may have been data (a strength of 0x5959): resync a byte on.
-                self.counters.bad_checksum += 1
-                del buf[:1]
-                continue
-            self.counters.frames += 1
-            frames.append(frame)
-            del buf[:FRAME_LEN]
-        return frames
+        return self._scan.feed(data)
 
 
 @dataclass(frozen=True)
