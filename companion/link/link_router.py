@@ -17,7 +17,8 @@ from companion.link.endpoints import Endpoint, Remote, UdpOut, default_budget
 from companion.link.link_budget import LinkBudget
 from companion.link.service import Outgoing, Peer, Service
 from companion.link.signing import configure_parser, shared_state, signing_encoder
-from companion.link.telemetry import STREAMS, Snapshot, StreamSchedule
+from companion.link.stream_schedule import StreamSchedule
+from companion.link.telemetry import STREAMS, Snapshot
 from companion.link.tlog import TlogWriter
 
 log = logging.getLogger(__name__)
