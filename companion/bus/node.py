@@ -181,8 +181,42 @@ class Waiter:
             r.consume_events()
         return ready
 
+    def wait_with_fds(
+        self, timeout_s: float, fds: Sequence[int]
+    ) -> tuple[list[Reader[Any]], list[int]]:
+        """Like :meth:`wait`, also woken by any of ``fds`` becoming readable.
+
+        The descriptors are attached for this one wait only: a socket or serial port may
+        close between two waits, and a closed descriptor must never stay in the WaitSet.
+        Returns the readers with data and the descriptors that are readable.
+        """
+        guards = [
+            self._waitset.attach_notification_fd(iox2.FileDescriptor.non_owning_new(f)) for f in fds
+        ]
+        fired: list[Any] = []
+        try:
+            if any(r.has_samples() for r in self.readers):
+                timeout_s = 0.0  # only look which descriptors are readable too
+            with self._idle:
+                try:
+                    fired, _ = self._waitset.wait_and_process_with_timeout(duration(timeout_s))
+                except iox2.WaitSetRunError:
+                    pass  # interrupted by a signal: the caller checks its stop flag
+            ready_fds = [f for f, g in zip(fds, guards, strict=True) if _fired(fired, g)]
+        finally:
+            for guard in guards:
+                guard.delete()
+        ready = [r for r in self.readers if r.has_samples()]
+        for r in self.readers:
+            r.consume_events()
+        return ready, ready_fds
+
     def close(self) -> None:
         """Detach from the readers."""
         for guard in self._guards:
             guard.delete()
         self._guards.clear()
+
+
+def _fired(attachments: list[Any], guard: Any) -> bool:
+    return any(a.has_event_from(guard) for a in attachments)

@@ -162,11 +162,11 @@ class LinkRouter:
             out += service.tick(now_s)
         return out
 
-    def stream_telemetry(self, snapshot: Snapshot, now_s: float) -> None:
+    def stream_telemetry(self, snapshot: Snapshot, now_s: float, nav_at_s: float) -> None:
         for index, endpoint in enumerate(self.endpoints):
             if not endpoint.has_remote():
                 continue
-            for msg_id in self.schedules[index].due(now_s):
+            for msg_id in self.schedules[index].due(now_s, nav_at_s):
                 try:
                     msg = STREAMS[msg_id].build(self.mav, snapshot)
                     # Framed once, for this endpoint; values out of a field's range raise here.

@@ -1,8 +1,25 @@
-"""When each telemetry stream is due, per endpoint (SET_MESSAGE_INTERVAL's rates)."""
+"""When each telemetry stream is due, per endpoint (SET_MESSAGE_INTERVAL's rates).
+
+The streams that carry the navigation state (attitude, position, speeds) are sent on the
+first state the navigator publishes once they are due, not on a timer: a timer would send
+a state up to one navigation period old. They wait for it at most ``NAV_HOLD_S`` past
+their time, so a vehicle whose navigator has stopped still reports at its rates.
+"""
 
 from __future__ import annotations
 
+from companion.link.codec import dialect as d
 from companion.link.telemetry import STREAMS
+
+NAV_HOLD_S = 0.05  # two and a half navigation periods at 50 Hz
+FOLLOWS_NAV = frozenset(
+    (
+        d.MAVLINK_MSG_ID_ATTITUDE,
+        d.MAVLINK_MSG_ID_ATTITUDE_QUATERNION,
+        d.MAVLINK_MSG_ID_GLOBAL_POSITION_INT,
+        d.MAVLINK_MSG_ID_VFR_HUD,
+    )
+)
 
 
 def _default_period(msg_id: int) -> float:
@@ -39,22 +56,33 @@ class StreamSchedule:
         period = self.period_s[msg_id]
         return -1 if period <= 0 else round(period * 1e6)
 
-    def due(self, now_s: float) -> list[int]:
+    def due(self, now_s: float, nav_at_s: float = float("inf")) -> list[int]:
         """The streams to send now, least recently sent first; schedules their next time.
 
-        When the link's budget cannot carry every stream, the ones it had to skip come
-        first next time, so a fast stream cannot starve the slow ones.
+        ``nav_at_s`` is when the newest navigation state arrived: a stream that follows
+        the navigator is sent once one has arrived since it fell due (or it waited
+        NAV_HOLD_S for one). When the link's budget cannot carry every stream, the ones it
+        had to skip come first next time, so a fast stream cannot starve the slow ones.
         """
         out = []
         for mid, period in self.period_s.items():
-            if period > 0 and now_s >= self.next_due[mid]:
-                out.append(mid)
-                self.next_due[mid] = max(self.next_due[mid] + period, now_s - period)
+            due_s = self.next_due[mid]
+            if period <= 0 or now_s < due_s:
+                continue
+            if mid in FOLLOWS_NAV and nav_at_s < due_s and now_s < due_s + NAV_HOLD_S:
+                continue
+            out.append(mid)
+            self.next_due[mid] = max(due_s + period, now_s - period)
         return sorted(out, key=self.last_sent.__getitem__)
 
     def mark_sent(self, msg_id: int, now_s: float) -> None:
         self.last_sent[msg_id] = now_s
 
     def next_time(self) -> float:
-        times = [self.next_due[m] for m, p in self.period_s.items() if p > 0]
+        """When a stream falls due without a navigation state (the wake-up for timers)."""
+        times = [
+            self.next_due[m] + (NAV_HOLD_S if m in FOLLOWS_NAV else 0.0)
+            for m, p in self.period_s.items()
+            if p > 0
+        ]
         return min(times) if times else float("inf")

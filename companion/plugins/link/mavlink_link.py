@@ -9,7 +9,6 @@ plug-ins act on go onto ``link/commands``; their answers come back on
 
 from __future__ import annotations
 
-import select
 import time
 from collections.abc import Mapping
 from pathlib import Path
@@ -44,7 +43,7 @@ from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChang
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 
-MAX_WAIT_S = 0.02
+MAX_WAIT_S = 0.05  # the newest health, status and sensor values are looked at this often
 PREARM_PERIOD_S = 1.0  # SYS_STATUS's ready-to-arm bit is judged once a second
 LINK_STATUS_PERIOD_S = 0.2  # link/status (ground-station silence) five times a second
 COMMANDER = "vehicle.commander"
@@ -169,7 +168,9 @@ class MavlinkLink(Plugin):
         self._serve_logs(ctx, sysid)
         register_commands(self.commands, self, self.identity, self.router, self.metadata)
         self.commands.on_refusal = self.refusal_text
-        self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
+        # Woken by a navigation state (the streams carrying it go out on it), an ack, a text.
+        self.waker = bus.waiter((self.readers["nav"], self.acks, self.texts))
+        self.nav_at_s = float("-inf")
         self._seq = 0
 
     def _serve_joystick(self, ctx: PluginContext, sysid: int) -> None:
@@ -307,14 +308,12 @@ class MavlinkLink(Plugin):
 
     def _wait_input(self, now_s: float) -> None:
         timeout = max(0.0, min(MAX_WAIT_S, self.router.next_due() - now_s))
-        fds = list(self.fd_owner)
-        with self.ctx.bus.idle:
-            ready, _, _ = select.select(fds, [], [], timeout) if fds else ([], [], [])
+        fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
+        woken, ready = self.waker.wait_with_fds(timeout, list(fd_owner))
+        if self.readers["nav"] in woken:
+            self.nav_at_s = time.monotonic()
         for fd in ready:
-            endpoint = self.fd_owner.get(fd)
-            if endpoint is not None:
-                self.router.receive(endpoint, fd, time.monotonic())
-        self.fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
+            self.router.receive(fd_owner[fd], fd, time.monotonic())
 
     def step(self) -> None:
         self._wait_input(time.monotonic())
@@ -337,7 +336,7 @@ class MavlinkLink(Plugin):
             status = LinkStatus(t_us=self.ctx.clock.now_us())
             status.gcs_silence_s = self.gcs.silence_s(now_s)
             self.link_status.publish(status)
-        self.router.stream_telemetry(self.snapshot, now_s)
+        self.router.stream_telemetry(self.snapshot, now_s, self.nav_at_s)
         counts = self.router.counters
         self.ctx.health.frames_ok, self.ctx.health.frames_bad = counts.ok, counts.bad
         parts = self.commands, self._params_service, self.missions, self.manual, self.metadata
@@ -385,6 +384,7 @@ class MavlinkLink(Plugin):
         return self._seq
 
     def close(self) -> None:
+        self.waker.close()
         self.router.close()
         for endpoint in self.endpoints:
             endpoint.close()

@@ -1,0 +1,46 @@
+"""Telemetry that carries the navigation state goes out on a fresh state, at its rate."""
+
+from __future__ import annotations
+
+from companion.link.codec import dialect as d
+from companion.link.stream_schedule import NAV_HOLD_S, StreamSchedule
+
+ATTITUDE = d.MAVLINK_MSG_ID_ATTITUDE
+SYS_STATUS = d.MAVLINK_MSG_ID_SYS_STATUS
+NAV_PERIOD_MS = 20
+
+
+def fly(schedule: StreamSchedule, seconds: float, nav_phase_ms: int) -> list[tuple[float, float]]:
+    """Step a link every millisecond with states every 20 ms; (sent at, state age) of ATTITUDE."""
+    sent, nav_at = [], float("-inf")
+    for ms in range(int(seconds * 1000)):
+        now = ms / 1000
+        if ms >= nav_phase_ms and (ms - nav_phase_ms) % NAV_PERIOD_MS == 0:
+            nav_at = now
+        if ATTITUDE in schedule.due(now, nav_at):
+            sent.append((now, now - nav_at))
+    return sent
+
+
+def test_attitude_is_sent_on_a_fresh_state_at_its_rate():
+    schedule = StreamSchedule()
+    assert schedule.set_interval(ATTITUDE, 100_000)  # 10 Hz, as QGroundControl asks
+    sent = fly(schedule, 10.0, nav_phase_ms=13)  # states out of phase with the 10 Hz grid
+    assert 99 <= len(sent) <= 101
+    assert max(age for _, age in sent[1:]) < 1e-9  # never a state from an earlier period
+
+
+def test_attitude_keeps_its_rate_when_the_navigator_is_silent():
+    schedule = StreamSchedule()
+    schedule.set_interval(ATTITUDE, 100_000)
+    times = [ms / 1000 for ms in range(5000) if ATTITUDE in schedule.due(ms / 1000)]
+    assert 49 <= len(times) <= 51
+    gaps = [b - a for a, b in zip(times, times[1:], strict=False)]
+    assert max(gaps) < 0.1 + NAV_HOLD_S
+    assert schedule.next_time() <= times[-1] + 0.1 + NAV_HOLD_S
+
+
+def test_streams_that_do_not_carry_the_state_keep_their_timer():
+    schedule = StreamSchedule()
+    times = [ms / 1000 for ms in range(3000) if SYS_STATUS in schedule.due(ms / 1000, -1.0)]
+    assert times == [0.0, 1.0, 2.0]
