@@ -2,6 +2,8 @@
 
 A full list is streamed a few PARAM_VALUEs per tick so a slow radio is not flooded;
 ``param_count`` and indexes are fixed (0..count-1) so QGroundControl can re-read gaps.
+A set of an alias (``companion.params.alias``) changes the parameters it stands for; the
+new values of both are sent, so a ground station's copy of either is never stale.
 """
 
 from __future__ import annotations
@@ -88,15 +90,19 @@ class ParamsService:
             self.on_refusal(f"Unknown parameter {name}")
             return []
         try:
-            self.on_change(name, self.store.set(name, msg.param_value))
+            changed = self.store.write(name, msg.param_value)
         except ParamError as exc:
             self.refused += 1
             self.on_refusal(f"Param refused: {exc}")
             # The old value, to the sender only: nothing changed for anyone else, and a
             # flood of bad writes on one link must not be repeated on every other one.
             return [Outgoing(self.value(self.store.index_of(name)), peer)]
-        # A change is news for every ground station.
-        return [Outgoing(self.value(self.store.index_of(name)), None)]
+        for own, value in changed.items():  # an alias's owners follow their own names
+            self.on_change(own, value)
+        # A change is news for every ground station: the name set first (the sender waits
+        # for it), then every name that reads the same value (an alias and its owner).
+        names = [name, *self.store.linked(name)]
+        return [Outgoing(self.value(self.store.index_of(n)), None) for n in names]
 
     def tick(self, now_s: float) -> list[Outgoing]:
         out = []

@@ -3,7 +3,8 @@
 Two files, in the schema QGroundControl reads (``CompInfoGeneral`` and ``CompInfoParam`` /
 ``FactMetaData::createFromJsonObject``): the general metadata file, which names the parameter
 file by URI and CRC32, and the parameter metadata file, one object a parameter with its
-description, unit, range, default and whether a change takes effect only after a reboot.
+description, unit, range (or enumerated values), default and whether a change takes effect
+only after a reboot.
 Both are generated from ``ParamDecl``s, so what a ground station shows is what the owner
 declared. JSON has no infinity: an unbounded side of a range is left out.
 """
@@ -43,6 +44,8 @@ def parameter_entry(decl: ParamDecl) -> dict[str, object]:
         entry["min"] = decl.min
     if math.isfinite(decl.max):
         entry["max"] = decl.max
+    if decl.values:  # QGroundControl offers exactly these in a combo box
+        entry["values"] = [{"value": v, "description": text} for v, text in decl.values]
     return entry
 
 

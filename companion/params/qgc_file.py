@@ -20,9 +20,11 @@ def save_params(store: ParamStore, path: Path, sysid: int = 1, compid: int = 1) 
 def load_params(store: ParamStore, path: Path) -> int:
     """Apply a .params file; ParamError names the line and parameter of the first bad line.
 
-    Nothing is applied unless every line is good.
+    Nothing is applied unless every line is good. An alias's line sets the parameters it
+    stands for; two lines that would set one parameter to different values are an error.
     """
-    updates: list[tuple[str, float]] = []
+    updates: dict[str, tuple[float, str]] = {}  # stored name -> value, the line's name
+    count = 0
     for lineno, raw in enumerate(path.read_text().splitlines(), start=1):
         line = raw.strip()
         if not line or line.startswith("#"):
@@ -35,13 +37,17 @@ def load_params(store: ParamStore, path: Path) -> int:
             value = float(text)
         except ValueError:
             raise ParamError(f"{path}:{lineno}: {name}: {text!r} is not a number") from None
-        decl = store.decls.get(name)
-        if decl is None:
-            raise ParamError(f"{path}:{lineno}: {name}: unknown parameter")
-        if (problem := decl.check(value)) is not None:
-            raise ParamError(f"{path}:{lineno}: {problem}")
-        updates.append((name, value))
-    for name, value in updates:
-        store.values[name] = value
+        try:
+            planned = store.plan(name, value)
+        except ParamError as exc:
+            raise ParamError(f"{path}:{lineno}: {exc}") from None
+        for own, own_value in planned.items():
+            earlier = updates.get(own)
+            if earlier is not None and earlier[0] != own_value:
+                raise ParamError(f"{path}:{lineno}: {name} disagrees with {earlier[1]}")
+            updates[own] = (own_value, name)
+        count += 1
+    for own, (own_value, _) in updates.items():
+        store.values[own] = own_value
     store.save()
-    return len(updates)
+    return count
