@@ -12,14 +12,13 @@ For each airframe, plan and condition (calm; 5 m/s wind from the west with light
 turbulence) it flies one campaign flight (``companion sim --speed max --exact
 --start-at 10`` with the plan preloaded, so every run of the same code flies the same
 flight; watched until the mission completes; ground/campaign/flight_run.py) and
-prints from the truth CSV:
-cross-track error RMS and 95th percentile on the straight part of each
-waypoint-to-waypoint leg (past the turn onto it and before the turn off it), and height
-error RMS and airspeed error RMS over the same samples (ground/campaign/scoring.py);
-then, per leg as flown (ground/campaign/legs.py): the turn onto it, the distance flown
+prints from the truth CSV the campaign's score (ground/campaign/scoring.py): cross-track
+error RMS and 95th percentile, height error RMS and airspeed error RMS, over the straight
+parts of the legs as flown (more than 500 m from either corner) pooled; then, per leg as
+flown (ground/campaign/legs.py, the same samples): the turn onto it, the distance flown
 from its first waypoint until within 2 m of the line for good, the cross-track RMS / p95 /
-mean and height RMS more than 500 m from either corner, and the bank-angle and heading
-standard deviations there (the wobble).
+mean and height RMS on its straight part, and the bank-angle and heading standard
+deviations there (the wobble).
 Targets (issue 27): calm cross-track RMS ≤ 1 m and p95 ≤ 2 m, in 5 m/s wind with light
 turbulence p95 ≤ 3 m, height RMS ≤ 1 m, settled within 600 m after a 90° turn and 900 m
 after 135°.
