@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 from companion.link.codec import dialect as d
 from companion.link.stream_schedule import NAV_HOLD_S, StreamSchedule
 
@@ -35,7 +37,7 @@ def test_attitude_keeps_its_rate_when_the_navigator_is_silent():
     schedule.set_interval(ATTITUDE, 100_000)
     times = [ms / 1000 for ms in range(5000) if ATTITUDE in schedule.due(ms / 1000)]
     assert 49 <= len(times) <= 51
-    gaps = [b - a for a, b in zip(times, times[1:], strict=False)]
+    gaps = [b - a for a, b in pairwise(times)]
     assert max(gaps) < 0.1 + NAV_HOLD_S
     assert schedule.next_time() <= times[-1] + 0.1 + NAV_HOLD_S
 
