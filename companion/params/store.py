@@ -67,13 +67,16 @@ def bind(decl: ParamDecl, decls: Mapping[str, ParamDecl]) -> ParamDecl:
     missing = [s for s in alias.sources if s not in decls or decls[s].alias is not None]
     if missing:
         doc = f"{decl.doc} [fixed: no {', '.join(missing)} on this vehicle]"
-        return replace(decl, alias=None, min=decl.default, max=decl.default, doc=doc)
+        values = tuple(v for v in decl.values if v[0] == decl.default)
+        fixed = {"min": decl.default, "max": decl.default, "values": values}
+        return replace(decl, alias=None, doc=doc, **fixed)
     lo, hi = decl.min, decl.max
     if alias.table is None and not alias.divisor:
         own = decls[alias.targets[0]]
         lo, hi = sorted((own.min * alias.scale, own.max * alias.scale))
+    values = tuple(v for v in decl.values if lo <= v[0] <= hi)  # only what the owner takes
     default = alias.read({name: d.default for name, d in decls.items()})
-    return replace(decl, default=default, min=lo, max=hi)
+    return replace(decl, default=default, min=lo, max=hi, values=values)
 
 
 class ParamStore:

@@ -214,9 +214,10 @@ def test_parameters_qgroundcontrols_px4_setup_pages_read_are_there(qgc):
     while len(names) < first.param_count:
         names.add(gcs.recv("PARAM_VALUE", 5.0).param_id)
     assert read_at_connect <= names, read_at_connect - names
-    # They describe the vehicle: a write does not change them.
-    gcs.mav.param_set_send(1, 1, b"COM_RC_IN_MODE", 1.0, m.MAV_PARAM_TYPE_REAL32)
-    assert gcs.recv("PARAM_VALUE", 5.0, param_id="COM_RC_IN_MODE").param_value == 4.0
+    # They describe the vehicle (no RC receiver here: the joystick only); a write does not
+    # change them. Every name every page reads: tests/protocol/test_qgc_setup_pages.py.
+    gcs.mav.param_set_send(1, 1, b"COM_RC_IN_MODE", 4.0, m.MAV_PARAM_TYPE_REAL32)
+    assert gcs.recv("PARAM_VALUE", 5.0, param_id="COM_RC_IN_MODE").param_value == 1.0
 
 
 def test_land_abort_on_the_approach_as_qgroundcontrol_sends_it(vehicle_factory, tmp_path):

@@ -32,7 +32,7 @@ from companion.link.metadata_service import MetadataService
 from companion.link.mission_service import MissionService
 from companion.link.mode_messages import current_mode, heartbeat_mode
 from companion.link.params_service import ParamsService
-from companion.link.px4_compat import PX4_SETUP_PARAMS
+from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
 from companion.link.service import Outgoing, refused_count
 from companion.link.signing import key_from
@@ -88,7 +88,7 @@ class MavlinkLink(Plugin):
         ParamDecl("SR_GPS", 2.0, 0.0, 10.0, "Hz", "GPS_RAW_INT rate"),
         ParamDecl("SYS_FAILURE_EN", 0.0, 0.0, 1.0, "", "accept MAV_CMD_INJECT_FAILURE (simulator)"),
         *PREARM_PARAMS,
-        *PX4_SETUP_PARAMS,
+        *PX4_PARAMS,
     )
     optional_inputs = (
         "nav/state",
@@ -222,8 +222,8 @@ class MavlinkLink(Plugin):
         self.mission_changes.publish(self.missions.store.changed(mission_type, now))
 
     def _serve_params(self, ctx: PluginContext, sysid: int) -> None:
-        path = Path(ctx.vehicle.get("state_dir", ".")) / "params.json"
-        self.store = ParamStore(ctx.param_decls or self.params, path)
+        decls = vehicle_facts(ctx.param_decls or self.params, sysid, ctx.plugins)
+        self.store = ParamStore(decls, Path(ctx.vehicle.get("state_dir", ".")) / "params.json")
         service = ParamsService(self.mav, self.store, sysid, ctx.settings["compid"])
         service.on_refusal = self.refusal_text
         service.on_change = self._param_changed
