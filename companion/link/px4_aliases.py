@@ -66,8 +66,9 @@ SAFETY_ALIASES = (
             ((-1.0, "Loiter at home, do not land"), (0.0, "Land (at the mission's landing)")),
             "After the return: lands only at a mission's DO_LAND_START, loiters otherwise",
             default=-1.0),
-    _same("COM_DISARM_LAND", "LAND_DISARMDELAY", "Disarm this long after the landing "
-          "stopped (0: at once; never is not offered)", "s"),
+    # PX4's 0 is "never", which the vehicle does not offer: the least it takes is 0.1 s.
+    ParamDecl("COM_DISARM_LAND", 0.0, 0.1, unit="s", alias=Alias(("LAND_DISARMDELAY",)),
+              doc="Disarm this long after the landing stopped (= LAND_DISARMDELAY)"),
 )  # fmt: skip
 
 # The low and critical levels' actions; PX4 has no "return at the low level": 1 is ours.

@@ -71,9 +71,10 @@ def bind(decl: ParamDecl, decls: Mapping[str, ParamDecl]) -> ParamDecl:
         fixed = {"min": decl.default, "max": decl.default, "values": values}
         return replace(decl, alias=None, doc=doc, **fixed)
     lo, hi = decl.min, decl.max
-    if alias.table is None and not alias.divisor:
+    if alias.table is None and not alias.divisor:  # the owner's range, narrowed by the alias's
         own = decls[alias.targets[0]]
-        lo, hi = sorted((own.min * alias.scale, own.max * alias.scale))
+        own_lo, own_hi = sorted((own.min * alias.scale, own.max * alias.scale))
+        lo, hi = max(lo, own_lo), min(hi, own_hi)
     values = tuple(v for v in decl.values if lo <= v[0] <= hi)  # only what the owner takes
     default = alias.read({name: d.default for name, d in decls.items()})
     return replace(decl, default=default, min=lo, max=hi, values=values)

@@ -42,12 +42,17 @@ def test_nav_rcl_act_is_thr_failsafe_and_decides_the_rc_loss(px4, own, mode):
     assert s.get("THR_FAILSAFE") == own and rc_lost_mode(s.values) == mode
 
 
+# PX4's Hold, Land, Warning-only fence, Land on low battery, a timed loiter, a distance
+# limit, no stick input, a loiter height of its own, another airframe, never disarming.
+CANNOT = (("NAV_RCL_ACT", 1.0), ("NAV_DLL_ACT", 3.0), ("GF_ACTION", 1.0),
+          ("COM_LOW_BAT_ACT", 2.0), ("RTL_LAND_DELAY", 60.0), ("GF_MAX_HOR_DIST", 100.0),
+          ("COM_RC_IN_MODE", 4.0), ("RTL_DESCEND_ALT", 30.0), ("SYS_AUTOSTART", 4001.0),
+          ("COM_DISARM_LAND", 0.0))  # fmt: skip
+
+
 def test_what_px4_offers_and_the_vehicle_cannot_do_is_refused_with_nothing_changed():
     s = store()
-    for name, value in (("NAV_RCL_ACT", 1.0), ("NAV_DLL_ACT", 3.0), ("GF_ACTION", 1.0),
-                        ("COM_LOW_BAT_ACT", 2.0), ("RTL_LAND_DELAY", 60.0),
-                        ("GF_MAX_HOR_DIST", 100.0), ("COM_RC_IN_MODE", 4.0),
-                        ("RTL_DESCEND_ALT", 30.0), ("SYS_AUTOSTART", 4001.0)):  # fmt: skip
+    for name, value in CANNOT:
         before = dict(s.values)
         with pytest.raises(ParamError):
             s.set(name, value)
