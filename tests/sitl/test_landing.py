@@ -28,7 +28,9 @@ from tests.sim.sim_run import finish, start_sim
 from tests.support.vehicle import REPO
 
 PLAN = REPO / "benchmarks" / "plans" / "land_east.plan"
-WALL_LIMIT_S = 600.0  # a hang guard only: the flight is judged by the simulator's truth
+# A hang guard only: the flight is judged by the simulator's truth. Alone the 250 s flight
+# takes about 2 min; a CI run beside several other simulations took over 600 s to the stop.
+WALL_LIMIT_S = 1500.0
 
 
 def _upload(gcs: GroundStation, items: list[MissionItem]) -> None:
@@ -80,7 +82,7 @@ def _fly(gcs: GroundStation) -> tuple[bool, bool, list[int]]:
     return completed, disarmed, states
 
 
-@pytest.mark.timeout(900)
+@pytest.mark.timeout(1800)
 def test_the_c172_lands_its_qgc_landing_pattern_in_a_crosswind_and_disarms(tmp_path: Path):
     items = checked_plan(PLAN)[0]
     port = free_udp_port()
