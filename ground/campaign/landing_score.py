@@ -86,6 +86,7 @@ def score_landing(
     When the approach point is a LOITER_TO_ALT centre, the line starts at its tangent
     point: give the radius (and direction) to have it found.
     """
+    truth = _until_first_stop(truth)
     frame = LocalFrame(*land)
     n, e = frame.ne(truth["lat"], truth["lon"])
     a = frame.ne(*approach)
@@ -131,6 +132,25 @@ def score_landing(
         stopped,
         on_runway,
     )
+
+
+def _until_first_stop(truth: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The truth up to the first stop on the ground after the flight proper.
+
+    A simulator left running once the vehicle has disarmed keeps integrating a parked
+    aircraft nobody flies (one sat pitching on its gear for 100 s, then tumbled); that is
+    not part of the landing.
+    """
+    height = truth["alt"] - float(truth["alt"][0])
+    flying = np.nonzero(height > AIRBORNE_M)[0]
+    if flying.size == 0:
+        return truth
+    speed = np.hypot(truth["vn"], truth["ve"])
+    still = np.nonzero((speed < STOPPED_M_S) & (height < TOUCH_M))[0]
+    still = still[still > flying[0]]
+    if still.size == 0:
+        return truth
+    return {key: values[: int(still[0]) + 1] for key, values in truth.items()}
 
 
 def _tangent_point(
