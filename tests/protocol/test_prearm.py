@@ -45,6 +45,8 @@ def _vehicle(vehicle_factory, tmp_path, servo: str, aligning=False, fix_type=3, 
     # Running is not yet publishing on a busy machine: the checks judge what nav/state says.
     nav = vehicle.bus.latest_reader("nav/state")
     wait_for(nav.get, 60, "the navigator's first solution")
+    # ... and the link's reader may join later still: NAV_STATUS says the link has it.
+    gcs.recv("NAV_STATUS", 60)
     return vehicle, gcs
 
 

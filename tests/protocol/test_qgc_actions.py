@@ -58,7 +58,9 @@ def qgc(vehicle_factory, tmp_path):
     gcs = GroundStation(port)  # sysid 255, compid 190, as QGroundControl
     first = gcs.connect()
     status = vehicle.bus.latest_reader("vehicle/status")
-    wait_for(status.get, 15, "the commander's first status")
+    # The commander has a position and a home (on a busy machine the navigator's first
+    # solution can come late, and Go to and Return would be refused until then).
+    wait_for(lambda: (s := status.get()) is not None and s.home_valid, 60, "a home position")
     yield gcs, status, first
     gcs.close()
 
