@@ -31,7 +31,9 @@ CONTROL_PARAMS = (
     _p("PTCH_D", 0.2, 0.0, 2.0, "s", "pitch loop: elevator per rad/s of pitch rate"),
     _p("PTCH_I", 0.3, 0.0, 2.0, "1/s", "pitch loop: integrator gain"),
     _p("PTCH_IMAX", 0.3, 0.0, 1.0, "", "pitch loop: integrator limit (elevator fraction)"),
-    _p("YAW_DAMP", 0.5, 0.0, 5.0, "s", "rudder per rad/s of yaw-rate error in a turn"),
+    # 0.5 left the c172p slipping up to 13° in and out of turns (5° p95): the heading then
+    # reads as metres per second of wind along the track, and the roll-out weaves.
+    _p("YAW_DAMP", 3.5, 0.0, 5.0, "s", "rudder per rad/s of yaw-rate error in a turn"),
     _p("SCALING_SPEED", 30.0, 5.0, 100.0, "m/s", "airspeed at which the loop gains apply as set"),
     _p("ROLL_LIMIT_DEG", 35.0, 5.0, 60.0, "deg", "largest bank angle"),
     _p("PTCH_LIM_MAX_DEG", 20.0, 0.0, 45.0, "deg", "largest nose-up pitch"),

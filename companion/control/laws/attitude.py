@@ -28,7 +28,7 @@ class AttitudeGains:
     pitch_d: float = 0.2
     pitch_i: float = 0.3
     pitch_imax: float = 0.3
-    yaw_damp: float = 0.5
+    yaw_damp: float = 3.5
     scaling_speed: float = 30.0  # m/s at which the gains are as given
 
 
