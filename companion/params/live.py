@@ -19,7 +19,7 @@ class LiveParams:
 
     def __init__(self, bus: Any, decls: Iterable[ParamDecl], state_dir: Path) -> None:
         decls = tuple(decls)
-        stored = ParamStore(decls, state_dir / "params.json")
+        stored = ParamStore(decls, state_dir / "params.json", partial=True)
         self.values = {d.name: stored.get(d.name) for d in decls}
         self._decls = {d.name: d for d in decls}
         self._changes = bus.queue_reader("params/changes")

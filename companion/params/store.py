@@ -83,7 +83,12 @@ def bind(decl: ParamDecl, decls: Mapping[str, ParamDecl]) -> ParamDecl:
 class ParamStore:
     """All parameters of the vehicle, in a fixed order (the index QGroundControl uses)."""
 
-    def __init__(self, decls: Iterable[ParamDecl], path: Path | None = None) -> None:
+    def __init__(
+        self, decls: Iterable[ParamDecl], path: Path | None = None, partial: bool = False
+    ) -> None:
+        """``partial``: one owner's parameters, restored from the vehicle's shared file,
+        whose other names belong to other owners (not worth a warning each)."""
+        self.partial = partial
         self.decls: dict[str, ParamDecl] = {}
         for decl in decls:
             if len(decl.name) > MAX_NAME or not decl.name:
@@ -176,6 +181,8 @@ class ParamStore:
             if name in self.aliases:  # a file from before it was an alias: its owner's holds
                 continue
             decl = self.decls.get(name)
+            if decl is None and self.partial:
+                continue
             if decl is None or not isinstance(value, int | float):
                 log.warning("parameter file %s: ignoring %s = %r", path, name, value)
                 continue

@@ -123,3 +123,12 @@ def test_a_params_file_sets_owners_through_aliases_and_refuses_disagreement(tmp_
     with pytest.raises(ParamError, match="RTL_ALT_M disagrees with RETURN_ALT"):
         load_params(s, path)
     assert s.get("RTL_ALT_M") == 300.0
+
+
+def test_one_owners_store_skips_the_other_owners_names_without_a_word(tmp_path, caplog):
+    store(tmp_path).set("RETURN_ALT", 150.0)  # the file now holds every owner's values
+    mine = ParamStore(OWN[:1], tmp_path / "p.json", partial=True)
+    assert mine.get("RTL_ALT_M") == 150.0
+    assert not caplog.records  # a warning per other name filled a plug-in's stderr pipe
+    ParamStore(OWN[:1], tmp_path / "p.json")
+    assert "ignoring FS_ON" in caplog.text  # the whole vehicle's store still says so
