@@ -62,16 +62,21 @@ class Vehicle:
         self.proc: subprocess.Popen[str] | None = None
         self.bus: BusNode | None = None
         self._health: Any = None
+        # The vehicle's output goes to a file: a pipe nobody reads until the end blocks the
+        # vehicle once 64 KiB of log lines have piled up (a link stopped before its first
+        # heartbeat that way).
+        self.log_path = tmp / "vehicle.log"
 
     def start(self) -> Vehicle:
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "companion", "run", "-c", str(self.config)],
-            env=companion_env(self.namespace),
-            cwd=REPO,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
+        with self.log_path.open("w") as log:
+            self.proc = subprocess.Popen(
+                [sys.executable, "-m", "companion", "run", "-c", str(self.config)],
+                env=companion_env(self.namespace),
+                cwd=REPO,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                text=True,
+            )
         self.bus = BusNode(self.namespace, "test")
         self._health = self.bus.latest_reader("system/health")
         return self
@@ -107,9 +112,10 @@ class Vehicle:
         return time.monotonic() - started
 
     def output(self) -> str:
-        if self.proc is None or self.proc.stdout is None or self.proc.poll() is None:
+        """What the vehicle printed, once it has exited."""
+        if self.proc is None or self.proc.poll() is None or not self.log_path.exists():
             return ""
-        return self.proc.stdout.read()
+        return self.log_path.read_text(errors="replace")
 
     def close(self) -> None:
         """Stop everything the test started, whatever state the test left it in."""
@@ -120,8 +126,6 @@ class Vehicle:
         for pid in pids:
             with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
-        if self.proc is not None and self.proc.stdout is not None:
-            self.proc.stdout.close()
         if self.bus is not None:
             self.bus.close()
             self.bus = None
