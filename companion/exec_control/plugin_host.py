@@ -19,6 +19,7 @@ from collections import deque
 from typing import Any
 
 from companion.bus import BusNode, MonotonicClock, SimulationClock, VehicleClock
+from companion.exec_control.profiling import run_profiled
 from companion.exec_control.registry import load
 from companion.messages import NAME_LEN, PluginStats
 from companion.params import ParamDecl
@@ -152,7 +153,7 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGINT, host.request_stop)
     try:
         plugin = load(spec["kind"])()
-        return host.run(plugin)
+        return run_profiled(spec["name"], lambda: host.run(plugin))
     finally:
         host.bus.close()
 

@@ -1,0 +1,58 @@
+"""Opt-in profiling of plug-in processes: where a plug-in's CPU goes, per function.
+
+``COMPANION_PROFILE=DIR`` makes every plug-in process run its plug-in (init, steps, close)
+under cProfile and write ``DIR/<name>.<pid>.prof`` when it stops; ``COMPANION_PROFILE_ONLY``
+(comma-separated plug-in names) limits it to those. Times are the process's CPU time
+(``time.process_time``: a function asleep in a wait costs nothing, the kernel's work in its
+system calls counts) unless ``COMPANION_PROFILE_CLOCK=wall``. The variables reach the
+plug-ins through the supervisor's and the fork server's environment, so
+
+    COMPANION_PROFILE=/tmp/prof companion sim --plan qgc_plans/square.plan
+
+profiles a whole real-time flight. Read a file with ``python -m pstats DIR/imu.123.prof``
+(``sort tottime``, ``stats 20``). cProfile slows Python calls severalfold: compare
+functions within one profile, never a profiled run's CPU with an unprofiled one's.
+"""
+
+from __future__ import annotations
+
+import cProfile
+import logging
+import os
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import TypeVar
+
+ENV_DIR = "COMPANION_PROFILE"
+ENV_ONLY = "COMPANION_PROFILE_ONLY"
+ENV_CLOCK = "COMPANION_PROFILE_CLOCK"
+T = TypeVar("T")
+
+log = logging.getLogger(__name__)
+
+
+def profile_path(name: str) -> Path | None:
+    """Where the profile of plug-in ``name`` goes; None when it is not profiled."""
+    folder = os.environ.get(ENV_DIR, "")
+    only = {n.strip() for n in os.environ.get(ENV_ONLY, "").split(",") if n.strip()}
+    if not folder or (only and name not in only):
+        return None
+    return Path(folder) / f"{name}.{os.getpid()}.prof"
+
+
+def run_profiled(name: str, run: Callable[[], T]) -> T:
+    """``run()``, under cProfile when the environment asks for plug-in ``name``."""
+    path = profile_path(name)
+    if path is None:
+        return run()
+    wall = os.environ.get(ENV_CLOCK, "cpu") == "wall"
+    profiler = cProfile.Profile(time.perf_counter if wall else time.process_time)
+    try:
+        return profiler.runcall(run)
+    finally:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            profiler.dump_stats(path)
+        except OSError as exc:
+            log.warning("profile of %s not written: %s", name, exc)
