@@ -2,8 +2,9 @@
 
 The streams that carry the navigation state (attitude, position, speeds) are sent on the
 first state the navigator publishes once they are due, not on a timer: a timer would send
-a state up to one navigation period old. They wait for it at most ``NAV_HOLD_S`` past
-their time, so a vehicle whose navigator has stopped still reports at its rates.
+a state up to one navigation period old. They wait for it at most ``NAV_HOLD_S`` (and
+half their period) past their time, so a vehicle whose navigator has stopped, or runs
+slower than a rate a ground station asked for, still reports at its rates.
 """
 
 from __future__ import annotations
@@ -20,6 +21,13 @@ FOLLOWS_NAV = frozenset(
         d.MAVLINK_MSG_ID_VFR_HUD,
     )
 )
+
+
+def _hold(period: float) -> float:
+    """How long a stream that follows the navigator waits for a fresh state: at most half
+    its period, so a rate asked for above the navigator's is still kept (with states
+    sent twice), as ArduPilot and PX4 keep it."""
+    return min(NAV_HOLD_S, 0.5 * period)
 
 
 def _default_period(msg_id: int) -> float:
@@ -69,7 +77,7 @@ class StreamSchedule:
             due_s = self.next_due[mid]
             if period <= 0 or now_s < due_s:
                 continue
-            if mid in FOLLOWS_NAV and nav_at_s < due_s and now_s < due_s + NAV_HOLD_S:
+            if mid in FOLLOWS_NAV and nav_at_s < due_s and now_s < due_s + _hold(period):
                 continue
             out.append(mid)
             self.next_due[mid] = max(due_s + period, now_s - period)
@@ -81,7 +89,7 @@ class StreamSchedule:
     def next_time(self) -> float:
         """When a stream falls due without a navigation state (the wake-up for timers)."""
         times = [
-            self.next_due[m] + (NAV_HOLD_S if m in FOLLOWS_NAV else 0.0)
+            self.next_due[m] + (_hold(p) if m in FOLLOWS_NAV else 0.0)
             for m, p in self.period_s.items()
             if p > 0
         ]

@@ -46,3 +46,18 @@ def test_streams_that_do_not_carry_the_state_keep_their_timer():
     schedule = StreamSchedule()
     times = [ms / 1000 for ms in range(3000) if SYS_STATUS in schedule.due(ms / 1000, -1.0)]
     assert times == [0.0, 1.0, 2.0]
+
+
+def test_a_rate_above_the_navigators_is_kept():
+    # 50 Hz asked for, states at 20 Hz: every 20 ms all the same, some states sent twice.
+    schedule = StreamSchedule()
+    schedule.set_interval(ATTITUDE, 20_000)
+    nav_at, sent = float("-inf"), []
+    for ms in range(5000):
+        if ms % 50 == 0:
+            nav_at = ms / 1000
+        if ATTITUDE in schedule.due(ms / 1000, nav_at):
+            sent.append(ms)
+    gaps = sorted(b - a for a, b in pairwise(sent))
+    assert 245 <= len(sent) <= 255
+    assert 15 <= gaps[len(gaps) // 2] <= 25
