@@ -9,7 +9,8 @@ full buffer made it lose.
   oldest samples (iceoryx2 "safe overflow"), the writer never blocks, the loss is counted.
 - Latest: a buffer of one with history one, so a reader always sees the newest value,
   including one published before it connected (once the writer's process has called
-  ``BusNode.update_connections``, which the plug-in host and the supervisor do often).
+  ``BusNode.update_connections``, which the plug-in host and the supervisor do often). A
+  reader that wants every value (the flight log) may keep up to the channel's depth.
 """
 
 from __future__ import annotations
@@ -39,6 +40,19 @@ class SampleHeader(ctypes.Structure):
     _fields_ = [("writer_id", ctypes.c_uint64), ("seq", ctypes.c_uint64)]
 
 
+# A sample's header and payload are read and written in place through their addresses:
+# iceoryx2's typed accessors (``user_header()``, a cast to a fresh ctypes pointer type)
+# cost more than the copy itself, several times per sample. Its Python wrappers around
+# loaning and initialising a sample check the payload's type on every sample; the channel's
+# type is fixed when its service is opened, so a writer calls what they call, once it has
+# checked the message's size itself.
+_header_at = SampleHeader.from_address
+_memmove = ctypes.memmove
+_addressof = ctypes.addressof
+_loan_uninit = getattr(iox2.Publisher, "__loan_uninit")
+_assume_init = getattr(iox2.SampleMutUninit, "__assume_init")
+
+
 def duration(timeout_s: float) -> iox2.Duration:
     """An iceoryx2 Duration from seconds (clamped to [0, 1 h])."""
     return iox2.Duration.from_secs_f64(min(max(timeout_s, 0.0), _MAX_WAIT_S))
@@ -62,8 +76,15 @@ class IdleTally:
 class Writer(Generic[M]):
     """Publishes samples of one channel and wakes its readers."""
 
-    def __init__(self, name: str, publisher: iox2.Publisher, notifier: iox2.Notifier) -> None:
+    def __init__(
+        self,
+        name: str,
+        publisher: iox2.Publisher,
+        notifier: iox2.Notifier,
+        msg_type: type[Message],
+    ) -> None:
         self.name = name
+        self._size = ctypes.sizeof(msg_type)
         self._publisher = publisher
         self._notifier = notifier
         self._writer_id = random.getrandbits(63)
@@ -72,12 +93,15 @@ class Writer(Generic[M]):
 
     def publish(self, msg: M) -> None:
         """Copy the message into shared memory, send it, and notify readers."""
-        sample = self._publisher.loan_uninit()
-        header = sample.user_header().contents
+        if ctypes.sizeof(msg) != self._size:
+            raise TypeError(f"{self.name}: a {type(msg).__name__} is not this channel's type")
+        sample = _loan_uninit(self._publisher)
+        header = _header_at(sample.user_header_ptr)
         header.writer_id = self._writer_id
         header.seq = self._seq
         self._seq += 1
-        sample.write_payload(msg).send()
+        _memmove(sample.payload_ptr, _addressof(msg), self._size)
+        _assume_init(sample).send()
         self._notifier.notify()
         self.sent += 1
 
@@ -109,6 +133,7 @@ class Reader(Generic[M]):
         self.name = name
         self._idle = idle or IdleTally()
         self.msg_type = msg_type
+        self._size = ctypes.sizeof(msg_type)
         self._subscriber = subscriber
         self.listener = listener
         # Losses are counted from the first sample seen of each writer onwards.
@@ -120,10 +145,10 @@ class Reader(Generic[M]):
         sample = self._subscriber.receive()
         if sample is None:
             return None
-        header = sample.user_header().contents
-        self._count_gap(int(header.writer_id), int(header.seq))
+        header = _header_at(sample.user_header_ptr)
+        self._count_gap(header.writer_id, header.seq)
         msg = self.msg_type()
-        ctypes.memmove(ctypes.byref(msg), sample.payload_ptr, ctypes.sizeof(msg))
+        _memmove(_addressof(msg), sample.payload_ptr, self._size)
         sample.delete()
         self.received += 1
         return msg
@@ -232,7 +257,7 @@ class LatestReader(Reader[M]):
 
     def get(self) -> M | None:
         """The newest value published so far, or None if nothing has been seen yet."""
-        for msg in self.drain():
+        while (msg := self._receive_one()) is not None:
             self._latest = msg
         return self._latest
 

@@ -68,7 +68,7 @@ class BusNode:
             .enable_safe_overflow(True)
         )
         if chan.pattern == "latest":
-            builder = builder.history_size(1).subscriber_max_buffer_size(1)
+            builder = builder.history_size(1).subscriber_max_buffer_size(chan.depth)
         else:
             builder = builder.history_size(0).subscriber_max_buffer_size(chan.depth)
         return builder.open_or_create()
@@ -88,7 +88,7 @@ class BusNode:
         chan = channel(name)
         pub = self._pubsub(chan).publisher_builder().create()
         notifier = self._event(chan).notifier_builder().create()
-        port: Writer[Any] = Writer(name, pub, notifier)
+        port: Writer[Any] = Writer(name, pub, notifier, chan.type)
         self._ports.append(port)
         if chan.pattern == "latest":
             self._latest_writers.append(port)
@@ -110,13 +110,14 @@ class BusNode:
         self._ports.append(port)
         return port
 
-    def latest_reader(self, name: str) -> LatestReader[Any]:
-        """A reader of the Latest channel ``name``."""
+    def latest_reader(self, name: str, keep: int = 1) -> LatestReader[Any]:
+        """A reader of the Latest channel ``name``; it holds the newest ``keep`` values
+        between reads (at most the channel's depth), for a reader that wants every one."""
         chan = channel(name)
         if chan.pattern != "latest":
             raise ValueError(f"channel {name!r} is a Queue channel; use queue_reader()")
         service = self._pubsub(chan)
-        sub = service.subscriber_builder().create()
+        sub = service.subscriber_builder().buffer_size(max(1, min(keep, chan.depth))).create()
         listener = self._event(chan).listener_builder().create()
         port: LatestReader[Any] = LatestReader(name, chan.type, sub, listener, self.idle, service)
         self._ports.append(port)
@@ -128,9 +129,12 @@ class BusNode:
             return self.queue_reader(name)
         return self.latest_reader(name)
 
-    def waiter(self, readers: Sequence[Reader[Any]]) -> Waiter:
-        """A reusable wait over several readers (one iceoryx2 WaitSet)."""
-        return Waiter(readers, self.idle)
+    def waiter(
+        self, readers: Sequence[Reader[Any]], triggers: Sequence[Reader[Any]] | None = None
+    ) -> Waiter:
+        """A reusable wait over several readers (one iceoryx2 WaitSet); only ``triggers``
+        (default: all of them) end the wait."""
+        return Waiter(readers, self.idle, triggers)
 
     def total_lost(self) -> int:
         """Samples this node's Queue readers lost to overflow, all channels together."""
@@ -155,31 +159,37 @@ class BusNode:
 
 
 class Waiter:
-    """Sleeps until any of several readers has data, or a timeout passes."""
+    """Sleeps until any of several readers (its triggers) has data, or a timeout passes.
 
-    def __init__(self, readers: Sequence[Reader[Any]], idle: IdleTally | None = None) -> None:
+    Readers that are not triggers wake nobody: their data waits for the next wake-up (a
+    navigator woken by its IMU only, its aiding samples being held for the next IMU sample
+    anyway), and their notifications are cleared then.
+    """
+
+    def __init__(
+        self,
+        readers: Sequence[Reader[Any]],
+        idle: IdleTally | None = None,
+        triggers: Sequence[Reader[Any]] | None = None,
+    ) -> None:
         self.readers = list(readers)
+        self.triggers = self.readers if triggers is None else list(triggers)
         self._idle = idle or IdleTally()
         self._waitset = (
             iox2.WaitSetBuilder.new()
             .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
             .create(iox2.ServiceType.Ipc)
         )
-        self._guards = [self._waitset.attach_notification(r.listener) for r in self.readers]
+        self._guards = [self._waitset.attach_notification(r.listener) for r in self.triggers]
+        # What each attachment's id, as the WaitSet reports it fired, belongs to.
+        self._owners = {
+            iox2.WaitSetAttachmentId.from_guard(g): r
+            for g, r in zip(self._guards, self.triggers, strict=True)
+        }
 
     def wait(self, timeout_s: float) -> list[Reader[Any]]:
         """The readers with data, after sleeping at most ``timeout_s`` for the first."""
-        ready = [r for r in self.readers if r.has_samples()]
-        if not ready:
-            with self._idle:
-                try:
-                    self._waitset.wait_and_process_with_timeout(duration(timeout_s))
-                except iox2.WaitSetRunError:
-                    pass  # interrupted by a signal: the caller checks its stop flag
-            ready = [r for r in self.readers if r.has_samples()]
-        for r in self.readers:
-            r.consume_events()
-        return ready
+        return self._settle(self._wait(timeout_s))
 
     def wait_with_fds(
         self, timeout_s: float, fds: Sequence[int]
@@ -193,30 +203,51 @@ class Waiter:
         guards = [
             self._waitset.attach_notification_fd(iox2.FileDescriptor.non_owning_new(f)) for f in fds
         ]
-        fired: list[Any] = []
         try:
-            if any(r.has_samples() for r in self.readers):
-                timeout_s = 0.0  # only look which descriptors are readable too
-            with self._idle:
-                try:
-                    fired, _ = self._waitset.wait_and_process_with_timeout(duration(timeout_s))
-                except iox2.WaitSetRunError:
-                    pass  # interrupted by a signal: the caller checks its stop flag
-            ready_fds = [f for f, g in zip(fds, guards, strict=True) if _fired(fired, g)]
+            fired = self._wait(timeout_s)
+            ids = {
+                iox2.WaitSetAttachmentId.from_guard(g): f for g, f in zip(guards, fds, strict=True)
+            }
+            ready_fds = [ids[a] for a in fired if a in ids]
         finally:
             for guard in guards:
                 guard.delete()
-        ready = [r for r in self.readers if r.has_samples()]
-        for r in self.readers:
-            r.consume_events()
-        return ready, ready_fds
+        return self._settle(fired), ready_fds
+
+    def _wait(self, timeout_s: float) -> list[Any]:
+        """The WaitSet's fired attachments; it only looks when a sample already waits."""
+        if any(r.has_samples() for r in self.triggers):
+            return self._wait_once(_NO_WAIT)
+        with self._idle:
+            return self._wait_once(duration(timeout_s))
+
+    def _wait_once(self, timeout: iox2.Duration) -> list[Any]:
+        try:
+            fired, _ = self._waitset.wait_and_process_with_timeout(timeout)
+        except iox2.WaitSetRunError:
+            return []  # interrupted by a signal: the caller checks its stop flag
+        return list(fired)
+
+    def _settle(self, fired: list[Any]) -> list[Reader[Any]]:
+        """The readers with data; their notifications and those of the woken listeners
+        are cleared (the caller reads the data now, so a notification left would only end
+        the next wait at once), the others' left alone: each clearing is a system call."""
+        woken = {self._owners.get(a) for a in fired}
+        ready = []
+        for reader in self.readers:
+            has_data = reader.has_samples()
+            if has_data:
+                ready.append(reader)
+            if has_data or reader in woken:
+                reader.consume_events()
+        return ready
 
     def close(self) -> None:
         """Detach from the readers."""
         for guard in self._guards:
             guard.delete()
         self._guards.clear()
+        self._owners.clear()
 
 
-def _fired(attachments: list[Any], guard: Any) -> bool:
-    return any(a.has_event_from(guard) for a in attachments)
+_NO_WAIT = duration(0.0)

@@ -31,9 +31,16 @@ class Channel:
     name: str
     type: type[Message]
     pattern: Literal["queue", "latest"]
+    # A queue's depth; for a latest channel, how many values a reader may ask to keep
+    # between its reads (the flight log keeps every one; other readers keep the newest).
     depth: int = 1
     doc: str = ""
     many_producers: bool = False  # every plug-in may publish (e.g. system/plugin_stats)
+
+
+# Latest channels that change at up to 100 Hz keep this many values for a reader that
+# asks: the flight log, reading every ~0.1 s, records each one.
+KEEP = 16
 
 
 def _channels(*chans: Channel) -> dict[str, Channel]:
@@ -46,18 +53,20 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("sensors/gps", GpsFix, "queue", 8, "GPS fixes"),
     Channel("sensors/compass", Compass, "queue", 32, "digital compass attitude"),
     Channel("sensors/baro", Baro, "queue", 32, "barometric altitude"),
-    Channel("sensors/range", RangeReading, "latest", doc="downward rangefinder's reading"),
-    Channel("sensors/rc", PilotInput, "latest", doc="the RC receiver's newest frame"),
+    Channel("sensors/range", RangeReading, "latest", KEEP, doc="downward rangefinder's reading"),
+    Channel("sensors/rc", PilotInput, "latest", KEEP, doc="the RC receiver's newest frame"),
     Channel("sensors/rc_switch", PilotInput, "queue", 8, "frames where the mode switch moved"),
-    Channel("link/manual_control", PilotInput, "latest", doc="the ground station's joystick"),
-    Channel("sensors/battery", Battery, "latest", doc="flight battery voltage, current, charge"),
-    Channel("nav/state", NavState, "latest", doc="navigation solution"),
+    Channel("link/manual_control", PilotInput, "latest", KEEP, doc="the ground station's joystick"),
+    Channel(
+        "sensors/battery", Battery, "latest", KEEP, doc="flight battery voltage, current, charge"
+    ),
+    Channel("nav/state", NavState, "latest", KEEP, doc="navigation solution"),
     Channel("sim/truth", SimTruth, "latest", doc="simulator's true state"),
     Channel("sim/clock", SimClock, "latest", doc="simulation time"),
-    Channel("vehicle/status", VehicleStatus, "latest", doc="mode, home, guided target"),
+    Channel("vehicle/status", VehicleStatus, "latest", KEEP, doc="mode, home, guided target"),
     Channel("control/actuators", ActuatorCommand, "queue", 8, "normalised surfaces"),
-    Channel("control/status", ControlStatus, "latest", doc="guidance and mission progress"),
-    Channel("actuators/servos", ServoOutput, "latest", doc="servo outputs written"),
+    Channel("control/status", ControlStatus, "latest", KEEP, doc="guidance and mission progress"),
+    Channel("actuators/servos", ServoOutput, "latest", KEEP, doc="servo outputs written"),
     Channel("link/commands", VehicleCommand, "queue", 16, "commands for the vehicle", True),
     Channel("link/command_acks", CommandAck, "queue", 16, "command outcomes"),
     Channel("system/plugin_stats", PluginStats, "queue", 64, "per-plug-in counters", True),
