@@ -82,7 +82,7 @@ class PublishedImu:
 
 
 # The promise: a power cut loses at most the last flush interval (1 s by default) of
-# samples. The margin is the logger's read period (20 ms) and the scheduling of a busy
+# samples. The margin is the logger's read period (20-100 ms) and the scheduling of a busy
 # machine between the drain it last flushed and the flush itself.
 MARGIN_S = 0.3
 

@@ -8,10 +8,14 @@ off, one file from start-up to the end). INFO ``nav.*`` keeps the navigator's se
 lockstep simulation, told by ``system/logged`` with ``in_step``, waits for it), and what
 a full queue made it lose is counted once, in its ``dropped`` health counter (the plug-in
 host adds every bus reader's losses), and in the log as a dropout and a warning where the
-gap is. The file is flushed and fsynced at least once a (wall) second, so a power cut
-loses at most that much and leaves a file pyulog reads up to its last complete message; a
-file appears only once its header is on disk. At each flush the oldest logs past
-``budget_mb`` go, and a file past ``file_mb`` goes on in a new one (``LogRecorder``).
+gap is. Latest channels are read keeping every value (``BusNode.latest_reader``'s
+``keep``), so the log holds each one however seldom it reads: it reads every ``period_s``
+at first, then less often (up to every 0.1 s) while its queues fill slowly, more often
+while one comes back over half full. The file is flushed and fsynced at least once a
+(wall) second, so a power cut loses at most that much and leaves a file pyulog reads up to
+its last complete message; a file appears only once its header is on disk. At each flush
+the oldest logs past ``budget_mb`` go, and a file past ``file_mb`` goes on in a new one
+(``LogRecorder``).
 """
 
 from __future__ import annotations
@@ -53,6 +57,10 @@ DEFAULT_CHANNELS = [
     "system/health",
 ]
 MIN_PERIOD_S = 0.001
+# While data flows and no queue comes back a quarter full, the reads spread out to this:
+# the IMU's 64-deep queue holds 0.64 s at 100 Hz, a Latest channel 16 values (0.32 s at
+# 50 Hz). Each read costs a wake-up and a pass over every channel.
+CALM_PERIOD_S = 0.1
 # With nothing arriving (a vehicle on the bench), it reads this seldom at most: a sensor
 # starting at 200 Hz fills a 64-deep queue in 0.32 s, and arming wakes it at once.
 IDLE_PERIOD_S = 0.25
@@ -62,6 +70,13 @@ IDLE_PERIOD_S = 0.25
 # The navigator plug-ins whose settings the log keeps.
 NAVIGATORS = ("nav.ins_ekf", "nav.gps_compass")
 _WAKERS = ("system/health", "vehicle/statustext", "link/commands", "params/changes")
+
+
+def _reader(ctx: PluginContext, name: str) -> Reader[Any]:
+    """A queue's reader, or a Latest channel's keeping every value between two reads."""
+    if CHANNELS[name].pattern == "queue":
+        return ctx.bus.queue_reader(name)
+    return ctx.bus.latest_reader(name, keep=CHANNELS[name].depth)
 
 
 def navigator_info(plugins: Mapping[str, Mapping[str, Any]]) -> dict[str, str]:
@@ -94,7 +109,9 @@ class LoggerPlugin(Plugin):
             float, 100.0, "a log goes on in a new file past this size (at most budget/2)", min=0.01
         ),
         "flush_s": Setting(float, 1.0, "wall seconds between fsyncs", min=0.05, max=1.0),
-        "period_s": Setting(float, 0.02, "wall seconds between reads of the queues", min=0.001),
+        "period_s": Setting(
+            float, 0.02, "wall seconds between reads of the queues (at first)", min=0.001
+        ),
         "prearm_samples": Setting(
             int, 1000, "samples before arming kept for the flight's log", min=0, max=100_000
         ),
@@ -122,15 +139,18 @@ class LoggerPlugin(Plugin):
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
         self.params = ParamStore(ctx.param_decls, state_dir / "params.json").values
         names = list(dict.fromkeys(s["channels"]))
-        self.readers = {name: ctx.bus.reader(name) for name in names}
+        self.readers = {name: _reader(ctx, name) for name in names}
+        self.topics = {name: topic_name(name) for name in names}
         # Its own reader: the one in ``readers`` hands every table to the log.
         self.health = ctx.bus.latest_reader("system/health")
         wakers = [r for n, r in self.readers.items() if s["in_step"] or n in _WAKERS]
         self.waiter = ctx.bus.waiter(wakers)
         self.progress = ctx.bus.writer("system/logged") if s["in_step"] else None
         self.written_us = -1
-        self.depths = {n: CHANNELS[n].depth for n in names}
+        # What can fill between two reads (a Latest channel of depth 1 keeps one value).
+        self.depths = {n: CHANNELS[n].depth for n in names if CHANNELS[n].depth > 1}
         self.period_s = s["period_s"]
+        self.quiet = False  # the last read found nothing at all
         info = {
             "sys_name": "companion",
             "ver_sw": __version__,
@@ -154,7 +174,10 @@ class LoggerPlugin(Plugin):
             self._open("boot")
 
     def step(self) -> None:
-        self.waiter.wait(self.period_s)
+        timeout = self.period_s
+        if self.recorder.is_open:  # the flush is due on time, whatever the period
+            timeout = min(timeout, max(0.0, self.next_flush - time.monotonic()))
+        self.waiter.wait(timeout)
         try:
             self._work()
         except OSError as exc:
@@ -174,7 +197,8 @@ class LoggerPlugin(Plugin):
         fill, total = 0.0, 0
         for name, reader in self.readers.items():
             count = self._drain(name, reader)
-            fill = max(fill, count / self.depths[name])
+            if count and name in self.depths:
+                fill = max(fill, count / self.depths[name])
             total += count
         self._adapt(fill, total)
         if self.progress is not None and self.writer is not None:
@@ -211,14 +235,14 @@ class LoggerPlugin(Plugin):
         runs its sensors many times faster than real time), less often again when calm,
         seldom when nothing comes at all."""
         base = self.ctx.settings["period_s"]
+        was_quiet, self.quiet = self.quiet, count == 0
         if count == 0:
             self.period_s = max(base, min(self.period_s * 2, IDLE_PERIOD_S))
-        elif self.period_s > base:
-            self.period_s = base
-        elif fill > 0.5:
-            self.period_s = max(self.period_s / 2, MIN_PERIOD_S)
-        elif fill < 0.25:
-            self.period_s = min(self.period_s * 1.25, base)
+        elif fill > 0.5:  # after a quiet spell, a stream has started: from the base period
+            self.period_s = base if was_quiet else max(self.period_s / 2, MIN_PERIOD_S)
+        elif fill < 0.25 and self.period_s < CALM_PERIOD_S:
+            # A trickle (a vehicle on the bench) leaves a quiet spell's period as it is.
+            self.period_s = min(self.period_s * 1.25, max(base, CALM_PERIOD_S))
 
     def _follow_arming(self) -> None:
         health = self.health.get()
@@ -246,7 +270,7 @@ class LoggerPlugin(Plugin):
         if self.writer is None:
             self.recent.append((name, msg))
             return
-        self.writer.data(topic_name(name), msg)
+        self.writer.data(self.topics[name], msg)
         if name == "sensors/imu":
             self.written_us = max(self.written_us, int(msg.t_us))
         if name == "vehicle/statustext":
