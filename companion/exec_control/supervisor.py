@@ -206,7 +206,9 @@ class Supervisor:
         acks = bus.writer("link/command_acks")
         commands = bus.queue_reader("link/commands")
         stats = bus.queue_reader("system/plugin_stats")
-        waiter = bus.waiter([commands, stats])
+        # Commands wake it; the plug-ins' counters (each plug-in's once a second) wait for
+        # the health table they go into.
+        waiter = bus.waiter([commands, stats], triggers=[commands])
         if self.forker.proc is not None and not self.forker.wait_ready(READY_TIMEOUT_S):
             log.warning("fork server not ready: spawning plug-ins until it is")
         self.start_group("core")

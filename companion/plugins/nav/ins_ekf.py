@@ -62,7 +62,10 @@ class InsEkfPlugin(Plugin):
         )
         self.runner = InsEkfRunner(config=config)
         self.readers = [ctx.bus.queue_reader(c) for c in FEED_ORDER]
-        self.waiter = ctx.bus.waiter(self.readers)
+        # Woken by the IMU only: an aiding sample waits for the IMU sample after it anyway
+        # (SampleOrder), and without an IMU there is nothing to publish (``WAIT_S`` still
+        # feeds it the aiding samples then).
+        self.waiter = ctx.bus.waiter(self.readers, triggers=self.readers[:1])
         self.out = ctx.bus.writer("nav/state")
         self.grid = PublishGrid(s["publish_hz"])
         self.order = SampleOrder()
