@@ -86,22 +86,45 @@ def switch_position(pulse: int) -> int:
     return sum(pulse > edge for edge in MODE_BANDS_US)
 
 
+@dataclass(frozen=True)
+class StickMap:
+    """The RC parameters resolved once into channels and calibrations: a receiver sends
+    50 frames a second, its parameters change when the pilot calibrates."""
+
+    axes: tuple[tuple[int, float, float, float, bool], ...]  # roll, pitch, yaw
+    throttle: tuple[int, float, float, bool]
+    mode_ch: int
+    throttle_failsafe_us: float
+
+    @classmethod
+    def from_params(cls, p: Mapping[str, float]) -> StickMap:
+        """The map the parameters ``p`` give."""
+        axes = []
+        for name in ("RCMAP_ROLL", "RCMAP_PITCH", "RCMAP_YAW"):
+            ch = round(p[name])
+            axes.append((ch, *_calibration(p, ch)))
+        thr_ch = round(p["RCMAP_THROTTLE"])
+        lo, hi, _trim, rev = _calibration(p, thr_ch)
+        return cls(tuple(axes), (thr_ch, lo, hi, rev), round(p["FLTMODE_CH"]), p["THR_FS_VALUE"])
+
+    def sticks(self, pulses: Sequence[int]) -> Sticks:
+        """The pilot's sticks from the channels' pulse widths."""
+        roll, pitch, yaw = (
+            centred(_pulse(pulses, ch), lo, hi, trim, rev) for ch, lo, hi, trim, rev in self.axes
+        )
+        thr_ch, lo, hi, rev = self.throttle
+        thr_pulse = _pulse(pulses, thr_ch)
+        mode_ch = self.mode_ch
+        return Sticks(
+            roll=roll,
+            pitch=pitch,
+            yaw=yaw,
+            throttle=ranged(thr_pulse, lo, hi, rev),
+            mode_switch=switch_position(_pulse(pulses, mode_ch)) if mode_ch else -1,
+            throttle_low=thr_pulse < self.throttle_failsafe_us,
+        )
+
+
 def sticks(pulses: Sequence[int], p: Mapping[str, float]) -> Sticks:
     """The pilot's sticks from the channels' pulse widths and the RC parameters."""
-
-    def axis(name: str) -> float:
-        ch = round(p[name])
-        return centred(_pulse(pulses, ch), *_calibration(p, ch))
-
-    thr_ch = round(p["RCMAP_THROTTLE"])
-    lo, hi, _trim, rev = _calibration(p, thr_ch)
-    thr_pulse = _pulse(pulses, thr_ch)
-    mode_ch = round(p["FLTMODE_CH"])
-    return Sticks(
-        roll=axis("RCMAP_ROLL"),
-        pitch=axis("RCMAP_PITCH"),
-        yaw=axis("RCMAP_YAW"),
-        throttle=ranged(thr_pulse, lo, hi, rev),
-        mode_switch=switch_position(_pulse(pulses, mode_ch)) if mode_ch else -1,
-        throttle_low=thr_pulse < p["THR_FS_VALUE"],
-    )
+    return StickMap.from_params(p).sticks(pulses)

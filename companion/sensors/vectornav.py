@@ -31,11 +31,17 @@ from dataclasses import dataclass
 from companion.messages import Imu, Magnetometer
 from companion.sensors.ascii_sentence import sentence_text, xor8
 
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_APPENDED = re.compile(r"[TS][0-9A-Fa-f]+")  # SerialCount / SerialStatus fields
+_NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+_APPENDED = r"[TS][0-9A-Fa-f]+"  # SerialCount / SerialStatus fields
 _HEADER = re.compile(r"VN[A-Z]{3}")
 _HEX = frozenset("0123456789abcdefABCDEF")
 _FIELD_COUNTS = {"VNYMR": 12, "VNIMU": 11}
+# A sentence's fields after its header, in one match (neither pattern holds a comma, so
+# this is the same as every field on its own): ``count`` numbers, then appended fields.
+_FIELDS = {
+    header: re.compile(f"(?:,{_NUMBER}){{{count}}}(?:,{_APPENDED})*")
+    for header, count in _FIELD_COUNTS.items()
+}
 _PLACEHOLDERS = ("XX", "XXXX")
 
 
@@ -89,7 +95,7 @@ class VectorNavDecoder:
         if count is None:
             self.counters.ignored += 1
             return None
-        numbers = _numbers(values, count)
+        numbers = _numbers(header, values, count)
         if numbers is None or not _angles_in_range(header, numbers):
             self.counters.garbage += 1
             return None
@@ -117,14 +123,12 @@ class VectorNavDecoder:
         return payload.split(",")
 
 
-def _numbers(values: list[str], count: int) -> list[float] | None:
+def _numbers(header: str, values: list[str], count: int) -> list[float] | None:
     """The first ``count`` fields as finite numbers; only appended T/S fields may follow."""
-    if len(values) < count or not all(_APPENDED.fullmatch(v) for v in values[count:]):
+    if not _FIELDS[header].fullmatch("," + ",".join(values)):
         return None
-    if not all(_NUMBER.fullmatch(v) for v in values[:count]):
-        return None
-    numbers = [float(v) for v in values[:count]]
-    return numbers if all(math.isfinite(n) for n in numbers) else None
+    numbers = list(map(float, values[:count]))
+    return numbers if all(map(math.isfinite, numbers)) else None
 
 
 def _angles_in_range(header: str, numbers: list[float]) -> bool:

@@ -7,7 +7,7 @@ import os
 
 import pytest
 
-from companion.messages import PilotFlags
+from companion.messages import PilotFlags, PilotInput
 from tests.support.configs import plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.sbus import frame, us_to_raw
@@ -29,6 +29,7 @@ def test_sticks_switch_and_failsafe_through_garbage(vehicle_factory, tmp_path):
     rc = plugin("rc", "sensors.rc_input", device=str(device))
     vehicle = vehicle_factory(vehicle_config("rc", rc))
     sticks = vehicle.bus.latest_reader("sensors/rc")
+    every = vehicle.bus.latest_reader("sensors/rc", keep=16)  # each frame, to count them
     switch = vehicle.bus.queue_reader("sensors/rc_switch")
     vehicle.wait_running("rc")
 
@@ -41,6 +42,17 @@ def test_sticks_switch_and_failsafe_through_garbage(vehicle_factory, tmp_path):
         return got is not None and got.roll == pytest.approx(roll, abs=0.01)
 
     wait_for(lambda: seen(1.0), 60, "full right roll")  # a minute, as on a busy machine
+    # The switch's start position is noted once two frames running show it: a driver may
+    # have decoded only the first when the test sees its roll.
+    at_start: list[PilotInput] = []
+
+    def start_noted() -> bool:
+        at_start.extend(s for s in every.drain() if s.mode_switch == 0)
+        if len(at_start) < 2:
+            send(frame(pulses(roll=1900, throttle=1500)))
+        return len(at_start) >= 2
+
+    wait_for(start_noted, 30, "two frames at the switch's start position")
     got = sticks.get()
     assert got.throttle == pytest.approx(0.5, abs=0.01) and got.mode_switch == 0
     assert got.usable() and got.channels_us[0] == 1900 and got.channel_count == 18

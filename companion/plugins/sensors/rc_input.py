@@ -24,7 +24,7 @@ from companion.messages import RC_MAX_CHANNELS, PilotFlags, PilotInput, PilotSou
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
 from companion.plugins.sensors.serial_sensor import serial_settings
-from companion.sensors.rc_channels import RC_PARAMS, sticks
+from companion.sensors.rc_channels import RC_PARAMS, StickMap
 from companion.sensors.sbus import SbusDecoder, SbusFrame
 from companion.sensors.serial_port import ReopeningSerial
 
@@ -45,6 +45,7 @@ class RcInput(Plugin):
         self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"], framing=framing)
         self.decoder = SbusDecoder()
         self.live = LiveParams(ctx.bus, self.params, Path(ctx.vehicle.get("state_dir", ".")))
+        self.stick_map = StickMap.from_params(self.live.values)
         self.out = ctx.bus.writer("sensors/rc")
         self.switch_out = ctx.bus.writer("sensors/rc_switch")
         # The switch position last put on sensors/rc_switch; None until the first one, which
@@ -57,8 +58,8 @@ class RcInput(Plugin):
         with self.ctx.bus.idle:  # waiting for the receiver is not busy time
             data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
         frames = self.decoder.feed(data)
-        if frames:
-            self.live.poll()
+        if frames and self.live.poll():
+            self.stick_map = StickMap.from_params(self.live.values)
         for frame in frames:
             self._publish(frame, t_us)
         c = self.decoder.counters
@@ -68,7 +69,7 @@ class RcInput(Plugin):
 
     def _publish(self, frame: SbusFrame, t_us: int) -> None:
         pulses = frame.pulses_us()
-        s = sticks(pulses, self.live.values)
+        s = self.stick_map.sticks(pulses)
         msg = PilotInput(t_us=t_us, source=PilotSource.RC, rssi=255)
         msg.roll, msg.pitch, msg.yaw, msg.throttle = s.roll, s.pitch, s.yaw, s.throttle
         msg.mode_switch = s.mode_switch
@@ -80,9 +81,8 @@ class RcInput(Plugin):
         if s.throttle_low:
             flags |= PilotFlags.THROTTLE_LOW
         msg.flags = int(flags)
-        msg.channel_count = min(len(pulses), RC_MAX_CHANNELS)
-        for i, pulse in enumerate(pulses[:RC_MAX_CHANNELS]):
-            msg.channels_us[i] = pulse
+        count = msg.channel_count = min(len(pulses), RC_MAX_CHANNELS)
+        msg.channels_us[:count] = pulses[:count]
         self.out.publish(msg)
         self._switch(msg)
 
