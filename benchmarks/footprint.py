@@ -15,8 +15,8 @@ the fork server; never the simulator bridge.
   process (its first ``system/plugin_stats``) and to its output on the bus again;
 - CPU time per real second (utime + stime from ``/proc/PID/stat``; the simulation runs at
   real time, and the ratio to simulated time is printed too) over ``--cpu-seconds`` of flight;
-- idle on the bench: ``companion run`` of the same config on ptys nobody writes to (sensors
-  connected but silent), its CPU per second;
+- idle on the bench: ``companion run`` of the same config, each of its ``sim://`` devices a
+  pty nobody writes to (sensors connected but silent), CPU per second of each process;
 - installed size of the on-board program: ``pip install .`` (no [ground] extra) into a
   fresh venv made by uv, ``du`` of its site-packages.
 
@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import signal
 import socket
 import statistics
@@ -275,33 +276,43 @@ def fly_once(cpu_seconds: float) -> dict[str, object]:
     return res
 
 
-def bench_idle(seconds: float) -> tuple[dict[str, float], dict[str, int]]:
-    """``companion run`` of the sim config with silent ptys for its devices."""
-    tmp = Path(tempfile.mkdtemp(prefix="footprint_idle"))
-    ptys = [os.openpty() for _ in range(4)]
-    names = dict(zip(("gps", "compass", "imu", "servos"), ptys, strict=True))
+def bench_config(tmp: Path) -> tuple[Path, list[tuple[int, int]]]:
+    """The sim config for ``companion run``: every ``sim://`` device a silent pty of its own
+    (whatever devices the config has), the airframe c172p, the host's clock, no links out."""
     text = (REPO / "companion" / "configs" / "sim.toml").read_text()
-    for dev, (_, slave) in names.items():
-        text = text.replace(f'"sim://{dev}"', f'"{os.ttyname(slave)}"')
-    text = text.replace('"sim://airframe"', '"c172p"').replace('clock = "sim"', "")
+    ptys: list[tuple[int, int]] = []
+    for name in sorted(set(re.findall(r'"sim://([^"]+)"', text))):
+        if name == "airframe":
+            path = "c172p"
+        else:
+            ptys.append(os.openpty())
+            path = os.ttyname(ptys[-1][1])
+        text = text.replace(f'"sim://{name}"', f'"{path}"')
+    text = text.replace('clock = "sim"', "")
     text = text.replace("[vehicle]", f'[vehicle]\nstate_dir = "{tmp / "state"}"', 1)
     text = text.replace("udpout://127.0.0.1:14550", "udpout://127.0.0.1:9")
     text = text.replace(', "udpout://127.0.0.1:14540"', "")
     config = tmp / "bench.toml"
     config.write_text(text)
+    return config, ptys
+
+
+def bench_idle(seconds: float) -> tuple[dict[str, float], dict[str, int]]:
+    """``companion run`` of the sim config with silent ptys for its devices."""
+    tmp = Path(tempfile.mkdtemp(prefix="footprint_idle"))
+    config, ptys = bench_config(tmp)
     namespace = f"fpidle{os.getpid()}"
     cmd = [sys.executable, "-m", "companion", "run", "-c", str(config), "--namespace", namespace,
            "--log-level", "ERROR"]  # fmt: skip
     v = Vehicle(cmd, namespace, None)
     try:
-        time.sleep(8.0)
-        cpu, _ = v.cpu(seconds)
-        pss = v.pss()
+        v.vehicle_up()
+        time.sleep(5.0)
+        cpu, pss = v.cpu(seconds)[0], v.pss()
     finally:
         v.stop()
-        for master, slave in ptys:
-            os.close(master)
-            os.close(slave)
+        for fd in (fd for pair in ptys for fd in pair):
+            os.close(fd)
     return cpu, pss
 
 
@@ -369,20 +380,21 @@ def main() -> None:
     ap.add_argument("--cpu-seconds", type=float, default=20.0)
     ap.add_argument("--no-install", action="store_true", help="skip the installed size")
     ap.add_argument("--no-idle", action="store_true", help="skip the bench idle figure")
+    ap.add_argument("--no-flight", action="store_true", help="skip the flight figures")
     ap.add_argument("--source", action="store_true", help="run without compiled bytecode")
     args = ap.parse_args()
     if not args.source:
         use_bytecode()
-    runs = [fly_once(args.cpu_seconds) for _ in range(args.repeat)]
-    print_flight(runs)
+    if not args.no_flight:
+        print_flight([fly_once(args.cpu_seconds) for _ in range(args.repeat)])
     if not args.no_idle:
         idles = [bench_idle(args.cpu_seconds) for _ in range(args.repeat)]
         cpu = _median_table([i[0] for i in idles])
         total = statistics.median(sum(i[0].values()) for i in idles) * 100
         pss = statistics.median(sum(i[1].values()) for i in idles) / 1024
-        worst = max(cpu, key=cpu.__getitem__)
-        print(f"idle on the bench (companion run, silent devices): CPU {total:.2f} % "
-              f"(most: {worst} {cpu[worst] * 100:.2f} %), PSS {pss:.1f} MB")  # fmt: skip
+        each = ", ".join(f"{n} {c * 100:.2f}" for n, c in sorted(cpu.items(), key=lambda i: -i[1]))
+        print(f"idle on the bench (companion run, silent devices): CPU {total:.2f} %, "
+              f"PSS {pss:.1f} MB\n  per process, % of a core: {each}")  # fmt: skip
     if not args.no_install:
         site, venv = installed_size()
         print(f"installed (pip install . into a fresh venv): site-packages {site:.0f} MB, "
