@@ -229,18 +229,16 @@ class Waiter:
         return list(fired)
 
     def _settle(self, fired: list[Any]) -> list[Reader[Any]]:
-        """The readers with data; their notifications and those of the woken listeners
-        are cleared (the caller reads the data now, so a notification left would only end
-        the next wait at once), the others' left alone: each clearing is a system call."""
+        """The readers with data. The notifications of the triggers that were woken or
+        have data are cleared (the caller reads the data now, so one left would only end
+        the next wait at once); the others' are left alone, each clearing being a system
+        call, and a listener outside the WaitSet ends no wait (a writer's notification
+        never fails for want of a listener clearing them)."""
         woken = {self._owners.get(a) for a in fired}
-        ready = []
-        for reader in self.readers:
-            has_data = reader.has_samples()
-            if has_data:
-                ready.append(reader)
-            if has_data or reader in woken:
-                reader.consume_events()
-        return ready
+        for trigger in self.triggers:
+            if trigger in woken or trigger.has_samples():
+                trigger.consume_events()
+        return [r for r in self.readers if r.has_samples()]
 
     def close(self) -> None:
         """Detach from the readers."""

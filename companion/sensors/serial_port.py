@@ -159,7 +159,7 @@ class ReopeningSerial:
         if port is None:
             return 0
         try:
-            written = port.write(data) or 0
+            written = _write_fd(port, data) if self._poll is not None else port.write(data) or 0
         except serial.SerialTimeoutException:
             log.debug("%s: write timed out", self.url)
             return 0
@@ -231,6 +231,19 @@ class ReopeningSerial:
                 port.close()
             except _PORT_ERRORS:
                 pass  # already gone; nothing more to release
+
+
+def _write_fd(port: serial.SerialBase, data: bytes) -> int:
+    """Straight to the descriptor; what does not fit at once goes through pyserial, which
+    waits for room up to the write timeout (it also waits, with a select, after a write
+    that fitted)."""
+    try:
+        written = os.write(port.fd, data)
+    except BlockingIOError:
+        written = 0
+    if written == len(data):
+        return written
+    return written + (port.write(data[written:]) or 0)
 
 
 def _poll_for(port: serial.SerialBase) -> select.poll | None:
