@@ -86,7 +86,6 @@ def score_landing(
     When the approach point is a LOITER_TO_ALT centre, the line starts at its tangent
     point: give the radius (and direction) to have it found.
     """
-    truth = _until_first_stop(truth)
     frame = LocalFrame(*land)
     n, e = frame.ne(truth["lat"], truth["lon"])
     a = frame.ne(*approach)
@@ -102,16 +101,17 @@ def score_landing(
     flying = np.nonzero(height > AIRBORNE_M)[0]
     if flying.size == 0:
         return LandingScore(False)
+    speed = np.hypot(truth["vn"], truth["ve"])
+    end = _first_stop(height, speed, int(flying[0]))
+    flying = flying[flying <= end]
     # The wheels meet the runway where the descent stops close to it (a tail dragger on its
     # main wheels sits higher than at rest, in its three-point attitude).
     vd = truth["vd"]
     low = (height < TOUCH_M) & (vd < SETTLED_M_S)
-    after = flying[-1] + np.nonzero(low[flying[-1] :])[0]
+    after = flying[-1] + np.nonzero(low[flying[-1] : end + 1])[0]
     if after.size == 0:
         return LandingScore(False)
     k = int(after[0])
-    speed = np.hypot(truth["vn"], truth["ve"])
-    end = len(alt) - 1
     stopped = bool(speed[end] < STOPPED_M_S)
     on_runway = bool(
         abs(across[end]) <= RUNWAY_HALF_WIDTH_M and -50.0 <= along[end] <= RUNWAY_LENGTH_M
@@ -125,7 +125,7 @@ def score_landing(
                 vd[(truth["t"] >= truth["t"][k] - SINK_WINDOW_S) & (truth["t"] <= truth["t"][k])]
             )
         ),
-        float(np.max(height[k:]) - height[k]),
+        float(np.max(height[k : end + 1]) - height[k]),
         float(math.degrees(truth["roll"][k])),
         float(along[end]),
         float(across[end]),
@@ -134,23 +134,17 @@ def score_landing(
     )
 
 
-def _until_first_stop(truth: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """The truth up to the first stop on the ground after the flight proper.
+def _first_stop(height: np.ndarray, speed: np.ndarray, took_off: int) -> int:
+    """Where the aircraft first stands still on the ground after ``took_off`` (the last
+    sample if it never does): the end of the landing.
 
     A simulator left running once the vehicle has disarmed keeps integrating a parked
     aircraft nobody flies (one sat pitching on its gear for 100 s, then tumbled); that is
     not part of the landing.
     """
-    height = truth["alt"] - float(truth["alt"][0])
-    flying = np.nonzero(height > AIRBORNE_M)[0]
-    if flying.size == 0:
-        return truth
-    speed = np.hypot(truth["vn"], truth["ve"])
     still = np.nonzero((speed < STOPPED_M_S) & (height < TOUCH_M))[0]
-    still = still[still > flying[0]]
-    if still.size == 0:
-        return truth
-    return {key: values[: int(still[0]) + 1] for key, values in truth.items()}
+    still = still[still > took_off]
+    return int(still[0]) if still.size else len(height) - 1
 
 
 def _tangent_point(
