@@ -9,17 +9,46 @@ ignores them. ``drop`` loses chosen packets on arrival, as a lossy radio would.
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 from collections.abc import Callable
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from tests.protocol.mav_client import GroundStation
+from tests.support.vehicle import wait_for
+
+if TYPE_CHECKING:
+    from tests.protocol.test_mavproxy import MavProxy
+
+log = logging.getLogger(__name__)
 
 BIN = 90
 TABLE_BINS = 512
 CHUNK = BIN * TABLE_BINS
 TIMEOUT_S = 0.5
+
+
+def mavproxy_download(
+    mavproxy: MavProxy, folder: Path, online: Callable[[], object], size: int, download_s: float
+) -> bytes:
+    """MAVProxy's ``log list`` and ``log download 0 flight.ulg`` (into ``folder``, where it
+    runs) once
+    ``online()`` has returned; the file's bytes. MAVProxy is closed and its output logged;
+    it must have listed the log at ``size`` bytes."""
+    try:
+        online()
+        mavproxy.type("log list")
+        wait_for(lambda: "numLogs 1" in "".join(mavproxy.lines), 30, "the log listed")
+        mavproxy.type("log download 0 flight.ulg")
+        done = "Finished downloading"
+        wait_for(lambda: done in "".join(mavproxy.lines), download_s, "the download")
+    finally:
+        output = mavproxy.close()
+        log.info("MAVProxy said:\n%s", output[-3000:])
+    assert f"size {size}" in output
+    return (folder / "flight.ulg").read_bytes()
 
 
 def list_logs(gcs: GroundStation, timeout_s: float = 10.0) -> dict[int, Any]:

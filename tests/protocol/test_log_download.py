@@ -3,7 +3,6 @@ Log Download page and MAVProxy's ``log`` module do it, from a vehicle that recor
 
 from __future__ import annotations
 
-import logging
 import time
 from pathlib import Path
 
@@ -13,7 +12,7 @@ from pyulog import ULog
 from companion.flight_log import being_written
 from companion.messages import CommandId, VehicleCommand
 from mavlink_dialect import companion as m
-from tests.protocol.log_client import QgcDownload, list_logs
+from tests.protocol.log_client import QgcDownload, list_logs, mavproxy_download
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.protocol.test_mavproxy import MavProxy
 from tests.support.configs import FAKE_NAV, TICKER, WAITING, link, plugin, vehicle_config
@@ -153,14 +152,6 @@ def test_mavproxy_log_list_and_download(vehicle_factory, tmp_path):
     vehicle = logging_vehicle(vehicle_factory, port, state)
     on_board = record_flight(vehicle, state / "logs")
     mavproxy = MavProxy(port, tmp_path)
-    try:
-        mavproxy.connected(vehicle)
-        mavproxy.type("log list")
-        wait_for(lambda: "numLogs 1" in "".join(mavproxy.lines), 30, "the log listed")
-        mavproxy.type("log download 0 flight.ulg")
-        wait_for(lambda: "Finished downloading" in "".join(mavproxy.lines), 120, "the download")
-    finally:
-        output = mavproxy.close()
-        logging.getLogger(__name__).info("MAVProxy said:\n%s", output[-3000:])
-    assert f"size {on_board.stat().st_size}" in output
-    assert (tmp_path / "flight.ulg").read_bytes() == on_board.read_bytes()
+    size = on_board.stat().st_size
+    data = mavproxy_download(mavproxy, tmp_path, lambda: mavproxy.connected(vehicle), size, 120)
+    assert data == on_board.read_bytes()

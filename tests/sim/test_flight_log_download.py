@@ -21,7 +21,7 @@ from pyulog import ULog
 from companion.bus import BusNode
 from companion.flight_log import being_written
 from mavlink_dialect import companion as m
-from tests.protocol.log_client import QgcDownload, list_logs
+from tests.protocol.log_client import QgcDownload, list_logs, mavproxy_download
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.protocol.test_mavproxy import MavProxy
 from tests.sim.sim_run import finish, start_sim
@@ -90,22 +90,16 @@ def disarm(flight: Flight, timeout_s: float = 60.0) -> None:
     raise AssertionError("no acknowledgement of the disarm")
 
 
-def download_with_mavproxy(flight: Flight, port: int, folder: Path, size: int) -> bytes:
+def download_with_mavproxy(port: int, folder: Path, size: int) -> bytes:
     mavproxy = MavProxy(port, folder)
-    try:
+
+    def online() -> None:
         # Typed once MAVProxy has heard the vehicle (the link's counters include QGC's
         # frames here, so MavProxy.connected would not tell).
         wait_for(lambda: "online system 1" in "".join(mavproxy.lines), 60, "MAVProxy online")
         time.sleep(2.0)
-        mavproxy.type("log list")
-        wait_for(lambda: "numLogs 1" in "".join(mavproxy.lines), 30, "the log listed")
-        mavproxy.type("log download 0 flight.ulg")
-        wait_for(lambda: "Finished downloading" in "".join(mavproxy.lines), 300, "the download")
-    finally:
-        output = mavproxy.close()
-        log.info("MAVProxy said:\n%s", output[-3000:])
-    assert f"size {size}" in output
-    return (folder / "flight.ulg").read_bytes()
+
+    return mavproxy_download(mavproxy, folder, online, size, 300)
 
 
 def download_both(flight: Flight, port: int, folder: Path, size: int) -> tuple[bytes, bytes]:
@@ -113,7 +107,7 @@ def download_both(flight: Flight, port: int, folder: Path, size: int) -> tuple[b
     started = time.monotonic()
     by_qgc = QgcDownload(flight.gcs, 0, size).run()
     qgc_s, started = time.monotonic() - started, time.monotonic()
-    by_mavproxy = download_with_mavproxy(flight, port, folder, size)
+    by_mavproxy = download_with_mavproxy(port, folder, size)
     took = (qgc_s, time.monotonic() - started)
     log.info("%d bytes: pymavlink as QGC in %.1f s, MAVProxy in %.1f s", size, *took)
     return by_qgc, by_mavproxy
