@@ -48,6 +48,7 @@ import psutil
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from benchmarks.process_probes import cpu_ticks, pss_kib, vehicle_pids  # noqa: E402
 from companion.bus import BusNode, cleanup_namespace  # noqa: E402
 from companion.messages import PluginState  # noqa: E402
 from mavlink_dialect import companion as m  # noqa: E402
@@ -79,43 +80,6 @@ def use_bytecode() -> None:
     ENV["PYTHONPYCACHEPREFIX"] = str(PYCACHE)
     cmd = [sys.executable, "-m", "compileall", "-q", "-j0", *dirs]
     subprocess.run(cmd, env=ENV, stdout=subprocess.DEVNULL, check=False)
-
-
-def pss_kib(pid: int) -> int:
-    try:
-        with open(f"/proc/{pid}/smaps_rollup") as f:
-            for line in f:
-                if line.startswith("Pss:"):
-                    return int(line.split()[1])
-    except OSError:
-        pass
-    return 0
-
-
-def cpu_ticks(pid: int) -> float:
-    """utime + stime of one process, in seconds."""
-    try:
-        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    except OSError:
-        return float("nan")
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-
-
-def vehicle_pids(root: int) -> list[int]:
-    """The vehicle's processes: the root and its descendants, the bridge's subtree left out."""
-    try:
-        top = psutil.Process(root)
-        kids = top.children(recursive=True)
-    except psutil.Error:
-        return []
-    bridge: set[int] = set()
-    for p in kids:
-        try:
-            if "ground.sitl.bridge" in " ".join(p.cmdline()):
-                bridge |= {p.pid} | {c.pid for c in p.children(recursive=True)}
-        except psutil.Error:
-            continue
-    return [root] + [p.pid for p in kids if p.pid not in bridge]
 
 
 class Vehicle:
