@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from companion.control.modes import PILOT_MODES  # the operator flies
 from companion.messages import FlightMode, NavFlags
 from companion.params import ParamDecl
 from mavlink_dialect import companion as d
@@ -34,7 +35,6 @@ FAILSAFE_PARAMS = (
     ParamDecl("FS_GPS_BACK_S", 3.0, 0.0, 60.0, "s", "good fixes this long: GPS back"),
     ParamDecl("FENCE_ENABLE", 1.0, 0.0, 1.0, "", "return home when the fence is breached"),
 )
-PILOT_MODES = frozenset({FlightMode.MANUAL, FlightMode.STABILIZED})  # the operator flies
 
 
 @dataclass(frozen=True)

@@ -14,9 +14,14 @@ LOITER), and Guided, which PX4 has no built-in mode for, is PX4's first *externa
 AVAILABLE_MODES (QGroundControl 5 shows "Guided"; a 4.4 release build does not read
 AVAILABLE_MODES and shows it as "Unknown").
 
-Standard modes: only the ones that mean what we fly (Mission, Return = SAFE_RECOVERY,
-Take-off, Land); our Loiter is automatic, not MAVLink's pilot-driven ORBIT or
-POSITION_HOLD (which QGroundControl 5 would also rename "Orbit" or "Position").
+The modes a pilot flies from the sticks are PX4's fixed-wing ones, because QGroundControl
+4.4 offers every one of them from its own fixed table whatever the vehicle says:
+Manual, Stabilized, Altitude, Position, Acro and Rattitude (PILOT_MODES).
+
+Standard modes: only the ones that mean what we fly, as PX4 reports its fixed-wing modes
+(Mission, Return = SAFE_RECOVERY, Take-off, Land, Altitude = ALTITUDE_HOLD, Position =
+CRUISE: the track held against the wind); our Loiter is automatic, not MAVLink's
+pilot-driven ORBIT (which QGroundControl 5 would also rename "Orbit").
 
 ``decode_set_mode`` reads DO_SET_MODE / SET_MODE in either encoding:
 1. a full 32-bit PX4 custom_mode (≥ 65536) → PX4;
@@ -35,7 +40,8 @@ from dataclasses import dataclass
 from companion.messages import FlightMode
 from mavlink_dialect import companion as d
 
-PX4_MAIN_MANUAL, PX4_MAIN_AUTO, PX4_MAIN_STABILIZED = 1, 4, 7
+PX4_MAIN_MANUAL, PX4_MAIN_ALTCTL, PX4_MAIN_POSCTL, PX4_MAIN_AUTO = 1, 2, 3, 4
+PX4_MAIN_ACRO, PX4_MAIN_STABILIZED, PX4_MAIN_RATTITUDE = 5, 7, 8
 PX4_SUB_TAKEOFF, PX4_SUB_LOITER, PX4_SUB_MISSION, PX4_SUB_RTL, PX4_SUB_LAND = 2, 3, 4, 5, 6
 PX4_SUB_EXTERNAL1 = 11  # PX4's first mode added from outside (a companion computer)
 
@@ -62,15 +68,30 @@ class ModeInfo:
     base_flags: int  # MAV_MODE_FLAG bits besides CUSTOM_MODE_ENABLED and SAFETY_ARMED
     user_selectable: bool = True
 
+    @property
+    def pilot(self) -> bool:
+        """Flown from the pilot's sticks (the receiver's, else the joystick's)."""
+        return bool(self.base_flags & d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED)
+
 
 _AUTO = d.MAV_MODE_FLAG_AUTO_ENABLED | d.MAV_MODE_FLAG_GUIDED_ENABLED
 _STAB = d.MAV_MODE_FLAG_STABILIZE_ENABLED
 _NONE = d.MAV_STANDARD_MODE_NON_STANDARD
+_PILOT = d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED
+NO_ARDUPLANE = -1  # ArduPlane has no such mode: a switch position cannot select it
 MODES: tuple[ModeInfo, ...] = (
     ModeInfo(FlightMode.MANUAL, "Manual", px4_custom_mode(PX4_MAIN_MANUAL), 0,
-             _NONE, d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED),
+             _NONE, _PILOT),
     ModeInfo(FlightMode.STABILIZED, "Stabilized", px4_custom_mode(PX4_MAIN_STABILIZED), 5,
-             _NONE, _STAB | d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED),
+             _NONE, _STAB | _PILOT),
+    # ArduPlane's FBWB and CRUISE are these two; its ACRO is Acro; it has no Rattitude.
+    ModeInfo(FlightMode.ALTITUDE, "Altitude", px4_custom_mode(PX4_MAIN_ALTCTL), 6,
+             d.MAV_STANDARD_MODE_ALTITUDE_HOLD, _STAB | _PILOT),
+    ModeInfo(FlightMode.POSITION, "Position", px4_custom_mode(PX4_MAIN_POSCTL), 7,
+             d.MAV_STANDARD_MODE_CRUISE, _STAB | d.MAV_MODE_FLAG_GUIDED_ENABLED | _PILOT),
+    ModeInfo(FlightMode.ACRO, "Acro", px4_custom_mode(PX4_MAIN_ACRO), 4, _NONE, _PILOT),
+    ModeInfo(FlightMode.RATTITUDE, "Rattitude", px4_custom_mode(PX4_MAIN_RATTITUDE),
+             NO_ARDUPLANE, _NONE, _STAB | _PILOT),
     ModeInfo(FlightMode.MISSION, "Mission", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_MISSION), 10,
              d.MAV_STANDARD_MODE_MISSION, _STAB | _AUTO),
     ModeInfo(FlightMode.LOITER, "Loiter", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_LOITER), 12,
@@ -87,7 +108,11 @@ MODES: tuple[ModeInfo, ...] = (
              d.MAV_STANDARD_MODE_LAND, _STAB | _AUTO, user_selectable=False),
 )  # fmt: skip
 BY_MODE = {m.mode: m for m in MODES}
-_ARDUPLANE = {m.arduplane: m.mode for m in MODES} | {1: FlightMode.LOITER, 2: FlightMode.STABILIZED}
+PILOT_MODES = frozenset(m.mode for m in MODES if m.pilot)
+_ARDUPLANE = {m.arduplane: m.mode for m in MODES if m.arduplane != NO_ARDUPLANE} | {
+    1: FlightMode.LOITER,
+    2: FlightMode.STABILIZED,
+}
 _PX4 = {m.px4: m.mode for m in MODES}
 _STANDARD = {m.standard: m.mode for m in MODES if m.standard != d.MAV_STANDARD_MODE_NON_STANDARD}
 _STANDARD[d.MAV_STANDARD_MODE_ORBIT] = FlightMode.LOITER  # the nearest we fly

@@ -17,8 +17,7 @@ Only a receiver or joystick that has been heard can be lost; each loss is said o
 from __future__ import annotations
 
 from companion.control.failsafe import Action
-from companion.control.flight.pilot import PILOT_MODES
-from companion.control.modes import from_arduplane
+from companion.control.modes import PILOT_MODES, from_arduplane
 from companion.messages import FlightMode, PilotInput
 from companion.params import ParamDecl
 from mavlink_dialect import companion as d

@@ -83,6 +83,10 @@ class FlightMode(enum.IntEnum):
     GUIDED = 6  # fly to a commanded point and circle there
     TAKEOFF = 7  # climb out from the runway and circle at the take-off height
     LAND = 8  # fly the mission's landing from its DO_LAND_START (refused without one)
+    ALTITUDE = 9  # the pilot's bank and climb rate, height and heading held hands off
+    POSITION = 10  # as Altitude, and the track over the ground held hands off
+    ACRO = 11  # the sticks command roll and pitch rates; the attitude held hands off
+    RATTITUDE = 12  # Stabilized near the centre of the sticks, Acro beyond it
 
 
 class VehicleStatus(Message):

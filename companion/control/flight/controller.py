@@ -10,11 +10,13 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+from companion.control.flight.assisted import AssistedHold
 from companion.control.flight.landing import Landing
 from companion.control.flight.landing_flight import LandingFlight
 from companion.control.flight.output import ControlOutput
 from companion.control.flight.params import FlightConfig
-from companion.control.flight.pilot import PILOT_MODES, Sticks, fly_pilot
+from companion.control.flight.pilot import AcroHold, Sticks
+from companion.control.flight.pilot_flight import PilotFlight
 from companion.control.flight.takeoff import Phase, RunwayTakeoff
 from companion.control.inputs import nav_usable, rates_or_zero, status_usable, sticks_usable
 from companion.control.laws.attitude import AttitudeController
@@ -23,6 +25,7 @@ from companion.control.laws.tecs import Tecs
 from companion.control.laws.wind import WindEstimator
 from companion.control.mission.executor import Kind, MissionExecutor, Setpoint, past_point
 from companion.control.mission.items import MissionItem
+from companion.control.modes import PILOT_MODES
 from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
@@ -35,7 +38,7 @@ TURN_BANK_FRACTION = 0.7
 MAX_TURN_WIND = 15.0  # m/s: a wind estimate beyond this is not trusted to size turns
 
 
-class FlightController(LandingFlight):
+class FlightController(LandingFlight, PilotFlight):
     """One aircraft's controller; ``step()`` once per navigation solution."""
 
     def __init__(self, config: FlightConfig, items: list[MissionItem] | None = None) -> None:
@@ -59,6 +62,8 @@ class FlightController(LandingFlight):
         self._line: tuple[tuple[float, float], tuple[float, float]] | None = None
         self._corner_from: tuple[float, float] | None = None
         self.attitude = AttitudeController(config.attitude)
+        self.acro = AcroHold()
+        self.assisted = AssistedHold()
         self.tecs = Tecs(config.tecs)
         self.l1 = L1Guidance(
             config["NAVL1_PERIOD"], config["NAVL1_DAMPING"], config["NAVL1_XTRACK_I"]
@@ -124,8 +129,7 @@ class FlightController(LandingFlight):
         out.brakes = self.config["LAND_BRAKE"] if self.landed else 0.0
         mode = FlightMode(status.mode) if status.mode else FlightMode.LOITER
         if mode in PILOT_MODES and sticks is not None:
-            self._mode_key = (int(mode), int(status.changes))
-            return self._fly_pilot(mode, sticks, nav, airspeed, dt, out)
+            return self._fly_sticks(mode, sticks, nav, airspeed, dt, out)
         if mode == FlightMode.MANUAL:
             out.throttle = self.config["TRIM_THROTTLE"] if not self.landed else 0.0
             return out
@@ -144,22 +148,6 @@ class FlightController(LandingFlight):
         self.landing = None
         self.go_arounds = status.go_arounds
         return self._fly(setpoint, pos, vel, nav, airspeed, dt, out)
-
-    def _fly_pilot(
-        self,
-        mode: FlightMode,
-        sticks: Sticks,
-        nav: NavState,
-        airspeed: float,
-        dt: float,
-        out: ControlOutput,
-    ) -> ControlOutput:
-        demand = fly_pilot(mode, sticks, nav, airspeed, dt, self.attitude, self.config)
-        out.aileron, out.elevator, out.rudder = demand.aileron, demand.elevator, demand.rudder
-        out.throttle = demand.throttle
-        out.nav_roll, out.nav_pitch = demand.roll, demand.pitch
-        self.tecs.reset(nav.pitch_rad)  # Auto takes over from the attitude the pilot left
-        return out
 
     def _dead_reckoning(
         self, setpoint: Setpoint | None, pos: tuple[float, float], nav: NavState
@@ -286,7 +274,7 @@ class FlightController(LandingFlight):
             if mode == FlightMode.GUIDED:
                 return Setpoint(Kind.LINE, pos, point, alt, radius)
             return Setpoint(Kind.CIRCLE, point, point, alt, radius)
-        if mode == FlightMode.STABILIZED:  # straight on, height held
+        if mode in PILOT_MODES:  # no fresh sticks: straight on, height held
             course = math.atan2(nav.ve_m_s, nav.vn_m_s)
             ahead = (pos[0] + 1e5 * math.cos(course), pos[1] + 1e5 * math.sin(course))
             return Setpoint(Kind.LINE, pos, ahead, alt)
@@ -344,14 +332,17 @@ class FlightController(LandingFlight):
         out: ControlOutput,
         least_speed: float = math.inf,
         climb_ff: float = 0.0,
+        roll_dem: float = math.nan,
     ) -> ControlOutput:
+        """Fly ``sp`` by the energy controller and the line guidance (or at ``roll_dem``)."""
         cfg = self.config
         speed_dem = sp.speed if math.isfinite(sp.speed) else cfg["AIRSPEED_CRUISE"]
         # The landing approach alone may fly slower than AIRSPEED_MIN.
         speed_min = min(cfg["AIRSPEED_MIN"], least_speed)
         speed_dem = max(speed_min, min(cfg["AIRSPEED_MAX"], speed_dem))
         lateral = self._lateral(sp, pos, vel, dt)
-        roll_dem = bank_for(lateral.lat_acc, cfg.roll_limit)
+        if not math.isfinite(roll_dem):
+            roll_dem = bank_for(lateral.lat_acc, cfg.roll_limit)
         energy = self.tecs.step(
             nav.alt_msl_m, -nav.vd_m_s, airspeed, sp.alt_msl, speed_dem, dt, climb_ff
         )

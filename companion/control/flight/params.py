@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from companion.control.flight.landing import LANDING_PARAMS
+from companion.control.flight.pilot import PILOT_PARAMS
 from companion.control.laws.attitude import AttitudeGains
 from companion.control.laws.tecs import TecsGains
 from companion.control.mission.executor import ExecutorConfig
@@ -63,6 +64,7 @@ CONTROL_PARAMS = (
     _p("WP_LOITER_RAD", 80.0, 10.0, 2000.0, "m", "loiter radius when an item gives none"),
     _p("RTL_ALT_M", 100.0, 10.0, 1000.0, "m", "return altitude above home"),
     *LANDING_PARAMS,
+    *PILOT_PARAMS,
 )
 BY_NAME = {p.name: p for p in CONTROL_PARAMS}
 

@@ -1,8 +1,13 @@
-"""The modes a pilot flies: Manual (sticks straight to the surfaces) and Stabilized
-(ArduPlane's FBWA: the roll stick commands a bank angle up to ``ROLL_LIMIT_DEG``, the
-pitch stick a pitch angle up to ``PTCH_LIM_MAX_DEG`` / ``PTCH_LIM_MIN_DEG``, the rudder
-stick adds to the turn coordinator, and the throttle stick is the throttle between
-``THR_MIN`` and ``THR_MAX``).
+"""The modes a pilot flies by attitude: Manual (sticks straight to the surfaces),
+Stabilized (ArduPlane's FBWA: the roll stick commands a bank angle up to
+``ROLL_LIMIT_DEG``, the pitch stick a pitch angle up to ``PTCH_LIM_MAX_DEG`` /
+``PTCH_LIM_MIN_DEG``), Acro (the sticks command roll and pitch rates up to
+``ACRO_ROLL_RATE`` / ``ACRO_PITCH_RATE``; released, the attitude reached is held, as
+ArduPlane's ACRO with ACRO_LOCKING; the roll is unlimited, the pitch within
+``ACRO_PITCH_LIM``) and Rattitude (PX4's: Stabilized while both sticks are within
+``RATT_TH`` of their centre, Acro beyond). In each the rudder stick adds to the turn
+coordinator and the throttle stick is the throttle between ``THR_MIN`` and ``THR_MAX``.
+Altitude and Position, which hold height and track, are ``assisted.py``.
 
 Pure: the sticks, the attitude and the time step in, surface commands out.
 """
@@ -11,16 +16,31 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from companion.control.flight.params import FlightConfig
 from companion.control.laws.attitude import AttitudeController
 from companion.control.laws.limits import clamp
+from companion.geodesy import wrap_pi
 from companion.messages import FlightMode, NavState, PilotInput
+from companion.params import ParamDecl
+
+if TYPE_CHECKING:
+    from companion.control.flight.params import FlightConfig
 
 # Sticks older than this (by the navigation's sensor time) are not flown: the aircraft
 # holds its wings level until the pilot is back or the failsafe takes it home.
 STICKS_STALE_US = 500_000
-PILOT_MODES = frozenset({FlightMode.MANUAL, FlightMode.STABILIZED})
+# Acro's held attitude never leads the aircraft's by more than this: a target the aircraft
+# cannot follow (full stick on a slow roll) would otherwise wind on and overshoot.
+ACRO_LEAD_RAD = math.radians(30.0)
+
+PILOT_PARAMS = (
+    ParamDecl("ACRO_ROLL_RATE", 90.0, 10.0, 500.0, "deg/s", "Acro: roll rate at full stick"),
+    ParamDecl("ACRO_PITCH_RATE", 45.0, 10.0, 500.0, "deg/s", "Acro: pitch rate at full stick"),
+    ParamDecl("ACRO_PITCH_LIM", 60.0, 10.0, 85.0, "deg", "Acro: largest pitch either way"),
+    ParamDecl("RATT_TH", 0.8, 0.0, 1.0, "norm",
+              "Rattitude: stick deflection beyond which the sticks command rates"),
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -66,6 +86,48 @@ class PilotDemand:
     pitch: float = math.nan
 
 
+class AcroHold:
+    """Acro's attitude target: the sticks move it at their rates, released it stays."""
+
+    def __init__(self) -> None:
+        self.target: tuple[float, float] | None = None
+
+    def reset(self) -> None:
+        """Out of Acro: the next Acro starts from the attitude the aircraft has then."""
+        self.target = None
+
+    def step(
+        self, sticks: Sticks, nav: NavState, dt: float, cfg: FlightConfig
+    ) -> tuple[float, float]:
+        """The roll and pitch (rad) to hold now."""
+        roll, pitch = self.target or (nav.roll_rad, nav.pitch_rad)
+        roll += sticks.roll * math.radians(cfg["ACRO_ROLL_RATE"]) * dt
+        pitch += sticks.pitch * math.radians(cfg["ACRO_PITCH_RATE"]) * dt
+        lead = wrap_pi(roll - nav.roll_rad)
+        roll = wrap_pi(nav.roll_rad + clamp(lead, -ACRO_LEAD_RAD, ACRO_LEAD_RAD))
+        pitch = clamp(pitch, nav.pitch_rad - ACRO_LEAD_RAD, nav.pitch_rad + ACRO_LEAD_RAD)
+        limit = math.radians(cfg["ACRO_PITCH_LIM"])
+        self.target = (roll, clamp(pitch, -limit, limit))
+        return self.target
+
+
+def stick_attitude(sticks: Sticks, cfg: FlightConfig) -> tuple[float, float]:
+    """Stabilized: the bank and pitch angles (rad) the sticks ask for."""
+    if sticks.pitch >= 0:
+        pitch = sticks.pitch * math.radians(cfg["PTCH_LIM_MAX_DEG"])
+    else:
+        pitch = -sticks.pitch * math.radians(cfg["PTCH_LIM_MIN_DEG"])
+    return sticks.roll * cfg.roll_limit, pitch
+
+
+def _rates_asked(mode: FlightMode, sticks: Sticks, cfg: FlightConfig) -> bool:
+    if mode == FlightMode.ACRO:
+        return True
+    if mode != FlightMode.RATTITUDE:
+        return False
+    return max(abs(sticks.roll), abs(sticks.pitch)) > cfg["RATT_TH"]
+
+
 def fly_pilot(
     mode: FlightMode,
     sticks: Sticks,
@@ -74,16 +136,17 @@ def fly_pilot(
     dt: float,
     attitude: AttitudeController,
     cfg: FlightConfig,
+    acro: AcroHold,
 ) -> PilotDemand:
-    """Manual or Stabilized flight from the sticks."""
+    """Manual, Stabilized, Acro or Rattitude flight from the sticks."""
     if mode == FlightMode.MANUAL:
         attitude.reset()  # the loops start afresh when the pilot hands back
         return PilotDemand(sticks.roll, sticks.pitch, sticks.yaw, sticks.throttle)
-    roll_dem = sticks.roll * cfg.roll_limit
-    if sticks.pitch >= 0:
-        pitch_dem = sticks.pitch * math.radians(cfg["PTCH_LIM_MAX_DEG"])
+    if _rates_asked(mode, sticks, cfg):
+        roll_dem, pitch_dem = acro.step(sticks, nav, dt, cfg)
     else:
-        pitch_dem = -sticks.pitch * math.radians(cfg["PTCH_LIM_MIN_DEG"])
+        acro.reset()
+        roll_dem, pitch_dem = stick_attitude(sticks, cfg)
     s = attitude.step(
         roll_dem,
         pitch_dem,

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from companion.control.laws.limits import clamp
 from companion.geodesy import STANDARD_GRAVITY as G
+from companion.geodesy import wrap_pi
 
 
 @dataclass
@@ -73,7 +74,7 @@ class AttitudeController:
         p, q, r = rates
         k = self.scaler(airspeed)
         v = max(airspeed, 5.0)
-        roll_err = roll_dem - roll
+        roll_err = wrap_pi(roll_dem - roll)  # the short way round (Acro rolls through ±π)
         # A coordinated turn pitches the body at g·tan φ·sin φ / V.
         q_turn = G / v * math.tan(clamp(roll, -1.2, 1.2)) * math.sin(roll)
         pitch_err = pitch_dem - pitch
