@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from companion.control.laws.fillet import corner_arc
 from companion.control.laws.l1_guidance import L1Guidance, bank_for
 from companion.geodesy import STANDARD_GRAVITY as G
 
@@ -82,15 +83,14 @@ def fly_legs(
 
 
 def _lead(a, b, nxt, radius: float) -> float:  # type: ignore[no-untyped-def]
+    """Where the executor switches legs: the arc's own lead (one geometry for both)."""
     if nxt is None:
         return 0.0
-    turn = abs(
-        math.remainder(
-            math.atan2(nxt[1] - b[1], nxt[0] - b[0]) - math.atan2(b[1] - a[1], b[0] - a[0]),
-            math.tau,
-        )
+    turn = math.remainder(
+        math.atan2(nxt[1] - b[1], nxt[0] - b[0]) - math.atan2(b[1] - a[1], b[0] - a[0]),
+        math.tau,
     )
-    return min(radius * math.tan(min(turn, math.radians(135.0)) / 2.0), math.dist(a, b) / 2)
+    return corner_arc(turn, radius, math.dist(a, b), math.dist(b, nxt))[0]
 
 
 def cross_track(

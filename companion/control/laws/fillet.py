@@ -15,11 +15,15 @@ from dataclasses import dataclass
 
 MIN_TURN_RAD = math.radians(3.0)  # below this a corner is flown as a straight line
 MAX_TURN_RAD = math.radians(175.0)  # beyond this (a reversal) L1 turns from the switch point
-# A corner sharper than 135° flown at the planned radius would begin its arc far back along
-# the leg (3.3 radii before a 146° corner): it is flown tighter instead, its arc starting no
-# earlier than a 135° one's, down to this fraction of the planned radius. Planned at 70 % of
-# the bank limit, 0.7 of the radius asks for tan(bank) 1/0.7 times larger: 41° of a 45° limit.
-SHARP_LEAD_TAN = math.tan(math.radians(135.0) / 2.0)
+# A corner sharper than 120° flown at the planned radius would begin and end its arc far
+# from the corner (2.4 radii for 135°, 3.3 for 146°): it is flown tighter instead, its arc
+# starting no earlier than a 120° one's (1.7 radii), down to this fraction of the planned
+# radius. Planned at 70 % of the bank limit at the fastest ground speed, 0.7 of the radius
+# asks for tan(bank) 1/0.7 times larger: 41° of a 45° limit, downwind only. With the lead of
+# a 135° corner the c172p in a 5 m/s wind (radius 280 m) was still on the arc, 28-58 m off
+# the new line, 500 m past the corner, where the straight part is scored; with a 120° lead
+# it is on the line by then (closed loop, jump plan: p95 14.5 -> 0.9 m).
+SHARP_LEAD_TAN = math.tan(math.radians(120.0) / 2.0)
 SHARP_RADIUS_SCALE = 0.7
 
 
@@ -46,7 +50,7 @@ def corner_arc(turn_rad: float, radius: float, l_in: float, l_out: float) -> tup
     half_tan = math.tan(abs(turn_rad) / 2.0)
     if half_tan <= 0.0 or radius <= 0.0:
         return 0.0, radius
-    if abs(turn_rad) > MAX_TURN_RAD:  # no arc: switch legs as early as for a 135° corner
+    if abs(turn_rad) > MAX_TURN_RAD:  # no arc: switch legs as early as for a 120° corner
         return min(radius * SHARP_LEAD_TAN, 0.5 * l_in, 0.5 * l_out), radius
     radius *= max(SHARP_RADIUS_SCALE, min(1.0, SHARP_LEAD_TAN / half_tan))
     # Short legs leave no room for the whole arc: a tighter one, flown at the bank limit.

@@ -40,17 +40,22 @@ def test_square_legs_are_flown_within_a_metre(airframe: str, wind):  # type: ign
     assert len(legs) == 4
     for leg in legs:
         assert leg.samples > 1000
-        assert leg.xt_rms_m <= 1.0 and leg.xt_p95_m <= 2.0
+        assert leg.xt_rms_m <= 1.0 and leg.xt_p95_m <= (3.0 if any(wind) else 2.0)
         assert leg.height_rms_m <= 1.0
     for leg in legs[1:]:
         assert abs(leg.turn_deg) == pytest.approx(90.0, abs=1.0)
         assert leg.settled_m <= 600.0
 
 
-def test_after_135_degree_turns_the_c172_is_on_the_new_leg_within_900_m():
-    legs = fly("c172p", SHARP)
+@pytest.mark.parametrize("wind", [(0.0, 0.0, 0.0), WIND], ids=["calm", "wind"])
+def test_after_135_degree_turns_the_c172_is_on_the_new_leg_within_900_m(wind):  # type: ignore[no-untyped-def]
+    """In the wind the turn is planned for a 41 m/s ground speed: with the arc of a 135°
+    corner at that radius the C172 was still turning onto the line 500 m past the corner,
+    p95 8.7 and 14.5 m on the two legs after the turns."""
+    legs = fly("c172p", SHARP, wind)
     sharp = [leg for leg in legs if abs(leg.turn_deg) > 130.0]
     assert len(sharp) == 2
     for leg in sharp:
         assert leg.settled_m <= 900.0
-        assert leg.xt_p95_m <= 3.0
+        assert leg.xt_rms_m <= 1.0 and leg.xt_p95_m <= (3.0 if any(wind) else 2.0)
+        assert leg.height_rms_m <= 1.0
