@@ -123,6 +123,19 @@ class BusNode:
         self._ports.append(port)
         return port
 
+    def newest_reader(self, name: str) -> LatestReader[Any]:
+        """The newest sample of channel ``name`` of either pattern, as ``latest_reader``
+        gives it: of a Queue channel it holds one sample, the older ones being overwritten
+        unread (not copied, not counted as lost), for a reader that shows only the newest
+        value (the link's telemetry of 100 Hz sensors)."""
+        chan = channel(name)
+        service = self._pubsub(chan)
+        sub = service.subscriber_builder().buffer_size(1).create()
+        listener = self._event(chan).listener_builder().create()
+        port: LatestReader[Any] = LatestReader(name, chan.type, sub, listener, self.idle, service)
+        self._ports.append(port)
+        return port
+
     def reader(self, name: str) -> Reader[Any]:
         """A reader of either pattern, chosen by the channel's registration."""
         if channel(name).pattern == "queue":

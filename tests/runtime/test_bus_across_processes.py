@@ -94,6 +94,27 @@ def test_slow_reader_loses_the_oldest_and_counts_the_loss(namespace):
     assert queue.lost == 200 - depth
 
 
+def test_newest_reader_of_a_queue_sees_only_the_newest_and_counts_no_loss(namespace):
+    with BusNode(namespace, "newest") as bus:
+        every = bus.queue_reader("sensors/imu")
+        newest = bus.newest_reader("sensors/imu")
+        writer = bus.writer("sensors/imu")
+        assert newest.get() is None
+        for i in range(1, 11):
+            writer.publish(Imu(t_us=i))
+        first = newest.get()
+        # Nothing newer: the newest stays what it was, as a Latest reader's does.
+        again = newest.get()
+        writer.publish(Imu(t_us=11))
+        later = newest.get()
+        assert [m.t_us for m in every.take()] == list(range(1, 12))
+        lost = bus.total_lost()
+    assert first is not None and first.t_us == 10
+    assert again is not None and again.t_us == 10
+    assert later is not None and later.t_us == 11
+    assert newest.received == 2 and lost == 0
+
+
 def test_latest_reader_that_joins_late_still_gets_the_newest_value(namespace):
     with BusNode(namespace, "w") as bus_w, BusNode(namespace, "r") as bus_r:
         writer = bus_w.writer("nav/state")

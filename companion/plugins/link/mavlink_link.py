@@ -181,14 +181,15 @@ class MavlinkLink(Plugin):
         self.router.add_service(self.manual)
 
     @staticmethod
-    def _readers(bus: Any) -> dict[str, Any]:  # queues are drained to their newest sample
+    def _readers(bus: Any) -> dict[str, Any]:
         latest = {"nav": "nav/state", "health": "system/health", "servos": "actuators/servos",
                   "status": "vehicle/status", "control": "control/status",
                   "rc": "sensors/rc", "battery": "sensors/battery",
                   "rangefinder": "sensors/range"}  # fmt: skip
         readers = {key: bus.latest_reader(name) for key, name in latest.items()}
+        # Telemetry shows the newest sensor sample: a buffer of one, not ~1300 copies a second.
         for key in ("gps", "imu", "mag", "compass", "baro"):
-            readers[key] = bus.queue_reader(f"sensors/{key}")
+            readers[key] = bus.newest_reader(f"sensors/{key}")
         return readers
 
     def _serve_missions(self, ctx: PluginContext, sysid: int) -> None:
@@ -262,9 +263,8 @@ class MavlinkLink(Plugin):
         s.rangefinder = r["rangefinder"].get()
         s.control = self._fresh_control()
         s.now_us = self.ctx.clock.now_us()
-        for key in ("gps", "imu", "mag", "compass", "baro"):
-            for latest in r[key].drain():  # the newest is left in the snapshot
-                setattr(s, key, latest)
+        s.gps, s.imu, s.mag = r["gps"].get(), r["imu"].get(), r["mag"].get()
+        s.compass, s.baro = r["compass"].get(), r["baro"].get()
         if s.status is not None and s.status.home_valid:  # home is the commander's alone
             s.home = (s.status.home_lat_deg, s.status.home_lon_deg, s.status.home_alt_msl_m)
             s.home_alt_m = s.status.home_alt_msl_m
