@@ -88,8 +88,9 @@ BATTERY_ALIASES = (
 )  # fmt: skip
 
 # COM_FLTMODEn: PX4's mode numbers (Guided is PX4's first external mode, 100).
-PX4_SLOT = {FlightMode.MANUAL: 0, FlightMode.STABILIZED: 8, FlightMode.MISSION: 3,
-            FlightMode.LOITER: 4, FlightMode.RTL: 5, FlightMode.TAKEOFF: 10,
+PX4_SLOT = {FlightMode.MANUAL: 0, FlightMode.ALTITUDE: 1, FlightMode.POSITION: 2,
+            FlightMode.MISSION: 3, FlightMode.LOITER: 4, FlightMode.RTL: 5,
+            FlightMode.ACRO: 6, FlightMode.STABILIZED: 8, FlightMode.TAKEOFF: 10,
             FlightMode.GUIDED: 100}  # fmt: skip
 UNASSIGNED = -1.0  # the switch position selects no mode
 

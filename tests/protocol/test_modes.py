@@ -64,8 +64,9 @@ def test_modes_are_listed_and_reported(station):
         x.mode_name for x in listed if not x.properties & m.MAV_MODE_PROPERTY_NOT_USER_SELECTABLE
     }
     assert "Land" not in selectable and {"Loiter", "Guided", "Return", "Mission"} <= selectable
-    gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AVAILABLE_MODES, 3)  # QGC 5.0 style
-    assert gcs.recv("AVAILABLE_MODES", 3.0, mode_index=3).mode_name == "Mission"
+    mission = 1 + [info.mode for info in MODES].index(FlightMode.MISSION)
+    gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AVAILABLE_MODES, mission)  # QGC 5.0
+    assert gcs.recv("AVAILABLE_MODES", 3.0, mode_index=mission).mode_name == "Mission"
     current = gcs.recv("CURRENT_MODE", 5.0)
     assert current.custom_mode == PX4[FlightMode.LOITER]
     # Our Loiter is automatic: not MAVLink's pilot-driven POSITION_HOLD or ORBIT.

@@ -27,14 +27,12 @@ param2 = 0) and names modes PX4 does not know from it.
 from __future__ import annotations
 
 import math
-import time
 
 import pytest
 
 from companion.control.mission.plan import checked_plan
 from companion.control.mission.store import MissionStore
 from companion.control.modes import BY_MODE
-from companion.link.refusal_texts import REFUSAL_TEXT_PERIOD_S
 from companion.messages import FlightMode
 from mavlink_dialect import companion as m
 from tests.protocol.mav_client import GroundStation, free_udp_port
@@ -242,20 +240,23 @@ def test_land_abort_on_the_approach_as_qgroundcontrol_sends_it(vehicle_factory, 
         gcs.close()
 
 
-def test_qgc44_modes_this_plane_does_not_fly_are_refused_with_a_reason(qgc):
-    """QGroundControl 4.4's PX4 plug-in lists Acro, Rattitude, Altitude and Position for a
-    fixed wing from its own fixed table (5 lists the vehicle's AVAILABLE_MODES): picked,
-    each is refused with a STATUSTEXT that names it, and the mode stays as it was."""
+def test_every_mode_qgc44_lists_for_a_fixed_wing_is_flown_and_shown_by_its_name(qgc):
+    """QGroundControl 4.4's PX4 plug-in lists Altitude, Position, Acro and Rattitude for a
+    fixed wing from its own fixed table (5 lists the vehicle's AVAILABLE_MODES): each,
+    picked from the dropdown, is accepted and the heartbeat then shows that very mode."""
     gcs, status, _ = qgc
-    before = status.get().mode
-    for main, name in ((2, "Altitude"), (3, "Position"), (5, "Acro"), (8, "Rattitude")):
-        gcs.command(m.MAV_CMD_DO_SET_MODE, m.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, main << 16)
-        got = {}
-        while len(got) < 2:  # the reason and the ack, in whichever order they come
-            msg = gcs.recv(["STATUSTEXT", "COMMAND_ACK"], 3.0)
-            got[msg.get_type()] = msg
-        assert got["STATUSTEXT"].id == 0  # one message, not chunks
-        assert got["STATUSTEXT"].text.startswith(f"{name}: not flown here")
-        assert got["COMMAND_ACK"].result == m.MAV_RESULT_DENIED
-        time.sleep(REFUSAL_TEXT_PERIOD_S)  # refusal texts are paced; an operator is slower
-    assert status.get().mode == before
+    for mode in (FlightMode.ALTITUDE, FlightMode.POSITION, FlightMode.ACRO,
+                 FlightMode.RATTITUDE, FlightMode.STABILIZED, FlightMode.MANUAL):  # fmt: skip
+        assert set_mode(gcs, mode) == m.MAV_RESULT_ACCEPTED, mode
+        shown(gcs, mode)
+        assert settled(status, lambda s, mode=mode: s.mode == mode, mode.name).mode == mode
+    # QGroundControl 5 names them from AVAILABLE_MODES as PX4 reports its fixed-wing modes.
+    gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AVAILABLE_MODES, 0)
+    count = len(BY_MODE)
+    listed = {}
+    for i in range(1, count + 1):
+        x = gcs.recv("AVAILABLE_MODES", 3.0, mode_index=i)
+        listed[x.mode_name] = x.standard_mode
+    assert listed["Altitude"] == m.MAV_STANDARD_MODE_ALTITUDE_HOLD
+    assert listed["Position"] == m.MAV_STANDARD_MODE_CRUISE
+    assert listed["Acro"] == listed["Rattitude"] == m.MAV_STANDARD_MODE_NON_STANDARD

@@ -12,16 +12,6 @@ from companion.link.command_service import SET_MODE_MESSAGE, CommandArgs, Comman
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
 from companion.messages import CommandId, FlightMode
 
-# PX4 modes QGroundControl 4.4's PX4 plug-in offers a fixed wing in its mode list (a fixed
-# table in PX4FirmwarePlugin.cc; QGroundControl 5 lists the vehicle's AVAILABLE_MODES
-# instead) that this vehicle does not fly: custom_mode main mode -> what to say.
-PX4_NOT_FLOWN = {  # each within one STATUSTEXT (50 characters)
-    2: "Altitude: not flown here; use Stabilized",  # no stick-driven height hold (FBWB)
-    3: "Position: not flown here; use Loiter",  # no stick-driven course and height hold
-    5: "Acro: not flown here; use Manual",  # no rate mode
-    8: "Rattitude: not flown here; use Stabilized",
-}
-
 RELATIVE_FRAMES = frozenset(
     {
         d.MAV_FRAME_GLOBAL_RELATIVE_ALT,
@@ -68,24 +58,23 @@ class ModeCommands:
         self.service.refused += 1
         self.service.on_refusal(text)
 
-    def set_mode(self, mode: FlightMode | None, what: str, custom: int = 0) -> Outcome:
+    def set_mode(self, mode: FlightMode | None, what: str) -> Outcome:
         if mode is None:
-            main = (custom >> 16) & 0xFF if custom >= 1 << 16 else -1
-            self._refuse(PX4_NOT_FLOWN.get(main, f"{what}: unknown mode"))
+            self._refuse(f"{what}: unknown mode")
             return Outcome(d.MAV_RESULT_DENIED)
         return self.to_commander(CommandId.SET_MODE, (float(mode),))
 
     def do_set_mode(self, args: CommandArgs) -> Outcome:
         base, custom, sub = args.params[:3]
         base, custom, sub = round(base), whole_or(custom, 0), whole_or(sub, 0)
-        return self.set_mode(decode_set_mode(base, custom, sub, self.px4), "Set mode", custom)
+        return self.set_mode(decode_set_mode(base, custom, sub, self.px4), "Set mode")
 
     def set_standard_mode(self, args: CommandArgs) -> Outcome:
         return self.set_mode(from_standard(round(args.params[0])), "Set standard mode")
 
     def set_mode_message(self, args: CommandArgs) -> Outcome:
         base, custom = round(args.params[0]), round(args.params[1])
-        return self.set_mode(decode_set_mode(base, custom, 0, self.px4), "SET_MODE", custom)
+        return self.set_mode(decode_set_mode(base, custom, 0, self.px4), "SET_MODE")
 
     def mission_start(self, args: CommandArgs) -> Outcome:
         first, last = whole_or(args.params[0], 0), whole_or(args.params[1], -1)
