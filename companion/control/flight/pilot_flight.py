@@ -38,7 +38,12 @@ class PilotFlight:
             self.assisted.reset()
             self.acro.reset()
         self._mode_key = key
-        if mode in ASSISTED_MODES:
+        if mode in ASSISTED_MODES and self.landed:
+            # On the wheels there is no height to hold, and the energy controller would open
+            # the throttle to reach flying speed: the pilot's throttle stick has it, as in
+            # Stabilized, until the aircraft has left the ground.
+            mode = FlightMode.STABILIZED
+        elif mode in ASSISTED_MODES:
             return self._fly_assisted(mode, sticks, nav, airspeed, dt, out)
         cfg = self.config
         demand = fly_pilot(mode, sticks, nav, airspeed, dt, self.attitude, cfg, self.acro)

@@ -9,6 +9,7 @@ import pytest
 from companion.actuators.airframe import load_airframe
 from companion.control.flight.controller import FlightController
 from companion.control.flight.params import control_params, flight_config
+from companion.control.flight.pilot import Sticks
 from companion.control.mission.plan import load_plan
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 from tests.support.vehicle import REPO
@@ -51,6 +52,10 @@ def _outputs(controller: FlightController, mode: FlightMode, flags: int = VALID)
         FlightMode.GUIDED,
         FlightMode.STABILIZED,
         FlightMode.MANUAL,
+        FlightMode.ALTITUDE,
+        FlightMode.POSITION,
+        FlightMode.ACRO,
+        FlightMode.RATTITUDE,
     ],
 )
 @pytest.mark.parametrize("flags", [VALID, VALID | int(NavFlags.DEAD_RECKONING)])
@@ -85,3 +90,17 @@ def test_a_navigator_drifting_upwards_on_the_runway_does_not_make_it_fly():
         nav.alt_msl_m += 0.2 * i  # 60 m of drift while standing still
         outs.append(controller.step(nav, _status(FlightMode.LOITER), i * 0.02))
     assert all(o.throttle == 0.0 and o.landed for o in outs)
+
+
+@pytest.mark.parametrize("mode", [FlightMode.ALTITUDE, FlightMode.POSITION])
+def test_on_the_ground_the_height_holding_modes_leave_the_throttle_to_the_pilot(mode):
+    """Altitude and Position would ask the energy controller for flying speed: on the
+    wheels the throttle is the pilot's stick, idle when the stick is."""
+    controller = _controller()
+    for throttle in (0.0, 0.4):
+        sticks = Sticks(0.0, 0.0, 0.0, throttle)
+        outs = [
+            controller.step(_on_runway(i * 0.02), _status(mode), i * 0.02, sticks)
+            for i in range(100)
+        ]
+        assert {out.throttle for out in outs} == {throttle}
