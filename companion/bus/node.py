@@ -149,6 +149,10 @@ class BusNode:
         (default: all of them) end the wait."""
         return Waiter(readers, self.idle, triggers)
 
+    def gated_waiter(self, gated: Reader[Any], others: Sequence[Reader[Any]]) -> GatedWaiter:
+        """A wait over ``gated`` and ``others`` that ``gated`` ends only when asked."""
+        return GatedWaiter(gated, others, self.idle)
+
     def total_lost(self) -> int:
         """Samples this node's Queue readers lost to overflow, all channels together."""
         return sum(p.lost for p in self._ports if isinstance(p, Reader))
@@ -262,3 +266,40 @@ class Waiter:
 
 
 _NO_WAIT = duration(0.0)
+
+
+class GatedWaiter:
+    """Two waits over the same readers, one of them also ended by the gated reader.
+
+    For a process that needs a channel's samples only from some moment on: the link sends
+    ATTITUDE on the first navigation state after it falls due (ten times a second), and
+    woken by every state (fifty a second) it did its whole step four times in five for
+    nothing. While the gate is shut the gated reader's samples wait unread, their
+    wake-ups are cleared when it opens, and a sample still there ends the wait at once.
+    """
+
+    def __init__(
+        self, gated: Reader[Any], others: Sequence[Reader[Any]], idle: IdleTally | None = None
+    ) -> None:
+        self.gated = gated
+        self._open = Waiter((gated, *others), idle)
+        self._shut = Waiter(others, idle)
+        self._was_open = True
+
+    def wait_with_fds(
+        self, timeout_s: float, fds: Sequence[int], gate_open: bool
+    ) -> tuple[list[Reader[Any]], list[int]]:
+        """:meth:`Waiter.wait_with_fds`; the gated reader ends it only when ``gate_open``
+        (and is among the readers returned only then)."""
+        if not gate_open:
+            self._was_open = False
+            return self._shut.wait_with_fds(timeout_s, fds)
+        if not self._was_open:
+            self.gated.consume_events()
+            self._was_open = True
+        return self._open.wait_with_fds(timeout_s, fds)
+
+    def close(self) -> None:
+        """Detach from the readers."""
+        self._open.close()
+        self._shut.close()

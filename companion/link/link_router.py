@@ -8,6 +8,7 @@ forwarded and handled. Replies go to the endpoint of the peer that asked.
 from __future__ import annotations
 
 import logging
+import math
 import struct
 from dataclasses import dataclass
 from typing import Any
@@ -190,9 +191,25 @@ class LinkRouter:
         return msg.pack(packer)
 
     def next_due(self) -> float:
-        times = [s.next_time() for s in self.schedules]
+        times = [s.next_time() for s in self._streaming()]
         nexts = [getattr(s, "next_due", lambda: float("inf"))() for s in self.services]
         return min([*times, *nexts, float("inf")])
+
+    def _streaming(self) -> list[StreamSchedule]:
+        """The schedules of the endpoints that have someone to send to. One nobody has
+        spoken to yet (udpin, tcpin) streams nothing: its streams, due since its start,
+        made every wait a zero one (the link spun) until a ground station came."""
+        pairs = zip(self.endpoints, self.schedules, strict=True)
+        return [schedule for endpoint, schedule in pairs if endpoint.has_remote()]
+
+    def next_wake(self, now_s: float, max_wait_s: float) -> tuple[float, bool]:
+        """How long the link may sleep (at most ``max_wait_s``), and whether a navigation
+        state should end the sleep: only once a stream that carries it is due on an
+        endpoint that has someone to send to (the navigator publishes five times as often
+        as ATTITUDE goes out, and a wake-up costs the whole step)."""
+        nav_due = min((s.nav_due() for s in self._streaming()), default=math.inf)
+        until = self.next_due() if now_s >= nav_due else min(self.next_due(), nav_due)
+        return max(0.0, min(max_wait_s, until - now_s)), now_s >= nav_due
 
     def close(self) -> None:
         for tlog in self.tlogs:

@@ -86,6 +86,12 @@ class StreamSchedule:
     def mark_sent(self, msg_id: int, now_s: float) -> None:
         self.last_sent[msg_id] = now_s
 
+    def nav_due(self) -> float:
+        """When the first stream that follows the navigator falls due (it then goes out
+        on the next navigation state); inf when none is on."""
+        times = [self.next_due[m] for m in FOLLOWS_NAV if self.period_s[m] > 0]
+        return min(times, default=float("inf"))
+
     def next_time(self) -> float:
         """When a stream falls due without a navigation state (the wake-up for timers)."""
         times = [

@@ -115,6 +115,24 @@ def test_newest_reader_of_a_queue_sees_only_the_newest_and_counts_no_loss(namesp
     assert newest.received == 2 and lost == 0
 
 
+def test_a_gated_reader_ends_a_wait_only_while_its_gate_is_open(namespace):
+    with BusNode(namespace, "gated") as bus:
+        nav, acks = bus.latest_reader("nav/state"), bus.queue_reader("link/command_acks")
+        waiter = bus.gated_waiter(nav, [acks])
+        writer = bus.writer("nav/state")
+        writer.publish(NavState(t_us=1))
+        shut, _ = waiter.wait_with_fds(0.05, [], gate_open=False)  # ends by its timeout
+        opened, _ = waiter.wait_with_fds(10.0, [], gate_open=True)  # ends on the state
+        first = nav.get()
+        writer.publish(NavState(t_us=2))
+        again, _ = waiter.wait_with_fds(10.0, [], gate_open=True)
+        second = nav.get()
+        waiter.close()
+    assert shut == [] and opened == [nav] and again == [nav]
+    assert first is not None and first.t_us == 1
+    assert second is not None and second.t_us == 2
+
+
 def test_latest_reader_that_joins_late_still_gets_the_newest_value(namespace):
     with BusNode(namespace, "w") as bus_w, BusNode(namespace, "r") as bus_r:
         writer = bus_w.writer("nav/state")

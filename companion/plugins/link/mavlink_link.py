@@ -168,8 +168,8 @@ class MavlinkLink(Plugin):
         self._serve_logs(ctx, sysid)
         register_commands(self.commands, self, self.identity, self.router, self.metadata)
         self.commands.on_refusal = self.refusal_text
-        # Woken by a navigation state (the streams carrying it go out on it), an ack, a text.
-        self.waker = bus.waiter((self.readers["nav"], self.acks, self.texts))
+        # Woken by an ack, a text, a navigation state when a stream carrying it is due.
+        self.waker = bus.gated_waiter(self.readers["nav"], (self.acks, self.texts))
         self.nav_at_s = float("-inf")
         self._seq = 0
 
@@ -307,9 +307,9 @@ class MavlinkLink(Plugin):
         state.custom_mode, state.mode_flags = custom, flags
 
     def _wait_input(self, now_s: float) -> None:
-        timeout = max(0.0, min(MAX_WAIT_S, self.router.next_due() - now_s))
+        timeout, nav_wanted = self.router.next_wake(now_s, MAX_WAIT_S)
         fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
-        woken, ready = self.waker.wait_with_fds(timeout, list(fd_owner))
+        woken, ready = self.waker.wait_with_fds(timeout, list(fd_owner), nav_wanted)
         if self.readers["nav"] in woken:
             self.nav_at_s = time.monotonic()
         for fd in ready:

@@ -1,0 +1,69 @@
+"""The link sleeps through the navigation states no stream is waiting for, and still sends
+every stream on the same states at the same times."""
+
+from __future__ import annotations
+
+import pytest
+
+from companion.link.codec import dialect as d
+from companion.link.codec import new_encoder
+from companion.link.endpoints import open_endpoint
+from companion.link.link_router import LinkRouter
+
+ATTITUDE = d.MAVLINK_MSG_ID_ATTITUDE
+MAX_WAIT_S = 0.05  # the link plug-in's
+
+
+@pytest.fixture
+def endpoint():
+    endpoint = open_endpoint("udpout://127.0.0.1:9")  # nothing is sent here
+    yield endpoint
+    endpoint.close()
+
+
+def fly(router: LinkRouter, gated: bool, nav_hz: int, seconds: float = 10.0):
+    """A link woken as ``next_wake`` says (or by every state when not ``gated``), states
+    at ``nav_hz`` out of phase with the streams' grid; returns (what was due at which
+    millisecond, with the age of the state it carries) and the number of wake-ups."""
+    period_ms, sent, wakes = 1000 // nav_hz, [], 0
+    nav_at, state_at, wake_at, nav_wanted = float("-inf"), float("-inf"), 0.0, True
+    for ms in range(int(seconds * 1000)):
+        now = ms / 1000
+        state = ms % period_ms == 7
+        if state:
+            state_at = now
+        if not ((state and (nav_wanted or not gated)) or now >= wake_at - 1e-9):
+            continue
+        wakes += 1
+        if state:
+            nav_at = now
+        due = router.schedules[0].due(now, nav_at)
+        sent += [(ms, msg_id, round(now - state_at, 6)) for msg_id in due]
+        timeout, nav_wanted = router.next_wake(now, MAX_WAIT_S)
+        wake_at = now + timeout
+    return sent, wakes
+
+
+@pytest.mark.parametrize("attitude_hz", [10, 50])
+def test_streams_go_out_on_the_same_states_with_fewer_wakeups(endpoint, attitude_hz):
+    runs = []
+    for gated in (False, True):
+        router = LinkRouter(new_encoder(1, 1), [endpoint], [], None)
+        router.schedules[0].set_interval(ATTITUDE, 1e6 / attitude_hz)
+        runs.append(fly(router, gated, nav_hz=50))
+    (every_state, woken_always), (gated_sent, woken_gated) = runs
+    assert gated_sent == every_state
+    attitude = [age for _, msg_id, age in gated_sent if msg_id == ATTITUDE]
+    assert abs(len(attitude) - 10 * attitude_hz) <= 1
+    assert max(attitude[1:]) == 0.0  # each on the state that woke the link
+    if attitude_hz == 10:  # fifty states a second, ten wanted
+        assert woken_gated < 0.6 * woken_always
+
+
+def test_an_endpoint_nobody_has_spoken_to_neither_spins_the_link_nor_wakes_it_on_states():
+    waiting = open_endpoint("udpin://127.0.0.1:0")  # no ground station has spoken yet
+    try:
+        router = LinkRouter(new_encoder(1, 1), [waiting], [], None)
+        assert router.next_wake(5.0, MAX_WAIT_S) == (MAX_WAIT_S, False)
+    finally:
+        waiting.close()
