@@ -80,7 +80,7 @@ def test_mission_mode_without_a_mission_is_refused_with_a_reason(station):
     assert "no mission" in gcs.recv("STATUSTEXT", 3.0).text
     gcs.command(m.MAV_CMD_NAV_RETURN_TO_LAUNCH)
     assert gcs.ack(m.MAV_CMD_NAV_RETURN_TO_LAUNCH).result == m.MAV_RESULT_ACCEPTED  # home known
-    assert status.get().mode == FlightMode.RTL
+    wait_for(lambda: status.get().mode == FlightMode.RTL, 15, "the commander's status")
     gcs.command(m.MAV_CMD_DO_SET_MODE, m.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, 99)
     assert gcs.ack(m.MAV_CMD_DO_SET_MODE).result == m.MAV_RESULT_DENIED
 
@@ -102,7 +102,9 @@ def test_do_set_mode_in_both_encodings(station, params, mode):
     _, gcs, status = station(with_mission=True)
     gcs.command(m.MAV_CMD_DO_SET_MODE, *params)
     assert gcs.ack(m.MAV_CMD_DO_SET_MODE).result == m.MAV_RESULT_ACCEPTED
-    assert status.get().mode == mode
+    # The commander publishes its status just after the ack: on a busy machine it can come
+    # a moment later than the ack reaches the ground station.
+    wait_for(lambda: status.get().mode == mode, 15, f"the commander in {mode.name}")
     heartbeat_mode(gcs, PX4[mode])
     assert gcs.recv("CURRENT_MODE", 5.0, custom_mode=PX4[mode])
 
@@ -111,13 +113,13 @@ def test_set_mode_message_standard_modes_mission_start_and_go_to(station):
     _, gcs, status = station(with_mission=True)
     gcs.mav.set_mode_send(1, m.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, 12)  # the old message
     assert gcs.ack(11).result == m.MAV_RESULT_ACCEPTED
-    assert status.get().mode == FlightMode.LOITER
+    wait_for(lambda: status.get().mode == FlightMode.LOITER, 15, "the commander's status")
     gcs.command(m.MAV_CMD_DO_SET_STANDARD_MODE, m.MAV_STANDARD_MODE_MISSION)
     assert gcs.ack(m.MAV_CMD_DO_SET_STANDARD_MODE).result == m.MAV_RESULT_ACCEPTED
-    assert status.get().mode == FlightMode.MISSION
+    wait_for(lambda: status.get().mode == FlightMode.MISSION, 15, "the commander's status")
     gcs.command(m.MAV_CMD_MISSION_START, 2, 0)
     assert gcs.ack(m.MAV_CMD_MISSION_START).result == m.MAV_RESULT_ACCEPTED
-    assert status.get().mission_first == 2
+    wait_for(lambda: status.get().mission_first == 2, 15, "the commander's status")
     gcs.mav.command_int_send(
         1, 1, m.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, m.MAV_CMD_DO_REPOSITION, 0, 0,
         -1, m.MAV_DO_REPOSITION_FLAGS_CHANGE_MODE, 0, float("nan"),
