@@ -64,6 +64,14 @@ def _yaw(i: int) -> Param:
 
 
 MSG_ID = Param(1, "message id", 0, MAX_MSG_ID, whole=True)
+# PREFLIGHT_CALIBRATION: each parameter 0 or one of PX4's uses of it
+# (companion.link.commands.calibration), never NaN.
+CALIBRATION = tuple(
+    Param(i, name, 0, most, whole=True)
+    for i, (name, most) in enumerate((("gyro", 3), ("compass", 1), ("pressure", 1),
+                                      ("radio", 2), ("accelerometer", 4), ("airspeed", 2),
+                                      ("ESC", 3)), start=1)
+)  # fmt: skip
 POINT = (_lat(5), _lon(6), _alt(7))
 
 RULES: dict[int, tuple[Param, ...]] = {
@@ -72,6 +80,11 @@ RULES: dict[int, tuple[Param, ...]] = {
         Param(2, "force", -1e9, 1e9, optional=True, whole=True),
     ),
     d.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN: (Param(1, "autopilot", 0, 3, whole=True),),
+    d.MAV_CMD_PREFLIGHT_CALIBRATION: CALIBRATION,
+    d.MAV_CMD_PREFLIGHT_STORAGE: (
+        Param(1, "parameter storage", 0, 4, whole=True),
+        Param(2, "mission storage", -1, 2, optional=True, whole=True),
+    ),
     d.MAV_CMD_INJECT_FAILURE: (
         Param(1, "failure unit", 0, 255, whole=True),
         Param(2, "failure type", 0, 255, whole=True),

@@ -283,6 +283,22 @@ def split_options(url: str) -> tuple[str, EndpointOptions]:
     return base, EndpointOptions(budget, tlog, signing)
 
 
+def endpoint_problems(urls: list[str], signing_key: str) -> list[str]:
+    """What is wrong with these endpoint URLs (the config check, before anything opens):
+    an unknown scheme or option, signing asked for without a key."""
+    problems = []
+    for url in urls:
+        try:
+            base, options = split_options(str(url))
+            if base.split("://", 1)[0] not in SCHEMES:
+                problems.append(f"endpoint {url!r}: scheme must be one of {sorted(SCHEMES)}")
+            if options.signing != "off" and not signing_key:
+                problems.append(f"endpoint {url!r} asks for signing but signing_key is empty")
+        except EndpointError as exc:
+            problems.append(str(exc))
+    return problems
+
+
 def open_endpoint(url: str) -> Endpoint:
     """Open the endpoint a URL names; EndpointError for an unknown scheme or option."""
     base, options = split_options(url)

@@ -90,15 +90,20 @@ class ParamsService:
             self.on_refusal(f"Unknown parameter {name}")
             return []
         try:
-            changed = self.store.write(name, msg.param_value)
+            return self.write(name, msg.param_value)
         except ParamError as exc:
             self.refused += 1
             self.on_refusal(f"Param refused: {exc}")
             # The old value, to the sender only: nothing changed for anyone else, and a
             # flood of bad writes on one link must not be repeated on every other one.
             return [Outgoing(self.value(self.store.index_of(name)), peer)]
-        for own, value in changed.items():  # an alias's owners follow their own names
-            self.on_change(own, value)
+
+    def write(self, name: str, value: float) -> list[Outgoing]:
+        """Set a parameter (from a ground station, or a calibration's result); ParamError
+        when refused, nothing changed."""
+        changed = self.store.write(name, value)
+        for own, new in changed.items():  # an alias's owners follow their own names
+            self.on_change(own, new)
         # A change is news for every ground station: the name set first (the sender waits
         # for it), then every name that reads the same value (an alias and its owner).
         names = [name, *self.store.linked(name)]

@@ -128,7 +128,8 @@ class Battery(Message):
         ("voltage_v", ctypes.c_double),  # pack voltage, filtered over ~1 s of sensor time
         ("current_a", ctypes.c_double),  # drawn from the pack (positive discharging); NaN unknown
         ("consumed_mah", ctypes.c_double),  # integrated current since start; NaN unknown
-        ("remaining", ctypes.c_double),  # 0..1 of BATT_CAPACITY; NaN when capacity is 0
+        ("remaining", ctypes.c_double),  # 0..1 of BATT_CAPACITY (of the cells' voltage range
+        # when the capacity is 0); NaN when neither is known
         ("level", ctypes.c_uint8),  # BatteryLevel
     ]
 

@@ -8,7 +8,9 @@ as they are now, writing it converts the value and sets theirs (the owners follo
 
 The forms, all plain data (declarations travel to every plug-in as JSON):
 - linear: alias = own * scale (one target), or own / values[divisor] * scale, a fraction
-  of another parameter (a charge threshold of the pack's capacity);
+  of another parameter (a charge threshold of the pack's capacity); ``times`` multiplies by
+  another parameter, ``inverse`` takes 1 / own (a time constant from a gain: another
+  autopilot's FW_R_TC is the vehicle's RLL_D / RLL_P); a divisor or factor at 0 reads 0;
 - table: rows of (alias value, the targets' values in order). Reading takes the first row
   the targets match, rounded as their owners read them (0.5 and above is on), else
   ``other``; writing takes the first row with that alias value, and an alias value with
@@ -44,6 +46,8 @@ class Alias:
     targets: tuple[str, ...]
     scale: float = 1.0
     divisor: str = ""  # linear: a fraction of this parameter
+    times: str = ""  # linear: times this parameter
+    inverse: bool = False  # linear: of 1 / own
     table: tuple[Row, ...] | None = None
     other: float = 0.0  # table: what no row matches reads as
     writable: bool = True
@@ -61,16 +65,22 @@ class Alias:
     @property
     def sources(self) -> tuple[str, ...]:
         """Every parameter the alias reads."""
-        return (*self.targets, self.divisor) if self.divisor else self.targets
+        return (*self.targets, *(name for name in (self.divisor, self.times) if name))
+
+    @property
+    def linear_only(self) -> bool:
+        """Plain own * scale: the owner's range, scaled, is the alias's."""
+        return self.table is None and not (self.divisor or self.times or self.inverse)
 
     def read(self, values: Mapping[str, float]) -> float:
         """The alias's value given the owners' values."""
         if self.table is None:
-            own = values[self.targets[0]] * self.scale
-            if not self.divisor:
-                return own
-            whole = values[self.divisor]
-            return own / whole if whole > 0 else 0.0
+            own = values[self.targets[0]]
+            if self.inverse:
+                own = 1.0 / own if own != 0 else 0.0
+            factor = values[self.times] if self.times else 1.0
+            whole = values[self.divisor] if self.divisor else 1.0
+            return own * self.scale * factor / whole if whole > 0 else 0.0
         for value, owns in self.table:
             if all(_as_read(values[t]) == o for t, o in zip(self.targets, owns, strict=True)):
                 return value
@@ -89,9 +99,13 @@ class Alias:
                     return dict(zip(self.targets, owns, strict=True))
             return f"{value:g} is not something this vehicle can do"
         own = value / self.scale
-        if self.divisor:
-            whole = values[self.divisor]
-            if whole <= 0:
-                return f"{value:g} needs {self.divisor} above 0"
-            own *= whole
+        for name in (self.divisor, self.times):
+            if name and values[name] <= 0:
+                return f"{value:g} needs {name} above 0"
+        own = own * (values[self.divisor] if self.divisor else 1.0)
+        own = own / (values[self.times] if self.times else 1.0)
+        if self.inverse:
+            if own == 0:
+                return f"{value:g} cannot be 0 (it is 1 / {self.targets[0]})"
+            own = 1.0 / own
         return {self.targets[0]: own}

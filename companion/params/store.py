@@ -71,7 +71,7 @@ def bind(decl: ParamDecl, decls: Mapping[str, ParamDecl]) -> ParamDecl:
         fixed = {"min": decl.default, "max": decl.default, "values": values}
         return replace(decl, alias=None, doc=doc, **fixed)
     lo, hi = decl.min, decl.max
-    if alias.table is None and not alias.divisor:  # the owner's range, narrowed by the alias's
+    if alias.linear_only:  # the owner's range, scaled, narrowed by the alias's
         own = decls[alias.targets[0]]
         own_lo, own_hi = sorted((own.min * alias.scale, own.max * alias.scale))
         lo, hi = max(lo, own_lo), min(hi, own_hi)

@@ -14,7 +14,8 @@ byte for byte.
 
 ``BatteryGauge`` turns the readings into what a ground station shows: voltage filtered
 over about a second, charge used (current integrated over the readings' own time stamps),
-remaining fraction of the capacity, and a level (OK, LOW, CRITICAL) against voltage and
+remaining fraction of the capacity (of the cells' voltage range, between empty and full,
+when the capacity is not known), and a level (OK, LOW, CRITICAL) against voltage and
 charge thresholds; a voltage threshold counts only after it has held for ``low_timer_s``
 of sensor time, so a sag under full throttle is not a low battery. Pure: no port, no clock.
 """
@@ -85,6 +86,9 @@ class GaugeSettings:
     low_mah: float = 0.0  # charge left, mAh
     crt_mah: float = 0.0
     low_timer_s: float = 10.0
+    cells: float = 0.0  # in series (0: not known)
+    cell_full_v: float = 0.0
+    cell_empty_v: float = 0.0
 
 
 class BatteryGauge:
@@ -122,10 +126,17 @@ class BatteryGauge:
         )
 
     def remaining(self) -> float:
-        capacity = self.settings.capacity_mah
-        if capacity <= 0:
+        """The charge left of the capacity; without one, where the cell voltage is between
+        empty and full (a loaded pack reads low); NaN when neither is known."""
+        s = self.settings
+        if s.capacity_mah > 0:
+            left = 1.0 - self.consumed_mah / s.capacity_mah
+        elif s.cells >= 1 and s.cell_full_v > s.cell_empty_v:
+            cell_v = self.voltage_v / round(s.cells)
+            left = (cell_v - s.cell_empty_v) / (s.cell_full_v - s.cell_empty_v)
+        else:
             return math.nan
-        return min(1.0, max(0.0, 1.0 - self.consumed_mah / capacity))
+        return min(1.0, max(0.0, left)) if math.isfinite(left) else math.nan
 
     def _judge(self, t_us: int) -> None:
         """The level only rises (a pack does not recharge in flight), as ArduPilot's."""

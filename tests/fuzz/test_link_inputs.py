@@ -29,6 +29,7 @@ from companion.link.params_service import ParamsService
 from companion.link.service import Peer
 from companion.messages import CommandId, VehicleCommand
 from companion.params import ParamDecl, ParamStore
+from companion.sensors.imu_calibration import IMU_CAL_PARAMS
 from mavlink_dialect import companion as d
 from tests.support.vehicle_port import RecordingVehicle
 
@@ -50,7 +51,8 @@ def command_service() -> Iterator[tuple[CommandService, RecordingVehicle]]:
     router = LinkRouter(mav, [endpoint], [], None)
     service = CommandService(mav, 1, 1)
     vehicle = RecordingVehicle()
-    register_commands(service, vehicle, identity, router)
+    params = ParamsService(mav, ParamStore(IMU_CAL_PARAMS), 1, 1)  # the IMU's calibration
+    register_commands(service, vehicle, identity, router, None, params)
     try:
         yield service, vehicle
     finally:

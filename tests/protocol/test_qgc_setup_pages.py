@@ -1,5 +1,8 @@
 """QGroundControl's PX4 Vehicle Setup pages against the vehicle: every name they read is
-there, and what the Safety page sets is the vehicle's own setting.
+there (but the Tuning page's for terms the controller lacks), the Sensors and Power pages
+show set up by QGroundControl's own test, and what the Safety, Power, Sensors, Radio and
+Tuning pages set is the vehicle's own setting. (The Sensors page's calibrations:
+test_qgc_sensor_calibration.py.)
 
 The names are those QGroundControl reads without first asking whether they exist (a
 FactPanelController::getParameterFact with reportMissing left true, or
@@ -12,6 +15,7 @@ FW_ARSP_MODE and CBRK_AIRSPD_CHK, for PX4 1.15 as we report, see mavlink/qground
 
 from __future__ import annotations
 
+import math
 import time
 
 import pytest
@@ -21,7 +25,7 @@ from mavlink_dialect import companion as m
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.support.configs import client_vehicle, plugin
 
-CHANNELS = range(1, 9)  # RC1..RC8: the receiver's calibrated channels
+CHANNELS = range(1, 19)  # RC1..RC18: every channel SBUS carries has its calibration
 # Page (and the files under src/ that read the names) → names.
 PAGES: dict[str, set[str]] = {
     # AutoPilotPlugins/PX4/AirframeComponent.cc (setupComplete), AirframeComponent.qml,
@@ -70,11 +74,23 @@ PAGES: dict[str, set[str]] = {
         "COM_LOW_BAT_ACT", "BAT_LOW_THR", "BAT_CRIT_THR", "BAT_EMERGEN_THR", "NAV_DLL_ACT",
         "COM_DL_LOSS_T", "RTL_RETURN_ALT", "GF_ACTION", "GF_MAX_HOR_DIST", "GF_MAX_VER_DIST",
     },
+    # AutoPilotPlugins/PX4/PX4TuningComponentPlaneRate.qml and ...PlaneAttitude.qml: the
+    # names with a gain of the vehicle's behind them (companion.link.px4_tuning).
+    "Tuning": {"FW_RR_P", "FW_RR_I", "FW_PR_P", "FW_PR_I", "FW_YR_P", "FW_R_TC", "FW_P_TC"},
 }  # fmt: skip
-# With a receiver: RadioComponentController.cc reads RCn_MIN/MAX/TRIM for every channel
-# whose RCn_MIN exists, and RCn_REVERSED (ArduPilot's 0/1) once RC1_REVERSED exists;
-# PX4SimpleFlightModesController.cc the mode channel's RCn_REV, _MIN, _MAX, _TRIM and
-# _DZ (n = RC_MAP_FLTMODE, 0 without a receiver).
+# What the Tuning page also reads, for terms the vehicle's loops do not have (a rate
+# derivative or feed-forward, a yaw integrator, aileron-to-rudder mixing): not declared,
+# so QGroundControl lists them in its "Parameters are missing" message rather than show a
+# slider that moves nothing.
+NO_SUCH_TERM = {
+    "FW_RR_D", "FW_RR_FF", "FW_PR_D", "FW_PR_FF", "FW_YR_D", "FW_YR_I", "FW_YR_FF",
+    "FW_RLL_TO_YAW_FF",
+}  # fmt: skip
+# With a receiver: RadioComponentController.cc reads and writes RCn_MIN/MAX/TRIM for every
+# channel up to 18 whose RCn_MIN exists, and RCn_REVERSED (ArduPilot's 0/1) once
+# RC1_REVERSED exists; PX4SimpleFlightModesController.cc reads the mode channel's RCn_REV,
+# _MIN, _MAX, _TRIM (n = RC_MAP_FLTMODE: any of 1..18, 0 without a receiver), asking for each
+# without looking first. RCn_DZ is PX4's dead zone, the receiver's own here.
 RECEIVER = {
     *(f"RC{n}_{what}" for n in CHANNELS for what in ("MIN", "MAX", "TRIM", "REVERSED")),
     *(f"RC{n}_{what}" for n in CHANNELS for what in ("REV", "DZ")),
@@ -92,11 +108,14 @@ ABSENT_DEVICE = "serial:///dev/companion-test-absent:100000"
 
 
 def whole_vehicle(port: int, state) -> str:
-    """The commander with a receiver, a battery monitor and the controller (in the flight
-    group, never started here): every owner of a setting PX4 names."""
+    """The commander with a receiver, a battery monitor, the VN-100 and the OS-3000 and the
+    controller (in the flight group, never started here): every owner of a setting PX4
+    names."""
     extra = (
         plugin("rc", "sensors.rc_input", device=ABSENT_DEVICE),
         plugin("battery", "sensors.battery", device=ABSENT_DEVICE),
+        plugin("imu", "sensors.serial_imu", device=ABSENT_DEVICE, publish_baro=False),
+        plugin("compass", "sensors.os3000", device=ABSENT_DEVICE),
     )
     control = plugin("control", "control.fixed_wing", group="flight", airframe="c172p")
     return client_vehicle(f"udpin://127.0.0.1:{port}", state, extra, control)
@@ -146,7 +165,7 @@ def test_every_name_qgroundcontrols_px4_pages_read_is_declared(vehicle_factory, 
     values = read_all(gcs)
     missing = {page: names - values.keys() for page, names in PAGES.items()}
     assert all(not names for names in missing.values()), missing
-    assert not ABSENT_ON_PURPOSE & values.keys()
+    assert not (ABSENT_ON_PURPOSE | NO_SUCH_TERM) & values.keys()
     # AirframeComponent::setupComplete: 0 would put every other page behind "Airframe
     # setup must be completed prior to ... setup" (PX4AutoPilotPlugin::prerequisiteSetup).
     assert values["SYS_AUTOSTART"] != 0
@@ -158,6 +177,84 @@ def test_every_name_qgroundcontrols_px4_pages_read_is_declared(vehicle_factory, 
         assert values["RC_MAP_FLTMODE"] != 0
     else:
         assert values["RC_MAP_FLTMODE"] == 0
+
+
+def sensors_set_up(v: dict[str, float], px4_1_15_logic: bool) -> bool:
+    """SensorsComponent::setupComplete for a fixed wing: gyro and accelerometer ids, the
+    first compass's id (SYS_HAS_MAG is not declared: a compass is expected), and an airspeed
+    sensor's offset unless none is fitted, told by SYS_HAS_NUM_ASPD (QGroundControl 5, and
+    4.4.1 on for PX4 1.15 as reported) or by FW_ARSP_MODE and CBRK_AIRSPD_CHK (4.4.0)."""
+    if not (v["CAL_GYRO0_ID"] and v["CAL_ACC0_ID"] and v["CAL_MAG0_ID"]):
+        return False
+    if px4_1_15_logic:
+        return not (v["SYS_HAS_NUM_ASPD"] and v["SENS_DPRES_OFF"] == 0)
+    airspeed_used = not v["FW_ARSP_MODE"] and int(v["CBRK_AIRSPD_CHK"]) != 162128
+    return not (airspeed_used and v["SENS_DPRES_OFF"] == 0)
+
+
+def power_set_up(v: dict[str, float]) -> bool:
+    """PowerComponent::setupComplete: no battery monitor (BAT1_SOURCE -1), or its cell count
+    and full and empty cell voltages."""
+    names = ("BAT1_SOURCE", "BAT1_V_CHARGED", "BAT1_V_EMPTY", "BAT1_N_CELLS")
+    if not all(n in v for n in names):
+        return True
+    cells = int(v["BAT1_N_CELLS"])
+    return v["BAT1_SOURCE"] == -1 or (v["BAT1_V_CHARGED"] != 0 and v["BAT1_V_EMPTY"] != 0 and cells)
+
+
+def test_sensors_and_power_show_set_up_from_the_sensors_the_vehicle_runs(vehicle_factory, tmp_path):
+    _, gcs = start(vehicle_factory, tmp_path)
+    v = read_all(gcs)
+    # The VN-100 (PX4's DRV_INS_DEVTYPE_VN100 on a serial bus) and the OS-3000.
+    assert v["CAL_GYRO0_ID"] == v["CAL_ACC0_ID"] == v["CAL_MAG0_ID"] == 0xE1 << 16 | 5
+    assert v["CAL_MAG1_ID"] == 0xFF << 16 | 1 << 3 | 5 and v["CAL_MAG2_ID"] == 0
+    assert sensors_set_up(v, True) and sensors_set_up(v, False)
+    # The monitor's own 3S LiPo: 4.2 V full, 3.5 V empty under load.
+    assert (v["BAT1_N_CELLS"], v["BAT1_V_CHARGED"], v["BAT1_V_EMPTY"]) == pytest.approx(
+        (3, 4.2, 3.5)
+    )
+    assert v["BAT1_N_CELLS"] == v["BATT_CELLS"] and v["BAT1_V_EMPTY"] == v["BATT_CELL_EMPTY"]
+    assert power_set_up(v)
+
+
+def test_a_vehicle_without_those_sensors_says_so(vehicle_factory, tmp_path):
+    _, gcs = start(vehicle_factory, tmp_path, bare_vehicle)
+    v = read_all(gcs)
+    assert (v["CAL_GYRO0_ID"], v["CAL_ACC0_ID"], v["CAL_MAG0_ID"]) == (0, 0, 0)
+    assert not sensors_set_up(v, True)  # nothing to calibrate: the page says so
+    assert v["BAT1_SOURCE"] == -1 and power_set_up(v)  # no battery monitor: nothing to set
+
+
+def test_setup_pages_write_the_vehicles_own_parameters(vehicle_factory, tmp_path):
+    """Power, Sensors, Radio and Tuning pages' writes land on the owners' parameters, in
+    the owners' units, and only those go to the owners."""
+    vehicle, gcs = start(vehicle_factory, tmp_path)
+    changes = vehicle.bus.queue_reader("params/changes")
+    before = read_all(gcs)
+    seen = param_set(gcs, "BAT1_N_CELLS", 4.0)  # "Number of Cells (in Series)"
+    assert seen["BAT1_N_CELLS"] == seen["BATT_CELLS"] == 4.0
+    seen = param_set(gcs, "BAT1_V_CHARGED", 4.15)  # "Full Voltage (per cell)"
+    assert seen["BATT_CELL_FULL"] == pytest.approx(4.15)
+    seen = param_set(gcs, "SENS_BOARD_X_OFF", 1.5)  # the Sensors page's orientation offset
+    assert seen["AHRS_TRIM_X"] == pytest.approx(math.radians(1.5))
+    # The radio calibration's write of channel 12 (a switch), reversed the PX4 way.
+    assert param_set(gcs, "RC12_MIN", 1000.0)["RC12_MIN"] == 1000.0
+    seen = param_set(gcs, "RC12_REV", -1.0)
+    assert seen["RC12_REV"] == -1.0 and seen["RC12_REVERSED"] == 1.0
+    # Tuning: the rate gain is the roll loop's damping; the time constant moves RLL_P.
+    seen = param_set(gcs, "FW_RR_P", 0.15)
+    assert seen["RLL_D"] == pytest.approx(0.15)
+    seen = param_set(gcs, "FW_R_TC", 0.5)
+    assert seen["FW_R_TC"] == pytest.approx(0.5)
+    assert seen["RLL_P"] == pytest.approx(0.15 / 0.5) != before["RLL_P"]
+    want = {"BATT_CELLS", "BATT_CELL_FULL", "AHRS_TRIM_X", "RC12_MIN", "RC12_REVERSED",
+            "RLL_D", "RLL_P"}  # fmt: skip
+    published: set[str] = set()
+    deadline = time.monotonic() + 5.0
+    while published != want and time.monotonic() < deadline:
+        published |= {change.name.decode() for change in changes.drain()}
+        time.sleep(0.05)
+    assert published == want  # under the owners' names only: no copy under PX4's
 
 
 def test_the_safety_page_sets_the_vehicles_own_failsafe_and_return_altitude(

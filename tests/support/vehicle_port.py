@@ -3,8 +3,24 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 from companion.link.telemetry import Snapshot
+
+
+@dataclass
+class SampleFeed:
+    """What ``open_imu`` gives: the samples a test puts in ``pending``, each drained once."""
+
+    pending: list[Any] = field(default_factory=list)
+    closed: bool = False
+
+    def drain(self) -> list[Any]:
+        out, self.pending = self.pending, []
+        return out
+
+    def close(self) -> None:
+        self.closed = True
 
 
 @dataclass
@@ -20,6 +36,7 @@ class RecordingVehicle:
     simulated: bool = True
     published: list[tuple[int, tuple[float, ...]]] = field(default_factory=list)
     texts: list[str] = field(default_factory=list)
+    feeds: list[SampleFeed] = field(default_factory=list)  # one per open_imu
 
     def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
         self.published.append((command, tuple(params)))
@@ -33,3 +50,7 @@ class RecordingVehicle:
 
     def param(self, name: str) -> float:
         return self.params[name]
+
+    def open_imu(self) -> SampleFeed:
+        self.feeds.append(SampleFeed())
+        return self.feeds[-1]

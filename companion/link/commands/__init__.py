@@ -8,19 +8,23 @@ command service.
 
 from __future__ import annotations
 
+from companion.link.calibration import Calibration
 from companion.link.command_rules import refusal
 from companion.link.command_service import CommandService
 from companion.link.commands.arming import ArmingCommands
+from companion.link.commands.calibration import CalibrationCommands
 from companion.link.commands.message_requests import MessageRequests
 from companion.link.commands.modes import ModeCommands
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
 from companion.link.metadata_service import MetadataService
+from companion.link.params_service import ParamsService
 
 __all__ = [
     "BUS_ACK_TIMEOUT_S",
     "ArmingCommands",
+    "CalibrationCommands",
     "MessageRequests",
     "ModeCommands",
     "VehiclePort",
@@ -34,10 +38,16 @@ def register_commands(
     identity: IdentityService,
     router: LinkRouter,
     metadata: MetadataService | None = None,
+    params: ParamsService | None = None,
 ) -> None:
-    """Register every supported MAV_CMD with ``service``, behind the parameter rules."""
+    """Register every supported MAV_CMD with ``service``, behind the parameter rules (the
+    sensor calibrations when there are parameters to keep their results)."""
     service.check = refusal
     service.on_refusal = port.statustext
     ArmingCommands(port).register(service)
     ModeCommands(port, identity.autopilot).register(service)
     MessageRequests(port, identity, router, metadata).register(service)
+    if params is not None:
+        calibration = Calibration(port, params)
+        CalibrationCommands(port, calibration).register(service)
+        router.add_service(calibration)

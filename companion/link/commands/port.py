@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Protocol
+from typing import Any, Protocol
 
 from companion.link.codec import dialect as d
 from companion.link.telemetry import Snapshot
@@ -31,6 +31,11 @@ class VehiclePort(Protocol):
 
     def param(self, name: str) -> float:
         """The current value of one of the link's own parameters."""
+        ...
+
+    def open_imu(self) -> Any:
+        """A reader of every IMU sample from now on (``drain()``, ``close()``), for a sensor
+        calibration: the telemetry reads only the newest."""
         ...
 
     def prearm_failures(self) -> list[str]:

@@ -22,7 +22,7 @@ from companion.link.codec import dialect as d
 from companion.link.codec import new_encoder
 from companion.link.command_service import CommandService
 from companion.link.commands import register_commands
-from companion.link.endpoints import SCHEMES, Endpoint, EndpointError, open_endpoint, split_options
+from companion.link.endpoints import Endpoint, EndpointError, endpoint_problems, open_endpoint
 from companion.link.gcs_watch import GcsWatch
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
@@ -117,17 +117,7 @@ class MavlinkLink(Plugin):
 
     @classmethod
     def validate(cls, settings: Mapping[str, Any]) -> list[str]:
-        problems = []
-        for url in settings["endpoints"]:
-            try:
-                base, options = split_options(str(url))
-                if base.split("://", 1)[0] not in SCHEMES:
-                    problems.append(f"endpoint {url!r}: scheme must be one of {sorted(SCHEMES)}")
-                if options.signing != "off" and not settings["signing_key"]:
-                    problems.append(f"endpoint {url!r} asks for signing but signing_key is empty")
-            except EndpointError as exc:
-                problems.append(str(exc))
-        return problems
+        return endpoint_problems(settings["endpoints"], settings["signing_key"])
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
@@ -166,7 +156,9 @@ class MavlinkLink(Plugin):
         self._serve_params(ctx, sysid)
         self._serve_missions(ctx, sysid)
         self._serve_logs(ctx, sysid)
-        register_commands(self.commands, self, self.identity, self.router, self.metadata)
+        register_commands(
+            self.commands, self, self.identity, self.router, self.metadata, self._params_service
+        )
         self.commands.on_refusal = self.refusal_text
         # Woken by an ack, a text, a navigation state when a stream carrying it is due.
         self.waker = bus.gated_waiter(self.readers["nav"], (self.acks, self.texts))
@@ -368,6 +360,10 @@ class MavlinkLink(Plugin):
             mission=items[d.MAV_MISSION_TYPE_MISSION], fence=items[d.MAV_MISSION_TYPE_FENCE],
         )  # fmt: skip
         return failures(r, self.store.values)
+
+    def open_imu(self) -> Any:
+        """A reader of every IMU sample, while a sensor calibration runs (VehiclePort)."""
+        return self.ctx.bus.queue_reader("sensors/imu")
 
     @property
     def simulated(self) -> bool:

@@ -30,7 +30,13 @@ BATTERY_PARAMS = (
     ParamDecl("BATT_LOW_MAH", 0.0, 0.0, 100_000.0, "mAh", "Low when less is left (0: off)"),
     ParamDecl("BATT_CRT_MAH", 0.0, 0.0, 100_000.0, "mAh", "Critical when less is left (0: off)"),
     ParamDecl("BATT_LOW_TIMER", 10.0, 0.0, 120.0, "s", "Voltage below a threshold this long"),
-)
+    # The pack's cells: what is left, from the voltage, while the capacity is 0 (unknown);
+    # the defaults are a 3S LiPo's (full 4.2 V; 3.5 V a cell is empty under load).
+    ParamDecl("BATT_CELLS", 3.0, 0.0, 24.0, "", "Cells in series (0: not known)",
+              values=tuple((float(n), f"{n}S" if n else "Unknown") for n in range(25))),
+    ParamDecl("BATT_CELL_FULL", 4.2, 2.0, 5.0, "V", "Voltage of a full cell"),
+    ParamDecl("BATT_CELL_EMPTY", 3.5, 2.0, 5.0, "V", "Voltage of an empty cell under load"),
+)  # fmt: skip
 
 
 class BatteryMonitor(SerialSensor[MonitorReading]):
@@ -56,6 +62,9 @@ class BatteryMonitor(SerialSensor[MonitorReading]):
             low_mah=v["BATT_LOW_MAH"],
             crt_mah=v["BATT_CRT_MAH"],
             low_timer_s=v["BATT_LOW_TIMER"],
+            cells=v["BATT_CELLS"],
+            cell_full_v=v["BATT_CELL_FULL"],
+            cell_empty_v=v["BATT_CELL_EMPTY"],
         )
 
     def make_decoder(self, settings: Mapping[str, Any]) -> BatteryMonitorDecoder:

@@ -3,23 +3,30 @@
 VectorNav's ASCII protocol is public (the VN-100 user manual documents every register and
 both checksums), is plain text a person can read on a terminal, and its ``$VNIMU`` and
 ``$VNYMR`` outputs carry accelerometer, gyro and magnetometer together; the sensor is common
-on small UAVs. The codec is ``companion.sensors.vectornav``.
+on small UAVs. The codec is ``companion.sensors.vectornav``. The plug-in owns the IMU's
+calibration (``companion.sensors.imu_calibration``: gyro offsets and the mounting's tilt,
+measured by MAV_CMD_PREFLIGHT_CALIBRATION) and publishes its samples corrected.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from companion.messages import Baro
+from companion.params.live import LiveParams
 from companion.plugin import PluginContext, Ports, Setting
 from companion.plugins.sensors.serial_sensor import SerialSensor, serial_settings
 from companion.sensors.barometer import pressure_altitude_m
+from companion.sensors.imu_calibration import IMU_CAL_PARAMS, ImuCalibration
 from companion.sensors.vectornav import VectorNavDecoder, VectorNavReading
 
 if TYPE_CHECKING:
     from companion.bus.channels import Writer
+
+PARAMS_EVERY_US = 100_000  # a calibration's new values are looked for this often
 
 
 class SerialImu(SerialSensor[VectorNavReading]):
@@ -32,12 +39,14 @@ class SerialImu(SerialSensor[VectorNavReading]):
         "publish_baro": Setting(bool, True, "also publish $VNIMU's pressure on sensors/baro"),
     }
 
+    params = IMU_CAL_PARAMS
+
     @classmethod
     def ports(cls, settings: Mapping[str, Any]) -> Ports:
         """sensors/mag and sensors/baro only when they are published."""
         mag = ("sensors/mag",) if settings.get("publish_mag", True) else ()
         baro = ("sensors/baro",) if settings.get("publish_baro", True) else ()
-        return Ports(outputs=("sensors/imu", *mag, *baro))
+        return Ports(optional_inputs=("params/changes",), outputs=("sensors/imu", *mag, *baro))
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
@@ -45,11 +54,25 @@ class SerialImu(SerialSensor[VectorNavReading]):
         self.mag = ctx.bus.writer("sensors/mag") if ctx.settings["publish_mag"] else None
         self.baro = ctx.bus.writer("sensors/baro") if ctx.settings["publish_baro"] else None
         self.baro_ref_m: float | None = None
+        self.live = LiveParams(ctx.bus, self.params, Path(ctx.vehicle.get("state_dir", ".")))
+        self._calibrate(self.live.values)
+        self.params_due_us = 0
 
     def make_decoder(self, settings: Mapping[str, Any]) -> VectorNavDecoder:
         return VectorNavDecoder()
 
+    def _calibrate(self, values: Mapping[str, float]) -> None:
+        self.calibration = ImuCalibration.from_params(values)
+        self.rotation = self.calibration.rotation
+        self.identity = self.rotation is None and not any(self.calibration.gyro_offsets)
+
     def publish(self, reading: VectorNavReading, t_us: int) -> None:
+        if t_us >= self.params_due_us:
+            self.params_due_us = t_us + PARAMS_EVERY_US
+            if self.live.poll():
+                self._calibrate(self.live.values)
+        if not self.identity:
+            self.calibration.correct(reading.imu, reading.mag, self.rotation)
         self.imu.publish(reading.imu)
         if self.mag is not None:
             self.mag.publish(reading.mag)
