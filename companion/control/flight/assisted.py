@@ -39,6 +39,12 @@ class AssistedDemand:
     climb_ff: float
 
 
+def track_ahead(pos: tuple[float, float], nav: NavState) -> tuple[float, float]:
+    """A point far along the track over the ground the aircraft now has, from ``pos``."""
+    course = math.atan2(nav.ve_m_s, nav.vn_m_s)
+    return pos[0] + LINE_LENGTH_M * math.cos(course), pos[1] + LINE_LENGTH_M * math.sin(course)
+
+
 def centred(stick: float) -> bool:
     """Whether a stick is within the dead band of its centre."""
     return abs(stick) <= STICK_DEADBAND
@@ -96,8 +102,5 @@ class AssistedHold:
         if self.line is None:
             if abs(nav.roll_rad) > LEVEL_RAD:
                 return 0.0  # level the wings first, then take the track they give
-            course = math.atan2(nav.ve_m_s, nav.vn_m_s)
-            ahead = (pos[0] + LINE_LENGTH_M * math.cos(course),
-                     pos[1] + LINE_LENGTH_M * math.sin(course))  # fmt: skip
-            self.line = (pos, ahead)
+            self.line = (pos, track_ahead(pos, nav))
         return math.nan

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from companion.control.flight.assisted import AssistedHold
+from companion.control.flight.assisted import AssistedHold, track_ahead
 from companion.control.flight.landing import Landing
 from companion.control.flight.landing_flight import LandingFlight
 from companion.control.flight.output import ControlOutput
@@ -129,7 +129,7 @@ class FlightController(LandingFlight, PilotFlight):
         out.brakes = self.config["LAND_BRAKE"] if self.landed else 0.0
         mode = FlightMode(status.mode) if status.mode else FlightMode.LOITER
         if mode in PILOT_MODES and sticks is not None:
-            return self._fly_sticks(mode, sticks, nav, airspeed, dt, out)
+            return self._fly_sticks(mode, sticks, pos, vel, nav, airspeed, dt, out)
         if mode == FlightMode.MANUAL:
             out.throttle = self.config["TRIM_THROTTLE"] if not self.landed else 0.0
             return out
@@ -162,10 +162,8 @@ class FlightController(LandingFlight, PilotFlight):
             self._hold_course = None
             return setpoint
         if self._hold_course is None:
-            course = math.atan2(nav.ve_m_s, nav.vn_m_s)
-            ahead = (pos[0] + 1e5 * math.cos(course), pos[1] + 1e5 * math.sin(course))
             alt = setpoint.alt_msl if setpoint is not None else nav.alt_msl_m
-            self._hold_course = Setpoint(Kind.LINE, pos, ahead, alt)
+            self._hold_course = Setpoint(Kind.LINE, pos, track_ahead(pos, nav), alt)
         return self._hold_course
 
     def _update_landed(self, nav: NavState, airspeed: float) -> None:
@@ -275,9 +273,7 @@ class FlightController(LandingFlight, PilotFlight):
                 return Setpoint(Kind.LINE, pos, point, alt, radius)
             return Setpoint(Kind.CIRCLE, point, point, alt, radius)
         if mode in PILOT_MODES:  # no fresh sticks: straight on, height held
-            course = math.atan2(nav.ve_m_s, nav.vn_m_s)
-            ahead = (pos[0] + 1e5 * math.cos(course), pos[1] + 1e5 * math.sin(course))
-            return Setpoint(Kind.LINE, pos, ahead, alt)
+            return Setpoint(Kind.LINE, pos, track_ahead(pos, nav), alt)
         return Setpoint(Kind.CIRCLE, pos, pos, alt, radius)
 
     def _fly_takeoff(

@@ -28,11 +28,14 @@ class PilotFlight:
         self: FlightController,
         mode: FlightMode,
         sticks: Sticks,
+        pos: tuple[float, float],
+        vel: tuple[float, float],
         nav: NavState,
         airspeed: float,
         dt: float,
         out: ControlOutput,
     ) -> ControlOutput:
+        """The pilot's ``mode`` from these sticks at ``pos`` and ``vel`` (local N, E)."""
         key = (int(mode), -1)  # a pilot's mode is entered once, whatever the commands
         if key != self._mode_key:
             self.assisted.reset()
@@ -44,32 +47,18 @@ class PilotFlight:
             # Stabilized, until the aircraft has left the ground.
             mode = FlightMode.STABILIZED
         elif mode in ASSISTED_MODES:
-            return self._fly_assisted(mode, sticks, nav, airspeed, dt, out)
+            demand = self.assisted.step(mode, sticks, pos, nav, self.config)
+            self.tecs.gains = self.config.tecs
+            out = self._fly(
+                demand.setpoint, pos, vel, nav, airspeed, dt, out,
+                climb_ff=demand.climb_ff, roll_dem=demand.roll,
+            )  # fmt: skip
+            out.rudder = clamp(out.rudder + sticks.yaw, -1.0, 1.0)
+            return out
         cfg = self.config
         demand = fly_pilot(mode, sticks, nav, airspeed, dt, self.attitude, cfg, self.acro)
         out.aileron, out.elevator, out.rudder = demand.aileron, demand.elevator, demand.rudder
         out.throttle = demand.throttle
         out.nav_roll, out.nav_pitch = demand.roll, demand.pitch
         self.tecs.reset(nav.pitch_rad)  # Auto takes over from the attitude the pilot left
-        return out
-
-    def _fly_assisted(
-        self: FlightController,
-        mode: FlightMode,
-        sticks: Sticks,
-        nav: NavState,
-        airspeed: float,
-        dt: float,
-        out: ControlOutput,
-    ) -> ControlOutput:
-        assert self.frame is not None
-        pos = self.frame.ne(nav.lat_deg, nav.lon_deg)
-        demand = self.assisted.step(mode, sticks, pos, nav, self.config)
-        self.tecs.gains = self.config.tecs
-        vel = (nav.vn_m_s, nav.ve_m_s)
-        out = self._fly(
-            demand.setpoint, pos, vel, nav, airspeed, dt, out,
-            climb_ff=demand.climb_ff, roll_dem=demand.roll,
-        )  # fmt: skip
-        out.rudder = clamp(out.rudder + sticks.yaw, -1.0, 1.0)
         return out
