@@ -37,6 +37,7 @@ class RecordingVehicle:
     published: list[tuple[int, tuple[float, ...]]] = field(default_factory=list)
     texts: list[str] = field(default_factory=list)
     feeds: list[SampleFeed] = field(default_factory=list)  # one per open_imu
+    prearm: list[str] = field(default_factory=list)  # what prearm_failures reports
 
     def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
         self.published.append((command, tuple(params)))
@@ -50,6 +51,9 @@ class RecordingVehicle:
 
     def param(self, name: str) -> float:
         return self.params[name]
+
+    def prearm_failures(self) -> list[str]:
+        return list(self.prearm)
 
     def open_imu(self) -> SampleFeed:
         self.feeds.append(SampleFeed())

@@ -38,6 +38,16 @@ def test_disarm_in_the_air_needs_the_force_number():
     assert vehicle.texts[-1].startswith("Disarmed in flight (forced)")
 
 
+def test_arming_is_refused_with_one_prearm_text_per_reason_unless_forced():
+    vehicle = RecordingVehicle(prearm=["GPS: no 3D fix", "a", "b", "c"])
+    arming = ArmingCommands(vehicle)
+    refused = arming.arm_disarm(args(m.MAV_CMD_COMPONENT_ARM_DISARM, 1))
+    assert refused.result == m.MAV_RESULT_DENIED and vehicle.published == []
+    assert vehicle.texts == ["PreArm: GPS: no 3D fix", "PreArm: a", "PreArm: b"]
+    forced = arming.arm_disarm(args(m.MAV_CMD_COMPONENT_ARM_DISARM, 1, 21196))
+    assert forced.defer_seq == 1 and vehicle.published == [(CommandId.START, (1.0, 0.0))]
+
+
 def test_a_disarm_on_the_ground_says_nothing_more():
     vehicle = RecordingVehicle()
     vehicle.snapshot.control = ControlStatus(landed=1)
