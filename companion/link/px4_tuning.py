@@ -14,9 +14,12 @@ So, with ``companion.params.alias`` doing the arithmetic both ways:
 - FW_RR_I = RLL_I · FW_R_TC (PX4 integrates the rate error, which in a steady state is the
   attitude error over the time constant), FW_PR_I likewise; FW_RR_IMAX = RLL_IMAX;
 - FW_YR_P = YAW_DAMP (rudder per rad/s of yaw-rate error: the turn-coordinating damper).
-Not declared, because the vehicle's loops have no such term (the page reports them
-missing): FW_RR_D, FW_PR_D, FW_YR_D (rate derivative), FW_RR_FF, FW_PR_FF, FW_YR_FF (rate
-feed-forward), FW_YR_I (yaw integrator), FW_RLL_TO_YAW_FF (aileron-to-rudder mixing).
+The page's other sliders are terms the vehicle's loops do not have: FW_RR_D, FW_PR_D,
+FW_YR_D (rate derivative), FW_RR_FF, FW_PR_FF, FW_YR_FF (rate feed-forward), FW_YR_I (yaw
+integrator), FW_RLL_TO_YAW_FF (aileron-to-rudder mixing). Each is declared as the fact it
+is, fixed at 0: undeclared, QGroundControl would stop the page with its "Parameters are
+missing" dialog; declared, the page opens, reads 0, and a slider moved is refused with a
+status text and snaps back.
 
 The PX4 1.15 names of the guidance and energy controllers a PX4 user tunes by (no page of
 4.4 or 5 reads them) are aliases too, where ``companion.control.laws.tecs`` has the same
@@ -82,4 +85,21 @@ GUIDANCE_ALIASES = (
     _same("FW_T_SPDWEIGHT", "TECS_SPDWEIGHT", "Pitch looks after height (0), both (1), speed "
           "(2)"),
 )  # fmt: skip
-TUNING_ALIASES = (*RATE_ALIASES, *LIMIT_ALIASES, *GUIDANCE_ALIASES)
+
+
+def _no_such_term(name: str, what: str) -> ParamDecl:
+    return ParamDecl(name, 0.0, 0.0, 0.0, doc=f"{what}: the controller has no such term, "
+                     "so it is 0 and cannot be changed")  # fmt: skip
+
+
+ABSENT_TERMS = (
+    _no_such_term("FW_RR_D", "Roll rate derivative gain"),
+    _no_such_term("FW_RR_FF", "Roll rate feed-forward"),
+    _no_such_term("FW_PR_D", "Pitch rate derivative gain"),
+    _no_such_term("FW_PR_FF", "Pitch rate feed-forward"),
+    _no_such_term("FW_YR_D", "Yaw rate derivative gain"),
+    _no_such_term("FW_YR_I", "Yaw rate integrator gain"),
+    _no_such_term("FW_YR_FF", "Yaw rate feed-forward"),
+    _no_such_term("FW_RLL_TO_YAW_FF", "Roll to yaw feed-forward (aileron-rudder mixing)"),
+)
+TUNING_ALIASES = (*RATE_ALIASES, *LIMIT_ALIASES, *GUIDANCE_ALIASES, *ABSENT_TERMS)

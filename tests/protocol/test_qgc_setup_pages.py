@@ -79,9 +79,9 @@ PAGES: dict[str, set[str]] = {
     "Tuning": {"FW_RR_P", "FW_RR_I", "FW_PR_P", "FW_PR_I", "FW_YR_P", "FW_R_TC", "FW_P_TC"},
 }  # fmt: skip
 # What the Tuning page also reads, for terms the vehicle's loops do not have (a rate
-# derivative or feed-forward, a yaw integrator, aileron-to-rudder mixing): not declared,
-# so QGroundControl lists them in its "Parameters are missing" message rather than show a
-# slider that moves nothing.
+# derivative or feed-forward, a yaw integrator, aileron-to-rudder mixing): declared at 0
+# and fixed, so the page opens without QGroundControl's "Parameters are missing" dialog
+# and a slider moved snaps back.
 NO_SUCH_TERM = {
     "FW_RR_D", "FW_RR_FF", "FW_PR_D", "FW_PR_FF", "FW_YR_D", "FW_YR_I", "FW_YR_FF",
     "FW_RLL_TO_YAW_FF",
@@ -165,7 +165,8 @@ def test_every_name_qgroundcontrols_px4_pages_read_is_declared(vehicle_factory, 
     values = read_all(gcs)
     missing = {page: names - values.keys() for page, names in PAGES.items()}
     assert all(not names for names in missing.values()), missing
-    assert not (ABSENT_ON_PURPOSE | NO_SUCH_TERM) & values.keys()
+    assert not ABSENT_ON_PURPOSE & values.keys()
+    assert {name: values.get(name) for name in NO_SUCH_TERM} == dict.fromkeys(NO_SUCH_TERM, 0.0)
     # AirframeComponent::setupComplete: 0 would put every other page behind "Airframe
     # setup must be completed prior to ... setup" (PX4AutoPilotPlugin::prerequisiteSetup).
     assert values["SYS_AUTOSTART"] != 0
@@ -294,6 +295,7 @@ def test_the_safety_page_sets_the_vehicles_own_failsafe_and_return_altitude(
     ("GF_MAX_HOR_DIST", 100.0),  # what the page's "Max Radius" check box writes
     ("RTL_LAND_DELAY", 60.0),  # "Loiter and land after specified time"
     ("COM_LOW_BAT_ACT", 2.0),  # Land mode
+    ("FW_RR_D", 0.003),  # the Tuning page's roll rate D slider: no such term
 ])  # fmt: skip
 def test_what_the_vehicle_cannot_do_gets_the_old_value_back(vehicle_factory, tmp_path, name,
                                                             value):  # fmt: skip
