@@ -14,6 +14,7 @@ from collections.abc import Callable
 from typing import Any
 
 from companion.link.service import Outgoing, Peer
+from companion.params.live import RELOAD_ALL
 from companion.params.store import ParamError, ParamStore
 
 log = logging.getLogger(__name__)
@@ -108,6 +109,18 @@ class ParamsService:
         # for it), then every name that reads the same value (an alias and its owner).
         names = [name, *self.store.linked(name)]
         return [Outgoing(self.value(self.store.index_of(n)), None) for n in names]
+
+    def reset(self) -> list[str]:
+        """Every parameter back to its default (MAV_CMD_PREFLIGHT_STORAGE); the stored ones
+        whose value changed. Their owners read the stored values again; every ground station
+        gets each new value, and its aliases', a few per tick."""
+        changed = sorted(self.store.reset())
+        if not changed:
+            return []
+        self.on_change(RELOAD_ALL, 0.0)
+        names = sorted({n for own in changed for n in (own, *self.store.linked(own))})
+        self._queue.extend((self.store.index_of(name), None) for name in names)
+        return changed
 
     def tick(self, now_s: float) -> list[Outgoing]:
         out = []

@@ -152,6 +152,18 @@ class ParamStore:
         self.write(name, value)
         return self.get(name)
 
+    def reset(self) -> dict[str, float]:
+        """Every parameter back to its declared default, persisted at once; the stored
+        values that changed (an alias follows its owners)."""
+        changed = {
+            name: float(self.decls[name].default)
+            for name, value in self.values.items()
+            if value != self.decls[name].default
+        }
+        self.values.update(changed)
+        self.save()
+        return changed
+
     def linked(self, name: str) -> list[str]:
         """The other names whose value follows ``name``'s: an alias's owners and their
         other aliases, or a parameter's aliases."""

@@ -16,6 +16,7 @@ from companion.link.commands.calibration import CalibrationCommands
 from companion.link.commands.message_requests import MessageRequests
 from companion.link.commands.modes import ModeCommands
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
+from companion.link.commands.storage import StorageCommands
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
 from companion.link.metadata_service import MetadataService
@@ -27,6 +28,7 @@ __all__ = [
     "CalibrationCommands",
     "MessageRequests",
     "ModeCommands",
+    "StorageCommands",
     "VehiclePort",
     "register_commands",
 ]
@@ -50,4 +52,5 @@ def register_commands(
     if params is not None:
         calibration = Calibration(port, params)
         CalibrationCommands(port, calibration).register(service)
+        StorageCommands(port, params, calibration).register(service)
         router.add_service(calibration)

@@ -11,8 +11,7 @@ result follows in "[cal]" status texts, ``companion.link.calibration``), DENIED 
 QGroundControl sends the Sensors page's commands without waiting for the ack and follows
 the texts; its Radio page sends param4 1 when it opens and, when it closes, all zero,
 whose ack must be ACCEPTED (anything else is shown as an error). The Sensors page's
-"Factory reset" is MAV_CMD_PREFLIGHT_STORAGE param1 3 (PARAM_RESET_SENSOR_DEFAULT): the
-IMU's calibration back to its defaults, and "Reset successful" once ACCEPTED.
+"Factory reset" is MAV_CMD_PREFLIGHT_STORAGE (``companion.link.commands.storage``).
 """
 
 from __future__ import annotations
@@ -63,7 +62,6 @@ class CalibrationCommands:
 
     def register(self, service: CommandService) -> None:
         service.register(d.MAV_CMD_PREFLIGHT_CALIBRATION, self.calibrate)
-        service.register(d.MAV_CMD_PREFLIGHT_STORAGE, self.storage)
 
     def _armed(self) -> bool:
         health = self.port.snapshot.health
@@ -110,15 +108,4 @@ class CalibrationCommands:
         if kind == "trims":
             self.port.statustext("Copy trims: not here, the servo trims are the airframe file's")
             return Outcome(d.MAV_RESULT_DENIED)
-        return Outcome(d.MAV_RESULT_ACCEPTED)
-
-    def storage(self, args: CommandArgs) -> Outcome:
-        """PREFLIGHT_STORAGE: the sensor calibration's reset; the parameters are kept as they
-        are set, so nothing else is asked of storage here."""
-        if round(args.params[0]) != d.PARAM_RESET_SENSOR_DEFAULT:
-            return Outcome(d.MAV_RESULT_UNSUPPORTED)
-        if self._armed() or self.calibration.running:
-            self.port.statustext("Sensor calibration reset: disarmed, no calibration running")
-            return Outcome(d.MAV_RESULT_DENIED)
-        self.calibration.reset()
         return Outcome(d.MAV_RESULT_ACCEPTED)

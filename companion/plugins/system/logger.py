@@ -30,6 +30,7 @@ from companion import __version__
 from companion.flight_log import LogDirectory, LogRecorder, ULogWriter, topic_name
 from companion.messages import LogProgress
 from companion.messages.channels import CHANNELS
+from companion.params.live import RELOAD_ALL
 from companion.params.store import ParamStore
 from companion.plugin import Plugin, PluginContext, Ports, Setting
 
@@ -137,6 +138,7 @@ class LoggerPlugin(Plugin):
         super().init(ctx)
         s = ctx.settings
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
+        self.state_dir = state_dir
         self.params = ParamStore(ctx.param_decls, state_dir / "params.json").values
         names = list(dict.fromkeys(s["channels"]))
         self.readers = {name: _reader(ctx, name) for name in names}
@@ -261,12 +263,7 @@ class LoggerPlugin(Plugin):
     def _record(self, name: str, msg: Any) -> None:
         self.last_us[name] = int(msg.t_us)
         if name == "params/changes":
-            value = float(msg.value)
-            key = msg.name.decode(errors="replace")
-            if key in self.params:
-                self.params[key] = value
-                if self.writer is not None:
-                    self.writer.parameter(key, value)
+            self._param_changes(msg)
         if self.writer is None:
             self.recent.append((name, msg))
             return
@@ -276,6 +273,19 @@ class LoggerPlugin(Plugin):
         if name == "vehicle/statustext":
             self.writer.log_string(msg.t_us, msg.severity, msg.text.decode(errors="replace"))
         self.ctx.health.ok()
+
+    def _param_changes(self, msg: Any) -> None:
+        """A ULog parameter change for each value that changed (all after a reset)."""
+        key = msg.name.decode(errors="replace")
+        if key == RELOAD_ALL:
+            stored = ParamStore(self.ctx.param_decls, self.state_dir / "params.json").values
+            changes = {k: v for k, v in stored.items() if self.params.get(k) != v}
+        else:
+            changes = {key: float(msg.value)} if key in self.params else {}
+        for k, value in changes.items():
+            self.params[k] = value
+            if self.writer is not None:
+                self.writer.parameter(k, value)
 
     def _open(self, label: str) -> None:
         self.recorder.open(label, self.ctx.clock.now_us())

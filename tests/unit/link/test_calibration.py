@@ -14,10 +14,12 @@ from companion.link.calibration import WINDOW_S, Calibration
 from companion.link.codec import new_encoder
 from companion.link.command_service import CommandArgs
 from companion.link.commands.calibration import CalibrationCommands, requested
+from companion.link.commands.storage import StorageCommands
 from companion.link.params_service import ParamsService
 from companion.link.service import Peer
 from companion.messages import Imu, SystemHealth
 from companion.params import ParamStore
+from companion.params.live import RELOAD_ALL
 from companion.sensors.imu_calibration import IMU_CAL_PARAMS, ImuCalibration, mounting, rotate
 from tests.support.vehicle_port import RecordingVehicle
 
@@ -45,6 +47,7 @@ class Bench:
         self.params.on_change = lambda name, value: self.changed.append((name, value))
         self.calibration = Calibration(self.vehicle, self.params)
         self.commands = CalibrationCommands(self.vehicle, self.calibration)
+        self.storage = StorageCommands(self.vehicle, self.params, self.calibration)
         self.t_us = 10_000_000
         self.vehicle.snapshot.now_us = self.t_us
         self.vehicle.snapshot.imu = Imu(t_us=self.t_us)
@@ -218,15 +221,34 @@ def test_the_radio_pages_start_is_accepted_and_copy_trims_refused():
     assert bench.command(2) == m.MAV_RESULT_UNSUPPORTED  # param1 2: no calibration
 
 
+def storage(*params: float) -> CommandArgs:
+    full = (*params, *[0.0] * (7 - len(params)))
+    return CommandArgs(m.MAV_CMD_PREFLIGHT_STORAGE, full, 0, GCS)
+
+
 def test_the_sensors_pages_factory_reset_puts_the_calibration_back_to_its_defaults():
     bench = Bench(AHRS_TRIM_X=0.05, INS_GYROFFS_Z=0.01)
-    storage = m.MAV_CMD_PREFLIGHT_STORAGE
-    reset = CommandArgs(storage, (3.0, -1.0, 0, 0, 0, 0, 0), 0, GCS)
-    assert bench.commands.storage(reset).result == m.MAV_RESULT_ACCEPTED
+    assert bench.storage.storage(storage(3, -1)).result == m.MAV_RESULT_ACCEPTED
     out = bench.calibration.tick(0.0)
     assert (bench.store.get("AHRS_TRIM_X"), bench.store.get("INS_GYROFFS_Z")) == (0.0, 0.0)
     assert {o.msg.param_id for o in out} >= {"AHRS_TRIM_X", "INS_GYROFFS_Z"}
-    other = CommandArgs(storage, (2.0, -1.0, 0, 0, 0, 0, 0), 0, GCS)
-    assert bench.commands.storage(other).result == m.MAV_RESULT_UNSUPPORTED
     bench.vehicle.snapshot.health = SystemHealth(flight_running=1)
-    assert bench.commands.storage(reset).result == m.MAV_RESULT_DENIED
+    assert bench.storage.storage(storage(3, -1)).result == m.MAV_RESULT_DENIED
+
+
+def test_reset_all_to_defaults_as_qgroundcontrol_sends_it(tmp_path):
+    bench = Bench(AHRS_TRIM_X=0.05, INS_GYROFFS_Z=0.01)
+    bench.store.path = tmp_path / "params.json"
+    bench.vehicle.snapshot.health = SystemHealth(flight_running=1)
+    assert bench.storage.storage(storage(2, -1)).result == m.MAV_RESULT_DENIED
+    assert bench.store.get("AHRS_TRIM_X") == 0.05  # nothing changed under the flight
+    bench.vehicle.snapshot.health = SystemHealth(flight_running=0)
+    assert bench.storage.storage(storage(2, -1)).result == m.MAV_RESULT_ACCEPTED
+    assert (bench.store.get("AHRS_TRIM_X"), bench.store.get("INS_GYROFFS_Z")) == (0.0, 0.0)
+    assert ParamStore(IMU_CAL_PARAMS, bench.store.path).get("AHRS_TRIM_X") == 0.0  # stored
+    assert bench.changed == [(RELOAD_ALL, 0.0)]  # the owners read the stored values again
+    assert bench.vehicle.texts[-1] == "Parameters reset to defaults: 2 changed"
+    sent = [(o.msg.param_id, o.msg.param_value, o.to) for o in bench.params.tick(0.0)]
+    assert sent == [("AHRS_TRIM_X", 0.0, None), ("INS_GYROFFS_Z", 0.0, None)]  # to every GCS
+    assert bench.storage.storage(storage(1)).result == m.MAV_RESULT_ACCEPTED  # stored as set
+    assert bench.storage.storage(storage(5)).result == m.MAV_RESULT_UNSUPPORTED

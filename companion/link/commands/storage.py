@@ -1,0 +1,59 @@
+"""MAV_CMD_PREFLIGHT_STORAGE: parameters back to their defaults.
+
+param1, as the MAVLink spec numbers it: 0 read and 1 write the stored parameters (accepted
+and nothing to do: every value is stored atomically as it is set), 2 reset every parameter
+to its default (QGroundControl's Parameters page, Tools → "Reset all to firmware's
+defaults", sends it and then reads the whole list again), 3 reset the sensor calibration
+(the Sensors page's "Factory reset": the IMU's offsets and trims, "Reset successful" once
+ACCEPTED), 4 reset everything, which here is 2 (the vehicle keeps no operation counters in
+its parameters). param2, the mission storage, is ignored: missions are stored as they are
+uploaded and cleared with MISSION_CLEAR_ALL. Refused while armed, as the values change
+under the flight plug-ins.
+"""
+
+from __future__ import annotations
+
+from companion.link.calibration import Calibration
+from companion.link.codec import dialect as d
+from companion.link.command_service import CommandArgs, CommandService, Outcome
+from companion.link.commands.port import VehiclePort
+from companion.link.params_service import ParamsService
+
+READ, WRITE = d.PARAM_READ_PERSISTENT, d.PARAM_WRITE_PERSISTENT
+RESET_ALL = (d.PARAM_RESET_FACTORY_DEFAULT, d.PARAM_RESET_ALL_DEFAULT)
+
+
+class StorageCommands:
+    """PREFLIGHT_STORAGE for the parameters and the sensor calibration kept in them."""
+
+    def __init__(self, port: VehiclePort, params: ParamsService, calibration: Calibration) -> None:
+        self.port = port
+        self.params = params
+        self.calibration = calibration
+
+    def register(self, service: CommandService) -> None:
+        service.register(d.MAV_CMD_PREFLIGHT_STORAGE, self.storage)
+
+    def _armed(self) -> bool:
+        health = self.port.snapshot.health
+        return health is not None and bool(health.flight_running)
+
+    def storage(self, args: CommandArgs) -> Outcome:
+        action = round(args.params[0])
+        if action in (READ, WRITE):
+            return Outcome(d.MAV_RESULT_ACCEPTED)
+        if self._armed() or self.calibration.running:
+            self.port.statustext("Parameter reset: disarm first, with no calibration running")
+            return Outcome(d.MAV_RESULT_DENIED)
+        if action == d.PARAM_RESET_SENSOR_DEFAULT:
+            self.calibration.reset()
+            return Outcome(d.MAV_RESULT_ACCEPTED)
+        if action not in RESET_ALL:
+            return Outcome(d.MAV_RESULT_UNSUPPORTED)
+        changed = self.params.reset()
+        later = [n for n in changed if self.params.store.decls[n].reboot_required]
+        after = f", {len(later)} after a reboot" if later else ""
+        self.port.statustext(
+            f"Parameters reset to defaults: {len(changed)} changed{after}", d.MAV_SEVERITY_NOTICE
+        )
+        return Outcome(d.MAV_RESULT_ACCEPTED)
