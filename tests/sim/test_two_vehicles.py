@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import os
-import subprocess
 import sys
 import time
 
@@ -21,7 +20,7 @@ from pymavlink import mavutil
 from companion.control.mission.plan import load_plan
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import free_udp_port
-from tests.sim.sim_run import finish
+from tests.sim.sim_run import SimRun, finish
 from tests.support.vehicle import REPO, companion_env, unique_namespace
 
 PLANS = {
@@ -38,10 +37,7 @@ def _start(tmp_path, name: str, port: int):
         sys.executable, "-m", "companion", "sim", "--speed", "max", "--namespace", namespace,
         "--link", f"udpout://127.0.0.1:{port}", "--duration", "1500",
     ]  # fmt: skip
-    proc = subprocess.Popen(
-        cmd, env=env, cwd=REPO, text=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT
-    )
-    return proc, namespace
+    return SimRun(cmd, tmp_path / f"{name}_output.log", env), namespace
 
 
 def _upload(conn, items) -> None:
