@@ -49,6 +49,9 @@ class ParamsService:
         self.on_change: Callable[[str, float], None] = lambda name, value: None
         self._queue: deque[tuple[int, Peer | None]] = deque()
         self.refused = 0
+        # Names whose write is an action, not a value to keep: the action runs (ParamError
+        # when it cannot now) and the parameter still reads its stored value.
+        self.actions: dict[str, Callable[[float], None]] = {}
         self.rejected_target = 0  # for another component of this system
 
     def _for_us(self, msg: Any) -> bool:
@@ -102,6 +105,11 @@ class ParamsService:
     def write(self, name: str, value: float) -> list[Outgoing]:
         """Set a parameter (from a ground station, or a calibration's result); ParamError
         when refused, nothing changed."""
+        action = self.actions.get(name)
+        if action is not None:
+            self.store.plan(name, value)  # its range and values: ParamError
+            action(value)
+            return [Outgoing(self.value(self.store.index_of(name)), None)]
         changed = self.store.write(name, value)
         for own, new in changed.items():  # an alias's owners follow their own names
             self.on_change(own, new)

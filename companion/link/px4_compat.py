@@ -59,8 +59,13 @@ def _fact(name: str, value: float, doc: str, unit: str = "", values: Any = ()) -
 AIRFRAME_FACTS = (
     _fact("SYS_AUTOSTART", AIRFRAME_STANDARD_PLANE, "PX4 airframe: a standard plane "
           "(ailerons, elevator, rudder, throttle); the config's airframe file says which"),
-    _fact("SYS_AUTOCONFIG", 0.0, "Reset to airframe defaults: not done (no PX4 airframes)",
-          values=((0.0, "Keep parameters"),)),
+    # Written 2 by the Parameters page's "Reset to vehicle's configuration defaults": done
+    # at once (PX4 waits for the next boot), and it reads 0 again. 1 is what the Airframe
+    # page writes with a new airframe, which the config decides here: refused.
+    ParamDecl("SYS_AUTOCONFIG", 0.0, 0.0, 2.0, doc="2: reset every parameter to the "
+              "vehicle's default at once (the Parameters page's 'Reset to vehicle's "
+              "configuration defaults'); reads 0", values=(
+                  (0.0, "Keep parameters"), (2.0, "Reset to the vehicle's defaults"))),
 )  # fmt: skip
 # The Sensors page is set up when CAL_GYRO0_ID, CAL_ACC0_ID and CAL_MAG0_ID are not 0
 # (SensorsComponent.cc): PX4 sets them when it calibrates a sensor. Here they name the

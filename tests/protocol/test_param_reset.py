@@ -62,3 +62,21 @@ def test_reset_all_to_defaults_reaches_the_owners_and_every_ground_station(
     assert heard["RTL_RETURN_ALT"] == 100.0, heard
     follow(owner, {"RTL_ALT_M": defaults["RTL_ALT_M"], "WP_RADIUS": defaults["WP_RADIUS"]})
     assert read_all(gcs) == defaults  # what QGroundControl reads again right after
+
+
+def test_reset_to_the_vehicles_configuration_defaults_through_sys_autoconfig(
+    vehicle_factory, tmp_path
+):
+    """The Parameters page's other item writes PX4's SYS_AUTOCONFIG = 2: the same reset,
+    at once; the Airframe page's 1 (a new airframe) is refused."""
+    state = tmp_path / "state"
+    vehicle, gcs = start(vehicle_factory, state)
+    defaults = read_all(gcs)
+    owner = LiveParams(vehicle.bus, CONTROL_PARAMS, state)
+    param_set(gcs, "WP_RADIUS", 45.0)
+    follow(owner, {"WP_RADIUS": 45.0})
+    assert param_set(gcs, "SYS_AUTOCONFIG", 1.0)["SYS_AUTOCONFIG"] == 0.0  # refused
+    seen = param_set(gcs, "SYS_AUTOCONFIG", 2.0)
+    assert seen["SYS_AUTOCONFIG"] == 0.0 and seen["WP_RADIUS"] == defaults["WP_RADIUS"]
+    follow(owner, {"WP_RADIUS": defaults["WP_RADIUS"]})
+    assert read_all(gcs) == defaults

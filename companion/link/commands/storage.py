@@ -8,7 +8,8 @@ defaults", sends it and then reads the whole list again), 3 reset the sensor cal
 ACCEPTED), 4 reset everything, which here is 2 (the vehicle keeps no operation counters in
 its parameters). param2, the mission storage, is ignored: missions are stored as they are
 uploaded and cleared with MISSION_CLEAR_ALL. Refused while armed, as the values change
-under the flight plug-ins.
+under the flight plug-ins. The Parameters page's other item, "Reset to vehicle's
+configuration defaults", writes PX4's SYS_AUTOCONFIG = 2, which does the same reset.
 """
 
 from __future__ import annotations
@@ -18,9 +19,11 @@ from companion.link.codec import dialect as d
 from companion.link.command_service import CommandArgs, CommandService, Outcome
 from companion.link.commands.port import VehiclePort
 from companion.link.params_service import ParamsService
+from companion.params import ParamError
 
 READ, WRITE = d.PARAM_READ_PERSISTENT, d.PARAM_WRITE_PERSISTENT
 RESET_ALL = (d.PARAM_RESET_FACTORY_DEFAULT, d.PARAM_RESET_ALL_DEFAULT)
+AUTOCONFIG = "SYS_AUTOCONFIG"  # PX4's, written by QGroundControl's other reset
 
 
 class StorageCommands:
@@ -33,6 +36,16 @@ class StorageCommands:
 
     def register(self, service: CommandService) -> None:
         service.register(d.MAV_CMD_PREFLIGHT_STORAGE, self.storage)
+        if AUTOCONFIG in self.params.store.decls:
+            self.params.actions[AUTOCONFIG] = self._autoconfig
+
+    def _autoconfig(self, value: float) -> None:
+        """PX4's SYS_AUTOCONFIG written 2: the same reset, asked through a parameter."""
+        if value == 0.0:
+            return
+        if self._armed() or self.calibration.running:
+            raise ParamError(f"{AUTOCONFIG}: disarm first, with no calibration running")
+        self._reset_all()
 
     def _armed(self) -> bool:
         health = self.port.snapshot.health
@@ -50,10 +63,13 @@ class StorageCommands:
             return Outcome(d.MAV_RESULT_ACCEPTED)
         if action not in RESET_ALL:
             return Outcome(d.MAV_RESULT_UNSUPPORTED)
+        self._reset_all()
+        return Outcome(d.MAV_RESULT_ACCEPTED)
+
+    def _reset_all(self) -> None:
         changed = self.params.reset()
         later = [n for n in changed if self.params.store.decls[n].reboot_required]
         after = f", {len(later)} after a reboot" if later else ""
         self.port.statustext(
             f"Parameters reset to defaults: {len(changed)} changed{after}", d.MAV_SEVERITY_NOTICE
         )
-        return Outcome(d.MAV_RESULT_ACCEPTED)

@@ -12,13 +12,13 @@ from pymavlink.dialects.v20 import common as m
 
 from companion.link.calibration import WINDOW_S, Calibration
 from companion.link.codec import new_encoder
-from companion.link.command_service import CommandArgs
+from companion.link.command_service import CommandArgs, CommandService
 from companion.link.commands.calibration import CalibrationCommands, requested
 from companion.link.commands.storage import StorageCommands
 from companion.link.params_service import ParamsService
 from companion.link.service import Peer
 from companion.messages import Imu, SystemHealth
-from companion.params import ParamStore
+from companion.params import ParamDecl, ParamError, ParamStore
 from companion.params.live import RELOAD_ALL
 from companion.sensors.imu_calibration import IMU_CAL_PARAMS, ImuCalibration, mounting, rotate
 from tests.support.vehicle_port import RecordingVehicle
@@ -252,3 +252,22 @@ def test_reset_all_to_defaults_as_qgroundcontrol_sends_it(tmp_path):
     assert sent == [("AHRS_TRIM_X", 0.0, None), ("INS_GYROFFS_Z", 0.0, None)]  # to every GCS
     assert bench.storage.storage(storage(1)).result == m.MAV_RESULT_ACCEPTED  # stored as set
     assert bench.storage.storage(storage(5)).result == m.MAV_RESULT_UNSUPPORTED
+
+
+def test_sys_autoconfig_2_resets_too_but_not_while_armed():
+    bench = Bench(AHRS_TRIM_X=0.05)
+    autoconfig = ParamDecl("SYS_AUTOCONFIG", 0.0, 0.0, 2.0, values=((0.0, "keep"), (2.0, "reset")))
+    bench.store = ParamStore((*IMU_CAL_PARAMS, autoconfig))
+    bench.store.set("AHRS_TRIM_X", 0.05)
+    bench.params = ParamsService(new_encoder(1, 1), bench.store, 1, 1)
+    StorageCommands(bench.vehicle, bench.params, bench.calibration).register(
+        CommandService(new_encoder(1, 1), 1)
+    )
+    bench.vehicle.snapshot.health = SystemHealth(flight_running=1)
+    with pytest.raises(ParamError, match="disarm first"):
+        bench.params.write("SYS_AUTOCONFIG", 2.0)
+    assert bench.store.get("AHRS_TRIM_X") == 0.05
+    bench.vehicle.snapshot.health = SystemHealth(flight_running=0)
+    out = bench.params.write("SYS_AUTOCONFIG", 2.0)
+    assert [(o.msg.param_id, o.msg.param_value) for o in out] == [("SYS_AUTOCONFIG", 0.0)]
+    assert bench.store.get("AHRS_TRIM_X") == 0.0
