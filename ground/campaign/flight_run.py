@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from companion.bus.namespace import cleanup_namespace
+from companion.bus.namespace import cleanup_namespace, leftover_files
 from companion.control.mission.plan import PlanError, load_plan
 from ground.campaign.scoring import TrackScore, score_track
 from ground.campaign.spec import REPO, Flight
@@ -39,6 +39,7 @@ GCS_SYSID, GCS_COMPID = 255, 190
 TAIL_S = 1.0  # keep flying this long (wall) after completion: the loiter at home is in the truth
 FAILSAFE_PREFIXES = ("Failsafe", "Fence breached")
 DISARM_WAIT_S = 20.0  # wall: a landed vehicle's disarm heard within this after completion
+CLEANUP_S = 10.0  # wall: a killed flight's processes gone and its files removed within
 TIMING_INTERVAL_US = 20_000  # MISSION_CURRENT and ATTITUDE at 50 Hz (wall) to this station
 
 
@@ -172,7 +173,7 @@ def _fly(job: FlightJob, folder: Path, tl: Timeline) -> None:
         finally:
             _end(proc)
             gcs.close()
-            cleanup_namespace(namespace)  # what a killed vehicle may have left in /dev/shm
+            _clean(namespace)
 
 
 def _sim_command(flight: Flight, folder: Path, port: int, namespace: str) -> list[str]:
@@ -329,6 +330,18 @@ def _end(proc: subprocess.Popen) -> None:
             log.warning("flight pid %d did not stop: killing its group", proc.pid)
     _signal_group(proc.pid, signal.SIGKILL)  # the group outlives a clean leader sometimes
     proc.wait()
+
+
+def _clean(namespace: str) -> None:
+    """Remove what a killed vehicle left in /dev/shm. A process of its group still being
+    torn down (it can take seconds on a busy machine) is a living node to iceoryx2, and
+    while one is, nothing is removed: so again, until nothing is left or time is up."""
+    deadline = time.monotonic() + CLEANUP_S
+    while cleanup_namespace(namespace) == 0 and leftover_files(namespace):
+        if time.monotonic() > deadline:
+            log.warning("flight namespace %s: files left in /dev/shm", namespace)
+            return
+        time.sleep(0.1)
 
 
 def _signal_group(pgid: int, sig: int) -> None:
