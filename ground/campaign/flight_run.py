@@ -39,7 +39,7 @@ GCS_SYSID, GCS_COMPID = 255, 190
 TAIL_S = 1.0  # keep flying this long (wall) after completion: the loiter at home is in the truth
 FAILSAFE_PREFIXES = ("Failsafe", "Fence breached")
 DISARM_WAIT_S = 20.0  # wall: a landed vehicle's disarm heard within this after completion
-CLEANUP_S = 10.0  # wall: a killed flight's processes gone and its files removed within
+CLEANUP_S = 30.0  # wall: time for the plug-ins (own sessions, ended by PDEATHSIG) to go
 TIMING_INTERVAL_US = 20_000  # MISSION_CURRENT and ATTITUDE at 50 Hz (wall) to this station
 
 
@@ -333,9 +333,10 @@ def _end(proc: subprocess.Popen) -> None:
 
 
 def _clean(namespace: str) -> None:
-    """Remove what a killed vehicle left in /dev/shm. A process of its group still being
-    torn down (it can take seconds on a busy machine) is a living node to iceoryx2, and
-    while one is, nothing is removed: so again, until nothing is left or time is up."""
+    """Remove what a killed vehicle left in /dev/shm. Its plug-ins run in sessions of their
+    own, out of reach of the group's signals: they end when their parent does, and one
+    still shutting down (seconds, on a busy machine) is a living node to iceoryx2, while
+    which nothing is removed. So again, until nothing is left or the time is up."""
     deadline = time.monotonic() + CLEANUP_S
     while cleanup_namespace(namespace) == 0 and leftover_files(namespace):
         if time.monotonic() > deadline:
