@@ -226,6 +226,8 @@ def sim(
     if count > 1:
         if sysid is not None:
             raise typer.BadParameter("a fleet's vehicles are sysid 1..N; --sysid is for one")
+        if pilot is not None or servo_log is not None:
+            raise typer.BadParameter("--pilot and --servo-log are for one vehicle")
         raise typer.Exit(_run_fleet(FleetRequest(
             count=count, opts=opts, config=config, links=list(link or [GCS_LINK]),
             state_dir=Path(state_dir or vehicle["state_dir"]).expanduser(),

@@ -137,6 +137,10 @@ def shared_args(req: FleetRequest) -> list[str]:
     args += ["--mount", o.mount, "--imu-hz", _number(o.rates.imu_hz)]
     if o.duration_s is not None:
         args += ["--duration", _number(o.duration_s)]
+    if o.exact:
+        args += ["--exact"]
+    if o.start_at_s is not None:  # each vehicle arms and starts its mission then
+        args += ["--start-at", _number(o.start_at_s)]
     for outage in o.outages:
         args += ["--gps-outage", f"{_number(outage.start_s)}:{_number(outage.duration_s)}"]
     if req.plan is not None:

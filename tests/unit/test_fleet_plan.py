@@ -23,7 +23,7 @@ def request(tmp_path: Path, **changes) -> FleetRequest:
     opts = BridgeOptions(
         airframe="J3Cub", speed=None, wind_ned=(5.0, 0.0, 0.0), turbulence="light",
         outages=[Outage(60.0, 30.0)], seed=7, duration_s=120.0, namespace="fl",
-        truth_path=str(tmp_path / "truth.csv"), airborne=True,
+        truth_path=str(tmp_path / "truth.csv"), airborne=True, exact=True, start_at_s=20.0,
     )  # fmt: skip
     req = FleetRequest(
         count=3, opts=opts, config=SIM_TOML, state_dir=tmp_path / "state",
@@ -95,6 +95,13 @@ def test_the_fleet_table_is_checked_and_ignored_by_run(tmp_path):
     config.write_text("[fleet]\ncount = 0\n")
     with pytest.raises(ConfigError, match="below the minimum 1"):
         load_sections(config)
+
+
+def test_a_fleet_refuses_what_is_for_one_vehicle(tmp_path):
+    pilot = tmp_path / "pilot.csv"
+    pilot.write_text("t,roll,pitch,yaw,throttle,switch,signal\n")
+    result = CliRunner().invoke(app, ["sim", "--count", "2", "--pilot", str(pilot)])
+    assert result.exit_code == 2 and "for one vehicle" in result.output
 
 
 def test_sim_refuses_a_misspelt_fleet_key_before_starting_anything(tmp_path):
