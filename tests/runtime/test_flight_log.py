@@ -13,7 +13,7 @@ from pyulog import ULog
 from pyulog.exceptions import ULogException
 
 from companion.messages import CommandId, SimClock, VehicleCommand
-from tests.support.configs import plugin, vehicle_config
+from tests.support.configs import flight_group, plugin, vehicle_config
 from tests.support.vehicle import Vehicle, wait_for
 
 ROWS = 200
@@ -232,3 +232,34 @@ def test_lost_samples_are_counted_once_and_marked_in_the_log(vehicle_factory, tm
     warnings = [m.message for m in ulog.logged_messages if "logger lost" in m.message]
     counted = sum(int(text.split()[2]) for text in warnings)
     assert counted == int(ax[-1] - ax[0] + 1) - len(ax)
+
+
+def test_samples_lost_before_arming_are_marked_in_the_armed_log(vehicle_factory, tmp_path):
+    """The samples kept from before the arming go into the flight's log with their gaps:
+    a loss while disarmed is a dropout and a warning there too, not a silent hole."""
+    state = tmp_path / "state"
+    vehicle = vehicle_factory(
+        vehicle_config(
+            "prearm_lossy",
+            plugin("logger", "system.logger", prearm_samples=20_000, period_s=0.1),
+            plugin("imu", "tests.support.plugins:Burst", size=2000, bursts=2),
+            flight_group(),
+            state_dir=state,
+        )
+    )
+    # Both bursts published and some of them lost by the logger, all before the arming.
+    wait_for(lambda: (r := vehicle.row("imu")) is not None and r.frames_ok >= 2, 30, "two bursts")
+    wait_for(lambda: (r := vehicle.row("logger")) is not None and r.dropped > 0, 30, "a loss")
+    vehicle.bus.writer("link/commands").publish(
+        VehicleCommand(t_us=0, seq=1, command=int(CommandId.START))
+    )
+    logs = state / "logs"
+    wait_for(lambda: imu_ax(read_log(logs)), 30, "the armed log with the samples kept")
+    vehicle.stop()
+    ulog = read_log(logs)
+    ax = imu_ax(ulog)
+    missing = int(ax[-1] - ax[0] + 1) - len(ax)
+    assert missing > 0 and ax[-1] == 4000  # a hole, and the last sample published is there
+    warnings = [m.message for m in ulog.logged_messages if "logger lost" in m.message]
+    assert sum(int(text.split()[2]) for text in warnings) == missing
+    assert ulog.dropouts

@@ -23,6 +23,7 @@ from __future__ import annotations
 import time
 from collections import deque
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -71,6 +72,17 @@ IDLE_PERIOD_S = 0.25
 # The navigator plug-ins whose settings the log keeps.
 NAVIGATORS = ("nav.ins_ekf", "nav.gps_compass")
 _WAKERS = ("system/health", "vehicle/statustext", "link/commands", "params/changes")
+LOSS = ""  # the channel name of a loss held among the samples kept from before arming
+
+
+@dataclass(frozen=True)
+class Loss:
+    """Samples a reader lost, before the first one after the gap."""
+
+    name: str
+    lost: int
+    t_us: int  # of the first sample after the gap
+    gap_us: int
 
 
 def _reader(ctx: PluginContext, name: str) -> Reader[Any]:
@@ -223,14 +235,22 @@ class LoggerPlugin(Plugin):
 
     def _mark_loss(self, name: str, lost: int, msg: Any) -> None:
         """A ULog dropout (Flight Review shows the gap) and a warning, before the first
-        sample after the gap. Not added to ``health.dropped``: the plug-in host already adds
-        every bus reader's losses to the status row."""
-        gap_us = int(msg.t_us) - self.last_us.get(name, int(msg.t_us))
+        sample after the gap; before arming, kept in order among the samples held for the
+        log, so a gap in them is marked too. Not added to ``health.dropped``: the plug-in
+        host already adds every bus reader's losses to the status row."""
+        loss = Loss(
+            name, lost, int(msg.t_us), int(msg.t_us) - self.last_us.get(name, int(msg.t_us))
+        )
         if self.writer is None:
+            self.recent.append((LOSS, loss))
             return
-        self.writer.dropout(gap_us // 1000)
-        text = f"logger lost {lost} samples of {name} (reader fell behind)"
-        self.writer.log_string(int(msg.t_us), 4, text)
+        self._write_loss(loss)
+
+    def _write_loss(self, loss: Loss) -> None:
+        assert self.writer is not None
+        self.writer.dropout(loss.gap_us // 1000)
+        text = f"logger lost {loss.lost} samples of {loss.name} (reader fell behind)"
+        self.writer.log_string(loss.t_us, 4, text)
 
     def _adapt(self, fill: float, count: int) -> None:
         """Read more often while a queue comes back over half full (a lockstep simulation
@@ -291,7 +311,10 @@ class LoggerPlugin(Plugin):
         self.recorder.open(label, self.ctx.clock.now_us())
         self.next_flush = time.monotonic() + self.ctx.settings["flush_s"]
         for name, msg in self.recent:
-            self._record(name, msg)
+            if name == LOSS:
+                self._write_loss(msg)
+            else:
+                self._record(name, msg)
         self.recent.clear()
 
     def _flush(self) -> None:
