@@ -21,7 +21,7 @@ import logging
 import random
 import time
 from collections.abc import Iterator
-from typing import Generic, TypeVar
+from typing import Any, Generic, TypeVar
 
 import iceoryx2 as iox2
 
@@ -82,9 +82,11 @@ class Writer(Generic[M]):
         publisher: iox2.Publisher,
         notifier: iox2.Notifier,
         msg_type: type[Message],
+        service: Any = None,
     ) -> None:
         self.name = name
         self._size = ctypes.sizeof(msg_type)
+        self._service = service
         self._publisher = publisher
         self._notifier = notifier
         self._writer_id = random.getrandbits(63)
@@ -104,6 +106,12 @@ class Writer(Generic[M]):
         _assume_init(sample).send()
         self._notifier.notify()
         self.sent += 1
+
+    def readers(self) -> int:
+        """How many readers the channel has now (0 when unknown)."""
+        if self._service is None:
+            return 0
+        return int(self._service.dynamic_config.number_of_subscribers)
 
     def update_connections(self) -> None:
         """Hand the history (the last sample) to readers that joined since the last send.

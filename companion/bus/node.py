@@ -86,9 +86,10 @@ class BusNode:
     def writer(self, name: str) -> Writer[Any]:
         """A writer for the registered channel ``name`` (Queue or Latest alike)."""
         chan = channel(name)
-        pub = self._pubsub(chan).publisher_builder().create()
+        service = self._pubsub(chan)
+        pub = service.publisher_builder().create()
         notifier = self._event(chan).notifier_builder().create()
-        port: Writer[Any] = Writer(name, pub, notifier, chan.type)
+        port: Writer[Any] = Writer(name, pub, notifier, chan.type, service)
         self._ports.append(port)
         if chan.pattern == "latest":
             self._latest_writers.append(port)

@@ -168,7 +168,9 @@ class Burst(Plugin):
     def step(self) -> None:
         with self.ctx.bus.idle:
             self._pace.wait(0.5)
-        if self.left <= 0:
+        # Not before a reader listens: a reader whose channel was being opened by this
+        # process at the same time can take seconds to join, and would miss every burst.
+        if self.left <= 0 or self.writer.readers() == 0:
             return
         self.left -= 1
         for _ in range(self.ctx.settings["size"]):
