@@ -108,7 +108,8 @@ class CommanderPlugin(Plugin):
             self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
         if (control := self.control.get()) is not None:
             c.land_phase = int(control.land_phase) if control.fresh(now) else 0
-        changed = self._commands() | self._mode_switch(now)
+        acks = self._commands()
+        changed = bool(acks) | self._mode_switch(now)
         if now >= self.next_failsafe_us or now < self.next_failsafe_us - FAILSAFE_PERIOD_US:
             self.next_failsafe_us = now + FAILSAFE_PERIOD_US
             changed |= self._failsafes(now, nav)
@@ -116,6 +117,11 @@ class CommanderPlugin(Plugin):
             self.out.publish(c.status(now))
             self.next_status_us = now + STATUS_PERIOD_US
             self.ctx.health.ok()
+        # After the status: whoever hears an ack finds the status already saying so (a
+        # simulation held for MISSION_START's ack resumed while the controller still read
+        # the old mode, when this process was preempted between the two).
+        for ack in acks:
+            self.acks.publish(ack)
 
     def _nav(self) -> Any:
         """The newest usable navigation solution: one whose position is not a place is
@@ -132,8 +138,9 @@ class CommanderPlugin(Plugin):
             self.ctx.health.refused += 1
         return self.nav_good
 
-    def _commands(self) -> bool:
-        changed = False
+    def _commands(self) -> list[CommandAck]:
+        """The mode commands handled, as their acks (published after the new status)."""
+        acks = []
         for cmd in self.commands.drain():
             if cmd.command not in MODE_COMMANDS:
                 continue  # START, STOP, restarts: the execution control's
@@ -144,11 +151,10 @@ class CommanderPlugin(Plugin):
             ack.result = int(decision.result)
             ack.source = self.ctx.name.encode()[: NAME_LEN - 1]
             ack.reason = decision.reason.encode()[:REASON_LEN]
-            self.acks.publish(ack)
+            acks.append(ack)
             if decision.reason:
                 self.ctx.log.info("refused: %s", decision.reason)
-            changed = True
-        return changed
+        return acks
 
     def _failsafes(self, now: int, nav: Any) -> bool:
         c = self.commander
