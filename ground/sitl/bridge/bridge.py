@@ -131,9 +131,13 @@ class SimBridge:
         self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]), lag)
         nav = self.bus.latest_reader("nav/state")
         self.navigated = FlightSync(period_us, nav, self.bus.waiter([nav]), 0, "t_us", True)
-        if not exact:  # exact lockstep keeps in step with every sample and servo answer
-            nav = self.bus.latest_reader("nav/state")
-            self.nav_sync = FlightSync(period_us, nav, self.bus.waiter([nav]), lag, "t_us", True)
+        # The navigator answers every grid state, armed or not. Exact lockstep waits for
+        # it from its first state on: a navigator left behind before the arming (nothing
+        # else holds the simulation then) lost samples from its queues on a busy machine
+        # and navigated differently from the same run on an idle one.
+        nav = self.bus.latest_reader("nav/state")
+        waiter = self.bus.waiter([nav])
+        self.nav_sync = FlightSync(period_us, nav, waiter, lag, "t_us", True, from_start=exact)
         if exact:
             readers = {
                 device: {c: self._sample_reader(c) for c in channels}
@@ -217,16 +221,19 @@ class SimBridge:
             _, _, name, data = heapq.heappop(self.pending)
             self.ports[name].write(data)
             written.add(name)
+        sampled: set[str] | None = None  # exact: the devices whose samples came this frame
         if self.samples is not None:  # sleeps on the bus: the pty check after is quick
             # A device whose driver stopped reading (or never ran) is not waited for.
             live = {n for n in written if self.lockstep.waiting_for.get(n, True)}
-            self.samples.wait(live - self.failures.garbled(), t_us)
+            sampled = live - self.failures.garbled()
+            self.samples.wait(sampled, t_us)
         if self.pacer is not None:
             self.pacer.wait(s.t_s)
         else:
             self.lockstep.wait()
         self.commands.serve(t_us)
-        if self.nav_sync is not None:
+        # Exact: the navigator answers the grid once an IMU sample at or past its tick came.
+        if self.nav_sync is not None and (sampled is None or "imu" in sampled):
             self.nav_sync.wait(t_us)
         if self.sync is not None:
             self.sync.wait(t_us)

@@ -128,7 +128,8 @@ class FlightSync(_BusWait):
     process still holds the simulation: sim time never runs ahead of what the vehicle has
     consumed (its queues would overflow and it would navigate and fly on a gap).
     ``stamp`` names the answer's time field; ``always`` waits whether or not the flight
-    plug-ins run (for the navigator), from its first answer on.
+    plug-ins run (for the navigator), from its first answer on, or with ``from_start``
+    for that first answer too.
     """
 
     def __init__(
@@ -139,12 +140,14 @@ class FlightSync(_BusWait):
         lag_periods: int = 0,
         stamp: str = "command_t_us",
         always: bool = False,
+        from_start: bool = False,
     ) -> None:
         super().__init__(waiter)
         self.period_us = period_us
         self.answers = answers
         self.lag_us = lag_periods * period_us
         self.stamp, self.always = stamp, always
+        self.from_start = from_start  # ``always``, and its first answer is waited for too
         self.flying = False  # the flight plug-ins were started
         self.synced = False  # they have answered in step since
         self.lagging = False  # they stopped answering: not waited for until they catch up
@@ -159,14 +162,15 @@ class FlightSync(_BusWait):
         """Return once the answer to the newest grid state at or before ``t_us`` is in."""
         if self.always:
             self._answered(0)
-            if self.answered_us < 0:
+            if self.answered_us < 0 and not self.from_start:
                 return  # not started yet: nothing to keep in step with
         elif not self.flying:
             return
         grid = (t_us - self.lag_us) // self.period_us * self.period_us
         if self._answered(grid) or self.lagging:
             return
-        limit = STALL_FLIGHT_S if self.synced or self.always else START_FLIGHT_S
+        started = self.synced or (self.always and self.answered_us >= 0)
+        limit = STALL_FLIGHT_S if started else START_FLIGHT_S
         if not self._until(lambda: self._answered(grid), limit):
             log.warning(
                 "lockstep: no answer to the state at %.2f s for %.0f s (newest"
