@@ -117,7 +117,11 @@ RULES: dict[int, tuple[Param, ...]] = {
         *POINT,
     ),
     d.MAV_CMD_NAV_LOITER_UNLIM: (Param(3, "radius", -1e5, 1e5, optional=True), _yaw(4), *POINT),
-    d.MAV_CMD_DO_SET_HOME: (Param(1, "use current", 0, 1, optional=True, whole=True), *POINT),
+    d.MAV_CMD_DO_SET_HOME: (
+        Param(1, "use current", 0, 1, optional=True, whole=True),
+        _yaw(4),
+        *POINT,
+    ),
     d.MAV_CMD_NAV_TAKEOFF: (Param(1, "pitch", -90, 90, optional=True), _yaw(4), *POINT),
     d.MAV_CMD_DO_ORBIT: (
         Param(1, "radius", -1e4, 1e4, optional=True),
