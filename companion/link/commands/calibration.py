@@ -19,7 +19,7 @@ from __future__ import annotations
 from companion.link.calibration import Calibration
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandArgs, CommandService, Outcome
-from companion.link.commands.port import VehiclePort
+from companion.link.commands.port import VehiclePort, armed
 
 STALE_IMU_US = 1_000_000
 # What cannot be calibrated here, and why: the text after "[cal] calibration failed: ".
@@ -63,10 +63,6 @@ class CalibrationCommands:
     def register(self, service: CommandService) -> None:
         service.register(d.MAV_CMD_PREFLIGHT_CALIBRATION, self.calibrate)
 
-    def _armed(self) -> bool:
-        health = self.port.snapshot.health
-        return health is not None and bool(health.flight_running)
-
     def calibrate(self, args: CommandArgs) -> Outcome:
         kind = requested(args.params)
         if kind is None:
@@ -88,7 +84,7 @@ class CalibrationCommands:
 
     def _refusal(self, kind: str) -> str | None:
         """Why the gyro or level calibration (or another) cannot run now."""
-        if self._armed():
+        if armed(self.port):
             return "disarm first"
         if kind in CANNOT:
             return CANNOT[kind]
@@ -102,7 +98,7 @@ class CalibrationCommands:
     def _radio(self, kind: str) -> Outcome:
         """The Radio page's: its start is taken note of (the pilot's sticks move nothing
         while disarmed), "Copy trims" refused: the servo trims are the airframe file's."""
-        if self._armed():
+        if armed(self.port):
             self.port.statustext("Radio calibration: disarm first")
             return Outcome(d.MAV_RESULT_DENIED)
         if kind == "trims":

@@ -46,3 +46,9 @@ class VehiclePort(Protocol):
     def simulated(self) -> bool:
         """Whether the vehicle runs on the simulator's clock."""
         ...
+
+
+def armed(port: VehiclePort) -> bool:
+    """Whether the flight plug-ins run, as the newest health table says."""
+    health = port.snapshot.health
+    return health is not None and bool(health.flight_running)

@@ -17,7 +17,7 @@ from __future__ import annotations
 from companion.link.calibration import Calibration
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandArgs, CommandService, Outcome
-from companion.link.commands.port import VehiclePort
+from companion.link.commands.port import VehiclePort, armed
 from companion.link.params_service import ParamsService
 from companion.params import ParamError
 
@@ -39,23 +39,23 @@ class StorageCommands:
         if AUTOCONFIG in self.params.store.decls:
             self.params.actions[AUTOCONFIG] = self._autoconfig
 
+    def _busy(self) -> bool:
+        """Armed, or a calibration under way: the values must not change under them."""
+        return armed(self.port) or self.calibration.running
+
     def _autoconfig(self, value: float) -> None:
         """PX4's SYS_AUTOCONFIG written 2: the same reset, asked through a parameter."""
         if value == 0.0:
             return
-        if self._armed() or self.calibration.running:
+        if self._busy():
             raise ParamError(f"{AUTOCONFIG}: disarm first, with no calibration running")
         self._reset_all()
-
-    def _armed(self) -> bool:
-        health = self.port.snapshot.health
-        return health is not None and bool(health.flight_running)
 
     def storage(self, args: CommandArgs) -> Outcome:
         action = round(args.params[0])
         if action in (READ, WRITE):
             return Outcome(d.MAV_RESULT_ACCEPTED)
-        if self._armed() or self.calibration.running:
+        if self._busy():
             self.port.statustext("Parameter reset: disarm first, with no calibration running")
             return Outcome(d.MAV_RESULT_DENIED)
         if action == d.PARAM_RESET_SENSOR_DEFAULT:

@@ -150,8 +150,8 @@ class LoggerPlugin(Plugin):
         super().init(ctx)
         s = ctx.settings
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
-        self.state_dir = state_dir
-        self.params = ParamStore(ctx.param_decls, state_dir / "params.json").values
+        self.params_path = state_dir / "params.json"
+        self.params = self._stored_params()
         names = list(dict.fromkeys(s["channels"]))
         self.readers = {name: _reader(ctx, name) for name in names}
         self.topics = {name: topic_name(name) for name in names}
@@ -294,11 +294,15 @@ class LoggerPlugin(Plugin):
             self.writer.log_string(msg.t_us, msg.severity, msg.text.decode(errors="replace"))
         self.ctx.health.ok()
 
+    def _stored_params(self) -> dict[str, float]:
+        """Every parameter's value as the link stored it (its default when not set)."""
+        return ParamStore(self.ctx.param_decls, self.params_path).values
+
     def _param_changes(self, msg: Any) -> None:
         """A ULog parameter change for each value that changed (all after a reset)."""
         key = msg.name.decode(errors="replace")
         if key == RELOAD_ALL:
-            stored = ParamStore(self.ctx.param_decls, self.state_dir / "params.json").values
+            stored = self._stored_params()
             changes = {k: v for k, v in stored.items() if self.params.get(k) != v}
         else:
             changes = {key: float(msg.value)} if key in self.params else {}
