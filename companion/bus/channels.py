@@ -122,9 +122,10 @@ class Writer(Generic[M]):
         self._publisher.update_connections()
 
     def close(self) -> None:
-        """Release the iceoryx2 ports."""
+        """Release the iceoryx2 ports and the service (which holds the node alive)."""
         self._notifier.delete()
         self._publisher.delete()
+        self._service = None
 
 
 class Reader(Generic[M]):

@@ -168,3 +168,17 @@ def test_first_without_a_writer_is_none(namespace):
         nobody = bus.latest_reader("vehicle/status")
         assert nobody.writers() == 0
         assert nobody.first(30.0) is None
+
+
+def test_a_closed_node_leaves_nothing_though_its_ports_are_still_referenced(namespace):
+    """A test or tool that keeps its readers and writers in variables after closing the
+    node must not keep the node alive: while it is, nothing of the namespace can be
+    removed, and its files outlive the process."""
+    bus = BusNode(namespace, "held")
+    ports = (bus.writer("link/commands"), bus.queue_reader("link/command_acks"))
+    nav = bus.latest_reader("nav/state")
+    assert nav.wait(0.05) is None
+    bus.close()
+    cleanup_namespace(namespace)
+    assert_clean(namespace)
+    assert ports and nav  # still referenced until here
