@@ -125,10 +125,11 @@ class ForkServer:
         read_fd, write_fd = os.pipe()
         request_fd, feed_fd = os.pipe()
         if self.starts == 0 and _threads() == 1:
-            # The supervisor's collector must not walk (and so copy) the pages it now
-            # shares with the fork server and every plug-in.
-            gc.collect()
-            gc.freeze()
+            # The supervisor imports the plug-ins' modules itself (their pre-arm checks,
+            # the simulation's session): imported once here, before the fork, they are one
+            # copy shared with the fork server and every plug-in, not two. The collector
+            # must then not walk (and so copy) the pages now shared.
+            _preload(self.kinds)
             pid = os.fork()
             if pid == 0:
                 os.close(read_fd)
