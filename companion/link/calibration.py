@@ -50,6 +50,7 @@ NO_DATA_S = 3.0  # beyond the window without it filled: the IMU has gone quiet
 MIN_SAMPLES = 20
 GRAVITY = 9.80665
 PREFIX = "[cal] "
+RUN_PERIOD_S = 0.05  # a running calibration takes in its samples this often
 INFO, CRITICAL = d.MAV_SEVERITY_INFO, d.MAV_SEVERITY_CRITICAL
 
 
@@ -109,6 +110,7 @@ class Calibration:
         self.progress = 0
         self._texts: list[tuple[str, int]] = []  # sent at the next tick: after the ack
         self._out: list[Outgoing] = []
+        self._ticked_s = -math.inf
 
     @property
     def running(self) -> bool:
@@ -154,7 +156,14 @@ class Calibration:
     def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
         return []
 
+    def next_due(self) -> float:
+        """While a calibration runs, its samples are taken in and judged this often."""
+        if self._out or self._texts:
+            return 0.0
+        return self._ticked_s + RUN_PERIOD_S if self.kind is not None else math.inf
+
     def tick(self, now_s: float) -> list[Outgoing]:
+        self._ticked_s = now_s
         out, self._out = self._out, []
         out += self._run() if self.kind is not None else []
         for text, severity in self._texts:

@@ -166,6 +166,10 @@ class CommandService:
         self._done[(args.peer.sysid, args.peer.compid, args.command)] = (now_s, result)
         return [self.ack(args, result)]
 
+    def next_due(self) -> float:
+        """When a command forwarded to the vehicle is failed for want of an answer."""
+        return min((p.deadline for p in self.pending.values()), default=math.inf)
+
     def tick(self, now_s: float) -> list[Outgoing]:
         out = []
         for seq, pending in list(self.pending.items()):

@@ -190,8 +190,8 @@ class LinkRouter:
         packer.seq = self.mav.seq
         return msg.pack(packer)
 
-    def next_due(self) -> float:
-        times = [s.next_time() for s in self._streaming()]
+    def next_due(self, nav_known: bool = True) -> float:
+        times = [s.next_time(nav_known) for s in self._streaming()]
         nexts = [getattr(s, "next_due", lambda: float("inf"))() for s in self.services]
         return min([*times, *nexts, float("inf")])
 
@@ -202,11 +202,17 @@ class LinkRouter:
         pairs = zip(self.endpoints, self.schedules, strict=True)
         return [schedule for endpoint, schedule in pairs if endpoint.has_remote()]
 
-    def next_wake(self, now_s: float, max_wait_s: float) -> tuple[float, bool]:
+    def next_wake(
+        self, now_s: float, max_wait_s: float, nav_known: bool = True
+    ) -> tuple[float, bool]:
         """How long the link may sleep (at most ``max_wait_s``), and whether a navigation
         state should end the sleep: only once a stream that carries it is due on an
         endpoint that has someone to send to (the navigator publishes five times as often
-        as ATTITUDE goes out, and a wake-up costs the whole step)."""
+        as ATTITUDE goes out, and a wake-up costs the whole step). Before the first state
+        (``nav_known`` false) the streams that carry one wait for it without a timer, and
+        that first state ends the sleep."""
+        if not nav_known:
+            return max(0.0, min(max_wait_s, self.next_due(False) - now_s)), True
         nav_due = min((s.nav_due() for s in self._streaming()), default=math.inf)
         until = self.next_due() if now_s >= nav_due else min(self.next_due(), nav_due)
         return max(0.0, min(max_wait_s, until - now_s)), now_s >= nav_due

@@ -207,6 +207,10 @@ class MissionService:
     def mission_current(self) -> Any:
         return mission_current_message(self.mav, self.current, len(self.store.items[0]))
 
+    def next_due(self) -> float:
+        """When an upload's item is next asked for again."""
+        return min((u.asked_at + ITEM_TIMEOUT_S for u in self.uploads.values()), default=math.inf)
+
     def tick(self, now_s: float) -> list[Outgoing]:
         out: list[Outgoing] = []
         for mission_type, upload in list(self.uploads.items()):

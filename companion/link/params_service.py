@@ -9,6 +9,7 @@ new values of both are sent, so a ground station's copy of either is never stale
 from __future__ import annotations
 
 import logging
+import math
 from collections import deque
 from collections.abc import Callable
 from typing import Any
@@ -20,6 +21,7 @@ from companion.params.store import ParamError, ParamStore
 log = logging.getLogger(__name__)
 REAL32 = 9
 PER_TICK = 25
+PACE_S = 0.05  # PER_TICK values this often while a list or a change waits to go out
 
 
 def _name(raw: Any) -> str:
@@ -48,6 +50,7 @@ class ParamsService:
         self.on_refusal = on_refusal or (lambda text: None)
         self.on_change: Callable[[str, float], None] = lambda name, value: None
         self._queue: deque[tuple[int, Peer | None]] = deque()
+        self._sent_at_s = -math.inf
         self.refused = 0
         # Names whose write is an action, not a value to keep: the action runs (ParamError
         # when it cannot now) and the parameter still reads its stored value.
@@ -130,8 +133,14 @@ class ParamsService:
         self._queue.extend((self.store.index_of(name), None) for name in names)
         return changed
 
+    def next_due(self) -> float:
+        """When the next values should go out (the link sleeps until then)."""
+        return self._sent_at_s + PACE_S if self._queue else math.inf
+
     def tick(self, now_s: float) -> list[Outgoing]:
         out = []
+        if self._queue:
+            self._sent_at_s = now_s
         for _ in range(min(PER_TICK, len(self._queue))):
             index, peer = self._queue.popleft()
             out.append(Outgoing(self.value(index), peer))

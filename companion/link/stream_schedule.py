@@ -92,11 +92,13 @@ class StreamSchedule:
         times = [self.next_due[m] for m in FOLLOWS_NAV if self.period_s[m] > 0]
         return min(times, default=float("inf"))
 
-    def next_time(self) -> float:
-        """When a stream falls due without a navigation state (the wake-up for timers)."""
+    def next_time(self, nav_known: bool = True) -> float:
+        """When a stream falls due without a navigation state (the wake-up for timers).
+        Before the first state (``nav_known`` false) the streams that carry one have
+        nothing to send: they wake nobody."""
         times = [
             self.next_due[m] + (_hold(p) if m in FOLLOWS_NAV else 0.0)
             for m, p in self.period_s.items()
-            if p > 0
+            if p > 0 and (nav_known or m not in FOLLOWS_NAV)
         ]
         return min(times) if times else float("inf")

@@ -43,9 +43,12 @@ from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChang
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 
-MAX_WAIT_S = 0.05  # the newest health, status and sensor values are looked at this often
+# Longest sleep: a stream, a service timer or link/status falling due end it sooner, and a
+# command ack, a text, a new mode or armed state (vehicle/status, system/health) at once.
+MAX_WAIT_S = 1.0
 PREARM_PERIOD_S = 1.0  # SYS_STATUS's ready-to-arm bit is judged once a second
 LINK_STATUS_PERIOD_S = 0.2  # link/status (ground-station silence) five times a second
+UNHEARD_STATUS_PERIOD_S = 1.0  # ... and once a second while no ground station was ever heard
 COMMANDER = "vehicle.commander"
 STREAM_PARAMS = {
     "SR_ATTITUDE": (d.MAVLINK_MSG_ID_ATTITUDE,),
@@ -160,8 +163,10 @@ class MavlinkLink(Plugin):
             self.commands, self, self.identity, self.router, self.metadata, self._params_service
         )
         self.commands.on_refusal = self.refusal_text
-        # Woken by an ack, a text, a navigation state when a stream carrying it is due.
-        self.waker = bus.gated_waiter(self.readers["nav"], (self.acks, self.texts))
+        # Woken by an ack, a text, a change of mode or arming (announced at once), and a
+        # navigation state when a stream carrying it is due.
+        r = self.readers
+        self.waker = bus.gated_waiter(r["nav"], (self.acks, self.texts, r["status"], r["health"]))
         self.nav_at_s = float("-inf")
         self._seq = 0
 
@@ -299,7 +304,9 @@ class MavlinkLink(Plugin):
         state.custom_mode, state.mode_flags = custom, flags
 
     def _wait_input(self, now_s: float) -> None:
-        timeout, nav_wanted = self.router.next_wake(now_s, MAX_WAIT_S)
+        nav_known = self.snapshot.nav is not None
+        timeout, nav_wanted = self.router.next_wake(now_s, MAX_WAIT_S, nav_known)
+        timeout = min(timeout, max(0.0, self.next_link_status_s - now_s))
         fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         woken, ready = self.waker.wait_with_fds(timeout, list(fd_owner), nav_wanted)
         if self.readers["nav"] in woken:
@@ -324,7 +331,10 @@ class MavlinkLink(Plugin):
         for text in self.texts.drain():  # failsafes and other plug-ins' announcements
             self.statustext(text.text.decode(errors="replace"), text.severity)
         if now_s >= self.next_link_status_s:
-            self.next_link_status_s = now_s + LINK_STATUS_PERIOD_S
+            heard = self.gcs.last_heard_s is not None
+            self.next_link_status_s = now_s + (
+                LINK_STATUS_PERIOD_S if heard else UNHEARD_STATUS_PERIOD_S
+            )
             status = LinkStatus(t_us=self.ctx.clock.now_us())
             status.gcs_silence_s = self.gcs.silence_s(now_s)
             self.link_status.publish(status)

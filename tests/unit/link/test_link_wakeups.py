@@ -67,3 +67,20 @@ def test_an_endpoint_nobody_has_spoken_to_neither_spins_the_link_nor_wakes_it_on
         assert router.next_wake(5.0, MAX_WAIT_S) == (MAX_WAIT_S, False)
     finally:
         waiting.close()
+
+
+def test_before_the_first_state_the_streams_that_carry_one_wake_nobody(endpoint):
+    """A vehicle on the bench with its sensors silent: ATTITUDE and the other streams of
+    the navigation state have nothing to send, so only the other streams' timers (2 Hz
+    at most) wake the link, and the first state ends any sleep."""
+    counts = {}
+    for nav_known in (True, False):
+        router = LinkRouter(new_encoder(1, 1), [endpoint], [], None)
+        now, wakes = 0.0, 0
+        while now < 10.0:
+            router.schedules[0].due(now)
+            timeout, nav_wanted = router.next_wake(now, 1.0, nav_known)
+            assert nav_wanted or nav_known
+            now, wakes = now + max(timeout, 1e-3), wakes + 1
+        counts[nav_known] = wakes / 10.0
+    assert counts[False] <= 3.0 < 10.0 <= counts[True]
