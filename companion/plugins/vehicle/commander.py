@@ -34,7 +34,9 @@ from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
 from mavlink_dialect import companion as d
 
-WAIT_S = 0.05
+WAIT_S = 0.05  # armed: navigation, sticks and failsafes looked at 20 times a wall second
+# Disarmed no failsafe acts: waking as often as the status goes out is enough on the bench.
+DISARMED_WAIT_S = 0.25
 STATUS_PERIOD_US = 250_000  # 4 Hz: the link and the controller follow it
 FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) second
 
@@ -84,9 +86,8 @@ class CommanderPlugin(Plugin):
         self.rc_switch = bus.queue_reader("sensors/rc_switch")
         self.joystick = bus.latest_reader("link/manual_control")
         # Commands and the mode switch wake it at once; the rest (navigation at 100 Hz and
-        # more, the sticks at 50 Hz) is read when it wakes on its own, 20 times a wall
-        # second: waking for every navigation sample cost a lockstep simulation a tenth of
-        # its speed.
+        # more, the sticks at 50 Hz) is read when it wakes on its own (``WAIT_S``): waking
+        # for every navigation sample cost a lockstep simulation a tenth of its speed.
         self.waiter = bus.waiter([self.commands, self.rc_switch])
         self.acks = bus.writer("link/command_acks")
         self.out = bus.writer("vehicle/status")
@@ -97,8 +98,8 @@ class CommanderPlugin(Plugin):
         self.nav_good: Any = None  # the last usable one
 
     def step(self) -> None:
-        self.waiter.wait(WAIT_S)
         c = self.commander
+        self.waiter.wait(WAIT_S if c.armed else DISARMED_WAIT_S)
         now = self.ctx.clock.now_us()
         nav = self._nav()
         if (health := self.health.get()) is not None:
