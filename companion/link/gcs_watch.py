@@ -13,6 +13,9 @@ from typing import Any
 from companion.link.codec import dialect as d
 from companion.link.service import Outgoing, Peer
 
+STATUS_PERIOD_S = 0.2  # link/status (the silence) five times a second once one was heard
+UNHEARD_STATUS_PERIOD_S = 1.0  # before: the silence is "never heard", which changes nothing
+
 
 class GcsWatch:
     """A service that only listens."""
@@ -29,6 +32,10 @@ class GcsWatch:
 
     def tick(self, now_s: float) -> list[Outgoing]:
         return []
+
+    def status_period_s(self) -> float:
+        """How often link/status is worth publishing."""
+        return UNHEARD_STATUS_PERIOD_S if self.last_heard_s is None else STATUS_PERIOD_S
 
     def silence_s(self, now_s: float) -> float:
         """Seconds since the last ground-station heartbeat; NaN before the first."""

@@ -43,12 +43,8 @@ from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChang
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import Plugin, PluginContext, Setting
 
-# Longest sleep: a stream, a service timer or link/status falling due end it sooner, and a
-# command ack, a text, a new mode or armed state (vehicle/status, system/health) at once.
-MAX_WAIT_S = 1.0
+MAX_WAIT_S = 1.0  # longest sleep: a stream or a timer falling due, or a trigger, ends it
 PREARM_PERIOD_S = 1.0  # SYS_STATUS's ready-to-arm bit is judged once a second
-LINK_STATUS_PERIOD_S = 0.2  # link/status (ground-station silence) five times a second
-UNHEARD_STATUS_PERIOD_S = 1.0  # ... and once a second while no ground station was ever heard
 COMMANDER = "vehicle.commander"
 STREAM_PARAMS = {
     "SR_ATTITUDE": (d.MAVLINK_MSG_ID_ATTITUDE,),
@@ -331,10 +327,7 @@ class MavlinkLink(Plugin):
         for text in self.texts.drain():  # failsafes and other plug-ins' announcements
             self.statustext(text.text.decode(errors="replace"), text.severity)
         if now_s >= self.next_link_status_s:
-            heard = self.gcs.last_heard_s is not None
-            self.next_link_status_s = now_s + (
-                LINK_STATUS_PERIOD_S if heard else UNHEARD_STATUS_PERIOD_S
-            )
+            self.next_link_status_s = now_s + self.gcs.status_period_s()
             status = LinkStatus(t_us=self.ctx.clock.now_us())
             status.gcs_silence_s = self.gcs.silence_s(now_s)
             self.link_status.publish(status)
