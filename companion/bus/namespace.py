@@ -22,6 +22,11 @@ DEFAULT_NAMESPACE = "companion"
 _VALID = re.compile(r"^[A-Za-z0-9_.-]{1,40}$")
 SHM_DIR = Path("/dev/shm")
 IOX_DIR = Path("/tmp/iceoryx2")
+# Per reader, room for publishers gone (a plug-in restarted) while their samples were still
+# unread. iceoryx2's default of 128 costs every reader ~0.5 MB of its process's own memory,
+# a quarter of the vehicle's; a reader reads at least once a second, and 16 restarts
+# between two of its reads would be a crash loop the supervisor's back-off rules out.
+EXPIRED_CONNECTIONS = 16
 
 _log_level_set = False
 
@@ -58,6 +63,7 @@ def make_config(namespace: str) -> iox2.config.Config:
     quiet_iceoryx()
     cfg = iox2.config.global_config()
     cfg.global_cfg.prefix = iox2.FileName.new(prefix_of(namespace))
+    cfg.defaults.publish_subscribe.subscriber_expired_connection_buffer = EXPIRED_CONNECTIONS
     return cfg
 
 
