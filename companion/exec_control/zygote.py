@@ -290,9 +290,13 @@ def _fork_plugin(spec_json: str, supervisor: int, fds: tuple[int, int]) -> int:
     middle = os.fork()
     if middle == 0:
         try:
+            # The middle's pid is taken before the fork: asked in the child, getppid() is
+            # already the supervisor's when the middle has exited first, and the child
+            # then waited its whole REPARENT_TIMEOUT_S (2 s) for an adoption long done.
+            middle_pid = os.getpid()
             pid = os.fork()
             if pid == 0:
-                _run_child(spec_json, os.getppid(), supervisor, (read_fd, write_fd, *fds))
+                _run_child(spec_json, middle_pid, supervisor, (read_fd, write_fd, *fds))
             os.write(write_fd, f"{pid}\n".encode())
         finally:
             os._exit(0)
