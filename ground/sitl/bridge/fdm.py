@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import jsbsim
 
@@ -22,6 +22,11 @@ IDLE_THROTTLE = 0.05
 TURBULENCE_MIN_AGL_M = 5.0
 DROP_HEIGHT_FT = 4.0  # above the resting height of the shipped airframes' gear
 SETTLE_S = 3.0
+# Faster than any airframe here can fly, or below the ground it hit: JSBSim's ground
+# reactions blow up at a crash (a 50 m/s dive gave 6,000 m/s the next frame, then 10^16).
+DIVERGED_SPEED_M_S = 1000.0
+DIVERGED_BELOW_GROUND_M = 50.0
+STANDARD_GRAVITY = 9.80665
 
 
 @dataclass(frozen=True)
@@ -51,6 +56,9 @@ class Flight:
         if not self.fdm.load_model(model):
             raise ValueError(f"JSBSim has no aircraft {model!r}")
         self.fdm.set_dt(1.0 / rate_hz)
+        self.dt_s = 1.0 / rate_hz
+        self.wreck: TrueState | None = None  # after a crash the model diverged at
+        self._sane: TrueState | None = None  # the last state that was physical
         self.home = home
         self.turbulence = False
         self.brake_channel = False  # until a brakes servo is heard, idle means brakes
@@ -169,20 +177,37 @@ class Flight:
         return float(self.fdm["position/h-agl-ft"]) * FT > TURBULENCE_MIN_AGL_M
 
     def step(self) -> None:
-        """Advance one frame."""
+        """Advance one frame; past a crash the flight model diverged at, the wreck lies
+        still where the aircraft came down (the vehicle on it keeps running)."""
+        if self.wreck is not None:
+            self.wreck = replace(self.wreck, t_s=self.wreck.t_s + self.dt_s)
+            return
         if self.turbulence:
             # JSBSim's MIL-F-8785C scale lengths shrink with height; on the runway they
             # give gusts that throw a parked Cub into the air and the model into NaNs.
             self.fdm["atmosphere/turb-type"] = MILSPEC if self._above_ground() else 0
         self.fdm.run()
+        s = self._model_state()
+        if _physical(s):
+            self._sane = s
+            return
+        last = self._sane or s
+        log.error("the aircraft crashed at %.2f s and JSBSim's model diverged: the wreck lies "
+                  "still where it came down", s.t_s)  # fmt: skip
+        self.wreck = _at_rest(last, s.t_s)
 
     @property
     def t_s(self) -> float:
         """Simulation time, seconds."""
+        if self.wreck is not None:
+            return self.wreck.t_s
         return float(self.fdm["simulation/sim-time-sec"])
 
     def state(self) -> TrueState:
         """The true state now."""
+        return self.wreck if self.wreck is not None else self._model_state()
+
+    def _model_state(self) -> TrueState:
         f = self.fdm
         mass = f["inertia/mass-slugs"]
         yaw = math.remainder(f["attitude/psi-rad"], math.tau)
@@ -204,3 +229,20 @@ class Flight:
             f_body=tuple(f[f"forces/fb{a}-total-lbs"] / mass * FT for a in "xyz"),
             airspeed_m_s=f["velocities/vtrue-fps"] * FT,
         )
+
+
+def _physical(s: TrueState) -> bool:
+    values = (s.lat_deg, s.lon_deg, s.alt_msl_m, s.alt_agl_m, s.vn, s.ve, s.vd, s.roll, s.pitch)
+    if not all(math.isfinite(v) for v in values):
+        return False
+    speed = math.sqrt(s.vn * s.vn + s.ve * s.ve + s.vd * s.vd)
+    return speed < DIVERGED_SPEED_M_S and s.alt_agl_m > -DIVERGED_BELOW_GROUND_M
+
+
+def _at_rest(s: TrueState, t_s: float) -> TrueState:
+    """The aircraft of state ``s`` lying level and still on the ground below it."""
+    ground = s.alt_msl_m - max(s.alt_agl_m, 0.0)
+    return replace(
+        s, t_s=t_s, alt_msl_m=ground, alt_agl_m=0.0, roll=0.0, pitch=0.0, vn=0.0, ve=0.0,
+        vd=0.0, p=0.0, q=0.0, r=0.0, f_body=(0.0, 0.0, -STANDARD_GRAVITY), airspeed_m_s=0.0,
+    )  # fmt: skip
