@@ -25,6 +25,10 @@ class BaroDatum:
         """The barometer has spoken recently enough to be the height source."""
         return self.last_us is not None and (now_us - self.last_us) / 1e6 < self.timeout_s
 
+    def due(self, t_us: int) -> bool:
+        """Whether a reading at this time would be used (the rate limit)."""
+        return t_us >= self.next_us
+
     def height(self, baro_m: float, t_us: int, ins_down: float) -> float | None:
         """The height measurement (metres up in the frame) for this reading, or None when
         it is not used (rate-limited or not a number)."""

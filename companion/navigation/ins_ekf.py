@@ -198,12 +198,17 @@ class InsEkf(InsCore):
 
     def on_baro(self, reading: Baro) -> None:
         """Barometric height: the vertical channel follows it; GPS only moves its datum."""
-        if not self.aligned:
+        if not self.aligned or not self.baro.due(reading.t_us):
             return
-        up = self.baro.height(reading.alt_rel_m, reading.t_us, self.p[2])
+        # Barometric heights are over the curved Earth, the frame is a plane: 6 km out, a
+        # height held by the barometer sat 2.8 m above where GPS put it in the frame, and
+        # the navigator's height ended 1.9 m above the truth.
+        assert self.frame is not None
+        drop = self.frame.drop(float(self.p[0]), float(self.p[1]))
+        up = self.baro.height(reading.alt_rel_m, reading.t_us, self.p[2] - drop)
         if up is None:
             return
-        y = np.array([-up - self.p[2]])
+        y = np.array([drop - up - self.p[2]])
         if self._update(y, _I15[[2]], np.array([[self.cfg.baro_std**2]])):
             self.baro_reject_run = 0
             return
@@ -211,7 +216,7 @@ class InsEkf(InsCore):
         if self.baro_reject_run >= self.cfg.reset_after:
             # The vertical channel ran away (a wild start, a long wrong tilt): rejoin the
             # barometer and let the vertical speed be learnt again.
-            self.p[2] = -up
+            self.p[2] = drop - up
             self.v[2] = 0.0
             self._reset_block([2, 5], [self.cfg.baro_std, 2.0])
             self.baro_reject_run = 0

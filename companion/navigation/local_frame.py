@@ -40,6 +40,13 @@ class LocalFrame:
         ecef = np.array(_TO_ECEF.transform(lat_deg, lon_deg, alt_m))
         return self.ecef_to_ned @ (ecef - self.origin)
 
+    def drop(self, north: float, east: float) -> float:
+        """How far the reference height lies below the frame's plane at this horizontal
+        position, m (down): the Earth curving away, 0 at the origin, 2.8 m 6 km out. A
+        height measured from the ground (a barometer) is in the frame ``-(h - ref) + drop``."""
+        lat, lon, _ = self.geodetic(np.array((north, east, 0.0)))
+        return float(self.ned(lat, lon, self.ref[2])[2])
+
     def geodetic(self, ned: np.ndarray) -> tuple[float, float, float]:
         """A point of this frame as (latitude, longitude, height)."""
         x, y, z = self.origin + self.ecef_to_ned.T @ ned
