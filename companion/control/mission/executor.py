@@ -201,7 +201,12 @@ class MissionExecutor:
     def _takeoff(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
         target = self.alt_of(item)
         if alt >= target - TAKEOFF_MARGIN_M:
-            self._advance(True, pos, target)
+            # The next leg starts where the take-off did (PX4: at the take-off item), not
+            # where the climb ended: a climb that ended beside or past the first waypoint
+            # made a leg of a few metres pointing back, and the c172p turned round for it
+            # (270 m off the zigzag's next leg). From the launch, the waypoint is reached by
+            # its radius, its turn lead or the square line, as any other.
+            self._advance(True, self._prev, target)
             return None
         return Setpoint(Kind.TAKEOFF, pos, pos, target, speed=self.speed)
 

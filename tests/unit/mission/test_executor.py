@@ -41,9 +41,32 @@ def test_takeoff_climbs_until_within_5_m_then_flies_on():
     sp = ex.step(pos, 125.1, 5.0)
     assert ex.drain_reached() == [0]
     assert sp.kind == Kind.LINE
-    assert sp.a == pos  # the leg starts where the climb ended
+    assert sp.a == (0.0, 0.0)  # the leg starts where the take-off did
     assert sp.b == pytest.approx((1_000.0, 0.0), abs=0.05)
     assert sp.alt_msl == pytest.approx(HOME_ALT + 100.0)
+
+
+def test_a_waypoint_the_climb_flew_past_is_reached_not_turned_back_for():
+    # Climbing east along the runway, the take-off ends 500 m beyond the first waypoint:
+    # that one counts as reached and the next leg (north-east from it) is flown at once.
+    items = [
+        item(0, d.MAV_CMD_NAV_TAKEOFF, None, z=100.0),
+        wp(1, (0.0, 900.0)),
+        wp(2, (1_500.0, 2_400.0)),
+    ]
+    ex = executor(items, alt=HOME_ALT)
+    ex.step((0.0, 0.0), HOME_ALT, 0.0)
+    sp = ex.step((0.0, 1_400.0), HOME_ALT + 99.0, 40.0)
+    assert ex.drain_reached() == [0, 1]
+    assert sp.kind == Kind.LINE
+    assert sp.a == pytest.approx((0.0, 900.0), abs=0.05)
+    assert sp.b == pytest.approx((1_500.0, 2_400.0), abs=0.05)
+    # Not yet at the waypoint when the climb ends: it is flown to, as before.
+    ex = executor(items, alt=HOME_ALT)
+    ex.step((0.0, 0.0), HOME_ALT, 0.0)
+    sp = ex.step((0.0, 600.0), HOME_ALT + 99.0, 30.0)
+    assert ex.drain_reached() == [0]
+    assert sp.b == pytest.approx((0.0, 900.0), abs=0.05)
 
 
 # --- waypoints -----------------------------------------------------------------------------
