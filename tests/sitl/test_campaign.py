@@ -13,7 +13,6 @@ import math
 import re
 import subprocess
 import sys
-from collections.abc import Collection
 from pathlib import Path
 
 import psutil
@@ -25,6 +24,7 @@ from ground.campaign.spec import Flight
 from tests.support.configs import vehicle_config
 from tests.support.vehicle import REPO, companion_env
 
+CAMPAIGN_FILE = re.compile(r"cmp_(camp\d+)p")  # a flight namespace's files, by campaign
 SPEC = """
 [campaign]
 name = "small"
@@ -65,19 +65,20 @@ def rows(out: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(f))
 
 
-@pytest.mark.timeout(900)  # five lockstep flights on two cores: minutes on a busy machine
-def campaign_files(others: Collection[str] = ()) -> list[Path]:
-    """Flight namespaces' files in /dev/shm (``camp<worker pid>p<port>``), but those of
-    ``others``: campaigns already running on the machine before this one (a benchmark)."""
-    found = []
+def campaign_files() -> dict[Path, str]:
+    """Flight namespaces' files in /dev/shm, each with its campaign (``camp<worker pid>``,
+    from the namespace ``camp<worker pid>p<port>``)."""
+    found = {}
     for path in Path("/dev/shm").iterdir():
-        if (m := re.match(r"cmp_(camp\d+)p", path.name)) and m.group(1) not in others:
-            found.append(path)
+        if m := CAMPAIGN_FILE.match(path.name):
+            found[path] = m.group(1)
     return found
 
 
+@pytest.mark.timeout(900)  # five lockstep flights on two cores: minutes on a busy machine
 def test_a_small_campaign_scores_each_flight_and_survives_hung_ones(tmp_path):
-    others = {re.match(r"cmp_(camp\d+)p", p.name).group(1) for p in campaign_files()}
+    # Campaigns already running on the machine (a benchmark) are not this one's to judge.
+    others = set(campaign_files().values())
     spec = tmp_path / "small.toml"
     spec.write_text(SPEC)
     silent_config(tmp_path / "silent.toml")
@@ -113,7 +114,7 @@ def test_a_small_campaign_scores_each_flight_and_survives_hung_ones(tmp_path):
     procs = psutil.process_iter(["cmdline"])
     left = [p for p in procs if str(out) in " ".join(p.info["cmdline"] or [])]
     assert not left, "a flight's processes outlived the campaign"
-    assert not campaign_files(others)
+    assert not [p for p, owner in campaign_files().items() if owner not in others]
 
     # The same flight flown again outside Ray scores exactly the same (exact lockstep).
     calm = next(r for r in flown if r["condition"] == "calm none")
