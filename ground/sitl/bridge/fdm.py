@@ -58,7 +58,7 @@ class Flight:
         self.fdm.set_dt(1.0 / rate_hz)
         self.dt_s = 1.0 / rate_hz
         self.wreck: TrueState | None = None  # after a crash the model diverged at
-        self._sane: TrueState | None = None  # the last state that was physical
+        self._sane: TrueState | None = None  # the last state stepped to, found physical
         self.home = home
         self.turbulence = False
         self.brake_channel = False  # until a brakes servo is heard, idle means brakes
@@ -204,8 +204,10 @@ class Flight:
         return float(self.fdm["simulation/sim-time-sec"])
 
     def state(self) -> TrueState:
-        """The true state now."""
-        return self.wreck if self.wreck is not None else self._model_state()
+        """The true state now (the one ``step`` read and judged, not read again)."""
+        if self.wreck is not None:
+            return self.wreck
+        return self._sane if self._sane is not None else self._model_state()
 
     def _model_state(self) -> TrueState:
         f = self.fdm
