@@ -35,9 +35,13 @@ from companion.plugin import Plugin, PluginContext
 from mavlink_dialect import companion as d
 
 WAIT_S = 0.05  # armed: navigation, sticks and failsafes looked at 20 times a wall second
-# Disarmed no failsafe acts: waking as often as the status goes out is enough on the bench.
-DISARMED_WAIT_S = 0.25
+# Disarmed no failsafe acts: waking as often as the status goes out is enough on the bench
+# (an arming wakes it at once: the supervisor's health table says so as it arms).
+DISARMED_WAIT_S = 1.0
 STATUS_PERIOD_US = 250_000  # 4 Hz: the link and the controller follow it
+# Disarmed, a status that has not changed goes out once a second: each one wakes the link
+# and the logger, and a change (an ack, the mode switch, a failsafe) is sent at once anyway.
+DISARMED_STATUS_PERIOD_US = 1_000_000
 FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) second
 
 
@@ -88,7 +92,9 @@ class CommanderPlugin(Plugin):
         # Commands and the mode switch wake it at once; the rest (navigation at 100 Hz and
         # more, the sticks at 50 Hz) is read when it wakes on its own (``WAIT_S``): waking
         # for every navigation sample cost a lockstep simulation a tenth of its speed.
-        self.waiter = bus.waiter([self.commands, self.rc_switch])
+        # The health table too: the supervisor publishes it as it arms or disarms, and a
+        # disarmed commander otherwise sleeps a whole second.
+        self.waiter = bus.waiter([self.commands, self.rc_switch, self.health])
         self.acks = bus.writer("link/command_acks")
         self.out = bus.writer("vehicle/status")
         self.texts = bus.writer("vehicle/statustext")
@@ -116,7 +122,7 @@ class CommanderPlugin(Plugin):
             changed |= self._failsafes(now, nav)
         if changed or now >= self.next_status_us:
             self.out.publish(c.status(now))
-            self.next_status_us = now + STATUS_PERIOD_US
+            self.next_status_us = now + (STATUS_PERIOD_US if c.armed else DISARMED_STATUS_PERIOD_US)
             self.ctx.health.ok()
         # After the status: whoever hears an ack finds the status already saying so (a
         # simulation held for MISSION_START's ack resumed while the controller still read
