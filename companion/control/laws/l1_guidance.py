@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from companion.control.laws.fillet import Fillet, arc_phase, fillet
+from companion.control.laws.fillet import Fillet, Loop, arc_phase, fillet, loop_phase
 from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import wrap_pi
 
@@ -61,8 +61,8 @@ class L1Guidance:
         self.xtrack_i = xtrack_i
         self.integ = 0.0
         self._line: tuple[tuple[float, float], tuple[float, float]] | None = None
-        self._fillet: Fillet | None = None
-        self._arc_state = 0  # 0 before the arc, 1 on it, 2 past it
+        self._fillet: Fillet | Loop | None = None
+        self._arc_state = 0  # 0 before the turn, 1 (and 2 for a loop) on its arcs, then past
 
     def l1_distance(self, speed: float) -> float:
         """How far ahead the reference point is, m."""
@@ -81,23 +81,30 @@ class L1Guidance:
         """Follow the line from ``a`` through ``b`` (north/east metres).
 
         With ``prev``, the start of the leg that ended at ``a``, the corner at ``a`` is
-        flown as an arc of ``turn_radius`` tangent to both legs (see ``fillet``).
+        flown as an arc of ``turn_radius`` tangent to both legs, or as a loop when sharper
+        than 120° (see ``fillet``).
         """
         if self._line != (a, b):
             self._line, self.integ = (a, b), 0.0
             self._fillet = fillet(prev, a, b, turn_radius) if prev is not None else None
             self._arc_state = 0
         f = self._fillet
-        if f is not None and self._arc_state < 2:
+        arcs = 1 if isinstance(f, Fillet) else 2
+        if f is not None and self._arc_state <= arcs:
             speed = max(math.hypot(*vel), MIN_SPEED)
+            early = speed * ROLL_OUT_S
             # Phases only move on: a gust never puts the aircraft back on an arc it left.
-            self._arc_state = max(self._arc_state, arc_phase(f, pos, speed * ROLL_OUT_S))
-            if self._arc_state == 1:
-                arc = self.circle(pos, vel, f.centre, f.radius, f.clockwise)
+            if isinstance(f, Fillet):
+                self._arc_state = max(self._arc_state, arc_phase(f, pos, early))
+            else:
+                self._arc_state = loop_phase(f, pos, self._arc_state, early)
+            if 1 <= self._arc_state <= arcs:
+                on = f if isinstance(f, Fillet) else f.arcs[self._arc_state - 1]
+                circling = self.circle(pos, vel, on.centre, on.radius, on.clockwise)
                 to_b = (b[0] - pos[0], b[1] - pos[1])
                 bearing = math.atan2(to_b[1], to_b[0])
-                return LateralDemand(arc.lat_acc, bearing, arc.xtrack, math.hypot(*to_b))
-            if self._arc_state == 0:  # not yet at the arc: still on the leg into it
+                return LateralDemand(circling.lat_acc, bearing, circling.xtrack, math.hypot(*to_b))
+            if self._arc_state == 0:  # not yet at the turn: still on the leg into it
                 assert prev is not None
                 return self._line_law(pos, vel, prev, a, b, 0.0)
         return self._line_law(pos, vel, a, b, b, dt)

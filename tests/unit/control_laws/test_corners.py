@@ -13,10 +13,11 @@ import math
 
 import pytest
 
+import companion.control.laws.fillet as corners
 from companion.actuators.airframe import load_airframe
 from companion.control.flight.controller import TURN_BANK_FRACTION
 from companion.control.flight.params import control_params
-from companion.control.laws.fillet import arc_phase, fillet
+from companion.control.laws.fillet import Loop, arc_phase, fillet, loop_phase
 from companion.control.laws.l1_guidance import L1Guidance
 from companion.geodesy import STANDARD_GRAVITY as G
 from tests.support.point_mass import PointMass, cross_track, fly_legs
@@ -85,6 +86,69 @@ def test_a_slight_corner_whose_arc_is_shorter_than_the_roll_out_is_not_followed_
     ]
     legs = fly_legs(guidance, aircraft, points, radius)
     assert straight_worst(legs[1], points[1], points[2]) < 0.5
+
+
+def _on_arc(arc: corners.Arc, turned: float) -> tuple[float, float]:
+    bearing = arc.start + (turned if arc.clockwise else -turned)
+    return (
+        arc.centre[0] + arc.radius * math.cos(bearing),
+        arc.centre[1] + arc.radius * math.sin(bearing),
+    )
+
+
+@pytest.mark.parametrize("turn_deg", [-170.0, -146.0, 125.0, 146.0])
+def test_a_sharp_corner_is_a_loop_that_ends_on_the_new_line_at_the_corner(turn_deg: float):
+    """Away from the new leg, then round onto it: the arcs meet, the second ends on the
+    new line heading along it, within a radius of the corner, and the loop starts no
+    earlier than a 120° arc would."""
+    course = math.radians(90.0 + turn_deg)  # from a leg flown due east
+    nxt = (2000.0 * math.cos(course), 2000.0 * math.sin(course))
+    loop = fillet((0.0, -2000.0), (0.0, 0.0), nxt, 200.0)
+    assert isinstance(loop, Loop)
+    away, onto = loop.arcs
+    assert away.clockwise == (turn_deg < 0) and onto.clockwise == (turn_deg > 0)
+    assert loop.lead == pytest.approx(200.0 * math.tan(math.radians(60.0)))
+    assert _on_arc(away, 0.0) == pytest.approx((0.0, -loop.lead))
+    assert _on_arc(away, away.sweep) == pytest.approx(_on_arc(onto, 0.0))
+    end = _on_arc(onto, onto.sweep)
+    u = loop.u_out
+    assert -end[0] * u[1] + end[1] * u[0] == pytest.approx(0.0, abs=1e-6)  # on the new line
+    assert abs(end[0] * u[0] + end[1] * u[1]) < loop.radius
+    assert onto.sweep - away.sweep == pytest.approx(math.radians(abs(turn_deg)))
+    # The phases: before the loop, on each arc in turn, then on the new leg.
+    assert loop_phase(loop, (0.0, -loop.lead - 50.0), 0) == 0
+    assert loop_phase(loop, _on_arc(away, 0.1), 0) == 1
+    assert loop_phase(loop, _on_arc(onto, 0.1), 1) == 2
+    assert loop_phase(loop, _on_arc(onto, onto.sweep - 0.01), 2, exit_early=30.0) == 3
+
+
+def test_a_corner_of_120_degrees_or_less_is_an_arc():
+    course = math.radians(90.0 + 118.0)
+    nxt = (2000.0 * math.cos(course), 2000.0 * math.sin(course))
+    assert isinstance(fillet((0.0, -2000.0), (0.0, 0.0), nxt, 200.0), corners.Fillet)
+
+
+@pytest.mark.parametrize("wind", [(0.0, 0.0), (0.0, 5.0)], ids=["calm", "wind"])
+@pytest.mark.parametrize("airframe", AIRFRAMES)
+def test_after_a_146_degree_corner_the_loop_is_on_the_new_line_by_the_corner(
+    airframe: str, wind: tuple[float, float], monkeypatch: pytest.MonkeyPatch
+):
+    """The jump plan's corner. An arc tangent to both legs ends 3.3 radii down the new
+    leg: the C172 in a 5 m/s wind was still on it, hundreds of metres off the line, where
+    the leg's straight part starts. The loop leaves it on the line there (its own start
+    lies beside the first 300-400 m of the new leg, as the leg into such a corner does)."""
+    legs_ne = [(0.0, 0.0), (0.0, 1800.0), (1000.0, 1800.0), (1000.0, 300.0), (0.0, 1800.0)]
+    legs_ne.append((1000.0, 1800.0))
+    worst = {}
+    for loops in (True, False):
+        if not loops:
+            monkeypatch.setattr(corners, "LOOP_TURN_RAD", math.pi)
+        guidance, aircraft, radius = setup(airframe, wind)
+        legs = fly_legs(guidance, aircraft, legs_ne, radius)
+        a, b = legs_ne[3], legs_ne[4]
+        worst[loops] = straight_worst(legs[3], a, b)
+    assert worst[True] < 0.5
+    assert worst[True] < worst[False]
 
 
 def test_no_arc_for_a_straight_on_corner():
