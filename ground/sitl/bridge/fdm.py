@@ -27,34 +27,16 @@ SETTLE_S = 3.0
 DIVERGED_SPEED_M_S = 1000.0
 DIVERGED_BELOW_GROUND_M = 50.0
 STANDARD_GRAVITY = 9.80665
-CALM_WIND_M_S = 0.5  # less along the runway than this: the default direction (east)
 
 
 @dataclass(frozen=True)
 class Home:
-    """Where the aircraft starts: WGS-84 degrees, ground height above MSL, runway heading.
-
-    Without a heading the aircraft stands on an east-west runway, facing whichever way has
-    the wind ahead (``runway_heading``).
-    """
+    """Where the aircraft starts: WGS-84 degrees, ground height above MSL, runway heading."""
 
     lat_deg: float = -37.9105
     lon_deg: float = 145.1340
     ground_msl_m: float = 80.0
-    heading_deg: float | None = None
-
-    def facing(self, wind_ned: tuple[float, float, float]) -> Home:
-        """This home with its heading settled: as given, or the runway's into the wind."""
-        if self.heading_deg is not None:
-            return self
-        return replace(self, heading_deg=runway_heading(wind_ned))
-
-
-def runway_heading(wind_ned: tuple[float, float, float]) -> float:
-    """The direction an east-west runway is used in: west when the wind blows from the west
-    (as a pilot takes off into the wind: a tailwind take-off ran the J3Cub 700 m past the
-    zigzag's first waypoint before it had climbed), east otherwise."""
-    return 270.0 if wind_ned[1] > CALM_WIND_M_S else 90.0
+    heading_deg: float = 90.0
 
 
 class Flight:
@@ -77,7 +59,7 @@ class Flight:
         self.dt_s = 1.0 / rate_hz
         self.wreck: TrueState | None = None  # after a crash the model diverged at
         self._sane: TrueState | None = None  # the last state stepped to, found physical
-        self.home = home.facing((0.0, 0.0, 0.0))
+        self.home = home
         self.turbulence = False
         self.brake_channel = False  # until a brakes servo is heard, idle means brakes
         self.rest_agl_m = 0.0  # the reference point's height on the wheels (0: not known)

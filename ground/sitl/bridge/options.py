@@ -44,7 +44,6 @@ class BridgeOptions:
     hold: bool = False  # wait for "run" on stdin before the first step
 
     def __post_init__(self) -> None:
-        self.home = self.home.facing(self.wind_ned)
         if self.turbulence not in TURBULENCE:
             raise ValueError(f"turbulence must be one of {', '.join(TURBULENCE)}")
         if self.mount not in MOUNTS:
