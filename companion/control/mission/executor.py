@@ -23,6 +23,7 @@ from mavlink_dialect import companion as d
 RELATIVE_FRAMES = (d.MAV_FRAME_GLOBAL_RELATIVE_ALT, d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT)
 ON_CIRCLE = 0.25  # within this fraction of the radius the aircraft counts as circling
 TAKEOFF_MARGIN_M = 5.0
+TURN_BACK_WIDTHS = 2.0  # a waypoint the climb overflew by more turn radii is flown back to
 MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
 
 
@@ -205,8 +206,18 @@ class MissionExecutor:
             # where the climb ended: a climb that ended beside or past the first waypoint
             # made a leg of a few metres pointing back, and the c172p turned round for it
             # (270 m off the zigzag's next leg). From the launch, the waypoint is reached by
-            # its radius, its turn lead or the square line, as any other.
-            self._advance(True, self._prev, target)
+            # its radius, its turn lead or the square line, as any other. A waypoint the
+            # climb overflew by more than a turn's width (a take-off with the wind behind:
+            # the J3Cub was 700 m past the zigzag's first one) is flown back to, so that
+            # the leg from it is flown along its line rather than met 1 km down it.
+            start = self._prev
+            first = self._next_point(pos)
+            if (
+                first is not None
+                and _beyond(start, first, pos) > TURN_BACK_WIDTHS * self._turn_radius > 0
+            ):
+                start = pos
+            self._advance(True, start, target)
             return None
         return Setpoint(Kind.TAKEOFF, pos, pos, target, speed=self.speed)
 
@@ -363,6 +374,15 @@ def tangent_angle(
 
 def _distance(a: tuple[float, float], b: tuple[float, float]) -> float:
     return math.hypot(b[0] - a[0], b[1] - a[1])
+
+
+def _beyond(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> float:
+    """How far ``pos`` is past ``b`` along the leg a→b, m (negative before it)."""
+    leg = (b[0] - a[0], b[1] - a[1])
+    length = math.hypot(*leg)
+    if length < 1.0:
+        return 0.0
+    return ((pos[0] - b[0]) * leg[0] + (pos[1] - b[1]) * leg[1]) / length
 
 
 def past_point(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> bool:
