@@ -177,6 +177,12 @@ def _split(truth: dict[str, np.ndarray], legs: list[Leg], frame: LocalFrame) -> 
         )
         ahead = np.nonzero(done & (along[start:] > 0.0))[0]
         end = start + int(ahead[0]) if len(ahead) else len(north)
+        if leg.first:
+            # Flown to from elsewhere, the aircraft may cross the line's start more than
+            # once (a climb that overflew the first waypoint, and the flight back to it):
+            # the leg is the stretch near its line that reaches its end.
+            away = np.nonzero(np.abs(cross[start:end]) >= OFF_LINE_M)[0]
+            start = start + int(away[-1]) + 1 if len(away) else start
         out.append(LegTrack(leg, length, start, end, along[start:end], cross[start:end]))
         start = end
     return out

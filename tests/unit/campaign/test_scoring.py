@@ -146,3 +146,16 @@ def test_an_empty_truth_gives_no_figures():
     empty = {k: [] for k in COLUMNS}  # a truth file with its header alone
     score = score_track(empty, jump_plan(), "c172p")
     assert score.samples == 0 and math.isnan(score.xtrack_p95_m)
+
+
+def test_a_first_waypoint_overflown_in_the_climb_is_scored_from_the_flight_back_to_it():
+    """A take-off with the wind behind it climbed on past W1 (here turning north-east,
+    beside W1-W2's first kilometre), turned back and flew W1-W2 from W1: the leg is the
+    stretch near its line that reaches W2, 1 m right of it, not the climb beside it."""
+    climb = line((0.0, 0.0), W1) + line(W1, (1000.0, 2800.0))
+    back = line((1000.0, 2800.0), (-300.0, 2000.0)) + line((-300.0, 2000.0), (-5.0, 2000.0))
+    legs = [line(a, b, right_m=1.0) for a, b in itertools.pairwise(FLOWN)]
+    points = [(0.0, 0.0, 0.0), *climb, *back, *itertools.chain.from_iterable(legs)]
+    score = score_track(truth(points), jump_plan(), "c172p")
+    assert score.xtrack_rms_m == pytest.approx(1.0, abs=0.01)
+    assert score.xtrack_p95_m == pytest.approx(1.0, abs=0.01)
