@@ -23,7 +23,6 @@ from mavlink_dialect import companion as d
 RELATIVE_FRAMES = (d.MAV_FRAME_GLOBAL_RELATIVE_ALT, d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT)
 ON_CIRCLE = 0.25  # within this fraction of the radius the aircraft counts as circling
 TAKEOFF_MARGIN_M = 5.0
-TURN_BACK_WIDTHS = 2.0  # a waypoint the climb overflew by more turn radii is flown back to
 MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
 
 
@@ -203,23 +202,31 @@ class MissionExecutor:
         target = self.alt_of(item)
         if alt >= target - TAKEOFF_MARGIN_M:
             # The next leg starts where the take-off did (PX4: at the take-off item), not
-            # where the climb ended: a climb that ended beside or past the first waypoint
-            # made a leg of a few metres pointing back, and the c172p turned round for it
-            # (270 m off the zigzag's next leg). From the launch, the waypoint is reached by
-            # its radius, its turn lead or the square line, as any other. A waypoint the
-            # climb overflew by more than a turn's width (a take-off with the wind behind:
-            # the J3Cub was 700 m past the zigzag's first one) is flown back to, so that
-            # the leg from it is flown along its line rather than met 1 km down it.
-            start = self._prev
-            first = self._next_point(pos)
-            if (
-                first is not None
-                and _beyond(start, first, pos) > TURN_BACK_WIDTHS * self._turn_radius > 0
-            ):
-                start = pos
-            self._advance(True, start, target)
+            # where the climb ended: ended beside the first waypoint, a leg of a few metres
+            # pointed back and the c172p turned round for it (270 m off the next leg).
+            self._advance(True, self._prev, target)
+            self._turn_back_if_overflown(pos)
             return None
         return Setpoint(Kind.TAKEOFF, pos, pos, target, speed=self.speed)
+
+    def _turn_back_if_overflown(self, pos: tuple[float, float]) -> None:
+        """A first waypoint the climb flew past, off the next leg by more than the
+        acceptance radius, is flown back to (PX4 flies to each waypoint): with the wind
+        behind, the J3Cub was 700 m past the zigzag's first one and met the next leg 1.1 km
+        down it; the c172p, 60 m past, swung 25 m about it at 49° of bank."""
+        if self.current >= len(self.items):
+            return
+        item = self.items[self.current]
+        if item.command != d.MAV_CMD_NAV_WAYPOINT:
+            return
+        first = self.point_of(item, pos)
+        if not past_point(self._prev, first, pos):
+            return
+        radius = item.param2 if item.param2 > 0 else self.config.wp_radius
+        nxt = self._next_point(first)
+        off = _distance(pos, first) if nxt is None else abs(_cross(first, nxt, pos))
+        if off > radius:
+            self._prev = pos
 
     def _waypoint(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
         b = self.point_of(item, pos)
@@ -376,13 +383,13 @@ def _distance(a: tuple[float, float], b: tuple[float, float]) -> float:
     return math.hypot(b[0] - a[0], b[1] - a[1])
 
 
-def _beyond(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> float:
-    """How far ``pos`` is past ``b`` along the leg a→b, m (negative before it)."""
+def _cross(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> float:
+    """How far ``pos`` is beside the line a→b, m (+ right of it)."""
     leg = (b[0] - a[0], b[1] - a[1])
     length = math.hypot(*leg)
     if length < 1.0:
-        return 0.0
-    return ((pos[0] - b[0]) * leg[0] + (pos[1] - b[1]) * leg[1]) / length
+        return _distance(pos, a)
+    return ((pos[1] - a[1]) * leg[0] - (pos[0] - a[0]) * leg[1]) / length
 
 
 def past_point(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> bool:

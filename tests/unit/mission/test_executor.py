@@ -46,11 +46,11 @@ def test_takeoff_climbs_until_within_5_m_then_flies_on():
     assert sp.alt_msl == pytest.approx(HOME_ALT + 100.0)
 
 
-def test_a_waypoint_the_climb_flew_far_past_is_flown_back_to():
+def test_a_waypoint_the_climb_flew_past_is_flown_back_to():
     """A take-off with the wind behind it ended 700 m beyond the J3Cub's first waypoint:
-    met 1 km down the next leg, that leg was flown 400 m off its line. More than two turn
-    radii past it, the aircraft now turns back and flies the first waypoint, from which
-    the next leg starts on its line."""
+    met 1 km down the next leg, that leg was flown 400 m off its line. Past the waypoint
+    and off the next leg by more than the acceptance radius, the aircraft now turns back
+    and flies the waypoint, from which the next leg starts on its line."""
     items = [
         item(0, d.MAV_CMD_NAV_TAKEOFF, None, z=100.0),
         wp(1, (0.0, 900.0)),
@@ -58,31 +58,31 @@ def test_a_waypoint_the_climb_flew_far_past_is_flown_back_to():
     ]
     ex = executor(items, alt=HOME_ALT)
     ex.step((0.0, 0.0), HOME_ALT, 0.0, turn_radius=150.0)
-    sp = ex.step((0.0, 1_600.0), HOME_ALT + 99.0, 40.0, turn_radius=150.0)
+    sp = ex.step((0.0, 1_000.0), HOME_ALT + 99.0, 40.0, turn_radius=150.0)
     assert ex.drain_reached() == [0]
     assert sp.kind == Kind.LINE
-    assert sp.a == pytest.approx((0.0, 1_600.0), abs=0.05)  # from here, back to it
+    assert sp.a == pytest.approx((0.0, 1_000.0), abs=0.05)  # from here, back to it
     assert sp.b == pytest.approx((0.0, 900.0), abs=0.05)
-    sp = ex.step((0.0, 1_300.0), HOME_ALT + 100.0, 60.0, turn_radius=150.0)
+    sp = ex.step((0.0, 1_000.0), HOME_ALT + 100.0, 41.0, turn_radius=150.0)
     assert ex.drain_reached() == [] and sp.b == pytest.approx((0.0, 900.0), abs=0.05)
 
 
-def test_a_waypoint_the_climb_flew_a_little_past_is_reached_not_turned_back_for():
-    # Climbing east along the runway, the take-off ends 200 m beyond the first waypoint,
-    # less than two turn radii: that one counts as reached and the next leg (north-east
-    # from it) is flown at once.
+def test_a_waypoint_the_climb_flew_past_on_the_next_legs_line_is_reached():
+    # Climbing east along the runway, the take-off ends 500 m beyond the first waypoint,
+    # on the line of the next leg (straight on east): that one counts as reached and the
+    # next leg is flown at once.
     items = [
         item(0, d.MAV_CMD_NAV_TAKEOFF, None, z=100.0),
         wp(1, (0.0, 900.0)),
-        wp(2, (1_500.0, 2_400.0)),
+        wp(2, (0.0, 2_400.0)),
     ]
     ex = executor(items, alt=HOME_ALT)
     ex.step((0.0, 0.0), HOME_ALT, 0.0, turn_radius=150.0)
-    sp = ex.step((0.0, 1_100.0), HOME_ALT + 99.0, 40.0, turn_radius=150.0)
+    sp = ex.step((0.0, 1_400.0), HOME_ALT + 99.0, 40.0, turn_radius=150.0)
     assert ex.drain_reached() == [0, 1]
     assert sp.kind == Kind.LINE
     assert sp.a == pytest.approx((0.0, 900.0), abs=0.05)
-    assert sp.b == pytest.approx((1_500.0, 2_400.0), abs=0.05)
+    assert sp.b == pytest.approx((0.0, 2_400.0), abs=0.05)
     # Not yet at the waypoint when the climb ends: it is flown to, as before.
     ex = executor(items, alt=HOME_ALT)
     ex.step((0.0, 0.0), HOME_ALT, 0.0)
