@@ -3,10 +3,11 @@
 Pure and replayable: positions in, a ``Setpoint`` and events out. Items as ArduPlane and
 PX4 fly them: NAV_TAKEOFF climbs to its altitude; NAV_WAYPOINT is reached inside its
 acceptance radius or when the aircraft crosses the line through the waypoint square to
-the leg (so an overshoot never makes it circle back); loiters circle their point (radius
-param3, negative for counter-clockwise) forever, for param1 seconds or param1 turns once
-on the circle; NAV_RETURN_TO_LAUNCH flies home and circles there; DO_CHANGE_SPEED and
-DO_JUMP act at once. After the last item the aircraft circles the last point (PX4).
+the leg (an overshoot never makes it circle back, but a first one the take-off's climb
+flew past may be flown back to); loiters circle their point (radius param3, negative for
+counter-clockwise) forever, for param1 seconds or param1 turns once on the circle;
+NAV_RETURN_TO_LAUNCH flies home and circles there; DO_CHANGE_SPEED and DO_JUMP act at
+once. After the last item the aircraft circles the last point (PX4).
 """
 
 from __future__ import annotations
