@@ -202,9 +202,8 @@ class MissionExecutor:
     def _takeoff(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
         target = self.alt_of(item)
         if alt >= target - TAKEOFF_MARGIN_M:
-            # The next leg starts where the take-off did (PX4: at the take-off item), not
-            # where the climb ended: ended beside the first waypoint, a leg of a few metres
-            # pointed back and the c172p turned round for it (270 m off the next leg).
+            # The next leg starts where the take-off did (PX4), not where the climb ended:
+            # a climb ended beside the first waypoint left a leg of a few metres pointing back.
             self._advance(True, self._prev, target)
             self._turn_back_if_overflown(pos)
             return None
