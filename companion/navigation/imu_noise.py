@@ -30,7 +30,9 @@ class ImuNoise:
         last, self.last = self.last, values
         if last is None or dt <= 0.0:
             return
-        a = sum((values[i] - last[i]) ** 2 for i in range(3)) / 6.0
+        # Written out: a generator's per-item cost shows at 100-400 Hz (same sum, same order).
+        a = ((values[0] - last[0]) ** 2 + (values[1] - last[1]) ** 2
+             + (values[2] - last[2]) ** 2) / 6.0  # fmt: skip
         w = min(1.0, dt / self.window_s)
         self.accel_var += w * (a - self.accel_var)
         self.dt += w * (dt - self.dt)

@@ -19,8 +19,16 @@ from companion.navigation.local_frame import LocalFrame
 
 CHI2_9999 = {1: 15.14, 2: 18.42, 3: 21.11, 4: 23.51, 5: 25.74, 6: 27.86}
 P, V, TH, BA, BG = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12), slice(12, 15)
-_I15, _I3 = np.eye(15), np.eye(3)
-_DIAG = np.diag_indices(15)
+_I15 = np.eye(15)
+# Where ``_flush_covariance`` writes Φ's entries besides δv/δθ: δp/δv (diagonal), δv/δb_a,
+# δθ/δθ (off the diagonal) and δθ/δb_g, in the order it lists them.
+_PHI_FLAT = np.ravel_multi_index(
+    (
+        [0, 1, 2, *[3] * 3, *[4] * 3, *[5] * 3, 6, 6, 7, 7, 8, 8, *[6] * 3, *[7] * 3, *[8] * 3],
+        [3, 4, 5, *[9, 10, 11] * 3, 7, 8, 6, 8, 6, 7, *[12, 13, 14] * 3],
+    ),
+    (15, 15),
+)
 _SOLUTION_VALID = int(
     NavFlags.ATTITUDE_VALID | NavFlags.HEADING_VALID | NavFlags.VELOCITY_VALID
     | NavFlags.POSITION_VALID | NavFlags.ALTITUDE_VALID
@@ -28,6 +36,12 @@ _SOLUTION_VALID = int(
 _DEAD_RECKONING = int(NavFlags.DEAD_RECKONING)
 _GPS_REJECTED = int(NavFlags.GPS_REJECTED)
 _HEADING_REJECTED = int(NavFlags.HEADING_REJECTED)
+
+
+def _picker(rows: list[int]) -> slice | list[int]:
+    """Consecutive states as a slice: a view costs a fraction of numpy's fancy indexing."""
+    first = rows[0]
+    return slice(first, first + len(rows)) if rows == [*range(first, first + len(rows))] else rows
 
 
 class InsCore:
@@ -41,9 +55,12 @@ class InsCore:
         self.p: list[float] = [0.0, 0.0, 0.0]
         self.v: list[float] = [0.0, 0.0, 0.0]
         self.q: rot.Quat = (1.0, 0.0, 0.0, 0.0)
-        self.ba, self.bg = np.zeros(3), np.zeros(3)
+        # Floats too: a numpy scalar taken from an array makes every sum it enters, the
+        # quaternion's included, a numpy scalar (several times slower than a float).
+        self.ba: list[float] = [0.0, 0.0, 0.0]
+        self.bg: list[float] = [0.0, 0.0, 0.0]
         self.P = np.zeros((15, 15))
-        self.g = np.array([0.0, 0.0, 9.80665])
+        self.g: list[float] = [0.0, 0.0, 9.80665]
         self.t_us: int | None = None
         self.rate: tuple[float, ...] = (0.0, 0.0, 0.0)
         self.history = StateHistory()
@@ -56,19 +73,23 @@ class InsCore:
         self.cov_f: tuple[float, ...] = (0.0, 0.0, 0.0)
         self.cov_w: tuple[float, ...] = (0.0, 0.0, 0.0)
         self.cov_r: list[list[float]] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-        self.walk_density = np.square([c.accel_bias_walk] * 3 + [c.gyro_bias_walk] * 3)
+        self.walk_density = [c.accel_bias_walk**2] * 3 + [c.gyro_bias_walk**2] * 3
 
     # -- propagation ----------------------------------------------------------------
     def _integrate(self, dt: float, f: tuple[float, ...], w: tuple[float, ...]) -> None:
         # Plain floats: at 100-400 Hz numpy's per-call cost would dominate 3-vector sums.
+        # Written out, not looped: the same sums in the same order, without the loops' cost.
         r = rot.rotation_matrix_rows(self.q)
+        (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = r
         f0, f1, f2 = f
-        p, v = self.p, self.v
-        a = [row[0] * f0 + row[1] * f1 + row[2] * f2 for row in r]
-        a[2] += self.g[2]
+        p0, p1, p2 = self.p
+        v0, v1, v2 = self.v
+        a0 = r00 * f0 + r01 * f1 + r02 * f2
+        a1 = r10 * f0 + r11 * f1 + r12 * f2
+        a2 = r20 * f0 + r21 * f1 + r22 * f2 + self.g[2]
         half = 0.5 * dt * dt
-        self.p = [p[i] + v[i] * dt + a[i] * half for i in range(3)]
-        self.v = [v[i] + a[i] * dt for i in range(3)]
+        self.p = [p0 + v0 * dt + a0 * half, p1 + v1 * dt + a1 * half, p2 + v2 * dt + a2 * half]
+        self.v = [v0 + a0 * dt, v1 + a1 * dt, v2 + a2 * dt]
         dq = rot.rotation_vector_quaternion(w[0] * dt, w[1] * dt, w[2] * dt)
         self.q = rot.normalized(rot.multiply(self.q, dq))
         self.rate = w
@@ -85,45 +106,66 @@ class InsCore:
         dt = self.cov_dt
         if dt <= 0.0:
             return
-        r, f, w = np.array(self.cov_r), np.array(self.cov_f), np.array(self.cov_w)
+        r = np.array(self.cov_r)
+        w0, w1, w2 = self.cov_w
         phi = _I15.copy()
-        phi[P, V] = _I3 * dt
-        phi[V, TH] = -(r @ rot.skew(f)) * dt
-        phi[V, BA] = -r * dt
-        phi[TH, TH] = _I3 - rot.skew(w) * dt
-        phi[TH, BG] = -_I3 * dt
-        self.P = phi @ self.P @ phi.T
+        phi[V, TH] = (r @ rot.skew(self.cov_f)) * -dt  # a matrix product: BLAS rounding kept
+        # The rest of Φ in one scatter (a numpy call per block costs more than the sums).
+        nd = -dt
+        phi.flat[_PHI_FLAT] = [
+            dt, dt, dt, *(c * nd for row in self.cov_r for c in row),
+            w2 * dt, -(w1 * dt), -(w2 * dt), w0 * dt, w1 * dt, -(w0 * dt),
+            nd, -0.0, -0.0, -0.0, nd, -0.0, -0.0, -0.0, nd,
+        ]  # fmt: skip
+        self.P = phi @ self.P @ phi.T  # a fresh C-contiguous array: ravel() is a view of it
         accel, gyro = self.noise.densities()
-        self.P[_DIAG] += np.concatenate(([0.0] * 3, [accel**2] * 3, [gyro**2] * 3,
-                                         self.walk_density)) * dt  # fmt: skip
+        qa, qg = accel**2 * dt, gyro**2 * dt
+        self.P.ravel()[::16] += [0.0, 0.0, 0.0, qa, qa, qa, qg, qg, qg,
+                                 *(d * dt for d in self.walk_density)]  # fmt: skip
         self.cov_dt = 0.0
 
     # -- updates --------------------------------------------------------------------
     def _update(  # type: ignore[no-untyped-def]
-        self, y: np.ndarray, h: np.ndarray, r: np.ndarray, k_mask=None, gate: bool = True
-    ) -> bool:
+        self, y: np.ndarray, h: np.ndarray | list[int], r: np.ndarray, k_mask=None,
+        gate: bool = True,
+    ) -> bool:  # fmt: skip
         """Gate (unless told not to), then correct; False when the innovation was rejected.
+        ``h``: the Jacobian, or the list of states measured directly (rows of the identity:
+        picking them out gives the same numbers as multiplying, with fewer numpy calls).
         ``k_mask`` (15 booleans) limits which error states this measurement may correct."""
         self._flush_covariance()
-        ph = self.P @ h.T
-        s = h @ ph + r
-        s_inv = np.linalg.inv(s)
+        rows = _picker(h) if isinstance(h, list) else None
+        if rows is None:
+            ph = self.P @ h.T
+            s = h @ ph + r
+        else:
+            ph = self.P[:, rows]
+            s = ph[rows] + r
+        s_inv = 1.0 / s if len(y) == 1 else np.linalg.inv(s)  # 1×1: inv is 1/s exactly
         if gate and float(y @ s_inv @ y) > CHI2_9999[len(y)]:
             return False
         k = ph @ s_inv
         if k_mask is not None:
             k = k * k_mask[:, None]
-        ikh = _I15 - k @ h
+        if rows is None:
+            ikh = _I15 - k @ h
+        else:
+            ikh = _I15.copy()
+            ikh[:, rows] -= k
         self.P = ikh @ self.P @ ikh.T + k @ r @ k.T  # Joseph form: valid for any gain
         self._correct(k @ y)
         return True
 
     def _correct(self, dx: np.ndarray) -> None:
-        self.p = (dx[P] + self.p).tolist()
-        self.v = (dx[V] + self.v).tolist()
-        self.q = rot.normalized(rot.multiply(self.q, rot.rotation_vector_quaternion(*dx[TH])))
-        self.ba = self.ba + dx[BA]
-        self.bg = self.bg + dx[BG]
+        # As floats: a numpy scalar in the quaternion would make every later IMU sample's
+        # arithmetic numpy scalar arithmetic (the same numbers, several times slower).
+        d = dx.tolist()
+        p, v, ba, bg = self.p, self.v, self.ba, self.bg
+        self.p = [d[0] + p[0], d[1] + p[1], d[2] + p[2]]
+        self.v = [d[3] + v[0], d[4] + v[1], d[5] + v[2]]
+        self.q = rot.normalized(rot.multiply(self.q, rot.rotation_vector_quaternion(*d[6:9])))
+        self.ba = [d[9] + ba[0], d[10] + ba[1], d[11] + ba[2]]
+        self.bg = [d[12] + bg[0], d[13] + bg[1], d[14] + bg[2]]
 
     def _innovation_var(self, h: np.ndarray, r: float) -> float:
         self._flush_covariance()
@@ -158,12 +200,12 @@ class InsCore:
         msg.roll_rate_rad_s, msg.pitch_rate_rad_s, msg.yaw_rate_rad_s = self.rate
         msg.lat_deg, msg.lon_deg, msg.alt_msl_m = self.frame.geodetic(np.array(self.p))
         msg.vn_m_s, msg.ve_m_s, msg.vd_m_s = self.v
-        std = np.sqrt(np.diag(self.P))
-        msg.pos_std_m[:] = std[P].tolist()
-        msg.vel_std_m_s[:] = std[V].tolist()
-        msg.att_std_rad[:] = std[TH].tolist()
-        msg.accel_bias_m_s2[:] = self.ba.tolist()
-        msg.gyro_bias_rad_s[:] = self.bg.tolist()
+        std = np.sqrt(np.diag(self.P)).tolist()
+        msg.pos_std_m[:] = std[0:3]
+        msg.vel_std_m_s[:] = std[3:6]
+        msg.att_std_rad[:] = std[6:9]
+        msg.accel_bias_m_s2[:] = self.ba
+        msg.gyro_bias_rad_s[:] = self.bg
         msg.flags = self._flags()
         return msg
 

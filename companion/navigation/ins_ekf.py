@@ -125,7 +125,7 @@ class InsEkf(InsCore):
         # tilt (gravity, GPS), and with the propellers turning they shift from the ground's
         # (vibration, g-sensitivity); the yaw-rate bias has nothing but a magnetometer in
         # flight, and a stationary window measures it to a few thousandths of a degree/s.
-        ok = self._update(gyro_mean[2:] - self.bg[2:], _I15[14:15], np.array([[variance]]))
+        ok = self._update(gyro_mean[2:] - self.bg[2:], [14], np.array([[variance]]))
         if ok:
             self.still_updates += 1
 
@@ -139,8 +139,9 @@ class InsEkf(InsCore):
         if self.gsf_dt < GSF_STEP_S:
             return
         roll, pitch, _ = rot.quaternion_to_euler(self.q)
-        mean = np.array(s) / self.gsf_dt
-        self.gsf.predict(self.gsf_dt, mean[:3], mean[3:], roll, pitch)
+        dt_sum = self.gsf_dt
+        mean = [x / dt_sum for x in s]  # floats: the bank's per-model sums stay off numpy scalars
+        self.gsf.predict(dt_sum, mean[:3], mean[3:], roll, pitch)
         self.gsf_dt = 0.0
         self.gsf_sums = [0.0] * 6
 
@@ -209,7 +210,7 @@ class InsEkf(InsCore):
         if up is None:
             return
         y = np.array([drop - up - self.p[2]])
-        if self._update(y, _I15[[2]], np.array([[self.cfg.baro_std**2]])):
+        if self._update(y, [2], np.array([[self.cfg.baro_std**2]])):
             self.baro_reject_run = 0
             return
         self.baro_reject_run += 1
@@ -333,7 +334,7 @@ class InsEkf(InsCore):
         # start in a pull-up or a roll): GPS is then the truth to converge to, not an
         # outlier to refuse.
         settling = fix.t_us - self.aligned_us < self.cfg.settle_s * 1e6
-        ok = self._update(y_all[rows], _I15[rows], np.diag(np.square(sig[rows])), gate=not settling)
+        ok = self._update(y_all[rows], rows, np.diag(np.square(sig[rows])), gate=not settling)
         self.last_gps_ok = ok
         if ok:
             self.gps_reject_run = 0

@@ -71,6 +71,7 @@ class GpsLag:
     def __init__(self, window_s: float, initial_s: float) -> None:
         self.window_s = window_s
         self.lags = np.arange(0.0, MAX_LAG_S + 1e-9, LAG_STEP_S)
+        self.lags_us = self.lags * 1e6
         self.cost = np.zeros(len(self.lags))
         self.excitation = 0.0
         self.fixes = 0
@@ -79,10 +80,10 @@ class GpsLag:
 
     def observe(self, t_us: int, v_gps: np.ndarray, history: StateHistory) -> None:
         """One fix's horizontal velocity against the INS history."""
-        if not np.all(np.isfinite(v_gps[:2])):
+        if not (math.isfinite(v_gps[0]) and math.isfinite(v_gps[1])):
             return
         ts, vs = history.velocities()
-        when = t_us - self.lags * 1e6
+        when = t_us - self.lags_us
         if len(ts) < 2 or when[-1] < ts[0]:
             return
         vn = np.interp(when, ts, vs[:, 0])

@@ -66,7 +66,7 @@ def mag_heading(
     if not math.isfinite(strength) or strength < 0.05 * field.intensity_gauss:
         return None
     sr, cr, sp, cp = math.sin(roll), math.cos(roll), math.sin(pitch), math.cos(pitch)
-    mx, my, mz = mag_body
+    mx, my, mz = mag_body.tolist()  # floats: numpy scalars make each sum below slower
     north = mx * cp + my * sr * sp + mz * cr * sp
     east = my * cr - mz * sr
     down = -mx * sp + my * sr * cp + mz * cr * cp
@@ -134,11 +134,10 @@ ALIGN_AGREE_RAD = math.radians(30.0)
 
 def yaw_jacobian(q: rot.Quat) -> tuple[float, np.ndarray] | None:
     """(yaw, ∂yaw/∂δθ) for a body-frame attitude error; None pointing straight up or down."""
-    r = rot.rotation_matrix(q)
-    den = r[0, 0] ** 2 + r[1, 0] ** 2
+    # Rows of floats: indexing an array gives numpy scalars, slower in every sum below.
+    (r00, r01, r02), (r10, r11, r12), _ = rot.rotation_matrix_rows(q)
+    den = r00**2 + r10**2
     if den < 1e-6:
         return None
-    h = np.zeros(3)
-    h[1] = (r[0, 2] * r[1, 0] - r[1, 2] * r[0, 0]) / den
-    h[2] = (r[1, 1] * r[0, 0] - r[0, 1] * r[1, 0]) / den
-    return math.atan2(r[1, 0], r[0, 0]), h
+    h = np.array([0.0, (r02 * r10 - r12 * r00) / den, (r11 * r00 - r01 * r10) / den])
+    return math.atan2(r10, r00), h

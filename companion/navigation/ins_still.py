@@ -44,10 +44,13 @@ class StillDetector:
         """One raw IMU sample and the latest GPS ground speed (NaN when unknown)."""
         if self.start_us is None:
             self.start_us = t_us
-        sums = self.sums
-        for i, v in enumerate((*accel, *gyro)):
-            sums[i] += v
-            sums[6 + i] += v * v
+        a0, a1, a2 = accel
+        w0, w1, w2 = gyro
+        s = self.sums  # written out: a loop over six values costs more than the sums
+        s[0], s[1], s[2] = s[0] + a0, s[1] + a1, s[2] + a2
+        s[3], s[4], s[5] = s[3] + w0, s[4] + w1, s[5] + w2
+        s[6], s[7], s[8] = s[6] + a0 * a0, s[7] + a1 * a1, s[8] + a2 * a2
+        s[9], s[10], s[11] = s[9] + w0 * w0, s[10] + w1 * w1, s[11] + w2 * w2
         self.n += 1
         if t_us - self.start_us < self.window_us:
             return None

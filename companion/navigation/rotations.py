@@ -57,10 +57,11 @@ def rotation_vector_quaternion(rx: float, ry: float, rz: float) -> Quat:
 
 def normalized(q: Quat) -> Quat:
     """q scaled to unit length, sign chosen so w ≥ 0."""
-    n = math.sqrt(sum(c * c for c in q))
-    if q[0] < 0:
+    w, x, y, z = q
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    if w < 0:
         n = -n
-    return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)
+    return (w / n, x / n, y / n, z / n)
 
 
 def rotation_matrix_rows(q: Quat) -> list[list[float]]:

@@ -19,6 +19,7 @@ allowed for in the velocity process noise. Pure library: numbers and dt in, numb
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -28,6 +29,8 @@ YAW_RATE_NOISE = 0.015  # rad/s (1-σ): gyro bias and the tilt error's part in t
 MIN_WEIGHT = 1e-4  # no hypothesis dies for good: a later manoeuvre may favour it again
 MAX_NIS = 50.0  # a single wild fix must not kill every hypothesis but one
 _I3 = np.eye(3)
+# The process noise per second of integration (diagonal); built once, scaled by dt.
+_Q_PER_S = np.diag([ACCEL_NOISE**2, ACCEL_NOISE**2, YAW_RATE_NOISE**2])
 
 
 class YawGsf:
@@ -39,6 +42,8 @@ class YawGsf:
         self.P = np.zeros((models, 3, 3))
         self.w = np.full(models, 1.0 / models)
         self.started = False
+        # One identity per hypothesis, copied rather than rebuilt on every step.
+        self._eye = np.tile(_I3, (models, 1, 1))
 
     def start(self, vn: float, ve: float, vel_std: float) -> None:
         """Spread the hypotheses round the circle, all starting at the GPS velocity."""
@@ -49,7 +54,7 @@ class YawGsf:
         self.w[:] = 1.0 / self.n
         self.started = True
 
-    def predict(self, dt: float, accel_body: np.ndarray, gyro_body: np.ndarray,
+    def predict(self, dt: float, accel_body: Sequence[float], gyro_body: Sequence[float],
                 roll: float, pitch: float) -> None:  # fmt: skip
         """Integrate dt seconds of the (bias-corrected) specific force and angular rate."""
         if not self.started or dt <= 0.0:
@@ -68,22 +73,21 @@ class YawGsf:
         self.x[:, 0] += a_n * dt
         self.x[:, 1] += a_e * dt
         self.x[:, 2] = np.remainder(yaw + yaw_rate * dt + math.pi, math.tau) - math.pi
-        phi = np.broadcast_to(_I3, (self.n, 3, 3)).copy()
+        phi = self._eye.copy()
         phi[:, 0, 2] = -a_e * dt
         phi[:, 1, 2] = a_n * dt
-        q = np.diag([ACCEL_NOISE**2 * dt, ACCEL_NOISE**2 * dt, YAW_RATE_NOISE**2 * dt])
-        self.P = phi @ self.P @ phi.transpose(0, 2, 1) + q
+        self.P = phi @ self.P @ phi.transpose(0, 2, 1) + _Q_PER_S * dt
 
     def update(self, vn: float, ve: float, vel_std: float) -> None:
         """Correct every hypothesis with a GPS velocity and re-weigh them by its likelihood."""
-        z = np.array([vn, ve])
-        if not np.all(np.isfinite(z)):
+        if not (math.isfinite(vn) and math.isfinite(ve)):
             return
         if not self.started:
             self.start(vn, ve, vel_std)
             return
-        r = np.eye(2) * vel_std**2
-        y = z - self.x[:, :2]
+        var = vel_std**2
+        r = np.array([[var, 0.0], [0.0, var]])
+        y = np.array([vn, ve]) - self.x[:, :2]
         s = self.P[:, :2, :2] + r
         s_inv = np.linalg.inv(s)
         nis = np.einsum("ni,nij,nj->n", y, s_inv, y)
@@ -93,7 +97,8 @@ class YawGsf:
         k = self.P[:, :, :2] @ s_inv  # (n, 3, 2)
         self.x += np.einsum("nij,nj->ni", k, y)
         self.x[:, 2] = np.remainder(self.x[:, 2] + math.pi, math.tau) - math.pi
-        ikh = np.broadcast_to(_I3, (self.n, 3, 3)) - k @ np.eye(2, 3)
+        ikh = self._eye.copy()  # I - K·H, H picking vn and ve: K's columns subtracted
+        ikh[:, :, :2] -= k
         self.P = ikh @ self.P @ ikh.transpose(0, 2, 1) + k @ r @ k.transpose(0, 2, 1)
         w = self.w * likelihood
         total = float(w.sum())

@@ -43,6 +43,7 @@ _FIELDS = {
     for header, count in _FIELD_COUNTS.items()
 }
 _PLACEHOLDERS = ("XX", "XXXX")
+_NUMBER_TEXT = "0123456789+-.eE,"  # every character of ``_NUMBER`` fields and their commas
 
 
 @dataclass
@@ -90,20 +91,21 @@ class VectorNavDecoder:
         fields = self._checked_fields(sentence)
         if fields is None:
             return None
-        header, values = fields[0], fields[1:]
+        payload, header = fields
         count = _FIELD_COUNTS.get(header)
         if count is None:
             self.counters.ignored += 1
             return None
-        numbers = _numbers(header, values, count)
+        numbers = _numbers(header, payload, count)
         if numbers is None or not _angles_in_range(header, numbers):
             self.counters.garbage += 1
             return None
         self.counters.ok += 1
         return _reading(header, numbers, t_us)
 
-    def _checked_fields(self, sentence: bytes | str) -> list[str] | None:
-        """The comma-separated fields of a whole VectorNav sentence whose checksum is right."""
+    def _checked_fields(self, sentence: bytes | str) -> tuple[str, str] | None:
+        """The payload (between ``$`` and ``*``) and header of a whole VectorNav sentence
+        whose checksum is right."""
         text = sentence_text(sentence)
         payload, star, given = text[1:].rpartition("*")
         header = payload.split(",", 1)[0]
@@ -120,14 +122,25 @@ class VectorNavDecoder:
         if int(given, 16) != expected:
             self.counters.bad_checksum += 1
             return None
-        return payload.split(",")
+        return payload, header
 
 
-def _numbers(header: str, values: list[str], count: int) -> list[float] | None:
-    """The first ``count`` fields as finite numbers; only appended T/S fields may follow."""
-    if not _FIELDS[header].fullmatch("," + ",".join(values)):
+def _numbers(header: str, payload: str, count: int) -> list[float] | None:
+    """The first ``count`` fields after the header as finite numbers; only appended T/S
+    fields may follow."""
+    values = payload.split(",")[1:]
+    # The usual sentence, ``count`` fields of number characters only, skips the pattern:
+    # float()'s grammar over those characters is ``_NUMBER``, so a field float() takes
+    # is one the pattern takes, and one it refuses, the pattern refuses too.
+    if len(values) == count and not payload[len(header) + 1 :].strip(_NUMBER_TEXT):
+        try:
+            numbers = list(map(float, values))
+        except ValueError:
+            return None
+    elif _FIELDS[header].fullmatch(payload, len(header)):  # appended fields, or garbage
+        numbers = list(map(float, values[:count]))
+    else:
         return None
-    numbers = list(map(float, values[:count]))
     return numbers if all(map(math.isfinite, numbers)) else None
 
 
