@@ -16,6 +16,7 @@ of a minute longer, and the new leg is flown on its line from the corner on.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -98,7 +99,7 @@ def corner_arc(turn_rad: float, radius: float, l_in: float, l_out: float) -> tup
         return min(radius * SHARP_LEAD_TAN, 0.5 * l_in, 0.5 * l_out), radius
     if abs(turn_rad) > LOOP_TURN_RAD:
         lead = min(radius * SHARP_LEAD_TAN, 0.5 * l_in)
-        if _loop_exit(abs(turn_rad), radius * SHARP_RADIUS_SCALE, lead) is not None:
+        if _loop_fits(abs(turn_rad), radius * SHARP_RADIUS_SCALE, lead):
             return lead, radius * SHARP_RADIUS_SCALE
     radius *= max(SHARP_RADIUS_SCALE, min(1.0, SHARP_LEAD_TAN / half_tan))
     # Short legs leave no room for the whole arc: a tighter one, flown at the bank limit.
@@ -143,32 +144,51 @@ def arc_phase(f: Fillet, pos: tuple[float, float], exit_early: float = 0.0) -> i
     return 1 if along_in > -f.lead else 0
 
 
-def _loop_exit(theta: float, radius: float, lead: float) -> tuple[float, float] | None:
-    """Where a loop begun ``lead`` before a ``theta`` corner ends on the new leg (m from the
-    corner), and how far its first arc turns away (rad); None if it cannot end near it.
+def _lead_in_radii(theta: float, exit_r: float) -> tuple[float, float]:
+    """The lead (in radii) of a loop round a ``theta`` corner that ends ``exit_r`` radii
+    along the new leg, and how far its first arc turns away (rad).
 
     With x along the leg in, y towards the turn, the first arc's centre is (-lead, -R), the
     second's 2R away at angle β, and the end is e along the new leg:
-    ``cos β = (1 + cos θ + e/R·sin θ) / 2`` and ``lead = 2R·sin β + R·sin θ - e·cos θ``;
-    the lead grows with e up to a largest one (beyond it β shrinks to nothing, the loop to an
-    arc), so e is found by bisection below that.
+    ``cos β = (1 + cos θ + e/R·sin θ) / 2`` and ``lead = 2R·sin β + R·sin θ - e·cos θ``.
     """
-    if radius <= 0.0 or not LOOP_TURN_RAD < theta < math.pi:
-        return None
     sin_t, cos_t = math.sin(theta), math.cos(theta)
+    beta = math.acos(max(-1.0, min(1.0, (1.0 + cos_t + exit_r * sin_t) / 2.0)))
+    return 2.0 * math.sin(beta) + sin_t - exit_r * cos_t, beta
 
-    def lead_at(e: float) -> tuple[float, float]:
-        beta = math.acos(max(-1.0, min(1.0, (1.0 + cos_t + e / radius * sin_t) / 2.0)))
-        return 2.0 * radius * math.sin(beta) + radius * sin_t - e * cos_t, beta
 
-    lo, hi = -LOOP_MAX_EARLY_EXIT * radius, radius * (1.0 - cos_t) / sin_t
-    hi = max((lo + (hi - lo) * k / 32 for k in range(33)), key=lambda e: lead_at(e)[0])
-    if not lead_at(lo)[0] <= lead <= lead_at(hi)[0]:
+@functools.lru_cache(maxsize=64)
+def _loop_span(theta: float) -> tuple[float, float]:
+    """The exits (radii along the new leg) between which a loop's lead grows with its exit:
+    from the earliest allowed to the one of the longest lead (beyond it β shrinks to
+    nothing, the loop to an arc). One corner's angle is the same at every control step, and
+    the executor asks for its lead at each: the search is done once."""
+    lo, hi = -LOOP_MAX_EARLY_EXIT, (1.0 - math.cos(theta)) / math.sin(theta)
+    peak = max(
+        (lo + (hi - lo) * k / 32 for k in range(33)), key=lambda e: _lead_in_radii(theta, e)[0]
+    )
+    return lo, peak
+
+
+def _loop_fits(theta: float, radius: float, lead: float) -> bool:
+    """Whether a loop begun ``lead`` before a ``theta`` corner can end near it."""
+    if radius <= 0.0 or not LOOP_TURN_RAD < theta < math.pi:
+        return False
+    lo, peak = _loop_span(theta)
+    return _lead_in_radii(theta, lo)[0] <= lead / radius <= _lead_in_radii(theta, peak)[0]
+
+
+def _loop_exit(theta: float, radius: float, lead: float) -> tuple[float, float] | None:
+    """Where a loop begun ``lead`` before a ``theta`` corner ends on the new leg (m from the
+    corner), and how far its first arc turns away (rad); None if it cannot end near it.
+    The lead grows with the exit over ``_loop_span``: the exit is found by bisection there."""
+    if not _loop_fits(theta, radius, lead):
         return None
+    lo, hi = _loop_span(theta)
     for _ in range(40):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if lead_at(mid)[0] < lead else (lo, mid)
-    return lo, lead_at(lo)[1]
+        lo, hi = (mid, hi) if _lead_in_radii(theta, mid)[0] < lead / radius else (lo, mid)
+    return lo * radius, _lead_in_radii(theta, lo)[1]
 
 
 def _loop(
