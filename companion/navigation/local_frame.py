@@ -1,8 +1,12 @@
-"""A local north-east-down frame on the WGS-84 ellipsoid, through pyproj.
+"""A local north-east-down frame on the WGS-84 ellipsoid.
 
 Exact (to the ellipsoid, not a sphere) at any distance: points go to Earth-centred
-coordinates with pyproj and are rotated into the tangent plane at the reference. The
-navigators work in metres in this frame; only their inputs and outputs are geodetic.
+coordinates and are rotated into the tangent plane at the reference. The navigators work in
+metres in this frame; only their inputs and outputs are geodetic.
+
+The two conversions are written here rather than taken from pyproj: they are a few lines
+of textbook geodesy, and pyproj (PROJ, its database and SQLite) cost the vehicle ~15 MB of
+memory for them. tests/unit/estimation/test_local_frame.py holds them to pyproj.
 """
 
 from __future__ import annotations
@@ -10,10 +14,45 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pyproj
 
-_TO_ECEF = pyproj.Transformer.from_crs("EPSG:4979", "EPSG:4978")
-_FROM_ECEF = pyproj.Transformer.from_crs("EPSG:4978", "EPSG:4979")
+WGS84_A = 6378137.0  # semi-major axis, m
+WGS84_F = 1 / 298.257223563
+_E2 = WGS84_F * (2 - WGS84_F)  # first eccentricity squared
+_LAT_TOLERANCE_RAD = 1e-15
+_MAX_ITERATIONS = 10
+
+
+def ecef(lat_deg: float, lon_deg: float, alt_m: float) -> tuple[float, float, float]:
+    """Earth-centred, Earth-fixed coordinates (m) of a point above the ellipsoid."""
+    lat, lon = math.radians(lat_deg), math.radians(lon_deg)
+    sin_lat, cos_lat = math.sin(lat), math.cos(lat)
+    n = WGS84_A / math.sqrt(1 - _E2 * sin_lat * sin_lat)  # prime vertical radius
+    r = (n + alt_m) * cos_lat
+    return r * math.cos(lon), r * math.sin(lon), (n * (1 - _E2) + alt_m) * sin_lat
+
+
+def geodetic(x: float, y: float, z: float) -> tuple[float, float, float]:
+    """Latitude, longitude (deg) and height above the ellipsoid (m) of an ECEF point.
+
+    The latitude solves tan(lat) = (z + e² N(lat) sin(lat)) / p by fixed-point iteration,
+    started from the spherical answer; each step shrinks the error by about e² (1/150),
+    so a point near the Earth's surface needs five to seven steps for 1e-15 rad.
+    """
+    p = math.hypot(x, y)
+    lat = math.atan2(z, p * (1 - _E2))
+    for _ in range(_MAX_ITERATIONS):
+        sin_lat = math.sin(lat)
+        n = WGS84_A / math.sqrt(1 - _E2 * sin_lat * sin_lat)
+        new = math.atan2(z + _E2 * n * sin_lat, p)
+        done = abs(new - lat) < _LAT_TOLERANCE_RAD
+        lat = new
+        if done:
+            break
+    sin_lat, cos_lat = math.sin(lat), math.cos(lat)
+    n = WGS84_A / math.sqrt(1 - _E2 * sin_lat * sin_lat)
+    # Projected on the normal: well conditioned at every latitude, poles included.
+    alt = p * cos_lat + z * sin_lat - WGS84_A * WGS84_A / n
+    return math.degrees(lat), math.degrees(math.atan2(y, x)), alt
 
 
 def normal_gravity(lat_deg: float, alt_m: float) -> float:
@@ -28,7 +67,7 @@ class LocalFrame:
 
     def __init__(self, lat_deg: float, lon_deg: float, alt_m: float) -> None:
         self.ref = (lat_deg, lon_deg, alt_m)
-        self.origin = np.array(_TO_ECEF.transform(lat_deg, lon_deg, alt_m))
+        self.origin = np.array(ecef(lat_deg, lon_deg, alt_m))
         lat, lon = math.radians(lat_deg), math.radians(lon_deg)
         sl, cl, so, co = math.sin(lat), math.cos(lat), math.sin(lon), math.cos(lon)
         self.ecef_to_ned = np.array(
@@ -37,8 +76,8 @@ class LocalFrame:
 
     def ned(self, lat_deg: float, lon_deg: float, alt_m: float) -> np.ndarray:
         """A geodetic point in this frame."""
-        ecef = np.array(_TO_ECEF.transform(lat_deg, lon_deg, alt_m))
-        return self.ecef_to_ned @ (ecef - self.origin)
+        point = np.array(ecef(lat_deg, lon_deg, alt_m))
+        return self.ecef_to_ned @ (point - self.origin)
 
     def drop(self, north: float, east: float) -> float:
         """How far the reference height lies below the frame's plane at this horizontal
@@ -50,5 +89,4 @@ class LocalFrame:
     def geodetic(self, ned: np.ndarray) -> tuple[float, float, float]:
         """A point of this frame as (latitude, longitude, height)."""
         x, y, z = self.origin + self.ecef_to_ned.T @ ned
-        lat, lon, alt = _FROM_ECEF.transform(x, y, z)
-        return float(lat), float(lon), float(alt)
+        return geodetic(float(x), float(y), float(z))
