@@ -2,7 +2,7 @@
 
 Inclusion polygons and circles: the aircraft must be inside every one of them (one is
 the usual case); exclusion polygons and circles: it must be outside all of them. Polygons are kept
-in a north/east frame in metres around the first fence point, where shapely answers containment.
+in a north/east frame in metres around the first fence point (companion.control.mission.zones).
 """
 
 from __future__ import annotations
@@ -10,9 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from shapely.geometry import Point, Polygon
-
 from companion.control.mission.items import MissionItem
+from companion.control.mission.zones import CircleZone, PolygonZone, Zone
 from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
 
@@ -31,8 +30,8 @@ class Fence:
     """Zones in metres north/east of the frame's origin."""
 
     frame: LocalFrame
-    inclusions: list[Polygon] = field(default_factory=list)
-    exclusions: list[Polygon] = field(default_factory=list)
+    inclusions: list[Zone] = field(default_factory=list)
+    exclusions: list[Zone] = field(default_factory=list)
 
     @classmethod
     def from_items(cls, items: list[MissionItem]) -> Fence:
@@ -46,13 +45,13 @@ class Fence:
             if item.command in POLYGONS:
                 count = max(3, round(item.param1))
                 vertices = [frame.ne(v.x / 1e7, v.y / 1e7) for v in items[i : i + count]]
-                zone = Polygon(vertices)
+                zone: Zone = PolygonZone(_without_repeats(vertices))
                 i += count
                 (fence.inclusions if POLYGONS[item.command] else fence.exclusions).append(zone)
                 continue
             if item.command in CIRCLES:
                 centre = frame.ne(item.x / 1e7, item.y / 1e7)
-                zone = Point(centre).buffer(abs(item.param1), quad_segs=32)
+                zone = CircleZone(centre, abs(item.param1))
                 (fence.inclusions if CIRCLES[item.command] else fence.exclusions).append(zone)
             i += 1
         return fence
@@ -66,9 +65,17 @@ class Fence:
         """Why this position breaches the fence, or None when it is allowed."""
         if not (math.isfinite(lat_deg) and math.isfinite(lon_deg)):
             return None
-        here = Point(self.frame.ne(lat_deg, lon_deg))
+        here = self.frame.ne(lat_deg, lon_deg)
         if any(not zone.covers(here) for zone in self.inclusions):
             return "outside the fence"
         if any(zone.contains(here) for zone in self.exclusions):
             return "inside an exclusion zone"
         return None
+
+
+def _without_repeats(vertices: list[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
+    """The vertices without one repeated in a row (or the first repeated at the end)."""
+    kept = [v for i, v in enumerate(vertices) if i == 0 or v != vertices[i - 1]]
+    while len(kept) > 1 and kept[-1] == kept[0]:
+        kept.pop()
+    return tuple(kept)
