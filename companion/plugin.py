@@ -82,6 +82,10 @@ class PluginContext:
     # Every plug-in's validated settings by plug-in kind (the flight log records the
     # navigator's, so a replay runs it as it flew).
     plugins: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    # Readable once a signal (a stop request) has come: a plug-in that waits on a device
+    # rather than on the bus polls it too (ReopeningSerial's stop_fd), so a long timeout
+    # still lets it stop at once. None where nobody set one up (a plug-in built in a test).
+    stop_fd: int | None = None
 
 
 class Plugin(ABC):

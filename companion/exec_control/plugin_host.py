@@ -64,6 +64,15 @@ class StepTimer:
         return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
 
 
+def _signal_pipe() -> int:
+    """The read end of a pipe Python writes a byte to whenever a signal arrives."""
+    read_fd, write_fd = os.pipe()
+    os.set_blocking(read_fd, False)
+    os.set_blocking(write_fd, False)
+    signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+    return read_fd
+
+
 class PluginHost:
     """Runs one plug-in instance until stopped."""
 
@@ -83,6 +92,7 @@ class PluginHost:
             vehicle=spec["vehicle"],
             param_decls=tuple(ParamDecl(**d) for d in spec.get("param_decls", [])),
             plugins=spec.get("plugins", {}),
+            stop_fd=_signal_pipe(),
         )
 
     def _clock(self, kind: str) -> VehicleClock:

@@ -12,6 +12,10 @@ timeout on the other URLs). When the device goes (unplugged USB adapter, a pty w
 closed, a socket whose peer left), the port is closed, ``reopens`` counts it, and opening is
 retried with back-off (0.1 s doubling to 2 s). While waiting, ``read`` sleeps at most
 ``read_timeout_s`` per call, so the caller's ``step()`` still returns regularly.
+
+A ``stop_fd`` (the plug-in host's signal wake-up pipe) ends a wait on a device at once: a
+stop request then needs no short timeout to be seen, so a silent device costs one wake-up
+per read timeout (a second), not several.
 """
 
 from __future__ import annotations
@@ -77,7 +81,8 @@ def _read_port(port: serial.SerialBase, now_us: Callable[[], int], size: int) ->
 # (a silent device on the bench woke six sensor processes five times a second at 0.2 s);
 # the bound is how fast a plug-in told to stop notices, well inside the supervisor's
 # grace before SIGKILL (exec_control/supervisor.py, STOP_GRACE_S).
-READ_TIMEOUT_S = 0.5
+READ_TIMEOUT_S = 1.0  # a silent device: the caller's step (and status) once a second
+WRITE_TIMEOUT_S = 0.5
 
 
 class ReopeningSerial:
@@ -89,8 +94,10 @@ class ReopeningSerial:
         baud: int = 9600,
         read_timeout_s: float = READ_TIMEOUT_S,
         framing: Mapping[str, Any] | None = None,
+        stop_fd: int | None = None,
     ) -> None:
         self.url = url
+        self.stop_fd = stop_fd
         self.framing = dict(framing or {})  # pyserial's parity/stopbits/bytesize, if not 8N1
         self.path, self.baud = split_device(url, baud)
         self.read_timeout_s = read_timeout_s
@@ -145,7 +152,11 @@ class ReopeningSerial:
         several Python calls, for every sentence of a 100 Hz device.
         """
         assert self._poll is not None
-        if not self._poll.poll(self._timeout_ms):
+        events = self._poll.poll(self._timeout_ms)
+        if self.stop_fd is not None and any(ready == self.stop_fd for ready, _ in events):
+            _drain(self.stop_fd)  # a signal: its handler has run; the caller looks now
+            return b"", now_us()
+        if not events:
             return b"", now_us()
         t_us = now_us()
         try:
@@ -159,8 +170,8 @@ class ReopeningSerial:
     def write(self, data: bytes) -> int:
         """Bytes written; 0 when the device is gone (it is reopened later) or too slow.
 
-        Blocks at most the read timeout. After a write timeout some bytes may have gone
-        out: pyserial does not say how many.
+        Blocks at most the write timeout (0.5 s, or the read timeout if shorter). After a
+        write timeout some bytes may have gone out: pyserial does not say how many.
         """
         port = self._ensure_open(wait=False)
         if port is None:
@@ -207,7 +218,7 @@ class ReopeningSerial:
                 self.path,
                 baudrate=self.baud,
                 timeout=self.read_timeout_s,
-                write_timeout=self.read_timeout_s,
+                write_timeout=min(self.read_timeout_s, WRITE_TIMEOUT_S),
                 **self.framing,
             )
         except _PORT_ERRORS as exc:
@@ -222,7 +233,7 @@ class ReopeningSerial:
         self.opens += 1
         self._retry_s = FIRST_RETRY_S
         self._port = port
-        self._poll = _poll_for(port)
+        self._poll = _poll_for(port, self.stop_fd)
         return port
 
     def _lost(self, exc: BaseException) -> None:
@@ -253,11 +264,23 @@ def _write_fd(port: serial.SerialBase, data: bytes) -> int:
     return written + (port.write(data[written:]) or 0)
 
 
-def _poll_for(port: serial.SerialBase) -> select.poll | None:
-    """A poll on the port's descriptor when it is a POSIX serial port (or pty), else None."""
+def _poll_for(port: serial.SerialBase, stop_fd: int | None) -> select.poll | None:
+    """A poll on the port's descriptor (and ``stop_fd``) when it is a POSIX serial port (or
+    pty), else None."""
     fd = getattr(port, "fd", None)
     if not isinstance(port, serial.Serial) or not isinstance(fd, int):
         return None
     poll = select.poll()
     poll.register(fd, select.POLLIN)
+    if stop_fd is not None:
+        poll.register(stop_fd, select.POLLIN)
     return poll
+
+
+def _drain(fd: int) -> None:
+    """Empty a non-blocking wake-up pipe, so it wakes the next poll only for a new signal."""
+    try:
+        while os.read(fd, 256):
+            pass
+    except (BlockingIOError, InterruptedError, OSError):
+        pass

@@ -16,7 +16,7 @@ from companion.navigation.offline import InsEkfRunner
 from companion.navigation.sample_order import FEED_ORDER, PublishGrid, SampleOrder
 from companion.plugin import Plugin, PluginContext, Setting
 
-WAIT_S = 0.5
+WAIT_S = 1.0  # without an IMU: its status, and any aiding samples, once a second
 _DEFAULTS = InsEkfConfig()
 
 

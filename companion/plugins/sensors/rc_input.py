@@ -42,7 +42,9 @@ class RcInput(Plugin):
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
         framing = SBUS_FRAMING
-        self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"], framing=framing)
+        self.port = ReopeningSerial(
+            ctx.settings["device"], ctx.settings["baud"], framing=framing, stop_fd=ctx.stop_fd
+        )
         self.decoder = SbusDecoder()
         self.live = LiveParams(ctx.bus, self.params, Path(ctx.vehicle.get("state_dir", ".")))
         self.stick_map = StickMap.from_params(self.live.values)

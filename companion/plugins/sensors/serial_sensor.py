@@ -68,7 +68,9 @@ class SerialSensor(Plugin, Generic[ReadingT]):
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
-        self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"])
+        self.port = ReopeningSerial(
+            ctx.settings["device"], ctx.settings["baud"], stop_fd=ctx.stop_fd
+        )
         self.framer = self.make_framer()
         self.decoder = self.make_decoder(ctx.settings)
 

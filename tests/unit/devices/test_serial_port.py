@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import os
+import signal
 import socket
+import threading
 import time
 from collections.abc import Callable
 
@@ -169,3 +171,35 @@ def test_a_socket_peer_that_leaves_is_reconnected():
         assert read_until(port, lambda d: d.endswith(b"\n"))[0] == b"two\n"
         peer.close()
         port.close()
+
+
+def test_a_signal_ends_a_wait_on_a_silent_device_at_once(tmp_path):
+    """The plug-in host's signal pipe: a stop request is seen now, not after the timeout."""
+    read_fd, write_fd = os.pipe()
+    os.set_blocking(read_fd, False)
+    os.set_blocking(write_fd, False)
+    handled = []
+    previous_handler = signal.signal(signal.SIGUSR1, lambda *_: handled.append(True))
+    previous_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+    pty = Pty(tmp_path / "ttyGPS")
+    try:
+        port = ReopeningSerial(str(pty.link), 9600, read_timeout_s=10.0, stop_fd=read_fd)
+        assert port.write(b"\r") == 1 and port.is_open  # a write opens it; it stays silent
+        timer = threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGUSR1))
+        timer.start()
+        start = time.monotonic()
+        data = port.read()
+        waited = time.monotonic() - start
+        timer.join()
+        assert data == b"" and handled == [True]
+        assert waited < 5.0, f"the read waited {waited:.1f} s, its whole 10 s timeout"
+        # The pipe was emptied: the next read waits for the device again, and gets it.
+        os.write(pty.master, b"$GPGGA\r\n")
+        assert read_until(port, lambda d: d.endswith(b"\n"))[0] == b"$GPGGA\r\n"
+        port.close()
+    finally:
+        pty.vanish()
+        signal.set_wakeup_fd(previous_fd)
+        signal.signal(signal.SIGUSR1, previous_handler)
+        os.close(read_fd)
+        os.close(write_fd)
