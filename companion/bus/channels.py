@@ -93,8 +93,10 @@ class Writer(Generic[M]):
         self._seq = 0
         self.sent = 0
 
-    def publish(self, msg: M) -> None:
-        """Copy the message into shared memory, send it, and notify readers."""
+    def publish(self, msg: M, wake: bool = True) -> None:
+        """Copy the message into shared memory, send it, and notify readers (unless not
+        ``wake``: a value whose news a reader only looks at when it reads, such as a table's
+        counters, need not end anybody's sleep)."""
         if ctypes.sizeof(msg) != self._size:
             raise TypeError(f"{self.name}: a {type(msg).__name__} is not this channel's type")
         sample = _loan_uninit(self._publisher)
@@ -104,7 +106,8 @@ class Writer(Generic[M]):
         self._seq += 1
         _memmove(sample.payload_ptr, _addressof(msg), self._size)
         _assume_init(sample).send()
-        self._notifier.notify()
+        if wake:
+            self._notifier.notify()
         self.sent += 1
 
     def readers(self) -> int:

@@ -66,6 +66,7 @@ class Supervisor:
         self.forker = forker or ForkServer(sorted({s.kind for s in cfg.plugins}), log_level)
         self.next_forker_at = 0.0
         self.flight_running = False
+        self._health_shape: tuple[object, ...] = ()  # of the last table that woke its readers
         self.reason = ""  # why the last command was refused, for its ack
         self.stopping = False
         self.clock: VehicleClock = MonotonicClock()
@@ -137,7 +138,11 @@ class Supervisor:
         for i, child in enumerate(self.children):
             child.sample_usage()
             msg.plugins[i] = child.health_row()
-        writer.publish(msg)  # type: ignore[attr-defined]
+        # Arming, a plug-in starting, dying or restarting wakes the readers that wait on
+        # the table (commander, link, logger); the counters alone, once a second, do not.
+        shape = (msg.flight_running, *((r.state, r.pid, r.restarts) for r in msg.rows()))
+        writer.publish(msg, wake=shape != self._health_shape)  # type: ignore[attr-defined]
+        self._health_shape = shape
 
     def absorb_stats(self, stats: Reader[PluginStats]) -> None:
         by_name = {c.spec.name: c for c in self.children}

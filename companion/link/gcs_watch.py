@@ -33,9 +33,14 @@ class GcsWatch:
     def tick(self, now_s: float) -> list[Outgoing]:
         return []
 
+    @property
+    def heard(self) -> bool:
+        """Whether any ground station has spoken yet."""
+        return self.last_heard_s is not None
+
     def status_period_s(self) -> float:
         """How often link/status is worth publishing."""
-        return UNHEARD_STATUS_PERIOD_S if self.last_heard_s is None else STATUS_PERIOD_S
+        return STATUS_PERIOD_S if self.heard else UNHEARD_STATUS_PERIOD_S
 
     def silence_s(self, now_s: float) -> float:
         """Seconds since the last ground-station heartbeat; NaN before the first."""

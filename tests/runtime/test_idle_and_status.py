@@ -9,6 +9,7 @@ import time
 
 import psutil
 
+from companion.messages import PluginState
 from tests.support.configs import pipeline
 from tests.support.vehicle import REPO, assert_clean, companion_env, unique_namespace, wait_for
 
@@ -84,3 +85,34 @@ def test_status_human_table_and_silence(vehicle_factory, tmp_path):
     assert silent.returncode == 1
     assert "no vehicle" in silent.stderr
     assert_clean(nobody)
+
+
+def test_the_health_table_wakes_its_readers_for_news_not_for_counters(vehicle_factory):
+    """Published every second, the table ends a sleeping reader's wait only when a plug-in
+    starts, dies or restarts, or the vehicle arms: the commander, the link and the logger
+    wait on it, and a vehicle on the bench should not wake them for its counters."""
+    vehicle = vehicle_factory(pipeline())
+    idle_pid = vehicle.wait_running("idle")
+    vehicle.wait_running("imu")
+    vehicle.wait_running("relay")
+    bus = vehicle.bus
+    health = bus.latest_reader("system/health")
+    waiter = bus.waiter([health])
+    try:
+        wait_for(lambda: health.get() is not None, 10, "a health table")
+        first_us = health.get().t_us
+        waiter.wait(0.0)  # whatever woke it before now is old news
+        start = time.monotonic()
+        waiter.wait(3.5)
+        slept = time.monotonic() - start
+        later = health.get()
+        assert slept > 3.0, f"a table with new counters only ended a wait after {slept:.2f} s"
+        assert later is not None and later.t_us > first_us, "the table is still published"
+        psutil.Process(idle_pid).kill()
+        start = time.monotonic()
+        waiter.wait(10.0)
+        assert time.monotonic() - start < 5.0, "a dead plug-in's row must wake its readers"
+        row = health.get().rows()[[r.name for r in health.get().rows()].index(b"idle")]
+        assert (row.pid, row.state) != (idle_pid, PluginState.RUNNING), "woken by other news"
+    finally:
+        waiter.close()

@@ -302,7 +302,8 @@ class MavlinkLink(Plugin):
     def _wait_input(self, now_s: float) -> None:
         nav_known = self.snapshot.nav is not None
         timeout, nav_wanted = self.router.next_wake(now_s, MAX_WAIT_S, nav_known)
-        timeout = min(timeout, max(0.0, self.next_link_status_s - now_s))
+        if self.gcs.heard:  # before, link/status says "never heard": it rides other wakes
+            timeout = min(timeout, max(0.0, self.next_link_status_s - now_s))
         fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         woken, ready = self.waker.wait_with_fds(timeout, list(fd_owner), nav_wanted)
         if self.readers["nav"] in woken:
