@@ -6,6 +6,7 @@ import contextlib
 import logging
 import os
 import signal
+import time
 from pathlib import Path
 
 import pytest
@@ -263,3 +264,31 @@ def test_samples_lost_before_arming_are_marked_in_the_armed_log(vehicle_factory,
     warnings = [m.message for m in ulog.logged_messages if "logger lost" in m.message]
     assert sum(int(text.split()[2]) for text in warnings) == missing
     assert ulog.dropouts
+
+
+def voluntary_switches(pid: int) -> int:
+    """Times the process's main thread went to sleep (each ends in one wake-up)."""
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("voluntary_ctxt_switches"):
+            return int(line.split()[1])
+    raise AssertionError("no context switch count")
+
+
+def test_on_a_quiet_bench_the_logger_sleeps_until_a_sample_comes(vehicle_factory, tmp_path):
+    """A trickle (2 samples a second) wakes the logger for each sample, not 4-5 times a
+    second on a timer; what it cannot lose it need not look for."""
+    vehicle = vehicle_factory(
+        vehicle_config(
+            "trickle",
+            plugin("logger", "system.logger"),
+            plugin("imu", "tests.support.plugins:Ticker", rate_hz=2.0),
+            state_dir=tmp_path / "state",
+        )
+    )
+    pid = vehicle.wait_running("logger")
+    wait_for(lambda: vehicle.row("logger").step_p50_us > 0, 30, "the logger stepping")
+    time.sleep(2.0)  # its reads have measured the trickle
+    before, start = voluntary_switches(pid), time.monotonic()
+    time.sleep(6.0)
+    per_s = (voluntary_switches(pid) - before) / (time.monotonic() - start)
+    assert per_s < 3.2, f"the logger woke {per_s:.1f} times a second for 2 samples a second"

@@ -11,7 +11,8 @@ host adds every bus reader's losses), and in the log as a dropout and a warning 
 gap is. Latest channels are read keeping every value (``BusNode.latest_reader``'s
 ``keep``), so the log holds each one however seldom it reads: it reads every ``period_s``
 at first, then less often (up to every 0.1 s) while its queues fill slowly, more often
-while one comes back over half full. The file is flushed and fsynced at least once a
+while one comes back over half full, and only when a sample comes while fewer than four
+arrive a second (a vehicle on the bench). The file is flushed and fsynced at least once a
 (wall) second, so a power cut loses at most that much and leaves a file pyulog reads up to
 its last complete message; a file appears only once its header is on disk. At each flush
 the oldest logs past ``budget_mb`` go, and a file past ``file_mb`` goes on in a new one
@@ -66,6 +67,10 @@ CALM_PERIOD_S = 0.1
 # With nothing arriving (a vehicle on the bench), it reads this seldom at most: a sensor
 # starting at 200 Hz fills a 64-deep queue in 0.32 s, and arming wakes it at once.
 IDLE_PERIOD_S = 0.25
+# Fewer samples a second than this (a vehicle on the bench: its status and little else):
+# the next sample of any channel wakes it, up to this long, instead of a timer.
+TRICKLE_HZ = 4.0
+TRICKLE_WAIT_S = 5.0
 # The channels that wake the logger at once (rare, and worth their exact order); the rest
 # is drained when it wakes on its own: waking for every 100 Hz sample would cost more CPU
 # than writing them.
@@ -159,6 +164,9 @@ class LoggerPlugin(Plugin):
         self.health = ctx.bus.latest_reader("system/health")
         wakers = [r for n, r in self.readers.items() if s["in_step"] or n in _WAKERS]
         self.waiter = ctx.bus.waiter(wakers)
+        self.any_sample = ctx.bus.waiter(list(self.readers.values()))
+        self.trickle = False  # the last read found under TRICKLE_HZ samples a second
+        self.read_at_s = time.monotonic()
         self.progress = ctx.bus.writer("system/logged") if s["in_step"] else None
         self.written_us = -1
         # What can fill between two reads (a Latest channel of depth 1 keeps one value).
@@ -188,10 +196,12 @@ class LoggerPlugin(Plugin):
             self._open("boot")
 
     def step(self) -> None:
-        timeout = self.period_s
+        timeout, waiter = self.period_s, self.waiter
+        if self.trickle:  # nothing can overflow: the first sample of a stream ends the wait
+            timeout, waiter = TRICKLE_WAIT_S, self.any_sample
         if self.recorder.is_open:  # the flush is due on time, whatever the period
             timeout = min(timeout, max(0.0, self.next_flush - time.monotonic()))
-        self.waiter.wait(timeout)
+        waiter.wait(timeout)
         try:
             self._work()
         except OSError as exc:
@@ -215,6 +225,9 @@ class LoggerPlugin(Plugin):
                 fill = max(fill, count / self.depths[name])
             total += count
         self._adapt(fill, total)
+        now_s = time.monotonic()
+        self.trickle = total < TRICKLE_HZ * (now_s - self.read_at_s)
+        self.read_at_s = now_s
         if self.progress is not None and self.writer is not None:
             self.progress.publish(LogProgress(t_us=self.written_us))
         if self.recorder.is_open and time.monotonic() >= self.next_flush:
