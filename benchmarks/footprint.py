@@ -13,10 +13,14 @@ the fork server; never the simulator bridge.
   simulator bridge's own start, JSBSim loading its model, is in it and is shown apart);
 - restart of a plug-in killed with SIGKILL: from the kill to its first step in the new
   process (its first ``system/plugin_stats``) and to its output on the bus again;
-- CPU time per real second (utime + stime from ``/proc/PID/stat``; the simulation runs at
-  real time, and the ratio to simulated time is printed too) over ``--cpu-seconds`` of flight;
+- CPU time per real second (the scheduler's nanosecond count of every thread,
+  ``/proc/PID/task/*/schedstat``; the simulation runs at real time, and the ratio to
+  simulated time is printed too) over ``--cpu-seconds`` of flight, and wake-ups per second
+  (voluntary context switches): with Python in each process, a wake-up's fixed cost is
+  most of what a plug-in spends (``benchmarks/wake_floor.py`` measures it);
 - idle on the bench: ``companion run`` of the same config, each of its ``sim://`` devices a
-  pty nobody writes to (sensors connected but silent), CPU per second of each process;
+  pty nobody writes to (sensors connected but silent), CPU and wake-ups per second of each
+  process;
 - installed size of the on-board program: ``pip install .`` (no [ground] extra) into a
   fresh venv made by uv, ``du`` of its site-packages.
 
@@ -48,7 +52,7 @@ import psutil
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from benchmarks.process_probes import cpu_ticks, pss_kib, vehicle_pids  # noqa: E402
+from benchmarks.process_probes import cpu_seconds, pss_kib, vehicle_pids, wakeups  # noqa: E402
 from companion.bus import BusNode, cleanup_namespace  # noqa: E402
 from companion.messages import PluginState  # noqa: E402
 from mavlink_dialect import companion as m  # noqa: E402
@@ -154,15 +158,18 @@ class Vehicle:
     def pss(self) -> dict[str, int]:
         return {name: pss_kib(pid) for name, pid in self.labelled().items()}
 
-    def cpu(self, seconds: float) -> tuple[dict[str, float], float]:
-        """CPU seconds per real second of each process, and simulated s per real s."""
+    def cpu(self, seconds: float) -> tuple[dict[str, float], dict[str, float], float]:
+        """CPU seconds and wake-ups per real second of each process, and simulated s per
+        real s."""
         pids = self.labelled()
-        before = {n: cpu_ticks(p) for n, p in pids.items()}
+        before = {n: (cpu_seconds(p), wakeups(p)) for n, p in pids.items()}
         wall0, sim0 = time.monotonic(), self.sim_s()
         time.sleep(seconds)
         wall, sim = time.monotonic() - wall0, self.sim_s() - sim0
-        after = {n: cpu_ticks(p) for n, p in pids.items()}
-        return {n: (after[n] - before[n]) / wall for n in pids}, sim / wall
+        after = {n: (cpu_seconds(p), wakeups(p)) for n, p in pids.items()}
+        cpu = {n: (after[n][0] - before[n][0]) / wall for n in pids}
+        wakes = {n: (after[n][1] - before[n][1]) / wall for n in pids}
+        return cpu, wakes, sim / wall
 
     def restart(self, name: str, channel: str) -> tuple[float, float]:
         """Kill -9 a plug-in; seconds until its first step and until its output again."""
@@ -210,7 +217,7 @@ def _guess(pid: int, supervisor: int) -> str:
     return "fork server" if "zygote" in cmd or parent == supervisor else f"other {pid}"
 
 
-def fly_once(cpu_seconds: float) -> dict[str, object]:
+def fly_once(cpu_s: float) -> dict[str, object]:
     tmp = Path(tempfile.mkdtemp(prefix="footprint"))
     namespace = f"fp{os.getpid()}_{int(time.time() * 1000) % 100000}"
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -230,7 +237,7 @@ def fly_once(cpu_seconds: float) -> dict[str, object]:
         res["pss_disarmed"] = v.pss()
         v.wait_sim(ARM_AT_S + FLYING_AFTER_S)
         res["pss_flying"] = v.pss()
-        res["cpu"], res["sim_rate"] = v.cpu(cpu_seconds)
+        res["cpu"], res["wakes"], res["sim_rate"] = v.cpu(cpu_s)
         for name, pss in v.pss().items():  # the larger of the two flying samples
             res["pss_flying"][name] = max(res["pss_flying"].get(name, 0), pss)  # type: ignore[index]
         res["restart"] = {name: v.restart(name, chan) for name, chan in KILLED}
@@ -261,7 +268,7 @@ def bench_config(tmp: Path) -> tuple[Path, list[tuple[int, int]]]:
     return config, ptys
 
 
-def bench_idle(seconds: float) -> tuple[dict[str, float], dict[str, int]]:
+def bench_idle(seconds: float) -> tuple[dict[str, float], dict[str, int], dict[str, float]]:
     """``companion run`` of the sim config with silent ptys for its devices."""
     tmp = Path(tempfile.mkdtemp(prefix="footprint_idle"))
     config, ptys = bench_config(tmp)
@@ -272,12 +279,13 @@ def bench_idle(seconds: float) -> tuple[dict[str, float], dict[str, int]]:
     try:
         v.vehicle_up()
         time.sleep(5.0)
-        cpu, pss = v.cpu(seconds)[0], v.pss()
+        cpu, wakes, _ = v.cpu(seconds)
+        pss = v.pss()
     finally:
         v.stop()
         for fd in (fd for pair in ptys for fd in pair):
             os.close(fd)
-    return cpu, pss
+    return cpu, pss, wakes
 
 
 def installed_size() -> tuple[float, float]:
@@ -316,17 +324,19 @@ def print_flight(runs: list[dict[str, object]]) -> None:
     dis = _median_table([r["pss_disarmed"] for r in runs])  # type: ignore[misc]
     fly = _median_table([r["pss_flying"] for r in runs])  # type: ignore[misc]
     cpu = _median_table([r["cpu"] for r in runs])  # type: ignore[misc]
+    wakes = _median_table([r["wakes"] for r in runs])  # type: ignore[misc]
     how = "from source" if "PYTHONPYCACHEPREFIX" not in ENV else "bytecode compiled"
     print(f"companion sim, real time, square mission, {how}; medians of {len(runs)} run(s)")
-    print(f"{'process':<14}{'PSS disarmed':>14}{'PSS flying':>12}{'CPU flying':>12}")
+    print(f"{'process':<14}{'PSS disarmed':>14}{'PSS flying':>12}{'CPU flying':>12}{'wakes/s':>9}")
     for name in _order(sorted(set(dis) | set(fly))):
         d, f, c = dis.get(name, 0) / 1024, fly.get(name, 0) / 1024, cpu.get(name, 0) * 100
-        print(f"{name:<14}{d:11.1f} MB{f:9.1f} MB{c:10.2f} %")
+        print(f"{name:<14}{d:11.1f} MB{f:9.1f} MB{c:10.2f} %{wakes.get(name, 0):9.0f}")
     total_d = statistics.median(sum(r["pss_disarmed"].values()) for r in runs) / 1024  # type: ignore[attr-defined]
     total_f = statistics.median(sum(r["pss_flying"].values()) for r in runs) / 1024  # type: ignore[attr-defined]
     total_c = statistics.median(sum(r["cpu"].values()) for r in runs) * 100  # type: ignore[attr-defined]
     rate = statistics.median(r["sim_rate"] for r in runs)  # type: ignore[misc]
-    print(f"{'total':<14}{total_d:11.1f} MB{total_f:9.1f} MB{total_c:10.2f} %")
+    total_w = sum(wakes.values())
+    print(f"{'total':<14}{total_d:11.1f} MB{total_f:9.1f} MB{total_c:10.2f} %{total_w:9.0f}")
     print(f"  (CPU: % of one core = CPU s per real s; simulated/real = {rate:.3f})")
     hb = statistics.median(r["heartbeat_s"] for r in runs)  # type: ignore[misc]
     up = statistics.median(r["up_s"] for r in runs)  # type: ignore[misc]
@@ -356,9 +366,14 @@ def main() -> None:
         cpu = _median_table([i[0] for i in idles])
         total = statistics.median(sum(i[0].values()) for i in idles) * 100
         pss = statistics.median(sum(i[1].values()) for i in idles) / 1024
-        each = ", ".join(f"{n} {c * 100:.2f}" for n, c in sorted(cpu.items(), key=lambda i: -i[1]))
+        wakes = _median_table([i[2] for i in idles])
+        each = ", ".join(
+            f"{n} {c * 100:.2f} ({wakes.get(n, 0):.1f})"
+            for n, c in sorted(cpu.items(), key=lambda i: -i[1])
+        )
         print(f"idle on the bench (companion run, silent devices): CPU {total:.2f} %, "
-              f"PSS {pss:.1f} MB\n  per process, % of a core: {each}")  # fmt: skip
+              f"PSS {pss:.1f} MB\n  per process, % of a core (wake-ups a second): "
+              f"{each}")  # fmt: skip
     if not args.no_install:
         site, venv = installed_size()
         print(f"installed (pip install . into a fresh venv): site-packages {site:.0f} MB, "
