@@ -10,11 +10,12 @@ declarations (``companion.params.metadata``); the FTP server is ``companion.link
 from __future__ import annotations
 
 from collections.abc import Iterable
+from functools import cached_property
 from typing import Any
 
 from companion.link.ftp import FtpServer
 from companion.link.service import Outgoing, Peer
-from companion.params.metadata import metadata_files
+from companion.params.metadata import MetadataFiles, metadata_files
 from companion.params.store import ParamDecl
 
 
@@ -27,13 +28,23 @@ class MetadataService:
         self.mav = mav
         self.sysid = sysid
         self.compid = compid
-        self.metadata = metadata_files(decls)
-        self.ftp = FtpServer(self.metadata.files)
+        self._decls = tuple(decls)
         self.rejected_target = 0  # for another component of this system
+
+    # Made when a ground station first asks (QGroundControl: once per connection), not at
+    # start-up: the JSON of every parameter costs ~50 ms and its garbage stays in the
+    # process's memory, on a vehicle that may never meet a ground station that asks.
+    @cached_property
+    def metadata(self) -> MetadataFiles:
+        return metadata_files(self._decls)
+
+    @cached_property
+    def ftp(self) -> FtpServer:
+        return FtpServer(self.metadata.files)
 
     @property
     def refused(self) -> int:
-        return self.ftp.refused
+        return self.ftp.refused if "ftp" in self.__dict__ else 0
 
     def component_metadata(self, time_boot_ms: int) -> Any:
         uri = self.metadata.general_uri.encode()
