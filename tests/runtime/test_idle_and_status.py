@@ -9,8 +9,9 @@ import time
 
 import psutil
 
-from companion.messages import PluginState
-from tests.support.configs import pipeline
+from companion.messages import CommandId, FlightMode, PluginState, VehicleCommand
+from tests.protocol.mav_client import free_udp_port
+from tests.support.configs import client_vehicle, pipeline
 from tests.support.vehicle import REPO, assert_clean, companion_env, unique_namespace, wait_for
 
 
@@ -114,5 +115,36 @@ def test_the_health_table_wakes_its_readers_for_news_not_for_counters(vehicle_fa
         assert time.monotonic() - start < 5.0, "a dead plug-in's row must wake its readers"
         row = health.get().rows()[[r.name for r in health.get().rows()].index(b"idle")]
         assert (row.pid, row.state) != (idle_pid, PluginState.RUNNING), "woken by other news"
+    finally:
+        waiter.close()
+
+
+def test_a_disarmed_commander_wakes_status_readers_for_a_change_only(vehicle_factory, tmp_path):
+    """The status goes out once a second while disarmed; a sleeping reader (the link) is
+    woken by a new mode, not by the same status again."""
+    port = free_udp_port()  # nobody listens there: the link only sends
+    vehicle = vehicle_factory(client_vehicle(f"udpout://127.0.0.1:{port}", tmp_path))
+    vehicle.wait_running("commander")
+    bus = vehicle.bus
+    status = bus.latest_reader("vehicle/status")
+    waiter = bus.waiter([status])
+    commands = bus.writer("link/commands")
+    try:
+        wait_for(lambda: status.get() is not None, 30, "a status")
+        time.sleep(1.5)  # the first statuses (home set from the navigation) are old news
+        waiter.wait(0.0)
+        first_us = status.get().t_us
+        start = time.monotonic()
+        waiter.wait(3.5)
+        slept = time.monotonic() - start
+        assert status.get().t_us > first_us, "the status is still published"
+        assert slept > 3.0, f"the same status again ended a wait after {slept:.2f} s"
+        command = VehicleCommand(t_us=0, seq=1, command=int(CommandId.SET_MODE))
+        command.param[0] = float(FlightMode.RTL)
+        start = time.monotonic()
+        commands.publish(command)
+        waiter.wait(10.0)
+        assert time.monotonic() - start < 5.0, "a new mode must wake the status's readers"
+        assert status.get().mode == FlightMode.RTL
     finally:
         waiter.close()

@@ -29,6 +29,7 @@ from companion.messages import (
     FlightMode,
     NavFlags,
     StatusText,
+    VehicleStatus,
 )
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
@@ -39,8 +40,8 @@ WAIT_S = 0.05  # armed: navigation, sticks and failsafes looked at 20 times a wa
 # (an arming wakes it at once: the supervisor's health table says so as it arms).
 DISARMED_WAIT_S = 1.0
 STATUS_PERIOD_US = 250_000  # 4 Hz: the link and the controller follow it
-# Disarmed, a status that has not changed goes out once a second: each one wakes the link
-# and the logger, and a change (an ack, the mode switch, a failsafe) is sent at once anyway.
+# Disarmed, a status that has not changed goes out once a second, and wakes no reader; a
+# change (an ack, the mode switch, a failsafe) is sent at once, and wakes them.
 DISARMED_STATUS_PERIOD_US = 1_000_000
 FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) second
 
@@ -99,6 +100,7 @@ class CommanderPlugin(Plugin):
         self.out = bus.writer("vehicle/status")
         self.texts = bus.writer("vehicle/statustext")
         self.next_status_us = 0
+        self.last_status = b""  # the last status published, time stamp left out
         self.next_failsafe_us = 0
         self.nav_seen: Any = None  # the last solution read, usable or not
         self.nav_good: Any = None  # the last usable one
@@ -121,7 +123,7 @@ class CommanderPlugin(Plugin):
             self.next_failsafe_us = now + FAILSAFE_PERIOD_US
             changed |= self._failsafes(now, nav)
         if changed or now >= self.next_status_us:
-            self.out.publish(c.status(now))
+            self._publish_status(c.status(now), c.armed)
             self.next_status_us = now + (STATUS_PERIOD_US if c.armed else DISARMED_STATUS_PERIOD_US)
             self.ctx.health.ok()
         # After the status: whoever hears an ack finds the status already saying so (a
@@ -129,6 +131,13 @@ class CommanderPlugin(Plugin):
         # the old mode, when this process was preempted between the two).
         for ack in acks:
             self.acks.publish(ack)
+
+    def _publish_status(self, status: VehicleStatus, armed: bool) -> None:
+        """Disarmed, the same status again wakes nobody (the link would wake for it each
+        second); armed, the controller started with the flight may be waiting for it."""
+        content = bytes(status)[VehicleStatus.mode.offset :]  # all but the time stamp
+        self.out.publish(status, wake=armed or content != self.last_status)
+        self.last_status = content
 
     def _nav(self) -> Any:
         """The newest usable navigation solution: one whose position is not a place is
