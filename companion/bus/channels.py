@@ -32,6 +32,7 @@ log = logging.getLogger(__name__)
 M = TypeVar("M", bound=Message)
 
 _MAX_WAIT_S = 3600.0
+_MIN_LISTENER_WAIT_S = 1e-6
 
 
 class SampleHeader(ctypes.Structure):
@@ -56,6 +57,12 @@ _assume_init = getattr(iox2.SampleMutUninit, "__assume_init")
 def duration(timeout_s: float) -> iox2.Duration:
     """An iceoryx2 Duration from seconds (clamped to [0, 1 h])."""
     return iox2.Duration.from_secs_f64(min(max(timeout_s, 0.0), _MAX_WAIT_S))
+
+
+def listener_timeout(timeout_s: float) -> iox2.Duration:
+    """A Listener's timeout: a zero Duration makes its ``timed_wait`` wait for ever (a
+    WaitSet's does not wait at all), so the shortest one is a microsecond."""
+    return duration(max(timeout_s, _MIN_LISTENER_WAIT_S))
 
 
 class IdleTally:
@@ -187,7 +194,7 @@ class Reader(Generic[M]):
             return True
         try:
             with self._idle:
-                events = self.listener.timed_wait(duration(timeout_s))
+                events = self.listener.timed_wait(listener_timeout(timeout_s))
         except iox2.ListenerWaitError:
             return False
         # timed_wait has consumed the notifications it returned.

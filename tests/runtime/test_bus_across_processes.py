@@ -10,7 +10,7 @@ import time
 import pytest
 
 from companion.bus import BusNode, cleanup_namespace
-from companion.messages import Imu, NavState
+from companion.messages import Imu, Magnetometer, NavState
 from tests.support.configs import PUBLISH_ONCE, plugin, vehicle_config
 from tests.support.vehicle import REPO, assert_clean, unique_namespace, wait_for
 
@@ -182,3 +182,26 @@ def test_a_closed_node_leaves_nothing_though_its_ports_are_still_referenced(name
     cleanup_namespace(namespace)
     assert_clean(namespace)
     assert ports and nav  # still referenced until here
+
+
+def test_a_waiter_on_one_trigger_sleeps_for_it_alone_and_never_for_ever(namespace):
+    """One trigger waits on its own listener, whose zero timeout would mean for ever: a
+    zero (or negative) timeout returns at once, a sample on the other reader wakes nobody,
+    and the trigger's sample does."""
+    with BusNode(namespace, "one") as bus:
+        imu, mag = bus.queue_reader("sensors/imu"), bus.queue_reader("sensors/mag")
+        waiter = bus.waiter([imu, mag], triggers=[imu])
+        imu_out, mag_out = bus.writer("sensors/imu"), bus.writer("sensors/mag")
+        started = time.monotonic()
+        assert waiter.wait(0.0) == [] and waiter.wait(-1.0) == []
+        assert time.monotonic() - started < 1.0
+        mag_out.publish(Magnetometer(t_us=1))
+        started = time.monotonic()
+        assert waiter.wait(0.3) == [mag]  # slept its whole timeout: mag is not a trigger
+        assert time.monotonic() - started >= 0.25
+        list(mag.drain())
+        imu_out.publish(Imu(t_us=2))
+        started = time.monotonic()
+        assert waiter.wait(30.0) == [imu]
+        assert time.monotonic() - started < 10.0
+        waiter.close()
