@@ -46,19 +46,21 @@ def test_takeoff_climbs_until_within_5_m_then_flies_on():
     assert sp.alt_msl == pytest.approx(HOME_ALT + 100.0)
 
 
+def climb_ending_at(end, second, turn_radius=150.0):
+    """A take-off to 100 m east along the runway, waypoints at (0, 900) and ``second``; the
+    executor and its setpoint when the climb ends at ``end``."""
+    items = [item(0, d.MAV_CMD_NAV_TAKEOFF, None, z=100.0), wp(1, (0.0, 900.0)), wp(2, second)]
+    ex = executor(items, alt=HOME_ALT)
+    ex.step((0.0, 0.0), HOME_ALT, 0.0, turn_radius=turn_radius)
+    return ex, ex.step(end, HOME_ALT + 99.0, 40.0, turn_radius=turn_radius)
+
+
 def test_a_waypoint_the_climb_flew_past_is_flown_back_to():
     """A take-off with the wind behind it ended 700 m beyond the J3Cub's first waypoint:
     met 1 km down the next leg, that leg was flown 400 m off its line. Past the waypoint
     and off the next leg by more than the acceptance radius, the aircraft now turns back
     and flies the waypoint, from which the next leg starts on its line."""
-    items = [
-        item(0, d.MAV_CMD_NAV_TAKEOFF, None, z=100.0),
-        wp(1, (0.0, 900.0)),
-        wp(2, (1_500.0, 2_400.0)),
-    ]
-    ex = executor(items, alt=HOME_ALT)
-    ex.step((0.0, 0.0), HOME_ALT, 0.0, turn_radius=150.0)
-    sp = ex.step((0.0, 1_000.0), HOME_ALT + 99.0, 40.0, turn_radius=150.0)
+    ex, sp = climb_ending_at((0.0, 1_000.0), (1_500.0, 2_400.0))
     assert ex.drain_reached() == [0]
     assert sp.kind == Kind.LINE
     assert sp.a == pytest.approx((0.0, 1_000.0), abs=0.05)  # from here, back to it
@@ -71,22 +73,13 @@ def test_a_waypoint_the_climb_flew_past_on_the_next_legs_line_is_reached():
     # Climbing east along the runway, the take-off ends 500 m beyond the first waypoint,
     # on the line of the next leg (straight on east): that one counts as reached and the
     # next leg is flown at once.
-    items = [
-        item(0, d.MAV_CMD_NAV_TAKEOFF, None, z=100.0),
-        wp(1, (0.0, 900.0)),
-        wp(2, (0.0, 2_400.0)),
-    ]
-    ex = executor(items, alt=HOME_ALT)
-    ex.step((0.0, 0.0), HOME_ALT, 0.0, turn_radius=150.0)
-    sp = ex.step((0.0, 1_400.0), HOME_ALT + 99.0, 40.0, turn_radius=150.0)
+    ex, sp = climb_ending_at((0.0, 1_400.0), (0.0, 2_400.0))
     assert ex.drain_reached() == [0, 1]
     assert sp.kind == Kind.LINE
     assert sp.a == pytest.approx((0.0, 900.0), abs=0.05)
     assert sp.b == pytest.approx((0.0, 2_400.0), abs=0.05)
     # Not yet at the waypoint when the climb ends: it is flown to, as before.
-    ex = executor(items, alt=HOME_ALT)
-    ex.step((0.0, 0.0), HOME_ALT, 0.0)
-    sp = ex.step((0.0, 600.0), HOME_ALT + 99.0, 30.0)
+    ex, sp = climb_ending_at((0.0, 600.0), (0.0, 2_400.0), turn_radius=0.0)
     assert ex.drain_reached() == [0]
     assert sp.b == pytest.approx((0.0, 900.0), abs=0.05)
 
