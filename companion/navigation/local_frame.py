@@ -15,20 +15,24 @@ import math
 
 import numpy as np
 
-WGS84_A = 6378137.0  # semi-major axis, m
-WGS84_F = 1 / 298.257223563
-_E2 = WGS84_F * (2 - WGS84_F)  # first eccentricity squared
+from companion.geodesy import E2, A
+
 _LAT_TOLERANCE_RAD = 1e-15
 _MAX_ITERATIONS = 10
+
+
+def _prime_vertical_radius(sin_lat: float) -> float:
+    """N: the ellipsoid's radius of curvature square to the meridian, m."""
+    return A / math.sqrt(1 - E2 * sin_lat * sin_lat)
 
 
 def ecef(lat_deg: float, lon_deg: float, alt_m: float) -> tuple[float, float, float]:
     """Earth-centred, Earth-fixed coordinates (m) of a point above the ellipsoid."""
     lat, lon = math.radians(lat_deg), math.radians(lon_deg)
     sin_lat, cos_lat = math.sin(lat), math.cos(lat)
-    n = WGS84_A / math.sqrt(1 - _E2 * sin_lat * sin_lat)  # prime vertical radius
+    n = _prime_vertical_radius(sin_lat)
     r = (n + alt_m) * cos_lat
-    return r * math.cos(lon), r * math.sin(lon), (n * (1 - _E2) + alt_m) * sin_lat
+    return r * math.cos(lon), r * math.sin(lon), (n * (1 - E2) + alt_m) * sin_lat
 
 
 def geodetic(x: float, y: float, z: float) -> tuple[float, float, float]:
@@ -39,19 +43,17 @@ def geodetic(x: float, y: float, z: float) -> tuple[float, float, float]:
     so a point near the Earth's surface needs five to seven steps for 1e-15 rad.
     """
     p = math.hypot(x, y)
-    lat = math.atan2(z, p * (1 - _E2))
+    lat = math.atan2(z, p * (1 - E2))
     for _ in range(_MAX_ITERATIONS):
         sin_lat = math.sin(lat)
-        n = WGS84_A / math.sqrt(1 - _E2 * sin_lat * sin_lat)
-        new = math.atan2(z + _E2 * n * sin_lat, p)
+        new = math.atan2(z + E2 * _prime_vertical_radius(sin_lat) * sin_lat, p)
         done = abs(new - lat) < _LAT_TOLERANCE_RAD
         lat = new
         if done:
             break
     sin_lat, cos_lat = math.sin(lat), math.cos(lat)
-    n = WGS84_A / math.sqrt(1 - _E2 * sin_lat * sin_lat)
     # Projected on the normal: well conditioned at every latitude, poles included.
-    alt = p * cos_lat + z * sin_lat - WGS84_A * WGS84_A / n
+    alt = p * cos_lat + z * sin_lat - A * A / _prime_vertical_radius(sin_lat)
     return math.degrees(lat), math.degrees(math.atan2(y, x)), alt
 
 
