@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 Point = tuple[float, float]  # north, east, m
 
@@ -43,14 +44,17 @@ class PolygonZone:
 
     vertices: tuple[Point, ...]
 
+    @cached_property
     def edges(self) -> list[tuple[Point, Point]]:
+        """Each vertex to the next, the last to the first (made once: the commander asks
+        whether it is inside ten times a second)."""
         v = self.vertices
         return [(v[i], v[(i + 1) % len(v)]) for i in range(len(v))]
 
     @property
     def area(self) -> float:
         """Area in m² (shoelace), whichever way the vertices turn."""
-        return abs(sum(_cross((0.0, 0.0), a, b) for a, b in self.edges())) / 2
+        return abs(sum(_cross((0.0, 0.0), a, b) for a, b in self.edges)) / 2
 
     @property
     def is_valid(self) -> bool:
@@ -59,7 +63,7 @@ class PolygonZone:
         v = self.vertices
         if len(v) < 3 or not all(math.isfinite(c) for p in v for c in p):
             return False
-        edges = self.edges()
+        edges = self.edges
         n = len(edges)
         for i in range(n):
             a, b = edges[i]
@@ -77,12 +81,12 @@ class PolygonZone:
         return self.area > 0
 
     def _on_boundary(self, p: Point) -> bool:
-        return any(_on_segment(p, a, b) for a, b in self.edges())
+        return any(_on_segment(p, a, b) for a, b in self.edges)
 
     def _inside(self, p: Point) -> bool:
         """Crossing-number test: a ray from p towards +east crosses the boundary oddly."""
         inside = False
-        for a, b in self.edges():
+        for a, b in self.edges:
             if (a[0] > p[0]) != (b[0] > p[0]):
                 east = a[1] + (p[0] - a[0]) * (b[1] - a[1]) / (b[0] - a[0])
                 if p[1] < east:
