@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 AIRSPEED_NOISE = 0.8  # m/s per √s: throttle and pitch change airspeed quickly
 WIND_NOISE = 0.03  # m/s per √s: the wind drifts slowly
 VELOCITY_NOISE = 0.5  # m/s, GPS velocity (1 σ) plus sideslip
@@ -24,11 +22,15 @@ OBSERVABLE_TURN_RAD = math.pi / 2
 
 
 class WindEstimator:
-    """State [airspeed, wind north, wind east] (m/s)."""
+    """State [airspeed, wind north, wind east] (m/s).
+
+    Written out in floats rather than numpy: at 50 Hz in the controller, numpy's small-array
+    overhead made this filter a fifth of the control step.
+    """
 
     def __init__(self) -> None:
-        self.x = np.zeros(3)
-        self.p = np.diag([100.0, WIND_PRIOR**2, WIND_PRIOR**2])
+        self.x = [0.0, 0.0, 0.0]
+        self.p = [[100.0, 0.0, 0.0], [0.0, WIND_PRIOR**2, 0.0], [0.0, 0.0, WIND_PRIOR**2]]
         self.started = False
         self._unwrapped = 0.0  # heading since the start, unwrapped, rad
         self._span = (0.0, 0.0)  # least and most of it
@@ -38,7 +40,7 @@ class WindEstimator:
     @property
     def airspeed(self) -> float:
         """Estimated true airspeed, m/s."""
-        return float(max(self.x[0], 0.0))
+        return max(self.x[0], 0.0)
 
     @property
     def turned(self) -> float:
@@ -48,19 +50,28 @@ class WindEstimator:
     @property
     def wind_ne(self) -> tuple[float, float]:
         """Estimated wind (the way it blows), m/s north and east."""
-        return float(self.x[1]), float(self.x[2])
+        return self.x[1], self.x[2]
 
     def _hold_along_wind(self, c: float, s: float) -> None:
         """Give the wind along the heading no uncertainty, so no update moves it; when the
-        headings flown first span enough to see it, it gets its prior uncertainty back."""
+        headings flown first span enough to see it, it gets its prior uncertainty back.
+
+        The wind block is projected on the crosswind direction ``u = (-s, c)``: with
+        ``T = u uᵀ``, ``P_ww ← T P_ww T`` and the airspeed-wind terms ``← P_aw T``.
+        """
+        p = self.p
         if self.turned >= OBSERVABLE_TURN_RAD:
             self.observable = True
-            self.p[1:, 1:] += np.eye(2) * WIND_PRIOR**2
+            p[1][1] += WIND_PRIOR**2
+            p[2][2] += WIND_PRIOR**2
             return
-        t = np.eye(2) - np.outer((c, s), (c, s))
-        self.p[1:, 1:] = t @ self.p[1:, 1:] @ t
-        self.p[0, 1:] = self.p[0, 1:] @ t
-        self.p[1:, 0] = t @ self.p[1:, 0]
+        un, ue = -s, c
+        cross = un * un * p[1][1] + 2.0 * un * ue * p[1][2] + ue * ue * p[2][2]
+        p[1][1], p[1][2], p[2][2] = cross * un * un, cross * un * ue, cross * ue * ue
+        p[2][1] = p[1][2]
+        airspeed_cross = p[0][1] * un + p[0][2] * ue
+        p[0][1] = p[1][0] = airspeed_cross * un
+        p[0][2] = p[2][0] = airspeed_cross * ue
 
     def on_ground(self, vel_ne: tuple[float, float], heading: float) -> None:
         """Rolling on wheels: no crab, so nothing to learn about the wind; airspeed is the
@@ -79,16 +90,37 @@ class WindEstimator:
             lo, hi = self._span
             self._span = (min(lo, self._unwrapped), max(hi, self._unwrapped))
         self._last_heading = heading
+        x, p = self.x, self.p
         if not self.started:
-            self.x[0] = max(0.0, vel_ne[0] * c + vel_ne[1] * s)
+            x[0] = max(0.0, vel_ne[0] * c + vel_ne[1] * s)
             self.started = True
-        self.p += np.diag([AIRSPEED_NOISE**2, WIND_NOISE**2, WIND_NOISE**2]) * max(dt, 0.0)
+        dt = max(dt, 0.0)
+        p[0][0] += AIRSPEED_NOISE**2 * dt
+        p[1][1] += WIND_NOISE**2 * dt
+        p[2][2] += WIND_NOISE**2 * dt
         if not self.observable:
             self._hold_along_wind(c, s)
-        h = np.array([[c, 1.0, 0.0], [s, 0.0, 1.0]])
-        innovation = np.asarray(vel_ne) - h @ self.x
-        ph = self.p @ h.T
-        gain = ph @ np.linalg.inv(h @ ph + np.eye(2) * VELOCITY_NOISE**2)
-        self.x += gain @ innovation
-        self.p = (np.eye(3) - gain @ h) @ self.p
-        self.p = 0.5 * (self.p + self.p.T)
+        self._fuse(vel_ne, c, s)
+
+    def _fuse(self, vel_ne: tuple[float, float], c: float, s: float) -> None:
+        """The Kalman update with H = [[c, 1, 0], [s, 0, 1]] and R = σ² I."""
+        x, p = self.x, self.p
+        innovation = (vel_ne[0] - c * x[0] - x[1], vel_ne[1] - s * x[0] - x[2])
+        # P Hᵀ, one row per state.
+        ph = [(c * row[0] + row[1], s * row[0] + row[2]) for row in p]
+        r = VELOCITY_NOISE**2
+        s00 = c * ph[0][0] + ph[1][0] + r
+        s01 = c * ph[0][1] + ph[1][1]
+        s10 = s * ph[0][0] + ph[2][0]
+        s11 = s * ph[0][1] + ph[2][1] + r
+        det = s00 * s11 - s01 * s10
+        i00, i01, i10, i11 = s11 / det, -s01 / det, -s10 / det, s00 / det
+        gain = [(a * i00 + b * i10, a * i01 + b * i11) for a, b in ph]
+        for i in range(3):
+            x[i] += gain[i][0] * innovation[0] + gain[i][1] * innovation[1]
+        # P - K (H P), with H P = (P Hᵀ)ᵀ for a symmetric P; then kept symmetric.
+        new = [
+            [p[i][j] - gain[i][0] * ph[j][0] - gain[i][1] * ph[j][1] for j in range(3)]
+            for i in range(3)
+        ]
+        self.p = [[0.5 * (new[i][j] + new[j][i]) for j in range(3)] for i in range(3)]

@@ -66,7 +66,7 @@ def test_two_circles_reveal_the_wind_and_the_airspeed(
     assert we == pytest.approx(wind[1], abs=0.5)
     assert estimator.airspeed == pytest.approx(30.0, abs=0.5)
     # The filter knows it: its wind uncertainty has shrunk well below the prior.
-    assert math.sqrt(estimator.p[1, 1]) < 1.0 and math.sqrt(estimator.p[2, 2]) < 1.0
+    assert math.sqrt(estimator.p[1][1]) < 1.0 and math.sqrt(estimator.p[2][2]) < 1.0
 
 
 def test_straight_flight_in_calm_air_gives_airspeed_equal_to_ground_speed():
@@ -96,7 +96,7 @@ def test_straight_leg_sees_only_the_cross_track_wind():
     estimator = WindEstimator()
     fly(estimator, 60.0, lambda t: 0.0, lambda t: 30.0, WIND_FROM_WEST, rng)
     assert estimator.wind_ne[1] == pytest.approx(6.0, abs=0.3)
-    assert math.sqrt(estimator.p[2, 2]) < 0.2
+    assert math.sqrt(estimator.p[2][2]) < 0.2
     assert not estimator.observable and estimator.wind_ne[0] == pytest.approx(0.0, abs=0.05)
     # What it can see is right: ground speed along the nose = airspeed + along-track wind.
     assert estimator.airspeed + estimator.wind_ne[0] == pytest.approx(30.0, abs=0.3)
@@ -128,7 +128,7 @@ def test_covariance_stays_symmetric_and_positive():
     rng = np.random.default_rng(9)
     estimator = WindEstimator()
     fly(estimator, 90.0, circling(10.0), lambda t: 30.0, WIND_FROM_WEST, rng)
-    p = estimator.p
+    p = np.array(estimator.p)
     assert np.allclose(p, p.T)
     assert np.all(np.linalg.eigvalsh(p) > 0.0)
 
