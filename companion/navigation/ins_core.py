@@ -198,7 +198,7 @@ class InsCore:
         msg.q[:] = self.q
         msg.roll_rad, msg.pitch_rad, msg.yaw_rad = rot.quaternion_to_euler(self.q)
         msg.roll_rate_rad_s, msg.pitch_rate_rad_s, msg.yaw_rate_rad_s = self.rate
-        msg.lat_deg, msg.lon_deg, msg.alt_msl_m = self.frame.geodetic(np.array(self.p))
+        msg.lat_deg, msg.lon_deg, msg.alt_msl_m = self.frame.geodetic(self.p)
         msg.vn_m_s, msg.ve_m_s, msg.vd_m_s = self.v
         std = np.sqrt(np.diag(self.P)).tolist()
         msg.pos_std_m[:] = std[0:3]
