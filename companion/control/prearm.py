@@ -56,9 +56,42 @@ class Readiness:
     fence: list[MissionItem] = field(default_factory=list)
 
 
-def failures(r: Readiness, params: dict[str, float]) -> list[str]:
-    """Every reason arming is refused now (empty: ready), each without the prefix."""
-    return [*_navigation(r), *_gps(r, params), *_fresh(r, params), *_plans(r)]
+class PlanVerdicts:
+    """Whether the stored mission and fence are valid, judged once per stored list.
+
+    The link asks every second, and a fence polygon's simple-polygon check is quadratic in
+    its vertices (~6 ms for 100 here). A stored list is replaced when the plan changes,
+    never changed in place (``MissionStore``), so the list itself is the key; holding it
+    keeps its identity from being reused.
+    """
+
+    def __init__(self) -> None:
+        self._mission: tuple[list[MissionItem], bool] | None = None
+        self._fence: tuple[list[MissionItem], Fence, bool] | None = None
+
+    def mission_valid(self, items: list[MissionItem]) -> bool:
+        """Whether the mission would be accepted from a ground station."""
+        if self._mission is None or self._mission[0] is not items:
+            self._mission = (items, check_mission(items) == d.MAV_MISSION_ACCEPTED)
+        return self._mission[1]
+
+    def fence(self, items: list[MissionItem]) -> tuple[Fence, bool]:
+        """The fence the items make, and whether every zone of it has a valid shape."""
+        if self._fence is None or self._fence[0] is not items:
+            fence = Fence.from_items(items)
+            zones = [*fence.inclusions, *fence.exclusions]
+            valid = not fence.empty and all(z.is_valid and z.area > 0 for z in zones)
+            self._fence = (items, fence, valid)
+        return self._fence[1], self._fence[2]
+
+
+def failures(
+    r: Readiness, params: dict[str, float], plans: PlanVerdicts | None = None
+) -> list[str]:
+    """Every reason arming is refused now (empty: ready), each without the prefix.
+    ``plans`` keeps the plans' verdicts between calls (a fresh one judges them now)."""
+    plans = plans or PlanVerdicts()
+    return [*_navigation(r), *_gps(r, params), *_fresh(r, params), *_plans(r, plans)]
 
 
 def _navigation(r: Readiness) -> list[str]:
@@ -96,17 +129,16 @@ def _fresh(r: Readiness, params: dict[str, float]) -> list[str]:
     return found
 
 
-def _plans(r: Readiness) -> list[str]:
+def _plans(r: Readiness, plans: PlanVerdicts) -> list[str]:
     found = []
     if r.mode == FlightMode.MISSION:
         if not r.mission:
             found.append("Mission: none stored")
-        elif check_mission(r.mission) != d.MAV_MISSION_ACCEPTED:
+        elif not plans.mission_valid(r.mission):
             found.append("Mission: not valid")
     if r.fence:
-        fence = Fence.from_items(r.fence)
-        zones = [*fence.inclusions, *fence.exclusions]
-        if fence.empty or not all(z.is_valid and z.area > 0 for z in zones):
+        fence, valid = plans.fence(r.fence)
+        if not valid:
             found.append("Fence: not valid")
         elif r.nav is not None and r.nav.flags & NavFlags.POSITION_VALID:
             breach = fence.breach(r.nav.lat_deg, r.nav.lon_deg)

@@ -16,6 +16,7 @@ from typing import Any
 
 from companion.control.mission.items import MISSION_TYPES, MissionItem, check_mission
 from companion.control.mission.store import MissionStore
+from companion.control.prearm import PlanVerdicts
 from companion.link.service import Outgoing, Peer
 from companion.messages import MissionState
 from mavlink_dialect import companion as d
@@ -73,6 +74,7 @@ class MissionService:
         self.completed = False
         self.refused = 0
         self.rejected_target = 0  # for another component of this system
+        self.verdicts = PlanVerdicts()  # the pre-arm checks' view of the stored plans
 
     def _ack(self, peer: Peer, result: int, mission_type: int) -> Outgoing:
         msg = self.mav.mission_ack_encode(peer.sysid, peer.compid, result, mission_type)

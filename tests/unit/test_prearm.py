@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from companion.control.mission.items import MissionItem
 from companion.control.mission.plan import load_plan
-from companion.control.prearm import PREARM_PARAMS, Readiness, failures
+from companion.control.prearm import PREARM_PARAMS, PlanVerdicts, Readiness, failures
 from companion.messages import (
     Baro,
     Compass,
@@ -80,3 +80,25 @@ def test_mission_mode_needs_a_valid_mission_and_a_fence_must_be_valid():
     assert failures(_ready(fence=[circle]), PARAMS) == ["Fence: not valid"]
     far = MissionItem(**{**circle.as_dict(), "param1": 100.0, "x": -378000000})
     assert failures(_ready(fence=[far]), PARAMS) == ["Fence: outside the fence"]
+
+
+def test_kept_verdicts_follow_each_newly_stored_plan():
+    # The link keeps one PlanVerdicts for its once-a-second checks: a plan stored again (a
+    # new list, as MissionStore keeps it) is judged again, whichever way the verdict goes.
+    plans = PlanVerdicts()
+    circle = MissionItem(
+        seq=0, frame=d.MAV_FRAME_GLOBAL, command=d.MAV_CMD_NAV_FENCE_CIRCLE_INCLUSION, current=0,
+        autocontinue=1, param1=500.0, param2=0, param3=0, param4=0,
+        x=-379105000, y=1451340000, z=0.0, mission_type=d.MAV_MISSION_TYPE_FENCE,
+    )  # fmt: skip
+    good, bad = [circle], [MissionItem(**{**circle.as_dict(), "param1": 0.0})]
+    for fence, expected in ((good, []), (bad, ["Fence: not valid"]), (good, [])):
+        for _ in range(2):
+            assert failures(_ready(fence=fence), PARAMS, plans) == expected
+    # The position is judged at every call against the kept fence.
+    away = NavState(t_us=NOW - 20_000, flags=VALID, lat_deg=-37.80, lon_deg=145.134)
+    assert failures(_ready(fence=good, nav=away), PARAMS, plans) == ["Fence: outside the fence"]
+    square = load_plan(REPO / "qgc_plans" / "square.plan")[0]
+    broken = [*square[:1], MissionItem(**{**square[1].as_dict(), "command": 9999}), *square[2:]]
+    for mission, expected in ((square, []), (broken, ["Mission: not valid"]), (square, [])):
+        assert failures(_ready(mode=FlightMode.MISSION, mission=mission), PARAMS, plans) == expected

@@ -363,7 +363,7 @@ class MavlinkLink(Plugin):
             mag=snap.mag, compass=snap.compass, baro=snap.baro,
             mission=items[d.MAV_MISSION_TYPE_MISSION], fence=items[d.MAV_MISSION_TYPE_FENCE],
         )  # fmt: skip
-        return failures(r, self.store.values)
+        return failures(r, self.store.values, self.missions.verdicts)
 
     def open_imu(self) -> Any:
         """A reader of every IMU sample, while a sensor calibration runs (VehiclePort)."""
