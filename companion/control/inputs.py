@@ -27,9 +27,7 @@ MAX_RATE_RAD_S = 40.0
 MAX_SPEED_M_S = 500.0
 MAX_RADIUS_M = 10_000.0  # as the commander's limit on an orbit
 KNOWN_MODES = frozenset(int(m) for m in FlightMode)
-NAV_ANGLES = ("roll_rad", "pitch_rad", "yaw_rad")
 NAV_RATES = ("roll_rate_rad_s", "pitch_rate_rad_s", "yaw_rate_rad_s")
-NAV_SPEEDS = ("vn_m_s", "ve_m_s", "vd_m_s")
 
 
 def _within(value: float, limit: float) -> bool:
@@ -65,11 +63,20 @@ def position_usable(nav: NavState) -> bool:
 
 def nav_usable(nav: NavState) -> bool:
     """Every field the control laws read is finite and within what an aircraft can be."""
+    # Written out (a chained comparison fails for NaN and infinity alike): the controller
+    # asks at every step, and the generators over field names were a tenth of its step.
+    a, v = MAX_ANGLE_RAD, MAX_SPEED_M_S
     return (
         position_usable(nav)
-        and all(_within(getattr(nav, f), MAX_ANGLE_RAD) for f in NAV_ANGLES)
-        and all(_rate_usable(getattr(nav, f)) for f in NAV_RATES)
-        and all(_within(getattr(nav, f), MAX_SPEED_M_S) for f in NAV_SPEEDS)
+        and -a <= nav.roll_rad <= a
+        and -a <= nav.pitch_rad <= a
+        and -a <= nav.yaw_rad <= a
+        and _rate_usable(nav.roll_rate_rad_s)
+        and _rate_usable(nav.pitch_rate_rad_s)
+        and _rate_usable(nav.yaw_rate_rad_s)
+        and -v <= nav.vn_m_s <= v
+        and -v <= nav.ve_m_s <= v
+        and -v <= nav.vd_m_s <= v
     )
 
 

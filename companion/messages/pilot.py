@@ -25,6 +25,11 @@ class PilotFlags(enum.IntFlag):
     THROTTLE_LOW = 4  # throttle channel below THR_FS_VALUE: a receiver's failsafe throttle
 
 
+# As a plain int: an IntFlag operand sends every ``&`` through the enum machinery, and the
+# controller asks at every step.
+_NOT_A_PILOT = int(PilotFlags.FAILSAFE | PilotFlags.THROTTLE_LOW)
+
+
 class PilotInput(Message):
     """Sticks in the stick convention of ``ActuatorCommand``: roll + right, pitch + nose up
     (stick pulled back), yaw + right, all in [-1, 1]; throttle in [0, 1].
@@ -52,4 +57,4 @@ class PilotInput(Message):
 
     def usable(self) -> bool:
         """Whether the sticks are a pilot's (not a receiver's failsafe positions)."""
-        return not self.flags & (PilotFlags.FAILSAFE | PilotFlags.THROTTLE_LOW)
+        return not self.flags & _NOT_A_PILOT
