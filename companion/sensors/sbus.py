@@ -33,6 +33,10 @@ def raw_to_us(raw: int) -> int:
     return round(880 + raw * 0.625)
 
 
+# Every 11-bit value's pulse, looked up: sixteen channels, fifty frames a second.
+_PULSE_US = tuple(raw_to_us(raw) for raw in range(RAW_MAX + 1))
+
+
 @dataclass(frozen=True)
 class SbusFrame:
     """One decoded frame: 16 raw channels (0-2047), the two digital ones and the flags."""
@@ -46,7 +50,7 @@ class SbusFrame:
     def pulses_us(self) -> list[int]:
         """All 18 channels as pulse widths (the digital ones as 1000 or 2000 µs)."""
         digital = [2000 if on else 1000 for on in (self.ch17, self.ch18)]
-        return [raw_to_us(raw) for raw in self.channels] + digital
+        return [_PULSE_US[raw] for raw in self.channels] + digital
 
 
 def decode_frame(frame: bytes) -> SbusFrame | None:

@@ -29,6 +29,9 @@ from companion.sensors.sbus import SbusDecoder, SbusFrame
 from companion.sensors.serial_port import ReopeningSerial
 
 SBUS_FRAMING = {"parity": serial.PARITY_EVEN, "stopbits": serial.STOPBITS_TWO}
+# Plain ints: IntFlag arithmetic goes through the enum machinery, 50 times a second here.
+_FAILSAFE, _FRAME_LOST = int(PilotFlags.FAILSAFE), int(PilotFlags.FRAME_LOST)
+_THROTTLE_LOW = int(PilotFlags.THROTTLE_LOW)
 
 
 class RcInput(Plugin):
@@ -75,14 +78,11 @@ class RcInput(Plugin):
         msg = PilotInput(t_us=t_us, source=PilotSource.RC, rssi=255)
         msg.roll, msg.pitch, msg.yaw, msg.throttle = s.roll, s.pitch, s.yaw, s.throttle
         msg.mode_switch = s.mode_switch
-        flags = PilotFlags(0)
-        if frame.failsafe:
-            flags |= PilotFlags.FAILSAFE
-        if frame.frame_lost:
-            flags |= PilotFlags.FRAME_LOST
-        if s.throttle_low:
-            flags |= PilotFlags.THROTTLE_LOW
-        msg.flags = int(flags)
+        msg.flags = (
+            (_FAILSAFE if frame.failsafe else 0)
+            | (_FRAME_LOST if frame.frame_lost else 0)
+            | (_THROTTLE_LOW if s.throttle_low else 0)
+        )
         count = msg.channel_count = min(len(pulses), RC_MAX_CHANNELS)
         msg.channels_us[:count] = pulses[:count]
         self.out.publish(msg)
