@@ -282,5 +282,5 @@ def _drain(fd: int) -> None:
     try:
         while os.read(fd, 256):
             pass
-    except (BlockingIOError, InterruptedError, OSError):
+    except OSError:  # empty (BlockingIOError), interrupted, or closed: nothing to take
         pass
