@@ -73,7 +73,11 @@ class ParamsService:
             return []
         kind = msg.get_type()
         if kind == "PARAM_REQUEST_LIST":
-            self._queue = deque((i, peer) for i in range(len(self.store)))
+            # A station asking again restarts its own list; another station's list and the
+            # values queued for everyone go on (ArduPilot keeps a list per link): QGC and
+            # MAVProxy connecting together each get every index.
+            self._queue = deque(entry for entry in self._queue if entry[1] != peer)
+            self._queue.extend((i, peer) for i in range(len(self.store)))
             return self.tick(now_s)
         if kind == "PARAM_REQUEST_READ":
             return self._read(msg, peer)
