@@ -29,6 +29,7 @@ class MetadataService:
         self.sysid = sysid
         self.compid = compid
         self._decls = tuple(decls)
+        self._ftp: FtpServer | None = None
         self.rejected_target = 0  # for another component of this system
 
     # Made when a ground station first asks (QGroundControl: once per connection), not at
@@ -38,13 +39,16 @@ class MetadataService:
     def metadata(self) -> MetadataFiles:
         return metadata_files(self._decls)
 
-    @cached_property
+    @property
     def ftp(self) -> FtpServer:
-        return FtpServer(self.metadata.files)
+        if self._ftp is None:
+            self._ftp = FtpServer(self.metadata.files)
+        return self._ftp
 
     @property
     def refused(self) -> int:
-        return self.ftp.refused if "ftp" in self.__dict__ else 0
+        """FTP requests refused; none before the first one made the server."""
+        return self._ftp.refused if self._ftp is not None else 0
 
     def component_metadata(self, time_boot_ms: int) -> Any:
         uri = self.metadata.general_uri.encode()
