@@ -113,7 +113,8 @@ def test_a_sharp_corner_is_a_loop_that_ends_on_the_new_line_at_the_corner(turn_d
     end = _on_arc(onto, onto.sweep)
     u = loop.u_out
     assert -end[0] * u[1] + end[1] * u[0] == pytest.approx(0.0, abs=1e-6)  # on the new line
-    assert abs(end[0] * u[0] + end[1] * u[1]) < loop.radius
+    assert end[0] * u[0] + end[1] * u[1] == pytest.approx(loop.exit)  # where it says
+    assert abs(loop.exit) < loop.radius
     assert onto.sweep - away.sweep == pytest.approx(math.radians(abs(turn_deg)))
     # The phases: before the loop, on each arc in turn, then on the new leg.
     assert loop_phase(loop, (0.0, -loop.lead - 50.0), 0) == 0
