@@ -52,9 +52,7 @@ DEVICES = ((float(VN100), "VectorNav VN-100 (serial)"),
            (float(OS3000), "OceanServer OS-3000 compass (serial)"))  # fmt: skip
 
 
-def _fact(name: str, value: float, doc: str, unit: str = "", values: Any = ()) -> ParamDecl:
-    return ParamDecl(name, value, value, value, unit, doc, values=values)
-
+_fact = ParamDecl.fixed
 
 AIRFRAME_FACTS = (
     _fact("SYS_AUTOSTART", AIRFRAME_STANDARD_PLANE, "PX4 airframe: a standard plane "

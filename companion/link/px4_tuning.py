@@ -88,8 +88,8 @@ GUIDANCE_ALIASES = (
 
 
 def _no_such_term(name: str, what: str) -> ParamDecl:
-    return ParamDecl(name, 0.0, 0.0, 0.0, doc=f"{what}: the controller has no such term, "
-                     "so it is 0 and cannot be changed")  # fmt: skip
+    return ParamDecl.fixed(name, 0.0, f"{what}: the controller has no such term, so it is "
+                           "0 and cannot be changed")  # fmt: skip
 
 
 ABSENT_TERMS = (

@@ -16,6 +16,7 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 from companion.params.alias import Alias
 from companion.params.atomic import atomic_write_text
@@ -46,6 +47,14 @@ class ParamDecl:
         object.__setattr__(self, "values", tuple((float(v), str(t)) for v, t in self.values))
         if isinstance(self.alias, Mapping):
             object.__setattr__(self, "alias", Alias(**self.alias))
+
+    @classmethod
+    def fixed(
+        cls, name: str, value: float, doc: str, unit: str = "", values: Any = ()
+    ) -> ParamDecl:
+        """A parameter that reads ``value`` and refuses any other (a fact about the vehicle
+        a ground station asks for by its own name, or a term this vehicle has not got)."""
+        return cls(name, value, value, value, unit, doc, values=values)
 
     def check(self, value: float) -> str | None:
         """Why ``value`` is not acceptable, or None."""
