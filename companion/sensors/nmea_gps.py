@@ -13,7 +13,8 @@ one:
 - When an epoch ends, the decoder notes which of GGA, RMC and VTG it held. A type is
   *expected* until it has been missing from 3 epochs in a row.
 - An epoch is emitted as soon as it holds every expected type; for u-blox that is on its
-  GGA, for SiRF on its VTG. The first epoch only teaches the order (no fix from it).
+  GGA, for SiRF on its VTG. The first epoch teaches the order: its fix, if it has a
+  GGA, comes when it ends, one epoch late.
 - An epoch that ends incomplete (a sentence lost to a bad checksum) is emitted then, one
   epoch late, if it has a GGA; otherwise it is dropped and counted. A fix needs a GGA, or
   an RMC when the receiver sends no GGA at all (then it is 2-D, without altitude).
@@ -205,6 +206,11 @@ class NmeaGpsDecoder:
                 late, epoch.emitted = self._build(epoch), True
             else:
                 self.counters.dropped_epochs += 1
+        elif not epoch.emitted and epoch.gga is not None:
+            # The first epoch, perhaps joined half-way: late, as an incomplete one is, so a
+            # restarted receiver's plug-in has a fix an epoch sooner. Without its GGA it may
+            # be a 3-D receiver's RMC alone: no 2-D fix is made of that.
+            late, epoch.emitted = self._build(epoch), True
         kinds = epoch.kinds()
         for kind in ("GGA", "RMC", "VTG"):
             if kind in kinds:

@@ -65,7 +65,9 @@ def sirf_epoch(second: int, alt: float) -> list[tuple[int, str]]:
 def test_rmc_first_receiver_gets_a_fix_on_each_gga(talker):
     dec = NmeaGpsDecoder()
     assert decode_all(dec, ublox_epoch(0, 100.0, talker)) == [], "it teaches the order"
-    assert len(decode_all(dec, ublox_epoch(1, 100.5, talker))) == 1
+    first, second = decode_all(dec, ublox_epoch(1, 100.5, talker))
+    assert first.t_us == 50_000 and first.alt_msl_m == 100.0, "the first epoch's, late"
+    assert second.t_us == 1_050_000, "then each epoch's on its GGA"
     fixes = decode_all(dec, ublox_epoch(2, 101.5, talker))
     assert len(fixes) == 1
     fix = fixes[0]
@@ -81,7 +83,7 @@ def test_rmc_first_receiver_gets_a_fix_on_each_gga(talker):
     assert fix.vd_m_s == pytest.approx(-1.0)
     assert fix.utc_us == utc_us(2026, 11, 23, 12, 0, 2)
     assert dec.counters.ok == 3 * 5 and dec.counters.ignored == 3 * 2
-    assert dec.counters.fixes == 2 and dec.counters.dropped_epochs == 0
+    assert dec.counters.fixes == 3 and dec.counters.dropped_epochs == 0
 
 
 def test_gga_first_receiver_gets_its_fix_once_the_velocity_arrived():
@@ -89,7 +91,8 @@ def test_gga_first_receiver_gets_its_fix_once_the_velocity_arrived():
     decode_all(dec, sirf_epoch(0, 50.0))
     timed = sirf_epoch(1, 48.0)
     fixes = [dec.decode(s, t) for t, s in timed]
-    assert fixes[:-1] == [None] * 4 and fixes[-1] is not None, "emitted on the epoch's VTG"
+    assert fixes[0] is not None and fixes[0].t_us == 50_000, "the first epoch's, late"
+    assert fixes[1:-1] == [None] * 3 and fixes[-1] is not None, "emitted on the epoch's VTG"
     fix = fixes[-1]
     assert fix.t_us == 1_050_000, "stamped with the epoch's first sentence (its GGA)"
     assert fix.lat_deg == pytest.approx(LAT, abs=1e-9)
@@ -99,13 +102,22 @@ def test_gga_first_receiver_gets_its_fix_once_the_velocity_arrived():
     assert fix.utc_us == utc_us(2026, 11, 23, 12, 0, 1)
 
 
+def test_an_epoch_joined_after_its_gga_gives_no_2d_fix_of_a_3d_receiver():
+    """Started (or restarted) half-way through a SiRF epoch: its RMC alone is no fix."""
+    dec = NmeaGpsDecoder()
+    timed = sirf_epoch(0, 50.0)[1:] + sirf_epoch(1, 48.0) + sirf_epoch(2, 47.0)
+    fixes = decode_all(dec, timed)
+    assert [f.t_us for f in fixes] == [1_050_000, 2_050_000]
+    assert all(f.fix_type == GpsFixType.FIX_3D for f in fixes)
+
+
 def test_gga_and_vtg_only_receiver_takes_velocity_from_vtg_in_kmh():
     dec = NmeaGpsDecoder()
     timed = []
     for second in range(3):  # VTG first, knots field left empty
         timed += [(second, vtg("180.0", "", "36.0")), (second, gga(f"0000{second:02d}.00"))]
     fixes = decode_all(dec, timed)
-    assert len(fixes) == 2
+    assert len(fixes) == 3  # the first epoch's when the second begins
     assert fixes[-1].vn_m_s == pytest.approx(-10.0) and abs(fixes[-1].ve_m_s) < 1e-9
     assert fixes[-1].course_rad == pytest.approx(math.pi)
     assert fixes[-1].utc_us == 0, "no RMC, no date"
@@ -175,5 +187,5 @@ def test_a_receiver_that_stops_sending_rmc_is_followed_after_three_epochs():
     fixes = decode_all(dec, timed)
     # Epochs 3-5 wait for an RMC and come late; at 6 RMC is forgotten: epoch 5's late fix
     # and epoch 6's on-time fix fall due together, and only the newer one is kept.
-    assert [f.t_us for f in fixes] == [1, 2, 3, 4, 6, 7, 8]
+    assert [f.t_us for f in fixes] == [0, 1, 2, 3, 4, 6, 7, 8]
     assert dec.counters.fixes == len(fixes) and dec.counters.dropped_epochs == 1

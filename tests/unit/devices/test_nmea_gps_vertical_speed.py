@@ -38,7 +38,8 @@ def test_across_midnight_and_the_date_rolls_over():
         (3, gga("000000.20", 202.0)),  # the date still rolls over at midnight
         (4, rmc("000000.40", "241126")),
     ]
-    fixes = decode_all(dec, timed)
+    first, *fixes = decode_all(dec, timed)
+    assert math.isnan(first.vd_m_s), "the first altitude has none before it"
     assert [f.vd_m_s for f in fixes] == [0.0, pytest.approx(-5.0), pytest.approx(-5.0)]
     assert fixes[1].utc_us == utc_us(2026, 11, 24, 0, 0, 0)
     assert fixes[2].utc_us == utc_us(2026, 11, 24, 0, 0, 0) + 200_000
