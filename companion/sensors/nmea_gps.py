@@ -13,8 +13,9 @@ one:
 - When an epoch ends, the decoder notes which of GGA, RMC and VTG it held. A type is
   *expected* until it has been missing from 3 epochs in a row.
 - An epoch is emitted as soon as it holds every expected type; for u-blox that is on its
-  GGA, for SiRF on its VTG. The first epoch teaches the order: its fix, if it has a
-  GGA, comes when it ends, one epoch late.
+  GGA, for SiRF on its VTG. The first epoch teaches the order; its fix comes as soon as
+  it holds a GGA and a velocity (RMC or VTG), or else, if it has a GGA, when it ends. So a
+  started or restarted plug-in has a fix from the first epoch it hears.
 - An epoch that ends incomplete (a sentence lost to a bad checksum) is emitted then, one
   epoch late, if it has a GGA; otherwise it is dropped and counted. A fix needs a GGA, or
   an RMC when the receiver sends no GGA at all (then it is 2-D, without altitude).
@@ -173,19 +174,20 @@ class NmeaGpsDecoder:
         else:
             epoch.vtg = data
         if not epoch.emitted and self._complete(epoch):
-            if late is not None:  # two fixes at once (the receiver changed its output)
+            # Two fixes at once: the receiver changed its output, or (not counted) the first
+            # epoch had no velocity and a GGA-only receiver's next one is due on its GGA.
+            if late is not None and epoch.index > 2:
                 self.counters.dropped_epochs += 1
             return self._emit(epoch)
         if late is not None:
             self.counters.fixes += 1
         return late
 
-    @staticmethod
-    def _begins_epoch(epoch: _Epoch, kind: str, tod_us: int | None) -> bool:
+    def _begins_epoch(self, epoch: _Epoch, kind: str, tod_us: int | None) -> bool:
         if kind in epoch.kinds():
             return True
-        if tod_us is None or epoch.tod_us is None:
-            return epoch.emitted
+        if tod_us is None or epoch.tod_us is None:  # a VTG: the first epoch may still grow
+            return epoch.emitted and self._learned
         return tod_us != epoch.tod_us
 
     def _expected(self) -> set[str]:
@@ -195,7 +197,9 @@ class NmeaGpsDecoder:
         return epoch.gga is not None or (epoch.rmc is not None and "GGA" not in self._expected())
 
     def _complete(self, epoch: _Epoch) -> bool:
-        return self._learned and self._expected() <= epoch.kinds() and self._emittable(epoch)
+        if not self._learned:  # the order unknown yet: a position and a velocity will do
+            return epoch.gga is not None and (epoch.rmc is not None or epoch.vtg is not None)
+        return self._expected() <= epoch.kinds() and self._emittable(epoch)
 
     def _close(self, epoch: _Epoch) -> GpsFix | None:
         """Learn from an ending epoch; its fix if it is still to be emitted (late), built
@@ -207,9 +211,9 @@ class NmeaGpsDecoder:
             else:
                 self.counters.dropped_epochs += 1
         elif not epoch.emitted and epoch.gga is not None:
-            # The first epoch, perhaps joined half-way: late, as an incomplete one is, so a
-            # restarted receiver's plug-in has a fix an epoch sooner. Without its GGA it may
-            # be a 3-D receiver's RMC alone: no 2-D fix is made of that.
+            # The first epoch without a velocity (joined half-way, or a GGA-only receiver):
+            # late, as an incomplete one is. Without its GGA it may be a 3-D receiver's RMC
+            # alone: no 2-D fix is made of that.
             late, epoch.emitted = self._build(epoch), True
         kinds = epoch.kinds()
         for kind in ("GGA", "RMC", "VTG"):

@@ -64,10 +64,10 @@ def sirf_epoch(second: int, alt: float) -> list[tuple[int, str]]:
 @pytest.mark.parametrize("talker", ["GP", "GN"])
 def test_rmc_first_receiver_gets_a_fix_on_each_gga(talker):
     dec = NmeaGpsDecoder()
-    assert decode_all(dec, ublox_epoch(0, 100.0, talker)) == [], "it teaches the order"
-    first, second = decode_all(dec, ublox_epoch(1, 100.5, talker))
-    assert first.t_us == 50_000 and first.alt_msl_m == 100.0, "the first epoch's, late"
-    assert second.t_us == 1_050_000, "then each epoch's on its GGA"
+    first = [dec.decode(s, t) for t, s in ublox_epoch(0, 100.0, talker)]
+    assert first[2] is not None and first[2].t_us == 50_000, "on the first epoch's GGA"
+    assert math.isnan(first[2].vdop), "its GSA comes after it"
+    assert len(decode_all(dec, ublox_epoch(1, 100.5, talker))) == 1
     fixes = decode_all(dec, ublox_epoch(2, 101.5, talker))
     assert len(fixes) == 1
     fix = fixes[0]
@@ -88,11 +88,13 @@ def test_rmc_first_receiver_gets_a_fix_on_each_gga(talker):
 
 def test_gga_first_receiver_gets_its_fix_once_the_velocity_arrived():
     dec = NmeaGpsDecoder()
-    decode_all(dec, sirf_epoch(0, 50.0))
+    first = [dec.decode(s, t) for t, s in sirf_epoch(0, 50.0)]
+    assert [f is not None for f in first] == [False, False, False, True, False], (
+        "the first epoch's on its RMC: a position and a velocity, the order not known yet"
+    )
     timed = sirf_epoch(1, 48.0)
     fixes = [dec.decode(s, t) for t, s in timed]
-    assert fixes[0] is not None and fixes[0].t_us == 50_000, "the first epoch's, late"
-    assert fixes[1:-1] == [None] * 3 and fixes[-1] is not None, "emitted on the epoch's VTG"
+    assert fixes[:-1] == [None] * 4 and fixes[-1] is not None, "emitted on the epoch's VTG"
     fix = fixes[-1]
     assert fix.t_us == 1_050_000, "stamped with the epoch's first sentence (its GGA)"
     assert fix.lat_deg == pytest.approx(LAT, abs=1e-9)
@@ -109,6 +111,14 @@ def test_an_epoch_joined_after_its_gga_gives_no_2d_fix_of_a_3d_receiver():
     fixes = decode_all(dec, timed)
     assert [f.t_us for f in fixes] == [1_050_000, 2_050_000]
     assert all(f.fix_type == GpsFixType.FIX_3D for f in fixes)
+
+
+def test_a_gga_only_receiver_gets_a_fix_on_each_gga_from_the_second_and_drops_nothing():
+    dec = NmeaGpsDecoder()
+    fixes = decode_all(dec, [(i, gga(f"1200{i:02d}.00", 100.0 + i)) for i in range(4)])
+    assert [f.t_us for f in fixes] == [1, 2, 3]
+    assert all(math.isnan(f.vn_m_s) for f in fixes), "NMEA's GGA has no velocity"
+    assert dec.counters.fixes == 3 and dec.counters.dropped_epochs == 0
 
 
 def test_gga_and_vtg_only_receiver_takes_velocity_from_vtg_in_kmh():
