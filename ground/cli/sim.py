@@ -52,7 +52,7 @@ def _outage(text: str):
 
 
 def _home(text: str | None):
-    from ground.sitl.bridge.fdm import Home
+    from ground.sitl.bridge.conditions import Home
 
     if text is None:
         return Home()

@@ -32,7 +32,7 @@ from companion.bus.namespace import cleanup_namespace, validate_namespace
 from companion.bus.node import BusNode
 from companion.exec_control.plugin_host import die_with_parent
 from companion.geodesy import LocalFrame
-from ground.sitl.bridge.fdm import Home
+from ground.sitl.bridge.conditions import Home
 from ground.sitl.bridge.options import BridgeOptions
 from ground.sitl.session import mode_name, status_line
 

@@ -4,18 +4,19 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import jsbsim
 
 from ground.simulation.true_state import TrueState
+from ground.sitl.bridge.conditions import TURBULENCE, Home
+
+__all__ = ["TURBULENCE", "Flight", "Home"]
 
 log = logging.getLogger(__name__)
 
 FT = 0.3048  # metres per foot
 
-# MIL-F-8785C probabilities of exceedance (JSBSim's table rows) and 20 ft wind speeds.
-TURBULENCE = {"none": (0, 0.0), "light": (2, 15.0), "moderate": (3, 30.0), "severe": (5, 45.0)}
 KT = 0.514444
 MILSPEC = 3  # atmosphere/turb-type: FGWinds::ttMilspec
 IDLE_THROTTLE = 0.05
@@ -27,16 +28,6 @@ SETTLE_S = 3.0
 DIVERGED_SPEED_M_S = 1000.0
 DIVERGED_BELOW_GROUND_M = 50.0
 STANDARD_GRAVITY = 9.80665
-
-
-@dataclass(frozen=True)
-class Home:
-    """Where the aircraft starts: WGS-84 degrees, ground height above MSL, runway heading."""
-
-    lat_deg: float = -37.9105
-    lon_deg: float = 145.1340
-    ground_msl_m: float = 80.0
-    heading_deg: float = 90.0
 
 
 class Flight:

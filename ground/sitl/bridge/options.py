@@ -6,8 +6,8 @@ import dataclasses
 import json
 from dataclasses import dataclass, field
 
+from ground.sitl.bridge.conditions import TURBULENCE, Home
 from ground.sitl.bridge.device_streams import DeviceRates, Outage
-from ground.sitl.bridge.fdm import TURBULENCE, Home
 
 # How the sensors sit in the airframe (ground/simulation/sensor_errors.py NoiseModel):
 # no defects, the residue of a good calibration, or the iron and motor field as they are.
