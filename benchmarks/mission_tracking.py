@@ -1,8 +1,12 @@
 """How well the whole vehicle flies the shipped plans, scored from the simulator's truth.
 
 Usage: uv run python benchmarks/mission_tracking.py [--aircraft c172p] [--plan square.plan]
-       [--lockstep exact|fast|both] [--calm-only]
+       [--lockstep exact|fast|both] [--calm-only] [--noise 1] [--gps-wander M]
 (aircraft and plan repeatable; default: c172p and J3Cub, the plans in DEFAULT_PLANS, exact)
+
+``--gps-wander 0`` keeps every sensor's noise but the GPS's slowly wandering error (1 m
+per axis, 60 s correlation: a receiver without corrections), which the navigation solution
+carries and no guidance can see; what is left of the cross-track error is guidance's.
 
 ``--lockstep fast`` flies the same flights in fast lockstep (``--fast``: the vehicle may
 trail the physics by one navigation period, never more), ``both`` flies each both ways,
@@ -56,6 +60,8 @@ def main() -> None:
     ap.add_argument("--lockstep", choices=("exact", "fast", "both"), default="exact")
     ap.add_argument("--calm-only", action="store_true")
     ap.add_argument("--noise", type=float, default=1.0, help="sensor noise scale (0: perfect)")
+    ap.add_argument("--gps-wander", type=float, help="the GPS's wandering error, m per axis "
+                    "(default: the receiver model's 1 m; 0: only its white noise)")  # fmt: skip
     args = ap.parse_args()
     modes = {"exact": [False], "fast": [True], "both": [False, True]}[args.lockstep]
     conditions = {"calm": CONDITIONS["calm"]} if args.calm_only else CONDITIONS
@@ -68,7 +74,8 @@ def main() -> None:
         for plan in plans:
             for (cond, (wind, turbulence)), fast in product(conditions.items(), modes):
                 flight = Flight(str(plan), name, wind, turbulence, (), 1, str(SIM_CONFIG),
-                                False, 900.0, START_AT_S, fast, args.noise)  # fmt: skip
+                                False, 900.0, START_AT_S, fast, args.noise,
+                                args.gps_wander)  # fmt: skip
                 with tempfile.TemporaryDirectory() as tmp:
                     r = fly_flight(FlightJob(flight, tmp, timeout_s=600.0))
                     legs = _legs(Path(tmp) / flight.flight_id / "truth.csv", plan, name, wind)

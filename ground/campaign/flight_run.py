@@ -192,6 +192,8 @@ def _sim_command(flight: Flight, folder: Path, port: int, namespace: str) -> lis
         cmd.append("--airborne")
     if flight.noise != 1.0:
         cmd += ["--noise", f"{flight.noise:g}"]
+    if flight.gps_wander_m is not None:
+        cmd += ["--gps-wander", f"{flight.gps_wander_m:g}"]
     if flight.start_at_s is not None:
         cmd += ["--start-at", f"{flight.start_at_s:g}", "--fast" if flight.fast else "--exact"]
     return cmd

@@ -81,6 +81,7 @@ class Flight:
     start_at_s: float | None = None  # exact lockstep, armed and started by the simulator then
     fast: bool = False  # with start_at_s: fast lockstep instead of exact (to compare the two)
     noise: float = 1.0  # sensor noise scale (0: perfect sensors)
+    gps_wander_m: float | None = None  # the GPS's wandering error; None: the model's
 
     @property
     def condition(self) -> str:
@@ -109,7 +110,8 @@ class Flight:
                config, self.airborne, self.max_sim_s, self.start_at_s,
                *(("fast",) if self.fast else ()))  # fmt: skip
         # Left out at its default so that earlier flights keep their ids.
-        return key + ((self.noise,) if self.noise != 1.0 else ())
+        key += (self.noise,) if self.noise != 1.0 else ()
+        return key + (("gps_wander", self.gps_wander_m) if self.gps_wander_m is not None else ())
 
 
 @dataclass(frozen=True)

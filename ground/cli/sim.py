@@ -155,6 +155,15 @@ def sim(
         ),
     ] = None,
     noise: Annotated[float, typer.Option(help="sensor noise scale (0: perfect)")] = 1.0,
+    gps_wander: Annotated[
+        float | None,
+        typer.Option(
+            min=0,
+            max=100,
+            help="the GPS's slowly wandering error, m per axis (default: the receiver "
+            "model's 1 m; 0: only its white noise)",
+        ),
+    ] = None,
     mount: Annotated[
         str,
         typer.Option(
@@ -212,6 +221,7 @@ def sim(
             airframe=aircraft, home=_home(home), airborne=airborne, speed=_speed(speed),
             wind_ned=_triple(wind), turbulence=turbulence,
             outages=[_outage(o) for o in gps_outage or []], noise_scale=noise, seed=seed,
+            gps_wander_m=gps_wander,
             mount=mount, airborne_bank_deg=airborne_bank,
             rates=DeviceRates(imu_hz=imu_hz),
             exact=exact, start_at_s=start_at,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import heapq
 import logging
 import time
@@ -63,6 +64,8 @@ def _devices(opts: BridgeOptions) -> EmulatedDevices:
         noise = NoiseModel(scale=opts.noise_scale)
     else:
         noise = NoiseModel.installed(opts.noise_scale, calibrated=opts.mount == "calibrated")
+    if opts.gps_wander_m is not None:
+        noise = dataclasses.replace(noise, gps_horizontal_m=opts.gps_wander_m)
     errors = SensorErrors(noise, MagneticField(), opts.seed)
     return EmulatedDevices(errors, opts.rates, opts.outages, opts.seed)
 

@@ -34,6 +34,9 @@ class BridgeOptions:
     outages: list[Outage] = field(default_factory=list)
     rates: DeviceRates = field(default_factory=DeviceRates)
     noise_scale: float = 1.0
+    # The GPS's slowly wandering error, metres per axis before noise_scale; None: the
+    # receiver model's own (NoiseModel.gps_horizontal_m). 0 leaves only its white noise.
+    gps_wander_m: float | None = None
     mount: str = "calibrated"  # the sensors' airframe defects: one of MOUNTS
     seed: int = 1
     duration_s: float | None = None
@@ -50,6 +53,8 @@ class BridgeOptions:
             raise ValueError(f"mount must be one of {', '.join(MOUNTS)}")
         if not -80.0 <= self.airborne_bank_deg <= 80.0:
             raise ValueError("the airborne start's bank must lie within ±80°")
+        if self.gps_wander_m is not None and not 0.0 <= self.gps_wander_m <= 100.0:
+            raise ValueError("the GPS wander must lie within 0-100 m")
         if self.speed is not None and self.speed <= 0:
             raise ValueError("speed must be positive (or None for lockstep)")
 

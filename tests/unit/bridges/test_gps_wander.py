@@ -1,0 +1,51 @@
+"""``companion sim --gps-wander M`` sets the simulated GPS's slowly wandering error alone: 0
+leaves its white noise, which averages out, and the default wanders by metres."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ground.simulation.sensor_errors import EARTH_RADIUS_M
+from ground.simulation.true_state import TrueState
+from ground.sitl.bridge.bridge import _devices
+from ground.sitl.bridge.options import BridgeOptions
+
+STILL = TrueState(
+    t_s=0.0, lat_deg=-37.9, lon_deg=145.1, alt_msl_m=100.0, alt_agl_m=20.0, roll=0.0,
+    pitch=0.0, yaw=0.0, vn=0.0, ve=0.0, vd=0.0, p=0.0, q=0.0, r=0.0,
+    f_body=(0.0, 0.0, -9.80665), airspeed_m_s=0.0,
+)  # fmt: skip
+RATE_HZ = 5.0
+
+
+def _smoothed_error_m(opts: BridgeOptions, seconds: float = 300.0) -> np.ndarray:
+    """The horizontal position error of a standing receiver, averaged over 30 s windows."""
+    errors = _devices(opts).errors
+    north, east = [], []
+    for _ in range(round(seconds * RATE_HZ)):
+        lat, lon, _alt, _vel = errors.gps(STILL, 1.0 / RATE_HZ)
+        north.append(math.radians(lat - STILL.lat_deg) * EARTH_RADIUS_M)
+        cos_lat = math.cos(math.radians(STILL.lat_deg))
+        east.append(math.radians(lon - STILL.lon_deg) * EARTH_RADIUS_M * cos_lat)
+    window = np.ones(round(30 * RATE_HZ)) / round(30 * RATE_HZ)
+    return np.hypot(np.convolve(north, window, "valid"), np.convolve(east, window, "valid"))
+
+
+def test_without_wander_only_white_noise_is_left_which_averages_out():
+    assert _smoothed_error_m(BridgeOptions(gps_wander_m=0.0)).max() < 0.15
+
+
+def test_the_default_receiver_wanders_by_metres_and_the_option_scales_it():
+    default = _smoothed_error_m(BridgeOptions())
+    assert default.max() > 1.0
+    doubled = _smoothed_error_m(BridgeOptions(gps_wander_m=2.0))  # the same seed
+    assert doubled.max() == pytest.approx(2.0 * default.max(), rel=0.1)
+
+
+@pytest.mark.parametrize("metres", [-0.1, 101.0, math.nan])
+def test_a_wander_outside_0_to_100_m_is_refused(metres):
+    with pytest.raises(ValueError, match="GPS wander"):
+        BridgeOptions(gps_wander_m=metres)
