@@ -11,8 +11,10 @@ the fork server; never the simulator bridge.
   and flying, and the total;
 - start-up: from launching ``companion sim`` to the first HEARTBEAT on the UDP link (the
   simulator bridge's own start, JSBSim loading its model, is in it and is shown apart);
-- restart of a plug-in killed with SIGKILL: from the kill to its first step in the new
-  process (its first ``system/plugin_stats``) and to its output on the bus again;
+- restart of a plug-in killed with SIGKILL: from the kill to its new process being up (its
+  first ``system/plugin_stats``, sent when its init is done), to its first step (which
+  waits for its device: a 5 Hz GPS speaks up to 0.2 s later) and to its output on the bus
+  again;
 - CPU time per real second (the scheduler's nanosecond count of every thread,
   ``/proc/PID/task/*/schedstat``; the simulation runs at real time, and the ratio to
   simulated time is printed too) over ``--cpu-seconds`` of flight, and wake-ups per second
@@ -171,11 +173,13 @@ class Vehicle:
         wakes = {n: (after[n][1] - before[n][1]) / wall for n in pids}
         return cpu, wakes, sim / wall
 
-    def restart(self, name: str, channel: str) -> tuple[float, float]:
-        """Kill -9 a plug-in; seconds until its first step and until its output again."""
+    def restart(self, name: str, channel: str) -> tuple[float, float, float]:
+        """Kill -9 a plug-in; seconds until its new process is up (its first
+        ``system/plugin_stats``, sent when its init is done), until its first step, and
+        until its output is on the bus again."""
         pid = {v: k for k, v in self.names().items()}.get(name, 0)
         if not pid:
-            return float("nan"), float("nan")
+            return float("nan"), float("nan"), float("nan")
         out = self.bus.reader(channel)
         self.stats.drain()
         os.kill(pid, signal.SIGKILL)
@@ -183,17 +187,19 @@ class Vehicle:
         # Output of the new process is stamped after the kill; what the dead one left
         # on the bus (a Latest channel's last value) is not.
         killed_at_us = int(self.sim_s() * 1e6)
-        stepped = flowing = float("nan")
+        up = stepped = flowing = float("nan")
         while time.monotonic() - t_kill < 10.0 and (stepped != stepped or flowing != flowing):
             now = time.monotonic() - t_kill
             for msg in self.stats.drain():
-                if msg.name.decode() == name and msg.pid != pid and stepped != stepped:
-                    stepped = now
+                if msg.name.decode() != name or msg.pid == pid:
+                    continue
+                up = now if up != up else up
+                stepped = now if stepped != stepped and msg.steps > 0 else stepped
             if flowing != flowing and any(s.t_us > killed_at_us for s in out.drain()):
                 flowing = now
             time.sleep(0.001)
         out.close()
-        return stepped, flowing
+        return up, stepped, flowing
 
     def stop(self) -> None:
         if self.proc.poll() is None:
@@ -342,10 +348,12 @@ def print_flight(runs: list[dict[str, object]]) -> None:
     up = statistics.median(r["up_s"] for r in runs)  # type: ignore[misc]
     print(f"start-up: launch -> first HEARTBEAT {hb:.2f} s; -> every plug-in stepping {up:.2f} s")
     for name, chan in KILLED:
-        stepped = statistics.median(r["restart"][name][0] for r in runs)  # type: ignore[index]
-        flowing = statistics.median(r["restart"][name][1] for r in runs)  # type: ignore[index]
-        print(f"restart of {name} after kill -9: first step {stepped * 1000:6.0f} ms, "
-              f"{chan} again {flowing * 1000:6.0f} ms")  # fmt: skip
+        up, stepped, flowing = (
+            statistics.median(r["restart"][name][k] for r in runs)  # type: ignore[index]
+            for k in range(3)
+        )
+        print(f"restart of {name} after kill -9: up {up * 1000:4.0f} ms, first step "
+              f"{stepped * 1000:4.0f} ms, {chan} again {flowing * 1000:4.0f} ms")  # fmt: skip
 
 
 def main() -> None:

@@ -52,6 +52,7 @@ class Child:
 
     def start(self) -> None:
         """Start the plug-in process now: forked by the fork server, or else spawned."""
+        self.stats = PluginStats()  # the dead process's counters are not the new one's
         forked = self.forker.spawn(self._argv_spec) if self.forker is not None else None
         self.proc = forked or subprocess.Popen(
             [sys.executable, "-m", "companion.exec_control.plugin_host", self._argv_spec],

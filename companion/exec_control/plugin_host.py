@@ -123,6 +123,9 @@ class PluginHost:
             log.exception("%s: init failed", self.spec["name"])
             return EXIT_INIT_FAILED
         code = 0
+        # Up: the health table has the new process's own counters before its first step,
+        # which waits for its device (a silent one: the read timeout, a second).
+        self.publish_stats()
         next_stats = next_connections = time.monotonic()
         try:
             while not self.stopping:

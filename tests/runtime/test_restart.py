@@ -94,3 +94,20 @@ def test_plugins_outlive_their_fork_server_and_are_still_restarted(vehicle_facto
     before = newest_nav_t(vehicle)
     wait_for(lambda: newest_nav_t(vehicle) > before, 10, "data flowing after the restart")
     assert vehicle.proc.poll() is None
+
+
+def test_a_restarted_plugin_is_announced_up_before_its_first_step(vehicle_factory):
+    """Its first stats come when its init is done, not when its device first speaks (a
+    silent one: after the read timeout, a second)."""
+    vehicle = vehicle_factory(pipeline())
+    stats = vehicle.bus.queue_reader("system/plugin_stats")
+    old_pid = vehicle.wait_running("idle")
+    os.kill(old_pid, signal.SIGKILL)
+
+    def first_of_new_process():
+        mine = [m for m in stats.drain() if m.name == b"idle" and m.pid != old_pid]
+        return mine[0] if mine else None
+
+    first = wait_for(first_of_new_process, 10, "stats of the new idle process", period_s=0.01)
+    assert first.steps == 0
+    wait_for(lambda: (r := vehicle.row("idle")) and r.pid == first.pid, 5, "the new pid listed")
