@@ -6,6 +6,11 @@ ListDirectory. Every request is a FILE_TRANSFER_PROTOCOL payload (251 bytes); ev
 echoes the request's opcode in ``req_opcode`` with ``seq_number`` one more than the request's
 (bursts count on from there). Anything malformed or unsupported gets a NAK with the protocol's
 error code and is counted; nothing a ground station sends raises.
+
+Sessions belong to the station that opened them (its system and component id): a
+ResetSessions ends only the asking station's own, and another station's session number
+reads as an invalid session, so QGroundControl's metadata download and a script's or
+MAVProxy's FTP on a second link never cut each other short.
 """
 
 from __future__ import annotations
@@ -69,16 +74,21 @@ def _path(request: Packet) -> str:
     return raw.decode("utf-8", errors="replace").strip("/")
 
 
+Client = tuple[int, int]  # the requesting station's system and component id
+
+
 @dataclass
 class FtpServer:
     """Read-only sessions over ``files`` (path without leading slash → content)."""
 
     files: Mapping[str, bytes]
-    sessions: dict[int, str] = field(default_factory=dict)
+    sessions: dict[int, tuple[Client, str]] = field(default_factory=dict)
     refused: int = 0  # malformed or unsupported requests, answered with a NAK
+    _client: Client = field(default=(0, 0), init=False, repr=False)  # the one asking now
 
-    def handle(self, payload: bytes) -> list[bytes]:
-        """The reply payloads to one request payload (several for a burst)."""
+    def handle(self, payload: bytes, client: Client = (0, 0)) -> list[bytes]:
+        """The reply payloads to one request payload (several for a burst) from ``client``."""
+        self._client = client
         request = parse(payload)
         if request is None:
             self.refused += 1
@@ -121,12 +131,17 @@ class FtpServer:
         free = [s for s in range(MAX_SESSIONS) if s not in self.sessions]
         if not free:
             return [self._nak(request, ERR_NO_SESSIONS)]
-        self.sessions[free[0]] = path
+        self.sessions[free[0]] = (self._client, path)
         size = struct.pack("<I", len(self.files[path]))
         return [self._reply(request, size, session=free[0], offset=0)]
 
+    def _own(self, session: int) -> str | None:
+        """The path of ``session`` if the asking station opened it."""
+        owner, path = self.sessions.get(session, (None, None))
+        return path if owner == self._client else None
+
     def _content(self, request: Packet) -> bytes | None:
-        path = self.sessions.get(request.session)
+        path = self._own(request.session)
         return None if path is None else self.files[path]
 
     def _read(self, request: Packet) -> list[bytes]:
@@ -155,12 +170,14 @@ class FtpServer:
         return out
 
     def _terminate(self, request: Packet) -> list[bytes]:
-        if self.sessions.pop(request.session, None) is None:
+        if self._own(request.session) is None:
             return [self._nak(request, ERR_INVALID_SESSION)]
+        del self.sessions[request.session]
         return [self._reply(request)]
 
     def _reset(self, request: Packet) -> list[bytes]:
-        self.sessions.clear()
+        for session in [s for s, (owner, _) in self.sessions.items() if owner == self._client]:
+            del self.sessions[session]
         return [self._reply(request)]
 
     def _list(self, request: Packet) -> list[bytes]:

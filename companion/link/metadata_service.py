@@ -66,7 +66,7 @@ class MetadataService:
         ):
             self.rejected_target += 1
             return []
-        replies = self.ftp.handle(bytes(msg.payload))
+        replies = self.ftp.handle(bytes(msg.payload), (peer.sysid, peer.compid))
         return [
             Outgoing(self.mav.file_transfer_protocol_encode(0, peer.sysid, peer.compid, r), peer)
             for r in replies

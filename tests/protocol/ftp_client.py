@@ -35,6 +35,7 @@ class FtpDownload:
         self.gcs = gcs
         self.timeout_s = timeout_s
         self.expected = 0  # the sequence number of the next reply
+        self.sysid = gcs.mav.srcSystem  # replies to another station are not this one's
 
     def send(self, opcode: int, **fields: Any) -> None:
         payload = request(self.expected + 1, opcode, **fields)
@@ -47,7 +48,7 @@ class FtpDownload:
         while time.monotonic() < deadline:
             conn = self.gcs.conn
             msg = conn.recv_match(type="FILE_TRANSFER_PROTOCOL", blocking=True, timeout=0.2)
-            if msg is None or msg.get_srcComponent() != 1 or msg.target_system != 255:
+            if msg is None or msg.get_srcComponent() != 1 or msg.target_system != self.sysid:
                 continue
             fields = decode(msg)
             if fields[4] == opcode:

@@ -13,10 +13,10 @@ import zlib
 import pytest
 from pymavlink.dialects.v20 import common as m
 
-from tests.protocol.ftp_client import FtpDownload, request
+from tests.protocol.ftp_client import OPEN_FILE_RO, READ_FILE, FtpDownload, request
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.protocol.test_params import fetch_all
-from tests.support.configs import link_vehicle
+from tests.support.configs import FAKE_NAV, link, link_vehicle, plugin, vehicle_config
 
 
 @pytest.fixture
@@ -91,3 +91,30 @@ def test_missing_file_and_unknown_opcode_are_refused_and_the_link_goes_on(gcs):
     gcs.mav.file_transfer_protocol_send(0, 1, 1, request(7, 5, session=200, data=b"\0" * 239))
     assert ftp.reply(5)[7] == bytes([4])  # ReadFile without a session: InvalidSession
     assert "SR_GPS" in parameter_metadata(gcs)
+
+
+def test_a_second_station_ending_its_download_leaves_the_first_ones_session_open(
+    vehicle_factory, tmp_path
+):
+    """QGroundControl mid-download on one endpoint while a script downloads on another:
+    the script's download ends with ResetSessions, as QGroundControl's own does."""
+    ports = free_udp_port(), free_udp_port()
+    endpoints = [f"udpin://127.0.0.1:{port}" for port in ports]
+    config = vehicle_config(
+        "twoftp", link(*endpoints), plugin("nav", FAKE_NAV), sysid=1, state_dir=tmp_path
+    )
+    vehicle_factory(config)
+    qgc, script = GroundStation(ports[0]), GroundStation(ports[1], sysid=254, compid=1)
+    qgc.connect()
+    script.connect()
+    uri, _ = general_metadata(qgc, 397)
+    first = FtpDownload(qgc)
+    first.send(OPEN_FILE_RO, data=ftp_path(uri).encode())
+    _, session, op, _, _, _, _, _ = first.reply(OPEN_FILE_RO)
+    assert op == 128
+    whole = FtpDownload(script).get(ftp_path(uri))
+    first.send(READ_FILE, session=session, offset=0, data=b"\0" * 239)
+    _, _, op, size, _, _, _, data = first.reply(READ_FILE)
+    assert op == 128 and data == whole[:size]
+    qgc.close()
+    script.close()

@@ -15,6 +15,7 @@ from companion.link.ftp import (
     DATA_MAX,
     ERR_EOF,
     ERR_INVALID_DATA_SIZE,
+    ERR_INVALID_SESSION,
     ERR_NO_SESSIONS,
     LIST_DIRECTORY,
     MAX_SESSIONS,
@@ -22,6 +23,7 @@ from companion.link.ftp import (
     OPEN_FILE_RO,
     PAYLOAD_LEN,
     READ_FILE,
+    RESET_SESSIONS,
     TERMINATE_SESSION,
     FtpServer,
     Packet,
@@ -125,3 +127,38 @@ def test_metadata_files_follow_the_declarations_in_qgc_schema():
     }  # fmt: skip
     batt = params["BATT_CAPACITY"]
     assert batt["rebootRequired"] is True and "max" not in batt  # no infinity in JSON
+
+
+QGC, SCRIPT = (255, 190), (254, 191)
+
+
+def test_a_station_resetting_its_sessions_leaves_another_stations_download_going():
+    server = FtpServer({"a/big.bin": BIG, "b.txt": b"hello"})
+    open_qgc = Packet(1, 0, OPEN_FILE_RO, 9, 0, 0, 0, b"a/big.bin").pack()
+    (opened,) = [parse(r) for r in server.handle(open_qgc, QGC)]
+    reset = Packet(1, 0, RESET_SESSIONS, 0, 0, 0, 0, b"").pack()
+    (reset_ack,) = [parse(r) for r in server.handle(reset, SCRIPT)]
+    assert reset_ack.opcode == ACK
+    read = Packet(3, opened.session, READ_FILE, DATA_MAX, 0, 0, 0, b"").pack()
+    (chunk,) = [parse(r) for r in server.handle(read, QGC)]
+    assert chunk.opcode == ACK and chunk.data[: chunk.size] == BIG[:DATA_MAX]
+    # The station's own reset does end it.
+    server.handle(reset, QGC)
+    (gone,) = [parse(r) for r in server.handle(read, QGC)]
+    assert gone.opcode == NAK and gone.data[0] == ERR_INVALID_SESSION
+
+
+def test_another_stations_session_number_is_an_invalid_session_to_read_or_end():
+    server = FtpServer({"b.txt": b"hello"})
+    open_script = Packet(1, 0, OPEN_FILE_RO, 5, 0, 0, 0, b"b.txt").pack()
+    (opened,) = [parse(r) for r in server.handle(open_script, SCRIPT)]
+    for opcode in (READ_FILE, BURST_READ_FILE, TERMINATE_SESSION):
+        raw = Packet(2, opened.session, opcode, 0, 0, 0, 0, b"").pack()
+        (reply,) = [parse(r) for r in server.handle(raw, QGC)]
+        assert reply.opcode == NAK and reply.data[0] == ERR_INVALID_SESSION
+    # Still the script's: it reads and ends it.
+    raw = Packet(3, opened.session, READ_FILE, 0, 0, 0, 0, b"").pack()
+    (reply,) = [parse(r) for r in server.handle(raw, SCRIPT)]
+    assert reply.opcode == ACK and reply.data[: reply.size] == b"hello"
+    raw = Packet(4, opened.session, TERMINATE_SESSION, 0, 0, 0, 0, b"").pack()
+    assert parse(server.handle(raw, SCRIPT)[0]).opcode == ACK
