@@ -80,7 +80,7 @@ class PlanVerdicts:
         if self._fence is None or self._fence[0] is not items:
             fence = Fence.from_items(items)
             zones = [*fence.inclusions, *fence.exclusions]
-            valid = not fence.empty and all(z.is_valid and z.area > 0 for z in zones)
+            valid = not fence.empty and all(z.is_valid for z in zones)
             self._fence = (items, fence, valid)
         return self._fence[1], self._fence[2]
 

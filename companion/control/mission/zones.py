@@ -115,7 +115,9 @@ class CircleZone:
 
     @property
     def is_valid(self) -> bool:
-        return math.isfinite(self.radius_m) and all(math.isfinite(c) for c in self.centre)
+        """A finite centre and a finite radius above zero."""
+        finite = math.isfinite(self.radius_m) and all(math.isfinite(c) for c in self.centre)
+        return finite and self.radius_m > 0
 
     def _distance(self, p: Point) -> float:
         return math.hypot(p[0] - self.centre[0], p[1] - self.centre[1])

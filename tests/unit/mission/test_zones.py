@@ -61,3 +61,5 @@ def test_a_circle_is_exact_where_a_polygon_of_it_was_not():
     assert circle.covers((100.0, 0.0)) and not circle.contains((100.0, 0.0))
     assert not circle.covers((70.8, 70.8))
     assert not CircleZone((0.0, 0.0), math.inf).is_valid
+    assert not CircleZone((0.0, 0.0), 0.0).is_valid  # no area: encloses nothing
+    assert not CircleZone((0.0, 0.0), -5.0).is_valid
