@@ -193,17 +193,27 @@ class Waiter:
         self.readers = list(readers)
         self.triggers = self.readers if triggers is None else list(triggers)
         self._idle = idle or IdleTally()
-        self._waitset = (
-            iox2.WaitSetBuilder.new()
-            .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
-            .create(iox2.ServiceType.Ipc)
-        )
-        self._guards = [self._waitset.attach_notification(r.listener) for r in self.triggers]
-        # What each attachment's id, as the WaitSet reports it fired, belongs to.
-        self._owners = {
-            iox2.WaitSetAttachmentId.from_guard(g): r
-            for g, r in zip(self._guards, self.triggers, strict=True)
-        }
+        self._guards: list[Any] = []
+        self._owners: dict[Any, Reader[Any]] = {}
+        self._built: Any = None
+
+    @property
+    def _waitset(self) -> Any:
+        """The WaitSet over the triggers, made when first needed: a single trigger waits on
+        its own listener and needs one only to wait on descriptors too."""
+        if self._built is None:
+            self._built = (
+                iox2.WaitSetBuilder.new()
+                .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
+                .create(iox2.ServiceType.Ipc)
+            )
+            self._guards = [self._built.attach_notification(r.listener) for r in self.triggers]
+            # What each attachment's id, as the WaitSet reports it fired, belongs to.
+            self._owners = {
+                iox2.WaitSetAttachmentId.from_guard(g): r
+                for g, r in zip(self._guards, self.triggers, strict=True)
+            }
+        return self._built
 
     def wait(self, timeout_s: float) -> list[Reader[Any]]:
         """The readers with data, after sleeping at most ``timeout_s`` for the first."""
