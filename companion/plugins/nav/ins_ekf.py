@@ -71,8 +71,10 @@ class InsEkfPlugin(Plugin):
         self.order = SampleOrder()
 
     def step(self) -> None:
-        self.waiter.wait(WAIT_S)  # the waiter counts its own idle time
-        samples = self.order.push(m for r in self.readers for m in r.drain())
+        # The waiter counts its own idle time and names the readers with data, in feed
+        # order: the empty ones are not asked again.
+        ready = self.waiter.wait(WAIT_S)
+        samples = self.order.push(m for r in ready for m in r.drain())
         if not samples:
             return
         nav = self.runner.nav
