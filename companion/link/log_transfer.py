@@ -147,7 +147,9 @@ class LogTransferService:
         if start >= len(entries):
             return self._refuse(f"LOG_REQUEST_LIST from {start}: only {len(entries)} logs")
         last = min(end, len(entries) - 1)
-        self.listing = deque((i, peer) for i in range(start, last + 1))
+        # A station asking again restarts its own list; another station's goes on.
+        others = (item for item in self.listing if item[1] != peer)
+        self.listing = deque([*others, *((i, peer) for i in range(start, last + 1))])
         return self.tick(now_s)
 
     def _request(self, log_id: int, ofs: int, count: int, peer: Peer, now_s: float) -> list[Any]:

@@ -183,3 +183,20 @@ def test_a_download_on_a_slow_radio_leaves_telemetry_its_share(tmp_path):
     assert skipped <= sent // 50, f"telemetry: {sent} sent, {skipped} skipped"
     data_rate = 30_000 / t
     assert 0.8 * SHARE * RADIO_BYTES_S * 90 / 109 < data_rate < 1.1 * SHARE * RADIO_BYTES_S
+
+
+def test_two_stations_listing_together_each_get_every_entry(tmp_path):
+    """QGroundControl's log page open while MAVProxy's ``log list`` runs on another link."""
+    make_logs(tmp_path / "logs", *([100] * 20))
+    st = Station(tmp_path / "logs", rate_bytes_s=RADIO_BYTES_S)
+    mavproxy = Peer(254, 1, 1)
+    req = st.gcs.log_request_list_encode(1, 1, 0, 0xFFFF)
+    req = st.rx.parse_buffer(req.pack(st.gcs))[0]
+    sent = st.svc.handle(req, GCS, 0.0) + st.svc.tick(0.05)
+    sent += st.svc.handle(req, mavproxy, 0.1)  # while the first list is going out
+    sent += st.svc.handle(req, mavproxy, 0.1)  # and again: its own list restarts, once
+    for k in range(1, 300):
+        sent += st.svc.tick(0.1 + k * 0.01)
+    for peer in (GCS, mavproxy):
+        ids = sorted(o.msg.id for o in sent if o.to == peer)
+        assert ids == list(range(20)), peer
