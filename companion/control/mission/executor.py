@@ -222,7 +222,7 @@ class MissionExecutor:
         first = self.point_of(item, pos)
         if not past_point(self._prev, first, pos):
             return
-        radius = item.param2 if item.param2 > 0 else self.config.wp_radius
+        radius = item.acceptance_m(self.config.wp_radius)
         nxt = self._next_point(first)
         off = _distance(pos, first) if nxt is None else abs(_cross(first, nxt, pos))
         if off > radius:
@@ -230,7 +230,7 @@ class MissionExecutor:
 
     def _waypoint(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
         b = self.point_of(item, pos)
-        radius = item.param2 if item.param2 > 0 else self.config.wp_radius
+        radius = item.acceptance_m(self.config.wp_radius)
         radius = max(radius, self._turn_lead(self._prev, b))
         if _distance(pos, b) <= radius or past_point(self._prev, b, pos):
             self._advance(True, b, self.alt_of(item))

@@ -119,6 +119,10 @@ class MissionItem:
     def as_dict(self) -> dict[str, float | int]:
         return asdict(self)
 
+    def acceptance_m(self, default_m: float) -> float:
+        """A waypoint's acceptance radius (param2, m), or ``default_m`` when it gives none."""
+        return self.param2 if self.param2 > 0 else default_m
+
 
 def check_params(item: MissionItem) -> int:
     """INVALID_PARAMn for a parameter that is infinite, huge, or NaN where a number is read."""
