@@ -21,8 +21,12 @@ from tests.support.vehicle import REPO
 PLAN = str(REPO / "qgc_plans" / "square.plan")
 MANUAL_AT, AUTO_AT, STABILIZED_AT, SILENT_AT = 80.0, 85.0, 110.0, 113.0
 FS_LONG_TIMEOUT = 5.0  # ArduPlane's default, and ours
-STICKS = {"roll": 0.3, "pitch": 0.2, "yaw": 0.1, "throttle": 0.7}
-SURFACES = {"aileron": 0.3, "elevator": 0.2, "rudder": 0.1, "throttle": 0.7}
+# Crossed controls (right aileron, left rudder): a coordinated autopilot never commands
+# them, so surfaces matching them are the pilot's. With the rudder the same way as the
+# aileron, the autopilot's own commands in a turn came within 0.06 of the sticks, and a CI
+# run found one within the servo card's resolution before the switch.
+STICKS = {"roll": 0.3, "pitch": 0.2, "yaw": -0.3, "throttle": 0.7}
+SURFACES = {"aileron": 0.3, "elevator": 0.2, "rudder": -0.3, "throttle": 0.7}
 # Switch positions 6 (Auto), 1 (Manual), 4 (Stabilized): a three-position switch.
 SCRIPT = f"""t,roll,pitch,yaw,throttle,switch,signal
 0,0,0,0,0,6,ok
