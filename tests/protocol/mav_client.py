@@ -13,6 +13,7 @@ from pymavlink import mavutil
 
 from mavlink_dialect import companion as d
 from mavlink_dialect import companion as dialect
+from tests.support.configs import FAKE_NAV, link, plugin, vehicle_config
 
 
 def free_udp_port() -> int:
@@ -82,3 +83,21 @@ def upload_mission(gcs: GroundStation) -> None:
             round((-37.9105 + dlat) * 1e7), round(145.134 * 1e7), 50, d.MAV_MISSION_TYPE_MISSION,
         )  # fmt: skip
     assert gcs.recv("MISSION_ACK", 10).type == d.MAV_MISSION_ACCEPTED
+
+
+def two_stations(
+    vehicle_factory: Any, tmp_path: Any, name: str
+) -> tuple[GroundStation, GroundStation]:
+    """A vehicle (sysid 1) on two udpin endpoints, and a ground station connected on each:
+    QGroundControl's identity on the first, another station's (254, 1: MAVProxy, a script)
+    on the second."""
+    ports = free_udp_port(), free_udp_port()
+    endpoints = [f"udpin://127.0.0.1:{port}" for port in ports]
+    config = vehicle_config(
+        name, link(*endpoints), plugin("nav", FAKE_NAV), sysid=1, state_dir=tmp_path
+    )
+    vehicle_factory(config)
+    qgc, other = GroundStation(ports[0]), GroundStation(ports[1], sysid=254, compid=1)
+    qgc.connect()
+    other.connect()
+    return qgc, other

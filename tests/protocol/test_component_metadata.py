@@ -14,9 +14,9 @@ import pytest
 from pymavlink.dialects.v20 import common as m
 
 from tests.protocol.ftp_client import OPEN_FILE_RO, READ_FILE, FtpDownload, request
-from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.protocol.mav_client import GroundStation, free_udp_port, two_stations
 from tests.protocol.test_params import fetch_all
-from tests.support.configs import FAKE_NAV, link, link_vehicle, plugin, vehicle_config
+from tests.support.configs import link_vehicle
 
 
 @pytest.fixture
@@ -98,15 +98,7 @@ def test_a_second_station_ending_its_download_leaves_the_first_ones_session_open
 ):
     """QGroundControl mid-download on one endpoint while a script downloads on another:
     the script's download ends with ResetSessions, as QGroundControl's own does."""
-    ports = free_udp_port(), free_udp_port()
-    endpoints = [f"udpin://127.0.0.1:{port}" for port in ports]
-    config = vehicle_config(
-        "twoftp", link(*endpoints), plugin("nav", FAKE_NAV), sysid=1, state_dir=tmp_path
-    )
-    vehicle_factory(config)
-    qgc, script = GroundStation(ports[0]), GroundStation(ports[1], sysid=254, compid=1)
-    qgc.connect()
-    script.connect()
+    qgc, script = two_stations(vehicle_factory, tmp_path, "twoftp")
     uri, _ = general_metadata(qgc, 397)
     first = FtpDownload(qgc)
     first.send(OPEN_FILE_RO, data=ftp_path(uri).encode())

@@ -7,8 +7,8 @@ import time
 import pytest
 from pymavlink.dialects.v20 import common as m
 
-from tests.protocol.mav_client import GroundStation, free_udp_port
-from tests.support.configs import FAKE_NAV, link, link_vehicle, plugin, vehicle_config
+from tests.protocol.mav_client import GroundStation, free_udp_port, two_stations
+from tests.support.configs import link_vehicle
 
 
 @pytest.fixture
@@ -89,15 +89,7 @@ def test_out_of_range_set_is_refused_with_the_old_value_echoed_and_a_statustext(
 
 def test_two_stations_asking_together_each_get_every_index(vehicle_factory, tmp_path):
     """QGroundControl on one endpoint and MAVProxy on another, connecting at once."""
-    ports = free_udp_port(), free_udp_port()
-    endpoints = [f"udpin://127.0.0.1:{port}" for port in ports]
-    config = vehicle_config(
-        "twostations", link(*endpoints), plugin("nav", FAKE_NAV), sysid=1, state_dir=tmp_path
-    )
-    vehicle_factory(config)
-    qgc, mavproxy = GroundStation(ports[0]), GroundStation(ports[1], sysid=254, compid=1)
-    qgc.connect()
-    mavproxy.connect()
+    qgc, mavproxy = two_stations(vehicle_factory, tmp_path, "twostations")
     qgc.mav.param_request_list_send(1, 0)
     mavproxy.mav.param_request_list_send(1, 0)  # while the first list is going out
     for gcs in (qgc, mavproxy):
