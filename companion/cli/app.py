@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-import logging
 import sys
 from pathlib import Path
 
 import typer
 from rich.console import Console
+
+from companion.exec_control.vehicle_process import EXIT_CONFIG
 
 app = typer.Typer(
     add_completion=False,
@@ -20,11 +21,6 @@ out = Console() if sys.stdout.isatty() else Console(width=200)
 
 CONFIG_OPT = typer.Option("--config", "-c", help="vehicle config (TOML)")
 NS_OPT = typer.Option("--namespace", "-n", help="bus namespace (default: config or $COMPANION_BUS)")
-EXIT_CONFIG = 2
-
-
-def setup_logging(level: str, who: str = "exec_control") -> None:
-    logging.basicConfig(level=level, format=f"%(asctime)s {who} %(levelname)s %(message)s")
 
 
 def load_checked(config: Path, namespace: str | None):

@@ -18,8 +18,8 @@ from companion.cli.app import (
     load_checked,
     out,
     plan_or_exit,
-    setup_logging,
 )
+from companion.exec_control.vehicle_process import setup_logging
 
 
 @app.command()
@@ -29,11 +29,12 @@ def run(
     log_level: Annotated[str, typer.Option(help="DEBUG, INFO, WARNING")] = "INFO",
 ) -> None:
     """Run the vehicle: every plug-in of the config in its own process, supervised."""
-    from companion.exec_control.supervisor import Supervisor
+    from companion.exec_control.handover import exec_module
 
     setup_logging(log_level)
     cfg = load_checked(config, namespace)
-    raise typer.Exit(Supervisor(cfg, log_level).run())
+    # The vehicle runs on in this process without the command line's libraries.
+    exec_module("companion.exec_control.vehicle_process", (cfg, log_level))
 
 
 @app.command()

@@ -12,8 +12,8 @@ from companion.cli.app import (
     app,
     err,
     out,
-    setup_logging,
 )
+from companion.exec_control.vehicle_process import setup_logging
 from ground.cli.extras import require_ground_extra
 
 

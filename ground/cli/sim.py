@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, NoReturn
 
 import typer
 
@@ -14,8 +14,8 @@ from companion.cli.app import (
     app,
     err,
     plan_or_exit,
-    setup_logging,
 )
+from companion.exec_control.vehicle_process import setup_logging
 from ground.cli.extras import require_ground_extra
 
 CONFIGS = Path(__file__).resolve().parents[2] / "companion" / "configs"
@@ -98,24 +98,11 @@ def _run_fleet(req) -> int:
     return fleet.run()
 
 
-def _run_one(req, opts, log_level: str, logs_dir: Path, truth: Path | None) -> int:
-    """One vehicle; then where its flight logs are (copied beside the truth CSV)."""
-    from companion.exec_control.config import ConfigError
-    from ground.sitl.run_logs import keep_beside, log_names, new_logs
-    from ground.sitl.session import run_sim
+def _run_one(req, opts, log_level: str, logs_dir: Path, truth: Path | None) -> NoReturn:
+    """One vehicle, flown on in this process without the command line's libraries."""
+    from companion.exec_control.handover import exec_module
 
-    before = log_names(logs_dir)
-    try:
-        code = run_sim(req, opts, log_level)
-    except ConfigError as exc:
-        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
-        raise typer.Exit(EXIT_CONFIG) from None
-    logs = new_logs(logs_dir, before)
-    for path in logs:
-        err.print(f"flight log: {path}", highlight=False, soft_wrap=True)
-    for path in keep_beside(truth, logs) if truth is not None else []:
-        err.print(f"flight log copied to {path}", highlight=False, soft_wrap=True)
-    return code
+    exec_module("ground.sitl.session_process", (req, opts, log_level, logs_dir, truth))
 
 
 @app.command()
@@ -247,4 +234,4 @@ def sim(
         )))  # fmt: skip
     req = SimRequest(config, _single_links(link, api_port_base), state_dir, lists, sysid)
     logs_dir = Path(state_dir or vehicle["state_dir"]).expanduser() / "logs"
-    raise typer.Exit(_run_one(req, opts, log_level, logs_dir, truth))
+    _run_one(req, opts, log_level, logs_dir, truth)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import pickle
 from pathlib import Path
 
 import pytest
@@ -59,22 +60,25 @@ def test_no_api_port_and_impossible_fleets(tmp_path):
 
 
 def test_the_vehicle_command_line_means_what_the_fleet_planned(tmp_path, monkeypatch):
-    """Run a vehicle's command line through the CLI: it asks run_sim for exactly that vehicle."""
+    """Run a vehicle's command line through the CLI: it hands exactly that vehicle over to
+    the process that flies it."""
     req = request(tmp_path)
     slot = plan_slots(req)[1]
     seen = {}
 
-    def fake_run_sim(sim_req, opts, log_level):
-        seen.update(req=sim_req, opts=opts)
-        return 0
+    def fake_exec_module(module, payload, title=None):
+        sim_req, opts, _log_level, _logs_dir, _truth = pickle.loads(pickle.dumps(payload))
+        seen.update(module=module, req=sim_req, opts=opts)
+        raise SystemExit(0)
 
-    monkeypatch.setattr("ground.sitl.session.run_sim", fake_run_sim)
+    monkeypatch.setattr("companion.exec_control.handover.exec_module", fake_exec_module)
     argv = vehicle_command(slot, shared_args(req))[3:]  # after "python -m companion"
     result = CliRunner().invoke(app, argv)
     assert result.exit_code == 0, result.output
     want = dataclasses.replace(
         req.opts, home=slot.home, seed=8, namespace="fl_v2", truth_path=str(slot.truth)
     )
+    assert seen["module"] == "ground.sitl.session_process"
     assert seen["opts"] == want
     assert seen["req"].sysid == 2 and seen["req"].links == slot.links
     assert seen["req"].state_dir == str(slot.state_dir) and seen["req"].plan is not None
