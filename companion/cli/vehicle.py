@@ -19,7 +19,6 @@ from companion.cli.app import (
     out,
     plan_or_exit,
 )
-from companion.exec_control.vehicle_process import setup_logging
 
 
 @app.command()
@@ -31,10 +30,9 @@ def run(
     """Run the vehicle: every plug-in of the config in its own process, supervised."""
     from companion.exec_control.handover import exec_module
 
-    setup_logging(log_level)
-    cfg = load_checked(config, namespace)
-    # The vehicle runs on in this process without the command line's libraries.
-    exec_module("companion.exec_control.vehicle_process", (cfg, log_level))
+    # The vehicle runs on in this process without the command line's libraries; it loads
+    # and checks the config itself (a refused one: exit status 2, as every command).
+    exec_module("companion.exec_control.vehicle_process", (str(config), namespace, log_level))
 
 
 @app.command()

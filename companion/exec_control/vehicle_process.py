@@ -1,9 +1,10 @@
 """``companion run`` once the command line has handed its process over: the supervisor.
 
 ``python -m companion.exec_control.vehicle_process`` is started only by the ``companion``
-command (``handover.exec_module``), with the checked config; this process never imports
-the command line's libraries (typer, rich, pydantic), and neither do the fork server and
-the plug-ins it forks.
+command (``handover.exec_module``), which parses the options and nothing more: the config
+is loaded and checked here, so the vehicle's libraries are imported once. This process
+never imports the command line's libraries (typer, rich, pydantic), and neither do the
+fork server and the plug-ins it forks.
 """
 
 from __future__ import annotations
@@ -22,11 +23,20 @@ def setup_logging(level: str, who: str = "exec_control") -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the handed-over config (a ``VehicleConfig``) until a stop signal."""
+    """Check the handed-over config (path, namespace, log level), then run it until a stop
+    signal. A refused config: its error on stderr and ``EXIT_CONFIG``, nothing started."""
+    from companion.exec_control.config import ConfigError, load_config
     from companion.exec_control.supervisor import Supervisor
+    from companion.exec_control.topology import check_topology
 
-    cfg, log_level = received(sys.argv[1:] if argv is None else argv)
+    config, namespace, log_level = received(sys.argv[1:] if argv is None else argv)
     setup_logging(log_level)
+    try:
+        cfg = load_config(config, namespace)
+        check_topology(cfg)
+    except ConfigError as exc:
+        sys.stderr.write(f"config error: {exc}\n")
+        return EXIT_CONFIG
     return Supervisor(cfg, log_level).run()
 
 
