@@ -19,13 +19,14 @@ import time
 import numpy as np
 import psutil
 
-from companion.bus import BusNode, cleanup_namespace
+from companion.bus.namespace import cleanup_namespace
+from companion.bus.node import BusNode
 from companion.messages import Imu, NavState
 
 ECHO = textwrap.dedent(
     """
     import sys
-    from companion.bus import BusNode
+    from companion.bus.node import BusNode
     from companion.messages import Imu, Magnetometer, NavState
     ns, pattern, count = sys.argv[1], sys.argv[2], int(sys.argv[3])
     with BusNode(ns, "echo") as bus:

@@ -25,7 +25,7 @@ from pathlib import Path
 os.environ.setdefault("MAVLINK20", "1")
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
-from companion.bus import cleanup_namespace  # noqa: E402
+from companion.bus.namespace import cleanup_namespace  # noqa: E402
 from mavlink_dialect import companion as m  # noqa: E402
 from tests.protocol.ftp_client import FtpDownload  # noqa: E402
 from tests.protocol.mav_client import GroundStation, free_udp_port  # noqa: E402

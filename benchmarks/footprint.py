@@ -55,7 +55,8 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from benchmarks.process_probes import cpu_seconds, pss_kib, vehicle_pids, wakeups  # noqa: E402
-from companion.bus import BusNode, cleanup_namespace  # noqa: E402
+from companion.bus.namespace import cleanup_namespace  # noqa: E402
+from companion.bus.node import BusNode  # noqa: E402
 from companion.messages import PluginState  # noqa: E402
 from mavlink_dialect import companion as m  # noqa: E402
 

@@ -30,7 +30,8 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from companion.bus import BusNode, cleanup_namespace  # noqa: E402
+from companion.bus.namespace import cleanup_namespace  # noqa: E402
+from companion.bus.node import BusNode  # noqa: E402
 from mavlink_dialect import companion as m  # noqa: E402
 
 WARM_UP_S = 15.0

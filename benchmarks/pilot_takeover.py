@@ -18,7 +18,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from companion.bus import cleanup_namespace
+from companion.bus.namespace import cleanup_namespace
 from companion.messages import FlightMode
 from tests.sitl.pilot_logs import first_entry, matches, mode_changes, servo_rows
 from tests.sitl.test_rc_pilot import AUTO_AT, MANUAL_AT, SCRIPT, SILENT_AT, SURFACES

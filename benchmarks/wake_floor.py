@@ -29,13 +29,14 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.process_probes import cpu_seconds, wakeups
-from companion.bus import BusNode, cleanup_namespace
+from companion.bus.namespace import cleanup_namespace
+from companion.bus.node import BusNode
 from companion.messages import Imu
 
 ECHO = textwrap.dedent(
     """
     import os, sys
-    from companion.bus import BusNode
+    from companion.bus.node import BusNode
     from companion.messages import Magnetometer
     kind, namespace, pipe_fd = sys.argv[1], sys.argv[2], int(sys.argv[3])
     if kind == "pipe":

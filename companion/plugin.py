@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar
 
 if TYPE_CHECKING:
-    from companion.bus import BusNode, VehicleClock
+    from companion.bus.clock import VehicleClock
+    from companion.bus.node import BusNode
     from companion.params import ParamDecl
 
 REQUIRED: Any = object()

@@ -1,5 +1,9 @@
 """Bus namespaces: each vehicle (and each test) gets its own iceoryx2 resource prefix.
 
+Naming and checking a namespace needs no iceoryx2 (the command line does it before the
+vehicle's process imports anything heavy): only the functions that reach the shared
+memory import it.
+
 Channels of one namespace are invisible to every other one, so two vehicles, or two
 tests running at once, never collide. The namespace comes from the vehicle config or
 the ``COMPANION_BUS`` environment variable (default ``companion``).
@@ -12,8 +16,10 @@ import os
 import re
 import shutil
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import iceoryx2 as iox2
+if TYPE_CHECKING:
+    import iceoryx2 as iox2
 
 log = logging.getLogger(__name__)
 
@@ -33,6 +39,8 @@ _log_level_set = False
 
 def quiet_iceoryx() -> None:
     """Keep iceoryx2's own console logging to errors (once per process)."""
+    import iceoryx2 as iox2
+
     global _log_level_set
     if not _log_level_set:
         iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
@@ -60,6 +68,8 @@ def prefix_of(namespace: str) -> str:
 
 def make_config(namespace: str) -> iox2.config.Config:
     """An iceoryx2 config whose every resource carries the namespace's prefix."""
+    import iceoryx2 as iox2
+
     quiet_iceoryx()
     cfg = iox2.config.global_config()
     cfg.global_cfg.prefix = iox2.FileName.new(prefix_of(namespace))
@@ -69,6 +79,8 @@ def make_config(namespace: str) -> iox2.config.Config:
 
 def alive_nodes(namespace: str) -> int:
     """How many iceoryx2 nodes of this namespace belong to living processes."""
+    import iceoryx2 as iox2
+
     cfg = make_config(namespace)
     states = iox2.Node.list(iox2.ServiceType.Ipc, cfg)
     return sum(1 for s in states if isinstance(s, iox2.NodeState.Alive))
@@ -82,6 +94,8 @@ def cleanup_namespace(namespace: str) -> int:
     management segment iceoryx2 keeps, and any orphaned segment) are deleted too, so
     nothing is left in /dev/shm.
     """
+    import iceoryx2 as iox2
+
     cfg = make_config(namespace)
     try:
         iox2.Node.try_cleanup_dead_nodes(iox2.ServiceType.Ipc, cfg)

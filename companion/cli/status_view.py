@@ -7,7 +7,8 @@ from typing import Any
 
 from rich.table import Table
 
-from companion.bus import BusNode, cleanup_namespace
+from companion.bus.namespace import cleanup_namespace
+from companion.bus.node import BusNode
 from companion.messages import PluginState, SystemHealth
 
 

@@ -58,7 +58,7 @@ def status(
     timeout: Annotated[float, typer.Option(help="seconds to wait for the table")] = 3.0,
 ) -> None:
     """Print the health table of a running vehicle (read from its bus)."""
-    from companion.bus import default_namespace
+    from companion.bus.namespace import default_namespace
     from companion.cli.status_view import health_dict, health_table, read_health
 
     ns = namespace or default_namespace()

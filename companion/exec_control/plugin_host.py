@@ -18,7 +18,8 @@ import time
 from collections import deque
 from typing import Any
 
-from companion.bus import BusNode, MonotonicClock, SimulationClock, VehicleClock
+from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
+from companion.bus.node import BusNode
 from companion.exec_control.profiling import run_profiled
 from companion.exec_control.registry import load
 from companion.messages import NAME_LEN, PluginStats

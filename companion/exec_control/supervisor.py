@@ -13,14 +13,10 @@ import signal
 import time
 from dataclasses import asdict
 
-from companion.bus import (
-    BusNode,
-    MonotonicClock,
-    Reader,
-    SimulationClock,
-    VehicleClock,
-    cleanup_namespace,
-)
+from companion.bus.channels import Reader
+from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
+from companion.bus.namespace import cleanup_namespace
+from companion.bus.node import BusNode
 from companion.exec_control.child import FIRST_BACKOFF_S, Child
 from companion.exec_control.config import VehicleConfig
 from companion.exec_control.registry import load

@@ -41,7 +41,8 @@ PRELOAD = (
     "numpy",
     "iceoryx2",
     "mavlink_dialect.companion",
-    "companion.bus",
+    "companion.bus.node",
+    "companion.bus.clock",
     "companion.messages",
     "companion.exec_control.plugin_host",
 )

@@ -42,7 +42,7 @@ def _triple(text: str) -> tuple[float, float, float]:
 
 
 def _outage(text: str):
-    from ground.sitl.bridge.device_streams import Outage
+    from ground.sitl.bridge.options import Outage
 
     try:
         start, seconds = (float(v) for v in text.split(":"))
@@ -69,7 +69,7 @@ def _home(text: str | None):
 def _single_links(link: list[str] | None, api_port_base: int | None) -> list[str]:
     """One vehicle: ``--link`` replaces the config's endpoints, as always; an explicit
     ``--api-port-base`` adds the API port (and the default ground station if no ``--link``)."""
-    from ground.sitl.fleet import GCS_LINK
+    from ground.sitl.requests import GCS_LINK
 
     links = list(link or [])
     if api_port_base is not None:
@@ -195,10 +195,8 @@ def sim(
     """
     require_ground_extra("sim", "jsbsim")
     from companion.bus.namespace import default_namespace
-    from ground.sitl.bridge.device_streams import DeviceRates
-    from ground.sitl.bridge.options import BridgeOptions
-    from ground.sitl.fleet import GCS_LINK, FleetRequest
-    from ground.sitl.session import SimRequest
+    from ground.sitl.bridge.options import BridgeOptions, DeviceRates
+    from ground.sitl.requests import GCS_LINK, FleetRequest, SimRequest
 
     setup_logging(log_level)
     lists = plan_or_exit(plan) if plan is not None else None

@@ -33,32 +33,16 @@ from companion.bus.node import BusNode
 from companion.exec_control.plugin_host import die_with_parent
 from companion.geodesy import LocalFrame
 from ground.sitl.bridge.conditions import Home
-from ground.sitl.bridge.options import BridgeOptions
+from ground.sitl.requests import FleetRequest
 from ground.sitl.session import mode_name, status_line
 
 log = logging.getLogger("ground.sitl.fleet")
 
-GCS_LINK = "udpout://127.0.0.1:14550"  # QGroundControl, shared by every vehicle
 POLL_S = 0.25
 STATUS_PERIOD_S = 0.5
 QUIET_STATUS_PERIOD_S = 10.0  # when stderr is not a terminal
 STOP_TIMEOUT_S = 20.0  # a vehicle stops its plug-ins, then its bridge: give it time
 LOG_TAIL_LINES = 15
-
-
-@dataclass(frozen=True)
-class FleetRequest:
-    """What the user asked of ``companion sim --count N``."""
-
-    count: int
-    opts: BridgeOptions  # the fleet's options; home, namespace, seed, truth are per vehicle
-    config: Path
-    state_dir: Path
-    links: list[str]  # shared endpoints (every vehicle)
-    spacing_m: float = 50.0
-    api_port_base: int = 14540  # 0: no per-vehicle API port
-    plan: Path | None = None
-    log_level: str = "INFO"
 
 
 @dataclass(frozen=True)

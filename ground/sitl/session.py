@@ -24,7 +24,6 @@ from pathlib import Path
 
 from companion.bus.namespace import cleanup_namespace
 from companion.bus.node import BusNode
-from companion.control.mission.items import MissionItem
 from companion.control.mission.store import MissionStore
 from companion.control.modes import BY_MODE
 from companion.exec_control.config import VehicleConfig, load_config
@@ -33,6 +32,7 @@ from companion.exec_control.supervisor import Supervisor
 from companion.exec_control.zygote import ForkServer
 from companion.messages import FlightMode, PluginState
 from ground.sitl.bridge.options import BridgeOptions
+from ground.sitl.requests import SimRequest
 
 log = logging.getLogger("companion.sim")
 
@@ -99,17 +99,6 @@ class BridgeProcess:
                 self.proc.kill()
                 self.proc.wait()
         return self.proc.returncode
-
-
-@dataclasses.dataclass
-class SimRequest:
-    """What the user asked of ``companion sim`` beyond the bridge's options."""
-
-    config: Path
-    links: list[str]
-    state_dir: str | None = None
-    plan: dict[int, list[MissionItem]] | None = None  # checked .plan lists to preload
-    sysid: int | None = None  # overrides the config's [vehicle] sysid (one of a fleet)
 
 
 def vehicle_config(req: SimRequest, opts: BridgeOptions, devices: dict[str, str]) -> VehicleConfig:

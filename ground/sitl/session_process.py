@@ -16,8 +16,8 @@ from companion.exec_control.handover import received
 from companion.exec_control.vehicle_process import EXIT_CONFIG, setup_logging
 from ground.sitl import session
 from ground.sitl.bridge.options import BridgeOptions
+from ground.sitl.requests import SimRequest
 from ground.sitl.run_logs import keep_beside, log_names, new_logs
-from ground.sitl.session import SimRequest
 
 
 def run_one(

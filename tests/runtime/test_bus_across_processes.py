@@ -9,7 +9,8 @@ import time
 
 import pytest
 
-from companion.bus import BusNode, cleanup_namespace
+from companion.bus.namespace import cleanup_namespace
+from companion.bus.node import BusNode
 from companion.messages import Imu, Magnetometer, NavState
 from tests.support.configs import PUBLISH_ONCE, plugin, vehicle_config
 from tests.support.vehicle import REPO, assert_clean, unique_namespace, wait_for
@@ -17,7 +18,7 @@ from tests.support.vehicle import REPO, assert_clean, unique_namespace, wait_for
 WRITER = textwrap.dedent(
     """
     import sys, time
-    from companion.bus import BusNode
+    from companion.bus.node import BusNode
     from companion.messages import Imu, NavState
     ns, count, subscribers = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
     with BusNode(ns, "writer") as bus:

@@ -6,7 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from companion.bus import cleanup_namespace, leftover_files
+from companion.bus.namespace import cleanup_namespace, leftover_files
 from tests.support.vehicle import REPO, companion_env, unique_namespace
 
 

@@ -24,7 +24,7 @@ import pytest
 
 os.environ.setdefault("MAVLINK20", "1")
 
-from companion.bus import cleanup_namespace
+from companion.bus.namespace import cleanup_namespace
 from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate as read_truth
 from ground.sitl.bridge.fdm import Home

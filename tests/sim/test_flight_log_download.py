@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from pyulog import ULog
 
-from companion.bus import BusNode
+from companion.bus.node import BusNode
 from companion.flight_log import being_written
 from mavlink_dialect import companion as m
 from tests.protocol.log_client import QgcDownload, list_logs, mavproxy_download

@@ -20,7 +20,8 @@ from typing import Any, TypeVar
 
 import psutil
 
-from companion.bus import BusNode, cleanup_namespace, leftover_files
+from companion.bus.namespace import cleanup_namespace, leftover_files
+from companion.bus.node import BusNode
 from companion.messages import SystemHealth
 
 REPO = Path(__file__).resolve().parents[2]

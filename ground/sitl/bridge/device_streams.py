@@ -12,7 +12,6 @@ from __future__ import annotations
 import datetime as dt
 import math
 import struct
-from dataclasses import dataclass
 
 import numpy as np
 import pynmea2
@@ -20,6 +19,7 @@ import pynmea2
 from ground.simulation.battery import BatteryModel
 from ground.simulation.sensor_errors import ImuSample, SensorErrors
 from ground.simulation.true_state import TrueState
+from ground.sitl.bridge.options import DeviceRates, Outage
 
 KNOT_M_S = 0.514444
 _VNIMU_FORMAT = "VNIMU," + ",".join(["%+.4f"] * 9) + ",%+.1f,%+.3f"
@@ -133,34 +133,6 @@ def lidar_reading(height_m: float, roll: float, pitch: float, noise_m: float) ->
     if not lo <= distance <= hi:
         return -1, 20
     return round(distance * 100.0), round(3000.0 / (1.0 + distance))
-
-
-@dataclass
-class Outage:
-    """A window of simulation time with no GPS fix."""
-
-    start_s: float
-    duration_s: float
-
-    def covers(self, t_s: float) -> bool:
-        """Whether ``t_s`` falls in the window."""
-        return self.start_s <= t_s < self.start_s + self.duration_s
-
-
-@dataclass
-class DeviceRates:
-    """How often each device talks, and the GPS's latency."""
-
-    imu_hz: float = 100.0
-    compass_hz: float = 20.0
-    gps_hz: float = 5.0
-    # A receiver sends its fix a computation after the epoch it describes, and not always
-    # equally late: each epoch's latency is drawn uniformly within ± the jitter.
-    gps_latency_s: float = 0.12
-    gps_latency_jitter_s: float = 0.03
-    rc_hz: float = 50.0  # SBUS receivers send every 7-20 ms
-    battery_hz: float = 10.0
-    range_hz: float = 100.0  # a TFmini's default frame rate
 
 
 class EmulatedDevices:

@@ -7,11 +7,38 @@ import json
 from dataclasses import dataclass, field
 
 from ground.sitl.bridge.conditions import TURBULENCE, Home
-from ground.sitl.bridge.device_streams import DeviceRates, Outage
 
 # How the sensors sit in the airframe (ground/simulation/sensor_errors.py NoiseModel):
 # no defects, the residue of a good calibration, or the iron and motor field as they are.
 MOUNTS = ("quiet", "calibrated", "uncalibrated")
+
+
+@dataclass
+class Outage:
+    """A window of simulation time with no GPS fix."""
+
+    start_s: float
+    duration_s: float
+
+    def covers(self, t_s: float) -> bool:
+        """Whether ``t_s`` falls in the window."""
+        return self.start_s <= t_s < self.start_s + self.duration_s
+
+
+@dataclass
+class DeviceRates:
+    """How often each device talks, and the GPS's latency."""
+
+    imu_hz: float = 100.0
+    compass_hz: float = 20.0
+    gps_hz: float = 5.0
+    # A receiver sends its fix a computation after the epoch it describes, and not always
+    # equally late: each epoch's latency is drawn uniformly within ± the jitter.
+    gps_latency_s: float = 0.12
+    gps_latency_jitter_s: float = 0.03
+    rc_hz: float = 50.0  # SBUS receivers send every 7-20 ms
+    battery_hz: float = 10.0
+    range_hz: float = 100.0  # a TFmini's default frame rate
 
 
 @dataclass
