@@ -83,7 +83,12 @@ class IdentityService:
     def tick(self, now_s: float) -> list[Outgoing]:
         if now_s < self._next_heartbeat:
             return []
-        self._next_heartbeat = max(self._next_heartbeat + HEARTBEAT_PERIOD_S, now_s - 0.5)
+        # On time or a little late: keep the 1 Hz phase. A period or more late (the first
+        # one, or after a stall): one heartbeat now and the phase starts again, never a
+        # second one to catch up (a ground station counts heartbeats as the link's rate).
+        self._next_heartbeat += HEARTBEAT_PERIOD_S
+        if self._next_heartbeat <= now_s:
+            self._next_heartbeat = now_s + HEARTBEAT_PERIOD_S
         return [Outgoing(self.heartbeat(), None)]
 
     def next_due(self) -> float:
