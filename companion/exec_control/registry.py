@@ -7,9 +7,12 @@ Two forms: a registered short name such as ``sensors.nmea_gps`` (entry-point gro
 
 from __future__ import annotations
 
+import functools
 import importlib
 import importlib.metadata
+from collections.abc import Mapping
 from difflib import get_close_matches
+from types import MappingProxyType
 
 from companion.plugin import Plugin
 
@@ -20,10 +23,17 @@ class PluginLoadError(Exception):
     """The named plug-in cannot be found or imported."""
 
 
-def registered() -> dict[str, str]:
-    """Short name → ``module:Class`` of every registered plug-in."""
+@functools.cache
+def registered() -> Mapping[str, str]:
+    """Short name → ``module:Class`` of every registered plug-in.
+
+    Read once per process: the installed packages do not change under a running vehicle,
+    and the supervisor's table is inherited by the fork server and every plug-in it forks.
+    Reading the entry points again in each plug-in cost it 1.7 MB of private memory (the
+    metadata machinery writes all over pages it shares with the fork server).
+    """
     eps = importlib.metadata.entry_points(group=ENTRY_POINT_GROUP)
-    return {ep.name: ep.value for ep in eps}
+    return MappingProxyType({ep.name: ep.value for ep in eps})
 
 
 def target_of(name: str) -> str:
