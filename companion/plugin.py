@@ -78,10 +78,11 @@ class PluginContext:
     clock: VehicleClock
     vehicle: Mapping[str, Any] = field(default_factory=dict)  # the config's [vehicle] table
     health: HealthCounters = field(default_factory=HealthCounters)
-    # Every parameter declared by the config's plug-ins (what the parameter server serves).
+    # Every parameter declared by the config's plug-ins (what the parameter server serves);
+    # only for a plug-in whose class sets wants_vehicle_tables, empty for the others.
     param_decls: tuple[ParamDecl, ...] = ()
     # Every plug-in's validated settings by plug-in kind (the flight log records the
-    # navigator's, so a replay runs it as it flew).
+    # navigator's, so a replay runs it as it flew); as param_decls, only when wanted.
     plugins: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     # Readable once a signal (a stop request) has come: a plug-in that waits on a device
     # rather than on the bus polls it too (ReopeningSerial's stop_fd), so a long timeout
@@ -102,6 +103,10 @@ class Plugin(ABC):
     inputs: ClassVar[tuple[str, ...]] = ()
     optional_inputs: ClassVar[tuple[str, ...]] = ()
     outputs: ClassVar[tuple[str, ...]] = ()
+    # Whether ctx.param_decls and ctx.plugins hold every plug-in's parameters and settings
+    # (the link serves them, the flight logger records them). Other plug-ins get them
+    # empty: parsing them cost each plug-in process ~1 MB of its own memory.
+    wants_vehicle_tables: ClassVar[bool] = False
 
     @classmethod
     def ports(cls, settings: Mapping[str, Any]) -> Ports:

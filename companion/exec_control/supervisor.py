@@ -49,15 +49,15 @@ class Supervisor:
         self, cfg: VehicleConfig, log_level: str = "INFO", forker: ForkServer | None = None
     ) -> None:
         self.cfg = cfg
-        decls = [asdict(d) for spec in cfg.plugins for d in spec.params]
-        base = {
-            "namespace": cfg.namespace,
-            "vehicle": cfg.vehicle,
-            "log_level": log_level,
-            "param_decls": decls,
+        base = {"namespace": cfg.namespace, "vehicle": cfg.vehicle, "log_level": log_level}
+        tables = {
+            "param_decls": [asdict(d) for spec in cfg.plugins for d in spec.params],
             "plugins": {spec.kind: spec.settings for spec in cfg.plugins},
         }
-        self.children = [Child(spec, base) for spec in cfg.plugins]
+        self.children = [
+            Child(spec, {**base, **tables} if load(spec.kind).wants_vehicle_tables else base)
+            for spec in cfg.plugins
+        ]
         # A fork server started early (while the simulator loads) may be handed in.
         self.forker = forker or ForkServer(sorted({s.kind for s in cfg.plugins}), log_level)
         self.next_forker_at = 0.0

@@ -66,6 +66,7 @@ CAPABILITIES = (
 class MavlinkLink(Plugin):
     """The MAVLink side of the vehicle."""
 
+    wants_vehicle_tables = True  # it serves every plug-in's parameters
     settings = {
         "endpoints": Setting(
             list,
@@ -77,9 +78,7 @@ class MavlinkLink(Plugin):
         # PX4: the QGroundControl plug-in that offers every guided action for a fixed wing
         # (companion.control.modes says why); generic: no guided action in QGroundControl.
         "autopilot": Setting(str, "px4", "MAV_AUTOPILOT reported", choices=tuple(AUTOPILOTS)),
-        "signing_key": Setting(
-            str, "", "signing key: 64 hex digits, or a passphrase (SHA-256, as MAVProxy)"
-        ),
+        "signing_key": Setting(str, "", "signing key: 64 hex digits or a passphrase (SHA-256)"),
     }
     params = (
         ParamDecl("SR_ATTITUDE", 10.0, 0.0, 100.0, "Hz", "ATTITUDE rate on every endpoint"),

@@ -135,6 +135,7 @@ class LoggerPlugin(Plugin):
         ),
         "airframe": Setting(str, "", "airframe name or file, for the log's INFO"),
     }
+    wants_vehicle_tables = True  # it records the parameters and the navigator's settings
 
     @classmethod
     def ports(cls, settings: Mapping[str, Any]) -> Ports:
