@@ -11,6 +11,7 @@ the ``COMPANION_BUS`` environment variable (default ``companion``).
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import re
@@ -120,6 +121,7 @@ def _matching(base: Path, prefix: str) -> list[Path]:
 
 def _remove_prefixed_files(prefix: str) -> int:
     removed = 0
+    emptied: set[Path] = set()
     for base in (SHM_DIR, IOX_DIR):
         if not base.exists():
             continue
@@ -134,6 +136,14 @@ def _remove_prefixed_files(prefix: str) -> int:
                 pass
             except OSError as exc:
                 log.warning("cannot remove %s: %s", path, exc)
+            if path.parent.parent == IOX_DIR / "nodes":  # in a dead node's own directory
+                emptied.add(path.parent)
+    # A node's directory is named by its id alone, not the namespace: once this
+    # namespace's files are out of it, it goes too. Left empty, every node created later
+    # on the machine (each plug-in's start) would still walk it.
+    for folder in emptied:
+        with contextlib.suppress(OSError):  # not empty: not only this namespace's
+            folder.rmdir()
     return removed
 
 

@@ -6,6 +6,7 @@ import subprocess
 import sys
 import textwrap
 import time
+from pathlib import Path
 
 import pytest
 
@@ -206,3 +207,29 @@ def test_a_waiter_on_one_trigger_sleeps_for_it_alone_and_never_for_ever(namespac
         assert waiter.wait(30.0) == [imu]
         assert time.monotonic() - started < 10.0
         waiter.close()
+
+
+def test_a_killed_processs_node_leaves_no_directory_behind(namespace):
+    """A vehicle killed outright (power lost: /tmp survives on a board whose /tmp is on
+    disk) leaves its nodes' directories; the next start's cleanup removes them whole.
+    Empty ones used to stay, and every node created later (each plug-in's start) walks
+    all of them."""
+    nodes = Path("/tmp/iceoryx2/nodes")
+    before = set(nodes.iterdir()) if nodes.exists() else set()
+    code = (
+        "import sys, time\nfrom companion.bus.node import BusNode\n"
+        "bus = BusNode(sys.argv[1], 'doomed'); w = bus.writer('link/commands')\n"
+        "print('up', flush=True); time.sleep(60)\n"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code, namespace], cwd=REPO, stdout=subprocess.PIPE, text=True
+    )
+    assert proc.stdout is not None and proc.stdout.readline() == "up\n"
+    created = set(nodes.iterdir()) - before
+    assert created, "the node made its directory"
+    proc.kill()
+    proc.wait()
+    cleanup_namespace(namespace)
+    assert_clean(namespace)
+    left = [d for d in created if d.exists() and (not d.is_dir() or not any(d.iterdir()))]
+    assert left == [], left
