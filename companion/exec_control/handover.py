@@ -23,11 +23,11 @@ from typing import Any, NoReturn
 PAYLOAD_FLAG = "--handover-fd"
 
 
-def exec_module(module: str, payload: Any, title: list[str] | None = None) -> NoReturn:
+def exec_module(module: str, payload: Any) -> NoReturn:
     """Become ``python -m module``, which reads ``payload`` back with ``received``.
 
-    ``title`` (the original command line, by default) follows on the new command line, so
-    that ``ps`` still says what the process is.
+    The original command line follows on the new one, so that ``ps`` still says what the
+    process is.
     """
     fd = os.memfd_create("companion-handover", 0)
     os.write(fd, pickle.dumps(payload, protocol=pickle.HIGHEST_PROTOCOL))
@@ -36,7 +36,7 @@ def exec_module(module: str, payload: Any, title: list[str] | None = None) -> No
     logging.shutdown()  # flushes every handler
     sys.stdout.flush()
     sys.stderr.flush()
-    argv = [sys.executable, "-m", module, PAYLOAD_FLAG, str(fd), "--", *(title or sys.argv)]
+    argv = [sys.executable, "-m", module, PAYLOAD_FLAG, str(fd), "--", *sys.argv]
     os.execv(sys.executable, argv)
 
 

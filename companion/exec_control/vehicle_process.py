@@ -22,6 +22,12 @@ def setup_logging(level: str, who: str = "exec_control") -> None:
     logging.basicConfig(level=level, format=f"%(asctime)s {who} %(levelname)s %(message)s")
 
 
+def config_refused(exc: Exception) -> int:
+    """Say why the config was refused, on stderr; the exit status that goes with it."""
+    sys.stderr.write(f"config error: {exc}\n")
+    return EXIT_CONFIG
+
+
 def main(argv: list[str] | None = None) -> int:
     """Check the handed-over config (path, namespace, log level), then run it until a stop
     signal. A refused config: its error on stderr and ``EXIT_CONFIG``, nothing started."""
@@ -35,8 +41,7 @@ def main(argv: list[str] | None = None) -> int:
         cfg = load_config(config, namespace)
         check_topology(cfg)
     except ConfigError as exc:
-        sys.stderr.write(f"config error: {exc}\n")
-        return EXIT_CONFIG
+        return config_refused(exc)
     return Supervisor(cfg, log_level).run()
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from companion.exec_control.config import ConfigError
 from companion.exec_control.handover import received
-from companion.exec_control.vehicle_process import EXIT_CONFIG, setup_logging
+from companion.exec_control.vehicle_process import config_refused, setup_logging
 from ground.sitl import session
 from ground.sitl.bridge.options import BridgeOptions
 from ground.sitl.requests import SimRequest
@@ -28,8 +28,7 @@ def run_one(
     try:
         code = session.run_sim(req, opts, log_level)
     except ConfigError as exc:
-        sys.stderr.write(f"config error: {exc}\n")
-        return EXIT_CONFIG
+        return config_refused(exc)
     logs = new_logs(logs_dir, before)
     for path in logs:
         sys.stderr.write(f"flight log: {path}\n")

@@ -66,7 +66,7 @@ def test_the_vehicle_command_line_means_what_the_fleet_planned(tmp_path, monkeyp
     slot = plan_slots(req)[1]
     seen = {}
 
-    def fake_exec_module(module, payload, title=None):
+    def fake_exec_module(module, payload):
         sim_req, opts, _log_level, _logs_dir, _truth = pickle.loads(pickle.dumps(payload))
         seen.update(module=module, req=sim_req, opts=opts)
         raise SystemExit(0)
