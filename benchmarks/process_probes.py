@@ -57,7 +57,7 @@ def vehicle_pids(root: int) -> list[int]:
     bridge: set[int] = set()
     for p in kids:
         try:
-            if "ground.sitl.bridge" in " ".join(p.cmdline()):
+            if "bridges.jsbsim" in " ".join(p.cmdline()):
                 bridge |= {p.pid} | {c.pid for c in p.children(recursive=True)}
         except psutil.Error:
             continue

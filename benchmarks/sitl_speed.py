@@ -38,8 +38,8 @@ RESULT = re.compile(
 
 def jsbsim_alone(aircraft: str, seconds: float) -> float:
     """Speed factor of the flight dynamics with nothing else (the ceiling)."""
+    from bridges.jsbsim.fdm import Flight, Home
     from companion.actuators.airframe import load_airframe
-    from ground.sitl.bridge.fdm import Flight, Home
 
     frame = load_airframe(aircraft)
     saved = os.dup(1)  # JSBSim prints a banner on stdout

@@ -29,7 +29,7 @@ def bridge_legacy_text(
     log_level: Annotated[str, typer.Option(help="DEBUG, INFO, WARNING")] = "INFO",
 ) -> None:
     """The thesis's 25-byte text link (ATT, POS down; START, STOP up) on a serial line."""
-    from companion.link.legacy_text.bridge import LegacyTextOptions, serve
+    from bridges.text_link.bridge import LegacyTextOptions, serve
 
     logging.basicConfig(level=log_level, format="%(asctime)s legacy_text %(levelname)s %(message)s")
     opts = LegacyTextOptions(

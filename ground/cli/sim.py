@@ -42,7 +42,7 @@ def _triple(text: str) -> tuple[float, float, float]:
 
 
 def _outage(text: str):
-    from ground.sitl.bridge.options import Outage
+    from bridges.jsbsim.options import Outage
 
     try:
         start, seconds = (float(v) for v in text.split(":"))
@@ -52,7 +52,7 @@ def _outage(text: str):
 
 
 def _home(text: str | None):
-    from ground.sitl.bridge.conditions import Home
+    from bridges.jsbsim.conditions import Home
 
     if text is None:
         return Home()
@@ -194,8 +194,8 @@ def sim(
     (i-1)*spacing m east of home, all on the --link endpoints, each on its own API port.
     """
     require_ground_extra("sim", "jsbsim")
+    from bridges.jsbsim.options import BridgeOptions, DeviceRates
     from companion.bus.namespace import default_namespace
-    from ground.sitl.bridge.options import BridgeOptions, DeviceRates
     from ground.sitl.requests import GCS_LINK, FleetRequest, SimRequest
 
     setup_logging(log_level)

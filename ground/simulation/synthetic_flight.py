@@ -17,13 +17,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from companion.navigation.local_frame import LocalFrame, normal_gravity
-from ground.simulation.sensor_errors import (
+from bridges.sensor_models.sensor_errors import (
     MagneticField,
     NoiseModel,
     body_from_ned,
 )
-from ground.simulation.true_state import TrueState
+from bridges.sensor_models.true_state import TrueState
+from companion.navigation.local_frame import LocalFrame, normal_gravity
 
 AOA_RAD = math.radians(2.0)
 TURN_LAG_S = 1.5

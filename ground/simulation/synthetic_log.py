@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
+from bridges.sensor_models.sensor_errors import SensorErrors
+from bridges.sensor_models.true_state import TrueState
 from companion.navigation.estimate_csv import EstimateWriter
-from ground.simulation.sensor_errors import SensorErrors
 from ground.simulation.synthetic_flight import FlightSpec, trajectory
-from ground.simulation.true_state import TrueState
 
 HEADER = (
     "t,kind,ax,ay,az,gx,gy,gz,lat,lon,alt_m,vn,ve,vd,fix,hdop,mx,my,mz,baro_alt_m,"

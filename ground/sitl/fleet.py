@@ -28,11 +28,11 @@ from pathlib import Path
 
 import psutil
 
+from bridges.jsbsim.conditions import Home
 from companion.bus.namespace import cleanup_namespace, validate_namespace
 from companion.bus.node import BusNode
 from companion.exec_control.plugin_host import die_with_parent
 from companion.geodesy import LocalFrame
-from ground.sitl.bridge.conditions import Home
 from ground.sitl.requests import FleetRequest
 from ground.sitl.session import mode_name, status_line
 

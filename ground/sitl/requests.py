@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ground.sitl.bridge.options import BridgeOptions
+from bridges.jsbsim.options import BridgeOptions
 
 if TYPE_CHECKING:
     from companion.control.mission.items import MissionItem

@@ -1,6 +1,6 @@
 """``companion sim``: the simulator bridge and the whole vehicle, started and stopped as one.
 
-The bridge runs in its own process (``python -m ground.sitl.bridge``) and makes the ptys; the
+The bridge runs in its own process (``python -m bridges.jsbsim``) and makes the ptys; the
 vehicle config's ``"sim://NAME"`` settings are then resolved to them and the execution
 control runs here, in the main thread. A monitor thread holds the simulation until every
 plug-in is up, shows the one-line status, and stops the vehicle when the bridge ends.
@@ -22,6 +22,7 @@ import tomllib
 from collections.abc import Callable
 from pathlib import Path
 
+from bridges.jsbsim.options import BridgeOptions
 from companion.bus.namespace import cleanup_namespace
 from companion.bus.node import BusNode
 from companion.control.mission.store import MissionStore
@@ -31,7 +32,6 @@ from companion.exec_control.plugin_host import die_with_parent
 from companion.exec_control.supervisor import Supervisor
 from companion.exec_control.zygote import ForkServer
 from companion.messages import FlightMode, PluginState
-from ground.sitl.bridge.options import BridgeOptions
 from ground.sitl.requests import SimRequest
 
 log = logging.getLogger("companion.sim")
@@ -48,7 +48,7 @@ class BridgeProcess:
 
     def __init__(self, opts: BridgeOptions) -> None:
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "ground.sitl.bridge", opts.to_json()],
+            [sys.executable, "-m", "bridges.jsbsim", opts.to_json()],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,

@@ -11,11 +11,11 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from bridges.jsbsim.options import BridgeOptions
 from companion.exec_control.config import ConfigError
 from companion.exec_control.handover import received
 from companion.exec_control.vehicle_process import config_refused, setup_logging
 from ground.sitl import session
-from ground.sitl.bridge.options import BridgeOptions
 from ground.sitl.requests import SimRequest
 from ground.sitl.run_logs import keep_beside, log_names, new_logs
 

@@ -8,7 +8,7 @@ import string
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from companion.link.legacy_text.frames import FrameReader, encode_frame
+from bridges.text_link.frames import FrameReader, encode_frame
 
 LETTERS = frozenset(string.ascii_letters.encode())
 # Noise that can never spell a command: any byte but an ASCII letter...

@@ -20,9 +20,9 @@ import time
 import numpy as np
 import pytest
 
+from bridges.jsbsim.device_streams import vnimu_sentence
+from bridges.sensor_models.sensor_errors import ImuSample
 from companion.link.refusal_texts import REFUSAL_TEXT_PERIOD_S
-from ground.simulation.sensor_errors import ImuSample
-from ground.sitl.bridge.device_streams import vnimu_sentence
 from mavlink_dialect import companion as m
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.support.configs import client_vehicle, plugin

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import math
 
-from ground.sitl.bridge.bridge import pressure_kpa
-from ground.sitl.bridge.fdm import Flight, Home
+from bridges.jsbsim.bridge import pressure_kpa
+from bridges.jsbsim.fdm import Flight, Home
 
 
 def test_a_diverged_model_leaves_the_wreck_still_on_the_ground_and_time_going_on():

@@ -7,25 +7,25 @@ import math
 import numpy as np
 import pytest
 
-from companion.messages import GpsFixType
-from companion.sensors.line_framer import LineFramer
-from companion.sensors.nmea_gps import NmeaGpsDecoder
-from companion.sensors.os3000 import Os3000Decoder
-from companion.sensors.vectornav import VectorNavDecoder
-from ground.simulation.sensor_errors import (
-    MagneticField,
-    NoiseModel,
-    SensorErrors,
-    body_from_ned,
-)
-from ground.simulation.true_state import TrueState
-from ground.sitl.bridge.device_streams import (
+from bridges.jsbsim.device_streams import (
     DeviceRates,
     EmulatedDevices,
     Outage,
     nmea_epoch,
     os3000_sentence,
 )
+from bridges.sensor_models.sensor_errors import (
+    MagneticField,
+    NoiseModel,
+    SensorErrors,
+    body_from_ned,
+)
+from bridges.sensor_models.true_state import TrueState
+from companion.messages import GpsFixType
+from companion.sensors.line_framer import LineFramer
+from companion.sensors.nmea_gps import NmeaGpsDecoder
+from companion.sensors.os3000 import Os3000Decoder
+from companion.sensors.vectornav import VectorNavDecoder
 
 FIELD = MagneticField()
 

@@ -24,10 +24,10 @@ import pytest
 
 os.environ.setdefault("MAVLINK20", "1")
 
+from bridges.jsbsim.fdm import Home
 from companion.bus.namespace import cleanup_namespace
 from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate as read_truth
-from ground.sitl.bridge.fdm import Home
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import free_udp_port
 from tests.support.vehicle import REPO, assert_clean, companion_env, unique_namespace

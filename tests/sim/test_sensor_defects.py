@@ -9,14 +9,19 @@ import math
 import numpy as np
 import pytest
 
+from bridges.jsbsim.device_streams import DeviceRates, EmulatedDevices
+from bridges.jsbsim.fdm import Flight, Home
+from bridges.jsbsim.options import BridgeOptions
+from bridges.sensor_models.sensor_errors import (
+    MagneticField,
+    NoiseModel,
+    SensorErrors,
+    body_from_ned,
+)
+from bridges.sensor_models.true_state import TrueState
 from companion.sensors.line_framer import LineFramer
 from companion.sensors.os3000 import Os3000Decoder
 from companion.sensors.vectornav import VectorNavDecoder
-from ground.simulation.sensor_errors import MagneticField, NoiseModel, SensorErrors, body_from_ned
-from ground.simulation.true_state import TrueState
-from ground.sitl.bridge.device_streams import DeviceRates, EmulatedDevices
-from ground.sitl.bridge.fdm import Flight, Home
-from ground.sitl.bridge.options import BridgeOptions
 
 FIELD = MagneticField()
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from bridges.jsbsim.fdm import Flight, Home
 from companion.actuators.airframe import load_airframe
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.params import control_params, flight_config
@@ -19,7 +20,6 @@ from companion.control.flight.pilot import Sticks
 from companion.control.mission.items import MissionItem
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
-from ground.sitl.bridge.fdm import Flight, Home
 from mavlink_dialect import companion as d
 
 PHYSICS_HZ = 100

@@ -9,11 +9,11 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
+from bridges.jsbsim.device_streams import Outage
+from bridges.jsbsim.options import BridgeOptions
 from companion.cli import app
 from companion.exec_control.config import ConfigError, load_config, load_sections
 from companion.geodesy import LocalFrame
-from ground.sitl.bridge.device_streams import Outage
-from ground.sitl.bridge.options import BridgeOptions
 from ground.sitl.fleet import FleetRequest, plan_slots, shared_args, vehicle_command
 from tests.support.vehicle import REPO
 

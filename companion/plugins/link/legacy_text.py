@@ -20,7 +20,7 @@ import threading
 from collections.abc import Mapping
 from typing import Any
 
-from companion.link.legacy_text.bridge import LegacyTextBridge, LegacyTextOptions
+from bridges.text_link.bridge import LegacyTextBridge, LegacyTextOptions
 from companion.plugin import Plugin, PluginContext, Setting
 
 WAIT_S = 0.5

@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from ground.simulation.sensor_errors import EARTH_RADIUS_M
-from ground.simulation.true_state import TrueState
-from ground.sitl.bridge.bridge import _devices
-from ground.sitl.bridge.options import BridgeOptions
+from bridges.jsbsim.bridge import _devices
+from bridges.jsbsim.options import BridgeOptions
+from bridges.sensor_models.sensor_errors import EARTH_RADIUS_M
+from bridges.sensor_models.true_state import TrueState
 
 STILL = TrueState(
     t_s=0.0, lat_deg=-37.9, lon_deg=145.1, alt_msl_m=100.0, alt_agl_m=20.0, roll=0.0,

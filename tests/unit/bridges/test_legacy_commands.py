@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from companion.link.legacy_text.commands import CommandSender
+from bridges.text_link.commands import CommandSender
 from mavlink_dialect import companion as mavlink
 
 ARM = mavlink.MAV_CMD_COMPONENT_ARM_DISARM

@@ -8,7 +8,7 @@ import itertools
 
 import pytest
 
-from companion.link.legacy_text.downlink import DownlinkSchedule, check_rates, frames_per_second
+from bridges.text_link.downlink import DownlinkSchedule, check_rates, frames_per_second
 
 STEP_S = 0.001
 

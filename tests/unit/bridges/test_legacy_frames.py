@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from companion.link.legacy_text.frames import (
+from bridges.text_link.frames import (
     FrameError,
     FrameReader,
     att_text,

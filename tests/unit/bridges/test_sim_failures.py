@@ -1,10 +1,10 @@
-"""Failure injection on the simulator's emulated devices (ground/sitl/bridge/failures.py)."""
+"""Failure injection on the simulator's emulated devices (bridges/jsbsim/failures.py)."""
 
 from __future__ import annotations
 
+from bridges.jsbsim.failures import DeviceFailures
 from companion.messages import CommandResult
 from companion.sensors.nmea_gps import NmeaGpsDecoder
-from ground.sitl.bridge.failures import DeviceFailures
 from mavlink_dialect import companion as d
 
 GGA = b"$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47\r\n"

@@ -1,4 +1,4 @@
-"""The simulator's TFmini writer (ground/sitl/bridge/device_streams.py) against the vehicle's
+"""The simulator's TFmini writer (bridges/jsbsim/device_streams.py) against the vehicle's
 codec: the frames the bridge writes are read as the heights it meant."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import math
 
 import pytest
 
+from bridges.jsbsim.device_streams import lidar_reading, tfmini_frame
 from companion.sensors.tfmini import TfminiDecoder, TfminiFramer
-from ground.sitl.bridge.device_streams import lidar_reading, tfmini_frame
 
 
 def read(data: bytes):

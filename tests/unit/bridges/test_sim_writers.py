@@ -15,6 +15,12 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
+from bridges.jsbsim.airframe_file import read_airframe
+from bridges.jsbsim.device_streams import KNOT_M_S, nmea_epoch
+from bridges.jsbsim.servo_card import MiniSscReader, ServoCommand
+from bridges.jsbsim.truth_log import TruthLog
+from bridges.sensor_models.sensor_errors import levelled_heading_deg
+from bridges.sensor_models.true_state import TrueState
 from companion.actuators import minissc
 from companion.actuators.airframe import load_airframe, shipped_airframes
 from companion.messages import GpsFixType
@@ -22,12 +28,6 @@ from companion.navigation.estimate_csv import read_estimate
 from companion.navigation.rotations import tilt_compensated_heading
 from companion.sensors.line_framer import LineFramer
 from companion.sensors.nmea_gps import NmeaGpsDecoder
-from ground.simulation.sensor_errors import levelled_heading_deg
-from ground.simulation.true_state import TrueState
-from ground.sitl.bridge.airframe_file import read_airframe
-from ground.sitl.bridge.device_streams import KNOT_M_S, nmea_epoch
-from ground.sitl.bridge.servo_card import MiniSscReader, ServoCommand
-from ground.sitl.bridge.truth_log import TruthLog
 
 latitudes = st.floats(-89.999, 89.999)
 longitudes = st.floats(-179.999, 179.999)

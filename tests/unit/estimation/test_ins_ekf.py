@@ -7,11 +7,11 @@ import math
 
 import pytest
 
+from bridges.sensor_models.sensor_errors import NoiseModel
 from companion.messages import Baro, GpsFix, Imu, NavFlags
 from companion.navigation.ins_ekf import InsEkfConfig
 from companion.navigation.offline import NAVIGATORS, InsEkfRunner, run_navigator, true_headings
 from ground.simulation.evaluation import messages
-from ground.simulation.sensor_errors import NoiseModel
 from ground.simulation.synthetic_flight import FlightSpec, Leg
 from ground.simulation.synthetic_log import synthesize
 from tests.unit.estimation.flights import DECLINATION, OUTAGE, flight, fly

@@ -9,12 +9,12 @@ import math
 
 import numpy as np
 
+from bridges.sensor_models.sensor_errors import NoiseModel
 from companion.messages import Magnetometer, NavState
 from companion.navigation import rotations
 from companion.navigation.ins_ekf import InsEkfConfig
 from companion.navigation.offline import InsEkfRunner
 from ground.simulation import evaluation
-from ground.simulation.sensor_errors import NoiseModel
 from ground.simulation.synthetic_flight import FlightSpec, Leg
 from ground.simulation.synthetic_log import SyntheticFlight, synthesize
 from tests.unit.estimation.flights import DECLINATION, OUTAGE, SHORT, flight, fly

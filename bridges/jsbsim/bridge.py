@@ -9,16 +9,11 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from companion.bus.channels import Reader
-from companion.bus.node import BusNode
-from companion.messages import SimClock, SimTruth, channel
-from ground.simulation.sensor_errors import MagneticField, NoiseModel, SensorErrors
-from ground.simulation.true_state import TrueState
-from ground.sitl.bridge.airframe_file import read_airframe
-from ground.sitl.bridge.device_streams import EmulatedDevices
-from ground.sitl.bridge.failures import DeviceFailures
-from ground.sitl.bridge.fdm import Flight
-from ground.sitl.bridge.lockstep import (
+from bridges.jsbsim.airframe_file import read_airframe
+from bridges.jsbsim.device_streams import EmulatedDevices
+from bridges.jsbsim.failures import DeviceFailures
+from bridges.jsbsim.fdm import Flight
+from bridges.jsbsim.lockstep import (
     EXACT_STALL_S,
     STALL_S,
     FlightSync,
@@ -26,12 +21,17 @@ from ground.sitl.bridge.lockstep import (
     RealTime,
     SampleSync,
 )
-from ground.sitl.bridge.options import BridgeOptions
-from ground.sitl.bridge.ptys import PtyPort
-from ground.sitl.bridge.rc_receiver import EmulatedReceiver, load_pilot
-from ground.sitl.bridge.servo_card import MiniSscReader
-from ground.sitl.bridge.truth_log import ServoLog, TruthLog
-from ground.sitl.bridge.vehicle_commands import VehicleCommands
+from bridges.jsbsim.options import BridgeOptions
+from bridges.jsbsim.ptys import PtyPort
+from bridges.jsbsim.rc_receiver import EmulatedReceiver, load_pilot
+from bridges.jsbsim.servo_card import MiniSscReader
+from bridges.jsbsim.truth_log import ServoLog, TruthLog
+from bridges.jsbsim.vehicle_commands import VehicleCommands
+from bridges.sensor_models.sensor_errors import MagneticField, NoiseModel, SensorErrors
+from bridges.sensor_models.true_state import TrueState
+from companion.bus.channels import Reader
+from companion.bus.node import BusNode
+from companion.messages import SimClock, SimTruth, channel
 
 log = logging.getLogger(__name__)
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from companion.link.legacy_text.frames import FRAME_BYTES
+from bridges.text_link.frames import FRAME_BYTES
 
 BITS_PER_BYTE = 10  # 8N1: start bit, eight data bits, stop bit
 

@@ -16,10 +16,10 @@ import struct
 import numpy as np
 import pynmea2
 
-from ground.simulation.battery import BatteryModel
-from ground.simulation.sensor_errors import ImuSample, SensorErrors
-from ground.simulation.true_state import TrueState
-from ground.sitl.bridge.options import DeviceRates, Outage
+from bridges.jsbsim.options import DeviceRates, Outage
+from bridges.sensor_models.battery import BatteryModel
+from bridges.sensor_models.sensor_errors import ImuSample, SensorErrors
+from bridges.sensor_models.true_state import TrueState
 
 KNOT_M_S = 0.514444
 _VNIMU_FORMAT = "VNIMU," + ",".join(["%+.4f"] * 9) + ",%+.1f,%+.3f"

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground.simulation.true_state import TrueState
+from bridges.sensor_models.true_state import TrueState
 
 EARTH_RADIUS_M = 6378137.0
 

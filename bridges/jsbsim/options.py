@@ -6,9 +6,9 @@ import dataclasses
 import json
 from dataclasses import dataclass, field
 
-from ground.sitl.bridge.conditions import TURBULENCE, Home
+from bridges.jsbsim.conditions import TURBULENCE, Home
 
-# How the sensors sit in the airframe (ground/simulation/sensor_errors.py NoiseModel):
+# How the sensors sit in the airframe (bridges/sensor_models/sensor_errors.py NoiseModel):
 # no defects, the residue of a good calibration, or the iron and motor field as they are.
 MOUNTS = ("quiet", "calibrated", "uncalibrated")
 

@@ -28,9 +28,9 @@ os.environ.setdefault("MAVLINK20", "1")
 
 from pymavlink import mavutil
 
-from companion.link.legacy_text.commands import CommandSender
-from companion.link.legacy_text.downlink import DownlinkSchedule, check_rates
-from companion.link.legacy_text.frames import FrameReader, att_text, encode_frame, pos_text
+from bridges.text_link.commands import CommandSender
+from bridges.text_link.downlink import DownlinkSchedule, check_rates
+from bridges.text_link.frames import FrameReader, att_text, encode_frame, pos_text
 from companion.sensors.serial_port import ReopeningSerial, split_device
 from mavlink_dialect import companion as mavlink
 

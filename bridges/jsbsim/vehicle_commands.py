@@ -15,12 +15,12 @@ import logging
 import time
 from typing import TYPE_CHECKING
 
+from bridges.jsbsim.failures import DeviceFailures
 from companion.messages import CommandAck, CommandId, CommandResult, VehicleCommand
-from ground.sitl.bridge.failures import DeviceFailures
 
 if TYPE_CHECKING:
+    from bridges.jsbsim.lockstep import FlightSync
     from companion.bus.node import BusNode
-    from ground.sitl.bridge.lockstep import FlightSync
 
 log = logging.getLogger(__name__)
 

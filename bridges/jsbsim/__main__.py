@@ -1,4 +1,4 @@
-"""``python -m ground.sitl.bridge OPTIONS_JSON``: run the simulator bridge as its own process.
+"""``python -m bridges.jsbsim OPTIONS_JSON``: run the simulator bridge as its own process.
 
 It prints one JSON line on stdout, device name → pty path, as soon as the ptys exist;
 with ``hold`` set it then waits for the line ``run`` on stdin before the first frame (the
@@ -16,10 +16,10 @@ import select
 import signal
 import sys
 
-from ground.sitl.bridge.bridge import SimBridge
-from ground.sitl.bridge.options import BridgeOptions
+from bridges.jsbsim.bridge import SimBridge
+from bridges.jsbsim.options import BridgeOptions
 
-log = logging.getLogger("ground.sitl.bridge")
+log = logging.getLogger("bridges.jsbsim")
 
 
 def _wait_for_run() -> None:

@@ -8,8 +8,8 @@ from dataclasses import replace
 
 import jsbsim
 
-from ground.simulation.true_state import TrueState
-from ground.sitl.bridge.conditions import TURBULENCE, Home
+from bridges.jsbsim.conditions import TURBULENCE, Home
+from bridges.sensor_models.true_state import TrueState
 
 __all__ = ["TURBULENCE", "Flight", "Home"]
 

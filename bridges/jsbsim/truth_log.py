@@ -11,7 +11,7 @@ import math
 from pathlib import Path
 from typing import TextIO
 
-from ground.simulation.true_state import TrueState
+from bridges.sensor_models.true_state import TrueState
 
 HEADER = "t,roll,pitch,yaw,lat,lon,alt,vn,ve,vd\n"
 

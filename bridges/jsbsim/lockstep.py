@@ -8,7 +8,7 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from ground.sitl.bridge.ptys import PtyPort
+from bridges.jsbsim.ptys import PtyPort
 
 if TYPE_CHECKING:
     from companion.bus.channels import LatestReader, Reader

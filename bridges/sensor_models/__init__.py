@@ -1,0 +1,1 @@
+"""The simulated aircraft's true state and what its sensors make of it (noise, bias, battery)."""
