@@ -6,7 +6,7 @@ metres in this frame; only their inputs and outputs are geodetic.
 
 The two conversions are written here rather than taken from pyproj: they are a few lines
 of textbook geodesy, and pyproj (PROJ, its database and SQLite) cost the vehicle ~15 MB of
-memory for them. tests/unit/estimation/test_local_frame.py holds them to pyproj.
+memory for them. tests/unit/navigation/test_local_frame.py holds them to pyproj.
 """
 
 from __future__ import annotations

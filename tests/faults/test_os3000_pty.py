@@ -9,7 +9,7 @@ import pytest
 from tests.support.configs import plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
-from tests.unit.devices.test_os3000 import sentence
+from tests.unit.sensors.test_os3000 import sentence
 
 
 @pytest.mark.timeout(60)

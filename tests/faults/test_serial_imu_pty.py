@@ -7,7 +7,7 @@ import pytest
 from tests.support.configs import plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
-from tests.unit.devices.test_vectornav import IMU, crc16, xor8
+from tests.unit.sensors.test_vectornav import IMU, crc16, xor8
 
 GOOD = f"$VNIMU,{IMU}*{xor8('VNIMU,' + IMU)}\r\n"
 GOOD_CRC = f"$VNIMU,{IMU}*{crc16('VNIMU,' + IMU)}\r\n"

@@ -3,7 +3,7 @@
 Written here rather than taken from shapely: a fence asks only whether a point is inside a
 simple polygon or a circle, and whether a polygon is simple, while shapely (GEOS) costs each
 vehicle ~9 MB of memory. A circle is now exact, where shapely's was a 128-sided polygon.
-tests/unit/mission/test_zones.py holds these answers to shapely's.
+tests/unit/control/mission/test_zones.py holds these answers to shapely's.
 """
 
 from __future__ import annotations

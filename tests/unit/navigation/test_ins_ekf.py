@@ -14,7 +14,7 @@ from companion.navigation.offline import NAVIGATORS, InsEkfRunner, run_navigator
 from ground.simulation.evaluation import messages
 from ground.simulation.synthetic_flight import FlightSpec, Leg
 from ground.simulation.synthetic_log import synthesize
-from tests.unit.estimation.flights import DECLINATION, OUTAGE, flight, fly
+from tests.unit.navigation.flights import DECLINATION, OUTAGE, flight, fly
 
 
 def test_meets_the_accuracy_targets_and_bridges_a_30_s_outage():

@@ -9,7 +9,7 @@ import pytest
 
 from companion.messages import GpsFixType
 from companion.sensors.nmea_gps import NmeaGpsDecoder
-from tests.unit.devices.nmea_text import (
+from tests.unit.sensors.nmea_text import (
     GSV,
     KNOT,
     LAT,

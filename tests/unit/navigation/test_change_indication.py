@@ -4,7 +4,7 @@ change of the navigator's behaviour shows as a failing test and, once accepted, 
 reviewable diff of ``golden/*.csv``.
 
 To accept a change, run this file with ``NAV_GOLDEN_UPDATE=1`` in the environment,
-then review ``git diff tests/unit/estimation/golden`` and commit it with the change.
+then review ``git diff tests/unit/navigation/golden`` and commit it with the change.
 """
 
 from __future__ import annotations

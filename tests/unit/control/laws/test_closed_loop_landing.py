@@ -20,7 +20,7 @@ from companion.messages import FlightMode
 from ground.campaign.landing_score import landing_score_for_plan
 from tests.support.closed_loop import ClosedLoop
 
-PLAN = Path(__file__).resolve().parents[3] / "benchmarks" / "plans" / "land_east.plan"
+PLAN = Path(__file__).resolve().parents[4] / "benchmarks" / "plans" / "land_east.plan"
 CROSSWIND = (5.0, 0.0, 0.0)  # from the south, across the runway (which runs east)
 
 

@@ -11,7 +11,7 @@ import pytest
 
 from companion.control.mission.executor import ExecutorConfig, Kind, MissionExecutor
 from mavlink_dialect import companion as d
-from tests.unit.mission.executor_flying import (
+from tests.unit.control.mission.executor_flying import (
     HOME,
     HOME_ALT,
     dist,

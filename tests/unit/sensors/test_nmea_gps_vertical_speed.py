@@ -7,7 +7,7 @@ import math
 import pytest
 
 from companion.sensors.nmea_gps import NmeaGpsDecoder
-from tests.unit.devices.nmea_text import decode_all, gga, rmc, utc_us
+from tests.unit.sensors.nmea_text import decode_all, gga, rmc, utc_us
 
 
 def gga_only(*epochs: tuple[str, float]) -> list[float]:

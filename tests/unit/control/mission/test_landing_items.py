@@ -16,7 +16,14 @@ from companion.control.mission.executor import Kind
 from companion.control.mission.items import check_mission
 from companion.control.mission.plan import checked_plan
 from mavlink_dialect import companion as d
-from tests.unit.mission.executor_flying import HOME, HOME_ALT, dist, executor, item, on_circle
+from tests.unit.control.mission.executor_flying import (
+    HOME,
+    HOME_ALT,
+    dist,
+    executor,
+    item,
+    on_circle,
+)
 
 LAND = (0.0, 300.0)
 CENTRE, RADIUS = (-250.0, -500.0), 250.0  # clockwise: leaves heading east for LAND

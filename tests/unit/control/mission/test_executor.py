@@ -14,7 +14,7 @@ import pytest
 
 from companion.control.mission.executor import Kind
 from mavlink_dialect import companion as d
-from tests.unit.mission.executor_flying import (
+from tests.unit.control.mission.executor_flying import (
     HOME_ALT,
     dist,
     executor,

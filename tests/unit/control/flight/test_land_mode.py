@@ -17,7 +17,7 @@ from companion.messages import (
     VehicleCommand,
 )
 from tests.support.vehicle import REPO
-from tests.unit.flight.test_ground_safety import HOME, VALID, _controller, _status
+from tests.unit.control.flight.test_ground_safety import HOME, VALID, _controller, _status
 
 LANDING_PLAN = REPO / "benchmarks" / "plans" / "land_east.plan"
 

@@ -64,7 +64,7 @@ def test_fixes_that_arrive_late_are_still_used_and_never_look_like_an_outage():
     from companion.messages import NavFlags
     from companion.navigation.offline import InsEkfRunner, true_headings
     from ground.simulation import evaluation
-    from tests.unit.estimation.flights import DECLINATION, OUTAGE, flight
+    from tests.unit.navigation.flights import DECLINATION, OUTAGE, flight
 
     samples = list(true_headings(evaluation.messages(flight()), DECLINATION))
     late_us = 600_000

@@ -7,7 +7,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from companion.sensors.nmea_gps import NmeaGpsDecoder
-from tests.unit.devices.nmea_text import GSV, gga, gsa, nmea, rmc, vtg
+from tests.unit.sensors.nmea_text import GSV, gga, gsa, nmea, rmc, vtg
 
 GOOD = [gga("120000.00"), rmc("120000.00"), vtg(), gsa()]
 

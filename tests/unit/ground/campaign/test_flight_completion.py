@@ -7,7 +7,7 @@ from pathlib import Path
 from ground.campaign.flight_run import Timeline, _Pilot, endless_final_item
 from mavlink_dialect import companion as d
 
-PLANS = Path(__file__).resolve().parents[3] / "qgc_plans"
+PLANS = Path(__file__).resolve().parents[4] / "qgc_plans"
 
 
 def _current(seq: int, state: int) -> d.MAVLink_mission_current_message:

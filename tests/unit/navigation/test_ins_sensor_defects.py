@@ -17,7 +17,7 @@ from companion.navigation.offline import InsEkfRunner
 from ground.simulation import evaluation
 from ground.simulation.synthetic_flight import FlightSpec, Leg
 from ground.simulation.synthetic_log import SyntheticFlight, synthesize
-from tests.unit.estimation.flights import DECLINATION, OUTAGE, SHORT, flight, fly
+from tests.unit.navigation.flights import DECLINATION, OUTAGE, SHORT, flight, fly
 
 # Banked 45° and already turning at the first sample, then rolled hard the other way.
 ROLLING_START = (Leg(2, turn_deg_s=-45), Leg(20, turn_deg_s=8), *SHORT[2:])

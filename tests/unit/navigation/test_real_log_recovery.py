@@ -12,7 +12,7 @@ import pytest
 from companion.navigation import rotations
 from companion.navigation.offline import InsEkfRunner, run_navigator
 from companion.sensors.sensorlog import read_sensor_log
-from tests.unit.estimation.test_change_indication import NAVLOGS
+from tests.unit.navigation.test_change_indication import NAVLOGS
 
 KNOCK_S = 40.0
 
