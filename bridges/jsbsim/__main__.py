@@ -46,7 +46,11 @@ def main(argv: list[str] | None = None) -> int:
     protocol = os.fdopen(os.dup(sys.stdout.fileno()), "w")
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, sys.stdout.fileno())
-    bridge = SimBridge(opts)
+    try:
+        bridge = SimBridge(opts)
+    except ValueError as exc:  # a line that cannot be opened (hardware in the loop)
+        sys.stderr.write(f"error: {exc}\n")
+        return 2
     signal.signal(signal.SIGTERM, lambda *_: bridge.stop())
     signal.signal(signal.SIGINT, lambda *_: bridge.stop())
     try:

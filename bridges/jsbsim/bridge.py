@@ -9,10 +9,11 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from bridges.jsbsim.airframe_file import read_airframe
+from bridges.jsbsim.airframe_file import SimAirframe, read_airframe
 from bridges.jsbsim.device_streams import EmulatedDevices
 from bridges.jsbsim.failures import DeviceFailures
 from bridges.jsbsim.fdm import Flight
+from bridges.jsbsim.hil_status import HilStatus
 from bridges.jsbsim.lockstep import (
     EXACT_STALL_S,
     STALL_S,
@@ -24,6 +25,7 @@ from bridges.jsbsim.lockstep import (
 from bridges.jsbsim.options import BridgeOptions
 from bridges.jsbsim.ptys import PtyPort
 from bridges.jsbsim.rc_receiver import EmulatedReceiver, load_pilot
+from bridges.jsbsim.serial_lines import SerialLine, open_line
 from bridges.jsbsim.servo_card import MiniSscReader
 from bridges.jsbsim.truth_log import ServoLog, TruthLog
 from bridges.jsbsim.vehicle_commands import VehicleCommands
@@ -70,25 +72,46 @@ def _devices(opts: BridgeOptions) -> EmulatedDevices:
     return EmulatedDevices(errors, opts.rates, opts.outages, opts.seed)
 
 
+def _flight(opts: BridgeOptions, airframe: SimAirframe) -> Flight:
+    """The aircraft in JSBSim at its start, in its weather, brakes set."""
+    flight = Flight(
+        airframe.jsbsim_model,
+        opts.physics_hz,
+        opts.home,
+        opts.airborne_agl_m if opts.airborne else None,
+        opts.airborne_speed_m_s or airframe.cruise_speed_m_s,
+        opts.airborne_bank_deg,
+    )
+    flight.set_wind(*opts.wind_ned)
+    flight.set_turbulence(opts.turbulence)
+    for servo in airframe.servos.values():
+        if servo.surface == "brakes":  # held at their safe setting until commanded
+            flight.set_controls({"brakes": servo.command(servo.trim)})
+    return flight
+
+
+def open_ports(opts: BridgeOptions) -> dict[str, PtyPort | SerialLine]:
+    """The lines the user wired (hardware in the loop), or a pty for every device."""
+    if not opts.hil:
+        return {name: PtyPort(name) for name in (*SENSORS, "battery", "servos")}
+    ports: dict[str, PtyPort | SerialLine] = {}
+    try:
+        for name, spec in opts.lines.items():
+            ports[name] = open_line(name, spec)
+    except ValueError:
+        for port in ports.values():
+            port.close()
+        raise
+    return ports
+
+
 class SimBridge:
     """One simulated aircraft with its devices on ptys."""
 
     def __init__(self, opts: BridgeOptions) -> None:
         self.opts = opts
         self.airframe = read_airframe(opts.airframe)
-        self.flight = Flight(
-            self.airframe.jsbsim_model,
-            opts.physics_hz,
-            opts.home,
-            opts.airborne_agl_m if opts.airborne else None,
-            opts.airborne_speed_m_s or self.airframe.cruise_speed_m_s,
-            opts.airborne_bank_deg,
-        )
-        self.flight.set_wind(*opts.wind_ned)
-        self.flight.set_turbulence(opts.turbulence)
-        for servo in self.airframe.servos.values():
-            if servo.surface == "brakes":  # held at their safe setting until commanded
-                self.flight.set_controls({"brakes": servo.command(servo.trim)})
+        self.flight = _flight(opts, self.airframe)
         self.devices = _devices(opts)
         self.devices.rest_agl_m = self.flight.rest_agl_m
         self.failures = DeviceFailures(opts.seed)
@@ -96,7 +119,7 @@ class SimBridge:
         self.receiver = EmulatedReceiver(pilot, opts.rates.rc_hz)
         # The battery monitor is not in lockstep (nothing steers by it at physics rate), so
         # a vehicle without its driver leaves the bridge unhindered.
-        self.ports = {name: PtyPort(name) for name in (*SENSORS, "battery", "servos")}
+        self.ports = open_ports(opts)
         self.pending: list[tuple[float, int, str, bytes]] = []  # (release, order, port, data)
         self.order = 0
         self.servo_card = MiniSscReader()
@@ -105,12 +128,14 @@ class SimBridge:
         lockstep = self.pacer is None and opts.sync_hz > 0
         exact = lockstep and opts.exact
         stall_s = EXACT_STALL_S if exact else STALL_S
-        self.lockstep = Lockstep([self.ports[n] for n in SENSORS], stall_s)
+        self.lockstep = Lockstep([self.ports[n] for n in SENSORS if n in self.ports], stall_s)
         self.truth = TruthLog(opts.truth_path) if opts.truth_path else None
         self.servo_log = ServoLog(opts.servo_log_path) if opts.servo_log_path else None
-        self.bus = BusNode(opts.namespace, "sim_bridge")
-        self.clock = self.bus.writer("sim/clock")
-        self.truth_out = self.bus.writer("sim/truth")
+        # Hardware in the loop: the vehicle runs apart, on its own clock; no bus to share.
+        self.bus = None if opts.hil else BusNode(opts.namespace, "sim_bridge")
+        self.clock = self.bus.writer("sim/clock") if self.bus else None
+        self.truth_out = self.bus.writer("sim/truth") if self.bus else None
+        self.hil_status = HilStatus(self.ports) if opts.hil else None
         self.sync: FlightSync | None = None
         self.nav_sync: FlightSync | None = None
         self.navigated: FlightSync | None = None
@@ -118,18 +143,22 @@ class SimBridge:
         self.logged: FlightSync | None = None
         if lockstep:
             self._keep_in_step(round(1e6 / opts.sync_hz), exact)
-        self.commands = VehicleCommands(
-            self.bus, self.failures, self.sync, opts.start_at_s, self.navigated
+        self.commands = (
+            VehicleCommands(self.bus, self.failures, self.sync, opts.start_at_s, self.navigated)
+            if self.bus
+            else None
         )
         self.frames = 0
         self.stopping = False
-        self.clock.publish(SimClock(t_us=0, frame=0))
+        if self.clock is not None:
+            self.clock.publish(SimClock(t_us=0, frame=0))
 
     def _keep_in_step(self, period_us: int, exact: bool) -> None:
         """Lockstep with the vehicle's navigator and control loop (and, exact, its samples)."""
         # Fast lockstep lets the vehicle trail by a period (it runs beside the physics)
         # but never further: a late process holds the simulation, whatever the load.
         lag = 0 if exact else FAST_LAG_PERIODS
+        assert self.bus is not None  # lockstep is refused with hardware in the loop
         answers = self.bus.latest_reader("actuators/servos")
         self.sync = FlightSync(period_us, answers, self.bus.waiter([answers]), lag)
         nav = self.bus.latest_reader("nav/state")
@@ -153,6 +182,7 @@ class SimBridge:
             self.logged = FlightSync(period_us, logged, self.bus.waiter([logged]), 1, "t_us", True)
 
     def _sample_reader(self, name: str) -> Reader[Any]:
+        assert self.bus is not None
         if channel(name).pattern == "latest":
             return self.bus.latest_reader(name)
         return self.bus.queue_reader(name)
@@ -203,7 +233,8 @@ class SimBridge:
         self.frames += 1
         s = self.flight.state()
         t_us = round(s.t_s * 1e6)
-        self.clock.publish(SimClock(t_us=t_us, frame=self.frames))
+        if self.clock is not None:
+            self.clock.publish(SimClock(t_us=t_us, frame=self.frames))
         self._publish_truth(s, t_us)
         throttle = self.flight.controls()["throttle"]
         due = self.devices.due(s, pressure_kpa(s.alt_msl_m), throttle)
@@ -218,8 +249,9 @@ class SimBridge:
         written = set()
         while self.pending and self.pending[0][0] <= s.t_s + 1e-9:
             _, _, name, data = heapq.heappop(self.pending)
-            self.ports[name].write(data)
-            written.add(name)
+            if (port := self.ports.get(name)) is not None:  # HIL: not every device is wired
+                port.write(data)
+                written.add(name)
         sampled: set[str] | None = None  # exact: the devices whose samples came this frame
         if self.samples is not None:  # sleeps on the bus: the pty check after is quick
             # A device whose driver stopped reading (or never ran) is not waited for.
@@ -230,7 +262,8 @@ class SimBridge:
             self.pacer.wait(s.t_s)
         else:
             self.lockstep.wait()
-        self.commands.serve(t_us)
+        if self.commands is not None:
+            self.commands.serve(t_us)
         # Exact: the navigator answers the grid once an IMU sample at or past its tick came.
         if self.nav_sync is not None and (sampled is None or "imu" in sampled):
             self.nav_sync.wait(t_us)
@@ -243,6 +276,10 @@ class SimBridge:
     def _publish_truth(self, s: TrueState, t_us: int) -> None:
         if self.truth is not None:
             self.truth.add_state(s)
+        if self.hil_status is not None:
+            self.hil_status.report(s, self.servo_bytes_in)
+        if self.truth_out is None:
+            return
         self.truth_out.publish(
             SimTruth(
                 t_us,
@@ -300,4 +337,5 @@ class SimBridge:
             self.servo_log.close()
         for port in self.ports.values():
             port.close()
-        self.bus.close()
+        if self.bus is not None:
+            self.bus.close()

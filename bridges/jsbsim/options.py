@@ -11,6 +11,8 @@ from bridges.jsbsim.conditions import TURBULENCE, Home
 # How the sensors sit in the airframe (bridges/sensor_models/sensor_errors.py NoiseModel):
 # no defects, the residue of a good calibration, or the iron and motor field as they are.
 MOUNTS = ("quiet", "calibrated", "uncalibrated")
+# The aircraft's serial devices, as the bridge names them (hardware in the loop: --gps ...).
+DEVICES = ("gps", "compass", "imu", "rc", "battery", "range", "servos")
 
 
 @dataclass
@@ -72,6 +74,9 @@ class BridgeOptions:
     servo_log_path: str | None = None  # the surface commands received, by simulation time
     namespace: str = "companion"
     hold: bool = False  # wait for "run" on stdin before the first step
+    # Hardware in the loop: device -> the serial line it is wired to (serial_lines.py). The
+    # vehicle runs apart, on its own clock: real time, no bus, devices not named stay silent.
+    lines: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.turbulence not in TURBULENCE:
@@ -84,6 +89,24 @@ class BridgeOptions:
             raise ValueError("the GPS wander must lie within 0-100 m")
         if self.speed is not None and self.speed <= 0:
             raise ValueError("speed must be positive (or None for lockstep)")
+        if self.lines:
+            self._check_hardware_in_the_loop()
+
+    @property
+    def hil(self) -> bool:
+        """Whether the devices are on real lines to a vehicle running apart."""
+        return bool(self.lines)
+
+    def _check_hardware_in_the_loop(self) -> None:
+        unknown = sorted(set(self.lines) - set(DEVICES))
+        if unknown:
+            raise ValueError(f"no such device: {', '.join(unknown)} (one of {', '.join(DEVICES)})")
+        if "servos" not in self.lines:
+            raise ValueError("hardware in the loop needs the servo line (--servos)")
+        if self.speed != 1.0:
+            raise ValueError("hardware in the loop runs in real time (speed 1)")
+        if self.exact or self.start_at_s is not None or self.hold or self.sync_hz:
+            raise ValueError("lockstep, start-at and hold need the vehicle on this bus")
 
     def to_json(self) -> str:
         """The options as one JSON line."""

@@ -19,15 +19,23 @@ log = logging.getLogger(__name__)
 
 
 class PtyPort:
-    """One emulated serial line; ``path`` is what the vehicle config names."""
+    """One emulated serial line; ``path`` is what the vehicle config names.
 
-    def __init__(self, name: str) -> None:
+    With ``link``, the line is also reachable at that path (a symbolic link made here and
+    removed on close), so a vehicle started separately can name it in its config.
+    """
+
+    def __init__(self, name: str, link: str | None = None) -> None:
         self.name = name
         self.master, self.slave = os.openpty()
         tty.setraw(self.slave)  # no echo, no line discipline: bytes pass as they are
         tty.setraw(self.master)
         os.set_blocking(self.master, False)
         self.path = os.ttyname(self.slave)
+        self.link = link
+        if link is not None:
+            _replace_link(self.path, link)
+            self.path = link
         self.bytes_out = 0
         self.dropped = 0  # bytes the driver left unread until the line's buffer was full
 
@@ -64,8 +72,20 @@ class PtyPort:
 
     def close(self) -> None:
         """Hang the line up."""
+        if self.link is not None and os.path.islink(self.link):
+            os.unlink(self.link)
         for fd in (self.master, self.slave):
             try:
                 os.close(fd)
             except OSError:
                 pass
+
+
+def _replace_link(target: str, link: str) -> None:
+    """Point ``link`` at ``target``; an old link (a bridge killed before its close) goes."""
+    os.makedirs(os.path.dirname(os.path.abspath(link)), exist_ok=True)
+    if os.path.islink(link):
+        os.unlink(link)
+    elif os.path.exists(link):
+        raise ValueError(f"{link} exists and is not a link: not replaced")
+    os.symlink(target, link)

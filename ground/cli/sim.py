@@ -17,6 +17,9 @@ from companion.cli.app import (
 )
 from companion.exec_control.vehicle_process import setup_logging
 from ground.cli.extras import require_ground_extra
+from ground.cli.flight_options import parse_home as _home
+from ground.cli.flight_options import parse_outage as _outage
+from ground.cli.flight_options import parse_triple as _triple
 
 CONFIGS = Path(__file__).resolve().parents[2] / "companion" / "configs"
 
@@ -31,39 +34,6 @@ def _speed(text: str) -> float | None:
     if value <= 0:
         raise typer.BadParameter("1 (real time), a factor such as 4, or max (lockstep)")
     return value
-
-
-def _triple(text: str) -> tuple[float, float, float]:
-    try:
-        n, e, d = (float(v) for v in text.split(","))
-    except ValueError:
-        raise typer.BadParameter("expected N,E,D in m/s, e.g. 5,0,0") from None
-    return n, e, d
-
-
-def _outage(text: str):
-    from bridges.jsbsim.options import Outage
-
-    try:
-        start, seconds = (float(v) for v in text.split(":"))
-    except ValueError:
-        raise typer.BadParameter("expected START:SECONDS, e.g. 60:30") from None
-    return Outage(start, seconds)
-
-
-def _home(text: str | None):
-    from bridges.jsbsim.conditions import Home
-
-    if text is None:
-        return Home()
-    try:
-        values = [float(v) for v in text.split(",")]
-    except ValueError:
-        values = []
-    if not 2 <= len(values) <= 4:
-        raise typer.BadParameter("expected LAT,LON[,GROUND_MSL_M[,HEADING_DEG]]")
-    names = ("lat_deg", "lon_deg", "ground_msl_m", "heading_deg")
-    return Home(**dict(zip(names, values, strict=False)))
 
 
 def _single_links(link: list[str] | None, api_port_base: int | None) -> list[str]:

@@ -8,51 +8,18 @@ from __future__ import annotations
 
 import asyncio
 import math
-import time
 
 import numpy as np
 import pytest
-from mavsdk.asyncio import Configuration, Mavsdk
-from mavsdk.asyncio.plugins.action import ActionAsync
-from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
-from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
-from mavsdk.component_type import ComponentType
-from mavsdk.plugins.action import ActionError
 
 from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate as read_truth
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
+from tests.support.mavsdk_flight import fly_plan
 from tests.support.vehicle import REPO
 
 HOME = (-37.9105, 145.1340)
-
-
-async def _fly_plan(port: int, plan: str, deadline_s: float) -> dict:
-    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
-    seen: dict = {"reached": []}
-    async with Mavsdk(config) as mavsdk:
-        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
-        system = await mavsdk.first_autopilot(timeout_s=60.0)
-        telemetry, action = TelemetryAsync(system), ActionAsync(system)
-        mission = MissionRawAsync(system)
-        async for _home in telemetry.subscribe_home():  # a position before arming
-            break
-        data = await mission.import_qgroundcontrol_mission(plan)
-        await mission.upload_mission(data.mission_items)
-        seen["total"] = len(data.mission_items)
-        await action.arm()
-        await mission.start_mission()
-        stop = time.monotonic() + deadline_s
-        while time.monotonic() < stop and not await mission.is_mission_finished():
-            await asyncio.sleep(0.5)
-        seen["finished"] = await mission.is_mission_finished()
-        try:  # disarming in the air drops the aircraft: refused unless forced
-            await action.disarm()
-            seen["disarm"] = "accepted"
-        except ActionError as exc:
-            seen["disarm"] = exc.result.name
-    return seen
 
 
 def _fly(tmp_path, airframe: str, plan: str, sim_s: int) -> tuple[dict, dict, str]:
@@ -61,7 +28,7 @@ def _fly(tmp_path, airframe: str, plan: str, sim_s: int) -> tuple[dict, dict, st
         tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", airframe, "--duration", str(sim_s)
     )
     try:
-        seen = asyncio.run(_fly_plan(port, str(REPO / "qgc_plans" / plan), 240.0))
+        seen = asyncio.run(fly_plan(port, str(REPO / "qgc_plans" / plan), 240.0))
     finally:
         out = finish(proc, namespace, 240)
     return seen, read_truth(truth_path), out
