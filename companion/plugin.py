@@ -10,6 +10,7 @@ short name (entry-point group ``companion.plugins``) or ``"package.module:ClassN
 from __future__ import annotations
 
 import logging
+import os
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -88,6 +89,13 @@ class PluginContext:
     # rather than on the bus polls it too (ReopeningSerial's stop_fd), so a long timeout
     # still lets it stop at once. None where nobody set one up (a plug-in built in a test).
     stop_fd: int | None = None
+    # The execution control's process id, as this process started. None outside one.
+    supervisor_pid: int | None = None
+
+    def supervisor_gone(self) -> bool:
+        """Whether the execution control died under this process (killed, crashed): its
+        orphaned plug-ins stop, and a restarted vehicle takes over their devices."""
+        return self.supervisor_pid is not None and os.getppid() != self.supervisor_pid
 
 
 class Plugin(ABC):

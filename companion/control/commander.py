@@ -17,6 +17,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from companion.control.flight_state import FlightState
 from companion.control.inputs import position_usable
 from companion.control.mission.items import MAX_ALT_M
 from companion.control.modes import INITIAL_MODE
@@ -204,6 +205,23 @@ class Commander:
         else:
             return Decision(CommandResult.DENIED, "Home: bad position")
         return ACCEPTED
+
+    def snapshot(self) -> FlightState:
+        """What a restarted commander needs to carry this flight on."""
+        return FlightState(
+            self.armed, int(self.mode), self.home, self.target, self.radius,
+            self.mission_first, self.changes, self.go_arounds,
+        )  # fmt: skip
+
+    def restore(self, saved: FlightState) -> None:
+        """Carry on the flight ``saved`` describes (armed, as the caller has judged)."""
+        self.mode, self.home = FlightMode(saved.mode), saved.home or self.home
+        self.target, self.radius = saved.target, saved.radius
+        # A mission goes on from the item it was flying to: a controller started after
+        # this (its process restarted too) takes the mission up there, not at item 0.
+        self.mission_first = saved.mission_seq
+        self.changes, self.go_arounds = saved.changes, saved.go_arounds
+        self.armed = True
 
     def status(self, t_us: int) -> VehicleStatus:
         """What the link and the controller are told."""

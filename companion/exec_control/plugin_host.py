@@ -94,6 +94,7 @@ class PluginHost:
             param_decls=tuple(ParamDecl(**d) for d in spec.get("param_decls", [])),
             plugins=spec.get("plugins", {}),
             stop_fd=_signal_pipe(),
+            supervisor_pid=os.getppid(),  # adopted by the supervisor before the host starts
         )
 
     def _clock(self, kind: str) -> VehicleClock:

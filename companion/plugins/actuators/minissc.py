@@ -2,7 +2,8 @@
 
 Group ``flight``: it runs while the vehicle is started (armed). On STOP (its process is
 stopped), when its command input goes stale, or when a command says disarmed, every
-channel goes to its safe position: throttle off, surfaces at trim.
+channel goes to its safe position: throttle off, surfaces at trim. When the supervisor
+itself dies, the card keeps its last positions for the restarted vehicle to take over.
 """
 
 from __future__ import annotations
@@ -104,10 +105,16 @@ class MiniSscOutput(Plugin):
             self._publish(int(received[-1].t_us) if received else -1)
 
     def close(self) -> None:
-        self.wanted = dict(self.safe)
-        self.sent = {}  # everything counts as changed: all channels go out
-        if self._send(len(self.safe)):
-            self._publish(-1)
+        if self.ctx.supervisor_gone():
+            # The execution control crashed, maybe in the air: throttle off would drop the
+            # aircraft while the vehicle restarts. The card holds the last positions until
+            # the restarted vehicle's controller commands it again.
+            self.ctx.log.warning("the supervisor is gone: the servos keep their positions")
+        else:
+            self.wanted = dict(self.safe)
+            self.sent = {}  # everything counts as changed: all channels go out
+            if self._send(len(self.safe)):
+                self._publish(-1)
         self.waiter.close()
         self.port.close()
 

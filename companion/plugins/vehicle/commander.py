@@ -19,6 +19,7 @@ from companion.control.battery_failsafe import BATTERY_FS_PARAMS, BatteryFailsaf
 from companion.control.commander import MODE_COMMANDS, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.control.flight.landing_flight import land_start
+from companion.control.flight_state import in_the_air, load_flight_state, save_flight_state
 from companion.control.mission.fence import Fence
 from companion.control.mission.store import MissionStore, StoreFollower
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch
@@ -26,9 +27,11 @@ from companion.messages import (
     NAME_LEN,
     REASON_LEN,
     CommandAck,
+    CommandId,
     FlightMode,
     NavFlags,
     StatusText,
+    VehicleCommand,
     VehicleStatus,
 )
 from companion.params.live import LiveParams
@@ -44,6 +47,11 @@ STATUS_PERIOD_US = 250_000  # 4 Hz: the link and the controller follow it
 # change (an ack, the mode switch, a failsafe) is sent at once, and wakes them.
 DISARMED_STATUS_PERIOD_US = 1_000_000
 FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) second
+# A restart with an armed flight state on file waits this long (vehicle time) for the
+# execution control's table and the navigator to say whether the flight is still on.
+RESUME_WAIT_US = 10_000_000
+REARM_WAIT_US = 5_000_000  # after asking to be armed again: the supervisor's answer, at most
+REARM_SEQ = (1 << 31) - 1  # the commander's own START, apart from the link's numbers
 
 
 class CommanderPlugin(Plugin):
@@ -62,11 +70,17 @@ class CommanderPlugin(Plugin):
         "link/manual_control",
         "sensors/battery",
     )
-    outputs = ("vehicle/status", "link/command_acks", "vehicle/statustext")
+    outputs = ("vehicle/status", "link/command_acks", "vehicle/statustext", "link/commands")
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
+        self.state_dir = state_dir
+        # The flight this commander's last process left (None: none, or nothing to resume).
+        self.saved = load_flight_state(state_dir)
+        self.resume_until_us: int | None = None
+        self.rearm_until_us = 0  # asked to be armed again: armed, whatever the table says yet
+        self.written = ""  # the flight state last written
         self.store = MissionStore(state_dir / "missions")
         self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
         # The link stores missions in its own process and says so on mission/changed.
@@ -97,6 +111,7 @@ class CommanderPlugin(Plugin):
         # disarmed commander otherwise sleeps a whole second.
         self.waiter = bus.waiter([self.commands, self.rc_switch, self.health])
         self.acks = bus.writer("link/command_acks")
+        self.arm_again = bus.writer("link/commands")
         self.out = bus.writer("vehicle/status")
         self.texts = bus.writer("vehicle/statustext")
         self.next_status_us = 0
@@ -110,7 +125,10 @@ class CommanderPlugin(Plugin):
         self.waiter.wait(WAIT_S if c.armed else DISARMED_WAIT_S)
         now = self.ctx.clock.now_us()
         nav = self._nav()
-        if (health := self.health.get()) is not None:
+        health = self.health.get()
+        if self.saved is not None and not self._resume(now, nav, health):
+            return  # no status until it is known whether the flight goes on
+        if health is not None and (health.flight_running or now >= self.rearm_until_us):
             c.on_armed(bool(health.flight_running))
         self.live.poll()
         if d.MAV_MISSION_TYPE_FENCE in self.follower.follow(self.mission_changes.get()):
@@ -131,6 +149,59 @@ class CommanderPlugin(Plugin):
         # the old mode, when this process was preempted between the two).
         for ack in acks:
             self.acks.publish(ack)
+        self._keep_flight_state(now)
+
+    def _resume(self, now: int, nav: Any, health: Any) -> bool:
+        """Carry on the flight the last process left, if it is still on; False: not known yet.
+
+        Still armed by the execution control (only this process restarted), or in the air
+        by the navigator's judgement (everything restarted): the mode, home, target and
+        mission item come back, and the aircraft is armed again if it must be. On the
+        ground, or when nothing says so in time, it starts disarmed as after any start.
+        """
+        saved = self.saved
+        assert saved is not None
+        if self.resume_until_us is None:
+            self.resume_until_us = now + RESUME_WAIT_US
+        armed = health is not None and bool(health.flight_running)
+        flying = in_the_air(nav, saved.home)
+        if saved.armed and (armed or flying):
+            self.saved = None
+            self.commander.restore(saved)
+            if not armed:
+                self._arm_again(now)
+            mode = FlightMode(saved.mode)
+            item = f" at item {saved.mission_seq}" if mode == FlightMode.MISSION else ""
+            text = f"Restarted in flight: {mode.name.title()} resumed{item}"
+            self.ctx.log.warning("%s", text)
+            self._say(now, text, d.MAV_SEVERITY_WARNING)
+            return True
+        judged = health is not None and nav is not None and nav.flags & NavFlags.POSITION_VALID
+        if not saved.armed or judged or now >= self.resume_until_us:
+            self.saved = None
+            return True
+        return False
+
+    def _arm_again(self, now: int) -> None:
+        """Ask the execution control to start the flight plug-ins, without pre-arm checks
+        (the aircraft is flying: a check that fails now must not drop it)."""
+        self.arm_again.publish(
+            VehicleCommand(t_us=now, seq=REARM_SEQ, command=CommandId.START, source_sysid=0)
+        )
+        self.rearm_until_us = now + REARM_WAIT_US
+
+    def _keep_flight_state(self, now: int) -> None:
+        """Write the flight state when it changed (the mission's item, from the controller)."""
+        c = self.commander
+        control = self.control.get()
+        flying_mission = c.armed and c.mode == FlightMode.MISSION
+        if flying_mission and control is not None and control.fresh(now):
+            c.mission_first = max(0, int(control.mission_seq))
+        state = c.snapshot()
+        text = state.to_json()
+        if text != self.written:
+            save_flight_state(self.state_dir, state)
+            self.written = text
 
     def _publish_status(self, status: VehicleStatus, armed: bool) -> None:
         """Disarmed, the same status again wakes nobody (the link would wake for it each

@@ -1,0 +1,71 @@
+"""The flight state a restarted commander reads back: written whole, read only if sane."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+from companion.control.commander import Commander
+from companion.control.flight_state import (
+    FILE_NAME,
+    FlightState,
+    in_the_air,
+    load_flight_state,
+    save_flight_state,
+)
+from companion.messages import FlightMode, NavFlags
+
+HOME = (-37.9105, 145.134, 50.0)
+
+
+def _state(**changes) -> FlightState:
+    base = dict(armed=True, mode=int(FlightMode.MISSION), home=HOME,
+                target=(math.nan, math.nan, math.nan), radius=math.nan, mission_seq=2,
+                changes=3, go_arounds=0)  # fmt: skip
+    return FlightState(**{**base, **changes})
+
+
+def test_a_state_written_is_read_back_the_same(tmp_path):
+    state = _state(target=(-37.9, 145.1, 150.0), radius=80.0)
+    save_flight_state(tmp_path, state)
+    assert load_flight_state(tmp_path) == state
+    nan_state = _state()
+    save_flight_state(tmp_path, nan_state)
+    back = load_flight_state(tmp_path)
+    assert back is not None and math.isnan(back.radius) and back.mission_seq == 2
+
+
+def test_no_file_or_a_damaged_one_resumes_nothing(tmp_path):
+    assert load_flight_state(tmp_path) is None
+    for junk in ("", "{", "[]", '{"armed": true}', "\x00\xff", '{"mode": 250}'):
+        (tmp_path / FILE_NAME).write_text(junk, errors="surrogateescape")
+        assert load_flight_state(tmp_path) is None, junk
+    save_flight_state(tmp_path, _state())
+    text = (tmp_path / FILE_NAME).read_text()
+    for bad in (text.replace("-37.9105", "-137.9"), text.replace('"mode": ', '"mode": 1e9 + ')):
+        (tmp_path / FILE_NAME).write_text(bad)
+        assert load_flight_state(tmp_path) is None, bad
+
+
+def _nav(vn: float, alt: float, valid: bool = True) -> SimpleNamespace:
+    flags = NavFlags.POSITION_VALID if valid else 0
+    return SimpleNamespace(flags=flags, vn_m_s=vn, ve_m_s=0.0, alt_msl_m=alt)
+
+
+def test_in_the_air_is_fast_or_high_by_the_navigator():
+    assert in_the_air(_nav(30.0, HOME[2] + 2), HOME)  # climbing out
+    assert in_the_air(_nav(0.0, HOME[2] + 40), HOME)  # high, whatever its speed reads
+    assert not in_the_air(_nav(3.0, HOME[2] + 1), HOME)  # taxiing
+    assert not in_the_air(_nav(30.0, HOME[2] + 40, valid=False), HOME)  # no solution yet
+    assert not in_the_air(None, HOME)
+
+
+def test_a_restored_commander_says_what_it_said_before_its_restart():
+    before = Commander(lambda: 4)
+    before.home, before.armed = HOME, True
+    before.mode, before.mission_first, before.changes = FlightMode.MISSION, 2, 3
+    after = Commander(lambda: 4)
+    after.restore(before.snapshot())
+    old, new = before.status(5), after.status(5)
+    assert bytes(old) == bytes(new)
+    assert after.armed and after.mode == FlightMode.MISSION and after.mission_first == 2
