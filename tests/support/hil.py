@@ -1,0 +1,74 @@
+"""Hardware in the loop on one machine, for tests and benchmarks: ``companion hil`` making
+its lines as ptys under a folder, and ``companion run`` started apart with the shipped HIL
+config pointed at them. Nothing joins the two but the ptys and the vehicle's UDP link."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+from companion.bus.namespace import cleanup_namespace
+from tests.protocol.mav_client import free_udp_port
+from tests.support.vehicle import REPO, companion_env, unique_namespace
+
+SHIPPED = REPO / "companion" / "configs" / "hil.toml"
+
+
+def hil_vehicle_config(tmp: Path, lines: Path, port: int, namespace: str) -> Path:
+    """The shipped HIL config, on these lines, state, bus and ground-station port."""
+    text = SHIPPED.read_text().replace("/tmp/companion-hil", str(lines))
+    text = text.replace(
+        '"udpout://127.0.0.1:14550", "udpout://127.0.0.1:14540"', f'"udpout://127.0.0.1:{port}"'
+    )
+    text = text.replace(
+        "[vehicle]\n", f'[vehicle]\nnamespace = "{namespace}"\nstate_dir = "{tmp / "state"}"\n'
+    )
+    config = tmp / "hil_vehicle.toml"
+    config.write_text(text)
+    return config
+
+
+class HilRun:
+    """The simulator and the vehicle, started apart; MAVLink from the vehicle on ``port``."""
+
+    def __init__(self, tmp: Path, *hil_args: str) -> None:
+        self.tmp, self.namespace, self.port = tmp, unique_namespace("hil"), free_udp_port()
+        self.lines, self.truth = tmp / "lines", tmp / "truth.csv"
+        config = hil_vehicle_config(tmp, self.lines, self.port, self.namespace)
+        env = companion_env(self.namespace)
+        self.sim = self._start("hil", env, "hil", "--ptys", str(self.lines),
+                               "--truth", str(self.truth), *hil_args)  # fmt: skip
+        self.vehicle = self._start("vehicle", env, "run", "--config", str(config))
+
+    def _start(self, name: str, env: dict[str, str], *args: str) -> subprocess.Popen[str]:
+        with (self.tmp / f"{name}.log").open("w") as out:
+            cmd = [sys.executable, "-m", "companion", *args]
+            return subprocess.Popen(cmd, cwd=REPO, env=env, text=True, stdout=out, stderr=out)
+
+    def stop(self) -> tuple[int, int]:
+        """End both as a person would (Ctrl-C, a service's SIGTERM); their exit statuses."""
+        statuses = (_end(self.sim, signal.SIGINT), _end(self.vehicle, signal.SIGTERM))
+        cleanup_namespace(self.namespace)
+        return statuses
+
+    def log(self, name: str) -> str:
+        """``hil`` or ``vehicle``: what the process printed."""
+        return (self.tmp / f"{name}.log").read_text(errors="replace")
+
+    def device_paths(self) -> dict[str, str]:
+        """The line of device paths the simulator printed when its lines were up."""
+        return json.loads(next(ln for ln in self.log("hil").splitlines() if ln.startswith("{")))
+
+
+def _end(proc: subprocess.Popen[str], sig: int) -> int:
+    if proc.poll() is None:
+        proc.send_signal(sig)
+    try:
+        return proc.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+        raise
