@@ -7,6 +7,7 @@ idle, and the vehicle must fly the same whatever the scheduler does).
 
 from __future__ import annotations
 
+import compileall
 import os
 import subprocess
 import sys
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.support.vehicle import Vehicle
+from tests.support.vehicle import REPO, Vehicle
 
 STRESS_ENV = "COMPANION_TEST_STRESS"
 _HOG = "while True:\n    pass\n"
@@ -23,10 +24,20 @@ _hogs: list[subprocess.Popen[bytes]] = []
 
 
 def pytest_sessionstart(session: pytest.Session) -> None:
-    """Start the CPU hogs when asked for a busy machine."""
+    """Compile the project's modules once; start the CPU hogs when asked for a busy machine."""
+    _compile_project()
     if os.environ.get(STRESS_ENV, "") not in ("", "0"):
         for _ in range(os.cpu_count() or 2):
             _hogs.append(subprocess.Popen([sys.executable, "-c", _HOG]))
+
+
+def _compile_project() -> None:
+    """Every vehicle a test starts imports the project's modules afresh (the generated
+    MAVLink dialect alone is 1.9 MB of source). Where PYTHONDONTWRITEBYTECODE keeps Python
+    from caching what it compiles, each start compiled them all again: written once here,
+    the bytecode is read by every process after (compileall writes it whatever that says)."""
+    for package in ("companion", "bridges", "ground", "mavlink_dialect"):
+        compileall.compile_dir(REPO / package, quiet=1)
 
 
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:

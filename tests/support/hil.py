@@ -8,6 +8,7 @@ import json
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 from companion.bus.namespace import cleanup_namespace
@@ -37,11 +38,17 @@ class HilRun:
     def __init__(self, tmp: Path, *hil_args: str) -> None:
         self.tmp, self.namespace, self.port = tmp, unique_namespace("hil"), free_udp_port()
         self.lines, self.truth = tmp / "lines", tmp / "truth.csv"
-        config = hil_vehicle_config(tmp, self.lines, self.port, self.namespace)
-        env = companion_env(self.namespace)
-        self.sim = self._start("hil", env, "hil", "--ptys", str(self.lines),
+        self.started = time.monotonic()  # about when the simulation's time began
+        self.config = hil_vehicle_config(tmp, self.lines, self.port, self.namespace)
+        self.env = companion_env(self.namespace)
+        self.sim = self._start("hil", self.env, "hil", "--ptys", str(self.lines),
                                "--truth", str(self.truth), *hil_args)  # fmt: skip
-        self.vehicle = self._start("vehicle", env, "run", "--config", str(config))
+        self.vehicle = self._start("vehicle", self.env, "run", "--config", str(self.config))
+
+    def restart_vehicle(self) -> None:
+        """Start ``companion run`` again (after it died), as its service would."""
+        args = ("run", "--config", str(self.config))
+        self.vehicle = self._start("vehicle_restarted", self.env, *args)
 
     def _start(self, name: str, env: dict[str, str], *args: str) -> subprocess.Popen[str]:
         with (self.tmp / f"{name}.log").open("w") as out:

@@ -1,0 +1,121 @@
+"""Crashes in the air: plug-ins killed in turn while a mission flies, then the supervisor.
+
+Hardware in the loop, so that the vehicle can die and be started again while the
+simulated aircraft flies on in real time, as it would in the field: each plug-in is killed
+with SIGKILL in turn on the mission's legs; the mission must go on to its end, in
+Mission, never near the ground. Then ``companion run`` itself is killed and started again
+at once (as its service would): the new vehicle must find the aircraft flying, arm itself
+again and carry on in its mode.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import signal
+import time
+from typing import Any
+
+import numpy as np
+import psutil
+import pytest
+from mavsdk.asyncio import Configuration, Mavsdk
+from mavsdk.asyncio.plugins.action import ActionAsync
+from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
+from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
+from mavsdk.component_type import ComponentType
+from mavsdk.plugins.telemetry import FlightMode
+
+from companion.navigation.estimate_csv import read_estimate
+from tests.support.hil import HilRun
+from tests.support.vehicle import REPO
+
+PLAN = REPO / "qgc_plans" / "short_leg.plan"
+# Killed in turn, one every KILL_EVERY_S from KILL_FROM_S of the mission (the climb-out is
+# over by then); then the supervisor.
+VICTIMS = ("commander", "control", "servos", "nav", "imu", "gps", "compass", "link")
+KILL_FROM_S, KILL_EVERY_S = 35.0, 3.0
+
+
+def _plugin_pid(run: HilRun, name: str) -> int | None:
+    kids = psutil.Process(run.vehicle.pid).children(recursive=True)
+    return next((k.pid for k in kids if k.name() == name), None)
+
+
+async def _mission_with_crashes(run: HilRun) -> dict:
+    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
+    seen: dict = {"killed": [], "modes": set()}
+    async with Mavsdk(config) as mavsdk:
+        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{run.port}")
+        system = await mavsdk.first_autopilot(timeout_s=60.0)
+        telemetry, action = TelemetryAsync(system), ActionAsync(system)
+        mission = MissionRawAsync(system)
+        async for _home in telemetry.subscribe_home():
+            break
+        data = await mission.import_qgroundcontrol_mission(str(PLAN))
+        await mission.upload_mission(data.mission_items)
+        await action.arm()
+        await mission.start_mission()
+        started = time.monotonic()
+        for k, name in enumerate(VICTIMS):
+            await asyncio.sleep(
+                max(0.0, started + KILL_FROM_S + k * KILL_EVERY_S - time.monotonic())
+            )
+            if (pid := _plugin_pid(run, name)) is not None:
+                os.kill(pid, signal.SIGKILL)
+                seen["killed"].append(name)
+        deadline = time.monotonic() + 150.0
+        while time.monotonic() < deadline and not await mission.is_mission_finished():
+            seen["modes"].add(await _first(telemetry.subscribe_flight_mode()))
+            await asyncio.sleep(0.5)
+        seen["finished"] = await mission.is_mission_finished()
+        seen["finished_at_s"] = time.monotonic() - run.started
+        # Done, circling at the mission's height: now the supervisor dies.
+        seen["back_after_s"] = await _kill_the_supervisor(run, telemetry)
+        await asyncio.sleep(10.0)  # flying on, restarted
+    return seen
+
+
+async def _kill_the_supervisor(run: HilRun, telemetry: TelemetryAsync) -> float:
+    """Kill ``companion run``, start it again at once; seconds until armed in Mission again."""
+    run.vehicle.send_signal(signal.SIGKILL)
+    run.vehicle.wait()
+    killed = time.monotonic()
+    run.restart_vehicle()
+    while time.monotonic() - killed < 30.0:
+        armed = await _first(telemetry.subscribe_armed())
+        mode = await _first(telemetry.subscribe_flight_mode())
+        if armed and mode == FlightMode.MISSION and _plugin_pid(run, "servos") is not None:
+            return time.monotonic() - killed
+        await asyncio.sleep(0.1)
+    return float("inf")
+
+
+async def _first(stream: Any) -> Any:
+    async for value in stream:
+        return value
+    return None
+
+
+@pytest.mark.timeout(400)
+def test_a_mission_flies_on_through_plugin_kills_and_a_supervisor_crash(tmp_path):
+    run = HilRun(tmp_path, "--duration", "300")
+    try:
+        seen = asyncio.run(_mission_with_crashes(run))
+    finally:
+        statuses = run.stop()
+    vehicle_log = run.log("vehicle") + run.log("vehicle_restarted")
+    assert seen["killed"] == list(VICTIMS), vehicle_log[-3000:]
+    assert seen["finished"], (seen, vehicle_log[-3000:])
+    assert seen["modes"] == {FlightMode.MISSION}, seen
+    # The restarted vehicle armed itself again and took the flight up. How soon depends on
+    # how fast Python starts on the machine (1-3 s idle here; much longer under load).
+    assert seen["back_after_s"] < 60.0, vehicle_log[-3000:]
+    assert "Restarted in flight: Mission resumed" in run.log("vehicle_restarted")
+    truth = read_estimate(run.truth)
+    t, alt = np.asarray(truth["t"]), np.asarray(truth["alt"])
+    height = alt - alt[0]
+    climbed = t > t[np.argmax(height > 70.0)]
+    assert np.min(height[climbed & (t < seen["finished_at_s"])]) > 40.0, "came down with a kill"
+    assert height[-1] > 20.0, "not flying after the supervisor's restart"
+    assert statuses == (0, 0)
