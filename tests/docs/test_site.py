@@ -9,6 +9,7 @@ import re
 import shlex
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 import typer.main
@@ -88,3 +89,8 @@ def test_shown_command_exists_and_its_options_too(where, line):
     path = words[: len(words) - len(rest)]
     result = CliRunner().invoke(app, [*path, "--help"])
     assert result.exit_code == 0, f"{where}: companion {' '.join(path)} --help: {result.output}"
+
+
+def test_the_readme_names_the_command_that_serves_the_site():
+    assert "python3 -m uv run mkdocs serve" in (REPO / "README.md").read_text()
+    assert Path(REPO / "mkdocs.yml").exists()
