@@ -117,4 +117,6 @@ def option_row(param: Any) -> tuple[str, str, str]:
     default = "required" if param.required else param.default
     if callable(default) or default is None or default == () or default == []:
         default = ""
-    return names, str(default), getattr(param, "help", "") or ""
+    # A default under this checkout (the shipped config) is shown as the repository path.
+    shown = str(default).replace(f"{REPO}/", "")
+    return names, shown, getattr(param, "help", "") or ""
