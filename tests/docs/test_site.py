@@ -94,3 +94,11 @@ def test_shown_command_exists_and_its_options_too(where, line):
 def test_the_readme_names_the_command_that_serves_the_site():
     assert "python3 -m uv run mkdocs serve" in (REPO / "README.md").read_text()
     assert Path(REPO / "mkdocs.yml").exists()
+
+
+def test_the_readmes_links_reach_files():
+    """The README is read on GitHub, outside the site: its relative links name files."""
+    links = re.findall(r"\]\(([^)#]+)(?:#[^)]*)?\)", (REPO / "README.md").read_text())
+    local = [link for link in links if "://" not in link]
+    assert local, "the README links to the documentation"
+    assert [link for link in local if not (REPO / link).is_file()] == []
