@@ -16,6 +16,8 @@ from urllib.parse import parse_qs, urlparse
 
 import serial
 
+from companion.sensors.serial_port import open_port
+
 log = logging.getLogger(__name__)
 
 Remote = tuple[str, int] | str  # a UDP/TCP peer address, or the serial device
@@ -208,7 +210,8 @@ class SerialEndpoint(Endpoint):
         super().__init__(url)
         path, baud = parse_serial_url(url)
         self.baud = baud
-        self.port = serial.serial_for_url(path, baudrate=baud, timeout=0, write_timeout=0)
+        # open_port: a radio at a custom rate reopens after a restart (pyserial issue #805).
+        self.port = open_port(path, baudrate=baud, timeout=0, write_timeout=0)
 
     def filenos(self) -> list[int]:
         return [self.port.fileno()]
