@@ -5,8 +5,10 @@ again (pyserial 3.5 alone failed that open with termios.error 22, and restarted 
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 import signal
+import time
 
 import pytest
 
@@ -51,6 +53,7 @@ def test_kill_9_of_the_rc_plugin_the_restarted_process_decodes_sbus_again(
     pid = vehicle.wait_running("rc")
     sticks_flow(vehicle, pty, 1900, "full right roll from the first process")
     for kill in range(1, KILLS + 1):
+        killed_at = time.monotonic()
         os.kill(pid, signal.SIGKILL)
         pid = wait_for(
             lambda old=pid: (r := vehicle.row("rc")) and r.pid not in (0, old) and r.pid,
@@ -59,6 +62,9 @@ def test_kill_9_of_the_rc_plugin_the_restarted_process_decodes_sbus_again(
         )
         roll_us = 1100 if kill % 2 else 1900
         sticks_flow(vehicle, pty, roll_us, f"sticks from the process after kill {kill}")
+        logging.getLogger(__name__).info(
+            "kill %d: sticks again %.2f s after the kill", kill, time.monotonic() - killed_at
+        )
     # Each kill restarted it once: the new process did not die opening the port.
     assert vehicle.row("rc").restarts == KILLS
     assert vehicle.row("rc").pid == pid
