@@ -28,6 +28,7 @@ import sys
 import termios
 
 import serial
+from serial.serialposix import PlatformSpecific
 
 # ``struct termios2`` as x86, ARM and RISC-V Linux define it: four tcflag_t, c_line, 19 c_cc,
 # then c_ispeed and c_ospeed; 11 unsigned ints (the ioctl numbers below encode 44 bytes).
@@ -47,10 +48,14 @@ _PARITY = {
 }
 _CLEARED = termios.CBAUD | termios.CIBAUD | termios.CSIZE | termios.PARENB | termios.PARODD
 PLACEHOLDER_BAUD = 38400  # what tcsetattr is given for a rate without a Bnnn constant
+# The kernel's own CBAUD encoding of the standard rates (pyserial's Linux table), for
+# TCSETS2: Python's ``termios.Bnnn`` are glibc's, which from 2.42 may be the rate itself.
+_KERNEL_SPEED: dict[int, int] = dict(PlatformSpecific.BAUDRATE_CONSTANTS)
 
 
 def speed_constant(baud: int) -> int | None:
-    """The ``Bnnn`` constant of a standard rate, None for a custom one."""
+    """The ``Bnnn`` constant (glibc's, for tcsetattr) of a standard rate, None for a custom
+    one."""
     return getattr(termios, f"B{baud}", None)
 
 
@@ -62,10 +67,9 @@ def apply_rate_and_framing(fd: int, baud: int, bytesize: int, parity: str) -> in
     buf = array.array("I", [0] * _TERMIOS2_WORDS)
     try:
         fcntl.ioctl(fd, TCGETS2, buf)
-        standard = speed_constant(baud)
         cflag = buf[_CFLAG] & ~(_CLEARED | CMSPAR)  # CIBAUD 0: input at the output's rate
         cflag |= _CHAR_SIZE[bytesize] | _PARITY[parity]
-        cflag |= BOTHER if standard is None else standard
+        cflag |= _KERNEL_SPEED.get(baud, BOTHER)
         buf[_CFLAG] = cflag
         buf[_ISPEED] = buf[_OSPEED] = baud
         fcntl.ioctl(fd, TCSETS2, buf)
