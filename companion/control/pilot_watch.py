@@ -11,14 +11,19 @@ time and the mode in; mode changes and operator messages out. As ArduPlane does 
   Stabilized; ``FS_LONG_ACTN`` 1: from every mode), and the mission goes on in Auto;
 - the joystick (MANUAL_CONTROL) lost for ``RC_OVERRIDE_TIME`` while it flies the
   aircraft in Manual or Stabilized → Return.
-Only a receiver or joystick that has been heard can be lost; each loss is said once.
+Only a receiver or joystick that has been heard can be lost; each loss is said once, with
+its cause: the receiver's failsafe flag, a failsafe throttle, silence, or the receiver's
+plug-in process down (dead, or restarted since its last usable frame: an operator reading
+"RC lost" must not go looking for a radio fault when a process is the cause).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from companion.control.failsafe import Action
 from companion.control.modes import PILOT_MODES, from_arduplane
-from companion.messages import FlightMode, PilotInput
+from companion.messages import FlightMode, PilotFlags, PilotInput
 from companion.params import ParamDecl
 from mavlink_dialect import companion as d
 
@@ -37,12 +42,21 @@ PILOT_PARAMS = (
 )
 
 
+@dataclass(frozen=True)
+class ReceiverProcess:
+    """The RC receiver's plug-in as the health table shows it."""
+
+    running: bool
+    restarts: int
+
+
 class PilotWatch:
     """Remembers what it has announced."""
 
     def __init__(self, params: dict[str, float]) -> None:
         self.params = params
         self.last_usable_rc_us: int | None = None
+        self.restarts_at_usable: int | None = None  # the receiver process's, at that frame
         self.rc_lost = False
         self.joystick_lost = False
 
@@ -59,10 +73,12 @@ class PilotWatch:
         flying: bool,
         rc: PilotInput | None,
         joystick: PilotInput | None,
+        receiver: ReceiverProcess | None = None,
     ) -> list[Action]:
-        """The actions the pilot's inputs call for at sensor time ``now_us``."""
+        """The actions the pilot's inputs call for at sensor time ``now_us`` (``receiver``:
+        the receiver plug-in's process, when the health table lists one)."""
         return [
-            *self._rc(now_us, mode, flying, rc),
+            *self._rc(now_us, mode, flying, rc, receiver),
             *self._joystick(now_us, mode, flying, rc, joystick),
         ]
 
@@ -75,24 +91,44 @@ class PilotWatch:
         )
 
     def _rc(
-        self, now_us: int, mode: FlightMode, flying: bool, rc: PilotInput | None
+        self,
+        now_us: int,
+        mode: FlightMode,
+        flying: bool,
+        rc: PilotInput | None,
+        receiver: ReceiverProcess | None,
     ) -> list[Action]:
         p = self.params
         if rc is None:
             return []
         if rc.usable():
+            if self.last_usable_rc_us is None or rc.t_us > self.last_usable_rc_us:
+                self.restarts_at_usable = receiver.restarts if receiver is not None else None
             self.last_usable_rc_us = max(self.last_usable_rc_us or rc.t_us, rc.t_us)
         since = self.last_usable_rc_us if self.last_usable_rc_us is not None else rc.t_us
         silent = now_us - since >= p["FS_LONG_TIMEOUT"] * 1e6
         if silent and not self.rc_lost and flying and p["THR_FAILSAFE"] >= 0.5:
             self.rc_lost = True
+            cause = self._lost_cause(now_us - since, rc, receiver)
             if mode in PILOT_MODES or (p["FS_LONG_ACTN"] >= 0.5 and mode != FlightMode.RTL):
-                return [Action(FlightMode.RTL, "Failsafe: RC lost, returning home")]
-            return [Action(None, "Failsafe: RC lost, carrying on")]
+                return [Action(FlightMode.RTL, f"Failsafe: RC lost, returning home ({cause})")]
+            return [Action(None, f"Failsafe: RC lost, carrying on ({cause})")]
         if self.rc_lost and not silent:
             self.rc_lost = False
             return [Action(None, "RC back", d.MAV_SEVERITY_NOTICE)]
         return []
+
+    def _lost_cause(self, silent_us: int, rc: PilotInput, receiver: ReceiverProcess | None) -> str:
+        """Why no usable frame came, in a few words for the operator."""
+        if receiver is not None:
+            before = self.restarts_at_usable
+            if not receiver.running or (before is not None and receiver.restarts > before):
+                return "RC input process down"
+        if rc.flags & PilotFlags.FAILSAFE:
+            return "receiver failsafe"
+        if rc.flags & PilotFlags.THROTTLE_LOW:
+            return "failsafe throttle"
+        return f"no receiver frame for {silent_us / 1e6:.0f} s"
 
     def _joystick(
         self,

@@ -34,8 +34,11 @@ class LogDirectory:
         return [p for _, p in sorted(found)]
 
     def new_path(self, label: str) -> Path:
-        """The path of the next log (the directory is made if needed)."""
-        self.path.mkdir(parents=True, exist_ok=True)
+        """The path of the next log (the directory is made if needed, durably: a power
+        cut must not take the directory, and every log in it, away)."""
+        if not self.path.is_dir():
+            self.path.mkdir(parents=True, exist_ok=True)
+            _fsync_dir(self.path.parent)
         numbers = [int(m.group(1)) for p in self.files() if (m := _NAME.match(p.name))]
         number = max(numbers, default=0) + 1
         safe = re.sub(r"[^A-Za-z0-9_-]", "_", label)
@@ -48,11 +51,7 @@ class LogDirectory:
     def publish(self, partial: Path, path: Path) -> None:
         """Rename a partial log into view, durably (the directory is fsynced too)."""
         os.rename(partial, path)
-        fd = os.open(self.path, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
+        _fsync_dir(self.path)
 
     def remove_partial(self) -> list[Path]:
         """Remove partial logs nobody writes (cut off before their header was on disk)."""
@@ -123,6 +122,14 @@ def being_written(path: Path) -> bool:
     except OSError:
         return False
     return False
+
+
+def _fsync_dir(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def _size(path: Path) -> int:

@@ -8,15 +8,21 @@ bytes only; framing is companion.link.codec's (one parser per remote), CRC and s
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import socket
+import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from urllib.parse import parse_qs, urlparse
 
 import serial
 
+from companion.sensors.serial_port import FIRST_RETRY_S, MAX_RETRY_S, open_port
+
 log = logging.getLogger(__name__)
+# What pyserial raises when a device is gone (TypeError: a port closed under a read).
+_PORT_ERRORS = (serial.SerialException, OSError, ValueError, TypeError)
 
 Remote = tuple[str, int] | str  # a UDP/TCP peer address, or the serial device
 MAX_DATAGRAM = 65535
@@ -202,36 +208,83 @@ class TcpIn(Endpoint):
 
 
 class SerialEndpoint(Endpoint):
-    """A radio modem or cable: ``serial:///dev/ttyUSB0:57600``."""
+    """A radio modem or cable: ``serial:///dev/ttyUSB0:57600``.
+
+    The first open happens here (a device missing at start-up is the config's fault). A
+    device lost later (a USB adapter pulled out: a read that fails, or readable with nothing
+    to read) is closed, ``reopens`` counts it, and ``filenos`` opens it again when it is
+    back, retrying after 0.1 s doubling to 2 s: the link's other endpoints fly on meanwhile.
+    """
 
     def __init__(self, url: str) -> None:
         super().__init__(url)
-        path, baud = parse_serial_url(url)
-        self.baud = baud
-        self.port = serial.serial_for_url(path, baudrate=baud, timeout=0, write_timeout=0)
+        self.path, self.baud = parse_serial_url(url)
+        self.reopens = 0
+        self._retry_s = FIRST_RETRY_S
+        self._next_try = 0.0
+        self.port: serial.SerialBase | None = self._open()
+
+    def _open(self) -> serial.SerialBase:
+        # open_port: a radio at a custom rate reopens after a restart (pyserial issue #805).
+        return open_port(self.path, baudrate=self.baud, timeout=0, write_timeout=0)
 
     def filenos(self) -> list[int]:
-        return [self.port.fileno()]
+        port = self.port if self.port is not None else self._reopen()
+        return [port.fileno()] if port is not None else []
+
+    def _reopen(self) -> serial.SerialBase | None:
+        now = time.monotonic()
+        if now < self._next_try:
+            return None
+        try:
+            self.port = self._open()
+        except _PORT_ERRORS as exc:
+            log.debug("%s: cannot reopen (%s)", self.url, exc)
+            self._next_try = now + self._retry_s
+            self._retry_s = min(2 * self._retry_s, MAX_RETRY_S)
+            return None
+        log.info("%s: reopened", self.url)
+        self._retry_s = FIRST_RETRY_S
+        return self.port
 
     def read_ready(self, fd: int) -> list[tuple[Remote, bytes]]:
+        if self.port is None:
+            return []
         try:
             data = self.port.read(4096)
-        except (serial.SerialException, OSError):
+        except _PORT_ERRORS as exc:  # pyserial: readable, yet nothing to read: it is gone
+            self._lost(exc)
             return []
         self.bytes_in += len(data)
-        return [(self.port.port, data)] if data else []
+        return [(self.path, data)] if data else []
 
     def send(self, data: bytes) -> int:
+        if self.port is None:
+            self.write_errors += 1
+            return 0
         try:
             sent = self.port.write(data) or 0
-        except (serial.SerialTimeoutException, serial.SerialException, OSError):
+        except serial.SerialTimeoutException:
             self.write_errors += 1
+            return 0
+        except _PORT_ERRORS as exc:
+            self.write_errors += 1
+            self._lost(exc)
             return 0
         self.bytes_out += sent
         return sent
 
+    def _lost(self, exc: BaseException) -> None:
+        log.warning("%s vanished (%s): reopening", self.url, exc)
+        self.reopens += 1
+        self.close()
+        self._next_try = time.monotonic() + self._retry_s
+
     def close(self) -> None:
-        self.port.close()
+        port, self.port = self.port, None
+        if port is not None:
+            with contextlib.suppress(*_PORT_ERRORS):
+                port.close()
 
 
 def parse_serial_url(url: str) -> tuple[str, int]:

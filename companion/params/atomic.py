@@ -2,13 +2,22 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
+import time
 from pathlib import Path
+
+# A temporary file older than this was left by a writer killed between making it and
+# renaming it over the file (a write takes milliseconds): it is removed at the next write.
+# Younger ones may be another process's write in progress, and are left alone.
+ORPHAN_AGE_S = 60.0
 
 
 def atomic_write_text(path: Path, text: str) -> None:
-    """Temp file in the same directory, fsync, rename over the old file, fsync the directory."""
+    """Temp file in the same directory, fsync, rename over the old file, fsync the directory
+    (and, the first time, the directory's own parent, so the new directory survives too)."""
+    created = not path.parent.is_dir()
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
@@ -20,7 +29,26 @@ def atomic_write_text(path: Path, text: str) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    dir_fd = os.open(path.parent, os.O_RDONLY)
+    _fsync_directory(path.parent)
+    if created:
+        _fsync_directory(path.parent.parent)
+    remove_orphans(path)
+
+
+def remove_orphans(path: Path, now: float | None = None) -> list[Path]:
+    """Remove the temporary files of ``path`` that killed writers left; those removed."""
+    now = time.time() if now is None else now
+    removed = []
+    for tmp in path.parent.glob(f".{path.name}.*.tmp"):
+        with contextlib.suppress(OSError):  # gone already: another writer swept it
+            if now - tmp.stat().st_mtime > ORPHAN_AGE_S:
+                tmp.unlink()
+                removed.append(tmp)
+    return removed
+
+
+def _fsync_directory(directory: Path) -> None:
+    dir_fd = os.open(directory, os.O_RDONLY)
     try:
         os.fsync(dir_fd)
     finally:

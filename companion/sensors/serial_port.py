@@ -30,6 +30,8 @@ from typing import Any
 
 import serial
 
+from companion.sensors.termios2_serial import port_class
+
 log = logging.getLogger(__name__)
 FIRST_RETRY_S = 0.1
 MAX_RETRY_S = 2.0
@@ -54,13 +56,25 @@ def open_problem(url: str, baud: int) -> str | None:
     """Why the device cannot be opened now (None: it can); it is closed again at once."""
     path, rate = split_device(url, baud)
     try:
-        serial.serial_for_url(path, baudrate=rate, timeout=0).close()
+        open_port(path, baudrate=rate, timeout=0).close()
     except _PORT_ERRORS as exc:
         text = str(getattr(exc, "strerror", None) or exc)
         # pyserial names the port twice ("could not open port P: [Errno 2] ...: 'P'"): once
         # is enough for a STATUSTEXT the operator reads.
         return text.removeprefix(f"could not open port {path}: ")
     return None
+
+
+def open_port(path: str, **settings: Any) -> serial.SerialBase:
+    """Open a device path or pyserial URL with pyserial's settings (``baudrate``, ...).
+
+    A device path opens with ``termios2_serial.port_class()``: pyserial 3.5 cannot reopen a
+    port left at a custom rate (SBUS's 100000 8E2) by a process that crashed or was
+    restarted, nor open one at all on glibc 2.42 (pyserial issue #805); see that module.
+    """
+    if "://" in path:
+        return serial.serial_for_url(path, **settings)
+    return port_class()(path, **settings)
 
 
 def _read_port(port: serial.SerialBase, now_us: Callable[[], int], size: int) -> tuple[bytes, int]:
@@ -214,7 +228,7 @@ class ReopeningSerial:
         try:
             # A bounded write timeout, not 0: pyserial's non-blocking write retries EAGAIN in
             # a busy loop while the device's buffer is full.
-            port = serial.serial_for_url(
+            port = open_port(
                 self.path,
                 baudrate=self.baud,
                 timeout=self.read_timeout_s,

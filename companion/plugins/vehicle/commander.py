@@ -22,7 +22,7 @@ from companion.control.flight.landing_flight import land_start
 from companion.control.flight_state import in_the_air, load_flight_state, save_flight_state
 from companion.control.mission.fence import Fence
 from companion.control.mission.store import MissionStore, StoreFollower
-from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch
+from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch, ReceiverProcess
 from companion.messages import (
     NAME_LEN,
     REASON_LEN,
@@ -30,6 +30,7 @@ from companion.messages import (
     CommandId,
     FlightMode,
     NavFlags,
+    PluginState,
     StatusText,
     VehicleCommand,
     VehicleStatus,
@@ -52,6 +53,7 @@ FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) secon
 RESUME_WAIT_US = 10_000_000
 REARM_WAIT_US = 5_000_000  # after asking to be armed again: the supervisor's answer, at most
 REARM_SEQ = (1 << 31) - 1  # the commander's own START, apart from the link's numbers
+RC_PLUGIN = b"sensors.rc_input"  # whose process the RC failsafe names when it is down
 
 
 class CommanderPlugin(Plugin):
@@ -263,8 +265,19 @@ class CommanderPlugin(Plugin):
         actions = self.failsafes.step(situation) + self.battery_failsafe.step(level, bool(flying))
         if nav is not None:  # the pilot's inputs are judged against the sensors' time
             rc, joystick = self.rc.get(), self.joystick.get()
-            actions += self.pilot.step(int(nav.t_us), c.mode, bool(flying), rc, joystick)
+            receiver = self._receiver()
+            actions += self.pilot.step(int(nav.t_us), c.mode, bool(flying), rc, joystick, receiver)
         return self._act(now, actions)
+
+    def _receiver(self) -> ReceiverProcess | None:
+        """The RC receiver plug-in's process in the health table (None: none listed)."""
+        health = self.health.get()
+        if health is None:
+            return None
+        row = next((r for r in health.rows() if r.kind == RC_PLUGIN), None)
+        if row is None:
+            return None
+        return ReceiverProcess(row.state == PluginState.RUNNING, int(row.restarts))
 
     def _mode_switch(self, now: int) -> bool:
         """The pilot's switch wins over the ground station each time it moves."""

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch
+from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch, ReceiverProcess
 from companion.messages import FlightMode, PilotFlags, PilotInput, PilotSource
 
 S = 1_000_000
@@ -50,6 +50,39 @@ def test_failsafe_flag_and_low_throttle_count_as_lost():
         for t in range(11, 17):
             actions += w.step(t * S, FlightMode.STABILIZED, True, frame(t, flags=int(flags)), None)
         assert modes(actions) == [FlightMode.RTL]
+
+
+def lost_text(w: PilotWatch, frames, receiver_at_loss: ReceiverProcess | None) -> str:
+    """What the operator reads when the receiver is lost after ``frames`` (time, flags,
+    receiver process)."""
+    for t, flags, receiver in frames:
+        w.step(round(t * S), FlightMode.MISSION, True, frame(t, flags=flags), None, receiver)
+    last_t, last_flags, _ = frames[-1]
+    (lost,) = w.step(
+        round((last_t + 6) * S), FlightMode.MISSION, True, frame(last_t, flags=last_flags),
+        None, receiver_at_loss,
+    )  # fmt: skip
+    return lost.text
+
+
+def test_the_rc_lost_text_names_its_cause():
+    up = ReceiverProcess(running=True, restarts=0)
+    silent = lost_text(watch(), [(10.0, 0, up)], up)
+    assert silent == "Failsafe: RC lost, carrying on (no receiver frame for 6 s)"
+    flag = lost_text(watch(), [(10.0, 0, up), (11.0, int(PilotFlags.FAILSAFE), up)], up)
+    assert flag.endswith("(receiver failsafe)")
+    throttle = lost_text(watch(), [(10.0, 0, up), (11.0, int(PilotFlags.THROTTLE_LOW), up)], up)
+    assert throttle.endswith("(failsafe throttle)")
+    # The receiver's plug-in is waiting to be restarted, or has been restarted since its
+    # last usable frame and has not delivered one: a process, not the radio, is the cause.
+    backoff = ReceiverProcess(running=False, restarts=1)
+    assert lost_text(watch(), [(10.0, 0, up)], backoff).endswith("(RC input process down)")
+    restarted = ReceiverProcess(running=True, restarts=3)
+    assert lost_text(watch(), [(10.0, 0, up)], restarted).endswith("(RC input process down)")
+    # Restarted before its last usable frame: it works again, and the silence is the radio's.
+    back = ReceiverProcess(running=True, restarts=1)
+    assert lost_text(watch(), [(10.0, 0, back)], back).endswith("(no receiver frame for 6 s)")
+    assert lost_text(watch(), [(10.0, 0, None)], None).endswith("(no receiver frame for 6 s)")
 
 
 def test_in_auto_the_mission_goes_on_unless_fs_long_actn_says_return():

@@ -4,6 +4,7 @@ cut at the wrong moment never leaves a headless ``.ulg`` in view."""
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
 import pytest
@@ -66,8 +67,12 @@ def test_the_budget_is_kept_while_a_file_is_written(tmp_path: Path) -> None:
 def test_a_cut_before_the_header_is_on_disk_leaves_no_log_in_view(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    def power_cut(fd: int) -> None:
-        raise OSError("power cut")
+    real_fsync = os.fsync
+
+    def power_cut(fd: int) -> None:  # at the header's fsync (a directory's goes through)
+        if stat.S_ISREG(os.fstat(fd).st_mode):
+            raise OSError("power cut")
+        real_fsync(fd)
 
     rec = recorder(tmp_path, budget=10**9, max_bytes=10**9)
     with monkeypatch.context() as patch:
