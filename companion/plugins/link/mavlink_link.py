@@ -22,7 +22,7 @@ from companion.link.codec import dialect as d
 from companion.link.codec import new_encoder
 from companion.link.command_service import CommandService
 from companion.link.commands import register_commands
-from companion.link.endpoints import Endpoint, EndpointError, endpoint_problems, open_endpoint
+from companion.link.endpoints import endpoint_problems, open_endpoints
 from companion.link.gcs_watch import GcsWatch
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
@@ -35,7 +35,7 @@ from companion.link.params_service import ParamsService
 from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
 from companion.link.service import Outgoing, refused_count
-from companion.link.signing import key_from
+from companion.link.signing import configured_secret, key_from
 from companion.link.statustext import StatusTexts
 from companion.link.telemetry import Snapshot
 from companion.link.timesync import TimesyncService
@@ -79,6 +79,8 @@ class MavlinkLink(Plugin):
         # (companion.control.modes says why); generic: no guided action in QGroundControl.
         "autopilot": Setting(str, "px4", "MAV_AUTOPILOT reported", choices=tuple(AUTOPILOTS)),
         "signing_key": Setting(str, "", "signing key: 64 hex digits or a passphrase (SHA-256)"),
+        # Kept out of the config (which is shown and copied), readable by the vehicle only.
+        "signing_key_file": Setting(str, "", "file holding the signing key (as signing_key)"),
     }
     params = (
         ParamDecl("SR_ATTITUDE", 10.0, 0.0, 100.0, "Hz", "ATTITUDE rate on every endpoint"),
@@ -115,13 +117,15 @@ class MavlinkLink(Plugin):
 
     @classmethod
     def validate(cls, settings: Mapping[str, Any]) -> list[str]:
-        return endpoint_problems(settings["endpoints"], settings["signing_key"])
+        key, key_file = settings["signing_key"], settings["signing_key_file"]
+        both = ["give signing_key or signing_key_file, not both"] if key and key_file else []
+        return both or endpoint_problems(settings["endpoints"], key or key_file)
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
         sysid = int(ctx.vehicle.get("sysid", 1))
         self.mav = new_encoder(sysid, ctx.settings["compid"])
-        self.endpoints = _open_endpoints(ctx.settings["endpoints"])
+        self.endpoints = open_endpoints(ctx.settings["endpoints"])
         autopilot = AUTOPILOTS[ctx.settings["autopilot"]]
         self.identity = IdentityService(self.mav, sysid, autopilot, CAPABILITIES)
         # The first heartbeat already names a mode (the commander's initial one).
@@ -143,7 +147,7 @@ class MavlinkLink(Plugin):
             self.mav, lambda: ctx.clock.now_us() * 1000, sysid, ctx.settings["compid"]
         )
         services = [self.identity, self.commands, self.timesync]
-        secret = ctx.settings["signing_key"]
+        secret = configured_secret(ctx.settings["signing_key"], ctx.settings["signing_key_file"])
         key = key_from(secret) if secret else None
         self.refusal_text = RefusalTexts(self.statustext, time.monotonic)
         self.texts_out = StatusTexts(self.mav)
@@ -387,13 +391,3 @@ class MavlinkLink(Plugin):
         self.router.close()
         for endpoint in self.endpoints:
             endpoint.close()
-
-
-def _open_endpoints(urls: list[str]) -> list[Endpoint]:
-    endpoints: list[Endpoint] = []
-    for url in urls:
-        try:
-            endpoints.append(open_endpoint(url))
-        except (EndpointError, OSError) as exc:
-            raise RuntimeError(f"endpoint {url}: {exc}") from exc
-    return endpoints

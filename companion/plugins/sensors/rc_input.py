@@ -37,7 +37,7 @@ _THROTTLE_LOW = int(PilotFlags.THROTTLE_LOW)
 class RcInput(Plugin):
     """Publishes the pilot's sticks and mode switch from every SBUS frame."""
 
-    settings = serial_settings("serial:///dev/ttyAMA0:100000", 100000)
+    settings = serial_settings("serial:///dev/ttyAMA0:100000", 100000, 70.0)
     params = RC_PARAMS
     optional_inputs = ("params/changes",)
     outputs = ("sensors/rc", "sensors/rc_switch")

@@ -53,11 +53,13 @@ class SentenceDecoder(Protocol[ReadingT_co]):
         ...
 
 
-def serial_settings(example_url: str, baud: int) -> dict[str, Setting]:
-    """The ``device`` and ``baud`` settings, with the device's usual URL and rate."""
+def serial_settings(example_url: str, baud: int, rate_hz: float) -> dict[str, Setting]:
+    """The ``device``, ``baud`` and ``rate_hz`` settings, with the device's usual URL, baud
+    rate and output rate (readings a second: what ``companion check`` expects to hear)."""
     return {
         "device": Setting(str, doc=f"{example_url}, a pty path or a pyserial URL"),
         "baud": Setting(int, baud, "baud rate when the URL does not give one", min=300),
+        "rate_hz": Setting(float, rate_hz, "readings a second the device sends", min=0.0),
     }
 
 
