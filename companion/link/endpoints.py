@@ -331,3 +331,9 @@ def open_endpoints(urls: list[str]) -> list[Endpoint]:
         except (EndpointError, OSError) as exc:
             raise RuntimeError(f"endpoint {url}: {exc}") from exc
     return endpoints
+
+
+def serial_endpoints(urls: list[str]) -> list[tuple[str, int]]:
+    """The serial endpoints' paths and baud rates (radios: devices ``companion check`` opens)."""
+    bases = [split_options(str(url))[0] for url in urls]
+    return [parse_serial_url(base) for base in bases if base.startswith("serial://")]

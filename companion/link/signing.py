@@ -75,6 +75,17 @@ def configured_secret(key: str, key_file: str) -> str:
     return read_key_file(key_file) if key_file else key
 
 
+def key_file_problem(path: str) -> str | None:
+    """Why the key file cannot give a key (None: it can, or none is named)."""
+    if not path:
+        return None
+    try:
+        read_key_file(path)
+    except (OSError, ValueError) as exc:
+        return f"signing key file: {getattr(exc, 'strerror', None) or exc} ({path})"
+    return None
+
+
 def signing_timestamp(unix_s: float | None = None) -> int:
     """Now, in MAVLink signing units (10 µs since 2015-01-01)."""
     now = time.time() if unix_s is None else unix_s

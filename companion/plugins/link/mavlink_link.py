@@ -18,11 +18,11 @@ from companion.control.mission.store import MissionStore
 from companion.control.modes import INITIAL_MODE
 from companion.control.prearm import PREARM_PARAMS, Readiness, failures
 from companion.flight_log import LogDirectory
+from companion.link.codec import MavlinkStream, new_encoder
 from companion.link.codec import dialect as d
-from companion.link.codec import new_encoder
 from companion.link.command_service import CommandService
 from companion.link.commands import register_commands
-from companion.link.endpoints import endpoint_problems, open_endpoints
+from companion.link.endpoints import endpoint_problems, open_endpoints, serial_endpoints
 from companion.link.gcs_watch import GcsWatch
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
@@ -35,13 +35,13 @@ from companion.link.params_service import ParamsService
 from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
 from companion.link.service import Outgoing, refused_count
-from companion.link.signing import configured_secret, key_from
+from companion.link.signing import configured_secret, key_file_problem, key_from
 from companion.link.statustext import StatusTexts
 from companion.link.telemetry import Snapshot
 from companion.link.timesync import TimesyncService
 from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChange, VehicleCommand
 from companion.params import ParamDecl, ParamStore
-from companion.plugin import Plugin, PluginContext, Setting
+from companion.plugin import DeviceProbe, Plugin, PluginContext, Setting
 
 MAX_WAIT_S = 1.0  # longest sleep: a stream or a timer falling due, or a trigger, ends it
 PREARM_PERIOD_S = 1.0  # SYS_STATUS's ready-to-arm bit is judged once a second
@@ -91,22 +91,11 @@ class MavlinkLink(Plugin):
         *PX4_PARAMS,
     )
     optional_inputs = (
-        "nav/state",
-        "sensors/gps",
-        "sensors/imu",
-        "sensors/mag",
-        "sensors/compass",
-        "sensors/baro",
-        "sensors/battery",
-        "sensors/range",
-        "actuators/servos",
-        "vehicle/status",
-        "system/health",
-        "link/command_acks",
-        "control/status",
-        "vehicle/statustext",
-        "sensors/rc",
-    )
+        "nav/state", "sensors/gps", "sensors/imu", "sensors/mag", "sensors/compass",
+        "sensors/baro", "sensors/battery", "sensors/range", "actuators/servos",
+        "vehicle/status", "system/health", "link/command_acks", "control/status",
+        "vehicle/statustext", "sensors/rc",
+    )  # fmt: skip
     outputs = (
         "link/commands",
         "params/changes",
@@ -120,6 +109,19 @@ class MavlinkLink(Plugin):
         key, key_file = settings["signing_key"], settings["signing_key_file"]
         both = ["give signing_key or signing_key_file, not both"] if key and key_file else []
         return both or endpoint_problems(settings["endpoints"], key or key_file)
+
+    @classmethod
+    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
+        """The radios (the ground station may be off: their silence is no failure)."""
+        radios = serial_endpoints(settings["endpoints"])
+        stream = MavlinkStream
+        return [DeviceProbe(p, b, stream(), must_answer=False, what="radio") for p, b in radios]
+
+    @classmethod
+    def bench_problems(cls, settings: Mapping[str, Any]) -> list[str]:
+        """The signing key file can be read."""
+        problem = key_file_problem(settings["signing_key_file"])
+        return [problem] if problem else []
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)

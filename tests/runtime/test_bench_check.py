@@ -1,0 +1,171 @@
+"""``companion check`` against pseudo-terminals standing in for the aircraft's devices.
+
+Good devices (real NMEA, ``$C`` and VectorNav sentences at their rates; a servo card that
+reads the neutral frames back) pass with exit status 0. A silent one, one set to another
+baud rate (its bytes as a UART at the config's rate would make of them), one spewing text
+that is no sentence, one with corrupted checksums and a binary one spewing noise each fail
+with exit status 1, named, and with what to look at in plain words.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import re
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+
+from companion.actuators.airframe import load_airframe
+from tests.support.configs import plugin, vehicle_config
+from tests.support.nmea import gga, rmc
+from tests.support.vehicle import REPO
+from tests.support.wrong_baud import heard_at
+from tests.unit.sensors.test_os3000 import MANUAL_SHORT
+from tests.unit.sensors.test_vectornav import IMU, xor8
+
+VNIMU = f"$VNIMU,{IMU}*{xor8('VNIMU,' + IMU)}\r\n"
+COMPASS = MANUAL_SHORT + "\r\n"
+
+
+def nmea_epoch(second: int) -> str:
+    t = f"1200{second % 60:02d}.00"
+    return gga(t, -37.9, 145.1, 50.0) + "\r\n" + rmc(t, "021226", -37.9, 145.1, 0.0, 0.0) + "\r\n"
+
+
+class FakeDevice:
+    """A pty whose other end a thread writes to at the device's rate, until stopped."""
+
+    def __init__(self, link: Path, chunks=None, period_s: float = 0.05) -> None:
+        self.master, self.slave = os.openpty()
+        os.set_blocking(self.master, False)  # an unread pty must not hold the writer
+        link.symlink_to(os.ttyname(self.slave))
+        self.link, self.chunks, self.period_s = link, chunks, period_s
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._write, daemon=True)
+
+    def _write(self) -> None:
+        n = 0
+        while self.chunks is not None and not self.stop.wait(self.period_s):
+            try:
+                os.write(self.master, self.chunks(n))
+            except (BlockingIOError, OSError):
+                pass  # not opened yet: a device sends whether anyone listens or not
+            n += 1
+
+    def read_all(self) -> bytes:
+        data = b""
+        while True:
+            try:
+                chunk = os.read(self.master, 4096)
+            except BlockingIOError:
+                return data
+            data += chunk
+
+    def close(self) -> None:
+        self.stop.set()
+        self.thread.join(2)
+        os.close(self.master)
+        os.close(self.slave)
+
+
+@pytest.fixture
+def devices(tmp_path):
+    made: list[FakeDevice] = []
+
+    def make(name: str, chunks=None, period_s: float = 0.05) -> FakeDevice:
+        device = FakeDevice(tmp_path / name, chunks, period_s)
+        device.thread.start()
+        made.append(device)
+        return device
+
+    yield make
+    for device in made:
+        device.close()
+
+
+def check(tmp_path: Path, *plugins: str) -> subprocess.CompletedProcess[str]:
+    config = tmp_path / "bench.toml"
+    config.write_text(vehicle_config("bench", *plugins))
+    cmd = [sys.executable, "-m", "companion", "check", "-c", str(config), "--seconds", "3"]
+    return subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=60)
+
+
+def verdict(out: str, name: str) -> str:
+    found = re.search(rf"^(ok  |FAIL) {name}: (.*)$", out, re.M)
+    assert found, out
+    return found.group(1).strip() + " " + found.group(2)
+
+
+def row(out: str, name: str) -> list[str]:
+    """The table's cells for a plug-in (bytes, frames, bad, rate...)."""
+    line = next(x for x in out.splitlines() if re.match(rf"^│ {name} ", x))
+    return [cell.strip() for cell in line.strip("│").split("│")]
+
+
+@pytest.mark.timeout(90)
+def test_good_devices_answer_and_the_servo_card_gets_neutral_frames(tmp_path, devices):
+    gps = devices("gps", lambda n: nmea_epoch(n).encode(), period_s=1.0)
+    compass = devices("compass", lambda n: COMPASS.encode(), period_s=0.05)
+    imu = devices("imu", lambda n: VNIMU.encode(), period_s=0.025)
+    servos = devices("servos")
+    done = check(
+        tmp_path,
+        plugin("gps", "sensors.nmea_gps", device=gps.link, baud=4800),
+        plugin("compass", "sensors.os3000", device=compass.link),
+        plugin("imu", "sensors.serial_imu", device=imu.link),
+        plugin("servos", "actuators.minissc", group="flight", device=servos.link),
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    for name in ("gps", "compass", "imu"):
+        assert verdict(done.stdout, name) == "ok answers.", done.stdout
+    _, _, _, nbytes, frames, bad, rate, _ = row(done.stdout, "compass")
+    assert int(nbytes) > 0 and int(frames) >= 30 and bad == "0"
+    measured, expected = re.match(r"([\d.]+)/s of ([\d.]+)/s", rate).groups()
+    assert 14 <= float(measured) <= 22 and expected == "20"  # 20 Hz, on a busy machine
+    gps_rate = float(row(done.stdout, "gps")[6].split("/")[0])
+    assert 0.7 <= gps_rate <= 1.3
+    channels = load_airframe("c172p").channels
+    assert verdict(done.stdout, "servos").startswith(f"ok sent {len(channels)} neutral frames")
+    # What reached the card: every channel once, at the airframe's safe position.
+    sent = servos.read_all()
+    frames = {sent[i + 1]: sent[i + 2] for i in range(0, len(sent), 3) if sent[i] == 0xFF}
+    assert len(sent) == 3 * len(channels)
+    assert frames == {c.servo: c.safe for c in channels}
+
+
+@pytest.mark.timeout(90)
+def test_silent_wrong_baud_and_garbage_devices_fail_with_what_to_look_at(tmp_path, devices):
+    # A GPS left at 9600 baud while the config says 4800: what the UART makes of it.
+    wrong = [heard_at(nmea_epoch(n).encode(), 9600, 4800) for n in range(60)]
+    gps = devices("gps", lambda n: wrong[n % 60], period_s=1.0)
+    battery = devices("battery")  # plugged in, says nothing
+    rng = random.Random(7)
+    letters = "abcdefghijklmnopqrstuvwxyz ,.0123456789"
+    junk = [("".join(rng.choices(letters, k=60)) + "\r\n").encode() for _ in range(50)]
+    imu = devices("imu", lambda n: junk[n % 50], period_s=0.025)
+    corrupt = COMPASS.replace("320.5", "321.5")  # a bit flipped on the line, checksum kept
+    compass = devices("compass", lambda n: (corrupt if n % 2 else COMPASS).encode())
+    noise = devices("range", lambda n: rng.randbytes(64), period_s=0.02)
+    done = check(
+        tmp_path,
+        plugin("gps", "sensors.nmea_gps", device=gps.link, baud=4800),
+        plugin("battery", "sensors.battery", device=battery.link),
+        plugin("imu", "sensors.serial_imu", device=imu.link),
+        plugin("compass", "sensors.os3000", device=compass.link),
+        plugin("range", "sensors.rangefinder", device=noise.link),
+        plugin("servos", "actuators.minissc", device=tmp_path / "unplugged", group="flight"),
+    )
+    assert done.returncode == 1, done.stdout + done.stderr
+    out = done.stdout
+    assert re.match(r"FAIL \d+ bytes, none of them text: the baud rate is wrong \(the config "
+                    r"says 4800", verdict(out, "gps"))  # fmt: skip
+    assert verdict(out, "battery").startswith("FAIL no bytes in 3 s. Look at the device's power")
+    assert "bytes of text, but none of the sentences this plug-in reads" in verdict(out, "imu")
+    assert re.match(r"FAIL garbled: \d+ of \d+ frames bad", verdict(out, "compass"))
+    assert "no valid frame: a wrong baud rate" in verdict(out, "range")
+    assert verdict(out, "servos").startswith("FAIL no such device: is it plugged in")
+    assert row(out, "battery")[3:6] == ["0", "0", "0"]  # bytes, frames, bad
