@@ -9,12 +9,10 @@ with exit status 1, named, and with what to look at in plain words.
 
 from __future__ import annotations
 
-import os
 import random
 import re
 import subprocess
 import sys
-import threading
 from pathlib import Path
 
 import pytest
@@ -22,6 +20,7 @@ import pytest
 from companion.actuators.airframe import load_airframe
 from tests.support.configs import plugin, vehicle_config
 from tests.support.nmea import gga, rmc
+from tests.support.pty import StreamingPty
 from tests.support.vehicle import REPO
 from tests.support.wrong_baud import heard_at
 from tests.unit.sensors.test_os3000 import MANUAL_SHORT
@@ -36,49 +35,13 @@ def nmea_epoch(second: int) -> str:
     return gga(t, -37.9, 145.1, 50.0) + "\r\n" + rmc(t, "021226", -37.9, 145.1, 0.0, 0.0) + "\r\n"
 
 
-class FakeDevice:
-    """A pty whose other end a thread writes to at the device's rate, until stopped."""
-
-    def __init__(self, link: Path, chunks=None, period_s: float = 0.05) -> None:
-        self.master, self.slave = os.openpty()
-        os.set_blocking(self.master, False)  # an unread pty must not hold the writer
-        link.symlink_to(os.ttyname(self.slave))
-        self.link, self.chunks, self.period_s = link, chunks, period_s
-        self.stop = threading.Event()
-        self.thread = threading.Thread(target=self._write, daemon=True)
-
-    def _write(self) -> None:
-        n = 0
-        while self.chunks is not None and not self.stop.wait(self.period_s):
-            try:
-                os.write(self.master, self.chunks(n))
-            except (BlockingIOError, OSError):
-                pass  # not opened yet: a device sends whether anyone listens or not
-            n += 1
-
-    def read_all(self) -> bytes:
-        data = b""
-        while True:
-            try:
-                chunk = os.read(self.master, 4096)
-            except BlockingIOError:
-                return data
-            data += chunk
-
-    def close(self) -> None:
-        self.stop.set()
-        self.thread.join(2)
-        os.close(self.master)
-        os.close(self.slave)
-
-
 @pytest.fixture
 def devices(tmp_path):
-    made: list[FakeDevice] = []
+    made: list[StreamingPty] = []
 
-    def make(name: str, chunks=None, period_s: float = 0.05) -> FakeDevice:
-        device = FakeDevice(tmp_path / name, chunks, period_s)
-        device.thread.start()
+    def make(name: str, chunks=None, period_s: float = 0.05) -> StreamingPty:
+        device = StreamingPty(tmp_path / name, chunks, period_s)
+        device.start()
         made.append(device)
         return device
 

@@ -14,6 +14,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from companion.control.device_watch import DeviceWatch
 from companion.control.mission.store import MissionStore
 from companion.control.modes import INITIAL_MODE
 from companion.control.prearm import PREARM_PARAMS, Readiness, failures
@@ -134,6 +135,7 @@ class MavlinkLink(Plugin):
         self.identity.state.custom_mode, self.identity.state.mode_flags = heartbeat_mode(None)
         self.commands = CommandService(self.mav, sysid, ctx.settings["compid"])
         self.snapshot = Snapshot()
+        self.devices = DeviceWatch(ctx.plugins)  # silent or garbled devices refuse arming
         self.boot_us = ctx.clock.now_us()
         bus = ctx.bus
         self.readers = self._readers(bus)
@@ -257,6 +259,7 @@ class MavlinkLink(Plugin):
     def _refresh_snapshot(self) -> None:
         s, r = self.snapshot, self.readers
         s.nav, s.health, s.servos = r["nav"].get(), r["health"].get(), r["servos"].get()
+        self.devices.update(s.health)
         s.status, s.rc, s.battery = r["status"].get(), r["rc"].get(), r["battery"].get()
         s.rangefinder = r["rangefinder"].get()
         s.control = self._fresh_control()
@@ -365,7 +368,7 @@ class MavlinkLink(Plugin):
         items = self.missions.store.items
         r = Readiness(
             now_us=self.ctx.clock.now_us(), nav=snap.nav, gps=snap.gps, imu=snap.imu, mode=mode,
-            mag=snap.mag, compass=snap.compass, baro=snap.baro,
+            mag=snap.mag, compass=snap.compass, baro=snap.baro, devices=self.devices.failures(),
             mission=items[d.MAV_MISSION_TYPE_MISSION], fence=items[d.MAV_MISSION_TYPE_FENCE],
         )  # fmt: skip
         return failures(r, self.store.values, self.missions.verdicts)
