@@ -34,6 +34,7 @@ importlib.import_module("companion.cli.vehicle")
 for _entry in sorted(entry_points(group=COMMANDS_GROUP), key=lambda e: _help_rank(e.name)):
     importlib.import_module(_entry.value)
 importlib.import_module("companion.cli.hardware")
+importlib.import_module("companion.cli.service")
 importlib.import_module("companion.cli.bridge")
 
 
