@@ -58,14 +58,14 @@ def check(tmp_path: Path, *plugins: str) -> subprocess.CompletedProcess[str]:
 
 
 def verdict(out: str, name: str) -> str:
-    found = re.search(rf"^(ok  |FAIL) {name}: (.*)$", out, re.M)
+    found = re.search(rf"^(ok  |FAIL) {re.escape(name)}: (.*)$", out, re.M)
     assert found, out
     return found.group(1).strip() + " " + found.group(2)
 
 
 def row(out: str, name: str) -> list[str]:
     """The table's cells for a plug-in (bytes, frames, bad, rate...)."""
-    line = next(x for x in out.splitlines() if re.match(rf"^│ {name} ", x))
+    line = next(x for x in out.splitlines() if re.match(rf"^│ {re.escape(name)} ", x))
     return [cell.strip() for cell in line.strip("│").split("│")]
 
 
@@ -132,3 +132,40 @@ def test_silent_wrong_baud_and_garbage_devices_fail_with_what_to_look_at(tmp_pat
     assert "no valid frame: a wrong baud rate" in verdict(out, "range")
     assert verdict(out, "servos").startswith("FAIL no such device: is it plugged in")
     assert row(out, "battery")[3:6] == ["0", "0", "0"]  # bytes, frames, bad
+
+
+@pytest.mark.timeout(90)
+def test_a_radio_counts_a_stations_frames_and_may_be_silent_but_its_key_must_be_there(
+    tmp_path, devices
+):
+    from mavlink_dialect import companion as m
+
+    mav = m.MAVLink(None, srcSystem=255, srcComponent=190)  # a ground station's heartbeat
+    heartbeat = mav.heartbeat_encode(m.MAV_TYPE_GCS, m.MAV_AUTOPILOT_INVALID, 0, 0, 0).pack(mav)
+    radio = devices("radio", lambda n: heartbeat, period_s=0.1)
+    key = tmp_path / "signing.key"
+    signed = f"serial://{radio.link}:57600?signing=required"
+    link = plugin("link", "link.mavlink", endpoints=[signed], signing_key_file=key)
+    done = check(tmp_path, link)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert verdict(done.stdout, "link (radio)") == "ok answers."
+    assert int(row(done.stdout, "link (radio)")[4]) >= 15  # frames: 10 a second for 3 s
+    assert re.search(r"^FAIL link: signing key file: No such file or directory", done.stdout, re.M)
+
+    key.write_text("ab" * 32 + "\n")
+    radio.chunks = None  # the ground station is off: the radio hears nothing
+    done = check(tmp_path, link)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert verdict(done.stdout, "link (radio)").startswith("ok silent: normal until a ground")
+
+
+@pytest.mark.timeout(60)
+def test_two_plugins_on_one_device_are_refused(tmp_path, devices):
+    shared = devices("shared", lambda n: COMPASS.encode())
+    done = check(
+        tmp_path,
+        plugin("compass", "sensors.os3000", device=shared.link),
+        plugin("gps", "sensors.nmea_gps", device=f"serial://{shared.link}:4800"),
+    )
+    assert done.returncode == 1
+    assert f"FAIL compass and gps: one device, {shared.link}" in done.stdout
