@@ -38,7 +38,9 @@ def _table(result) -> Table:
 @app.command()
 def check(
     config: Annotated[Path, CONFIG_OPT],
-    seconds: Annotated[float, typer.Option(help="how long each device is heard")] = 4.0,
+    seconds: Annotated[
+        float, typer.Option(help="how long each device is heard", min=0.5, max=600)
+    ] = 4.0,
 ) -> None:
     """Open every device of the config for a few seconds: bytes, frames, bad frames, rate.
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import getpass
 import os
+import pwd
 import shutil
 import subprocess
 import sys
@@ -39,6 +40,14 @@ def _default_user() -> str:
     return os.environ.get("SUDO_USER") or getpass.getuser()
 
 
+def _user_exists(name: str) -> bool:
+    try:
+        pwd.getpwnam(name)
+    except KeyError:
+        return False
+    return True
+
+
 def _systemctl(*args: str) -> None:
     if shutil.which("systemctl") is None:
         err.print(f"systemctl not found: run `systemctl {' '.join(args)}` where systemd runs")
@@ -63,6 +72,10 @@ def install(
 
     load_checked(config, namespace)  # a config refused now would be refused at every boot
     who = user or _default_user()
+    manage = root is None and unit_dir is None  # this machine's systemd, not a staging place
+    if manage and not _user_exists(who):
+        err.print(f"[red]no user {who!r} on this machine[/red] (give --user NAME)")
+        raise typer.Exit(2)
     if who == "root" and user is None:
         err.print("[yellow]the vehicle will run as root: give --user NAME to avoid it[/yellow]")
     spec = UnitSpec(config.resolve(), who, _command(), name, namespace, log_level)
@@ -70,7 +83,7 @@ def install(
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(unit_text(spec))
     out.print(f"wrote {path} (runs as {who}, state in /var/lib/companion)", highlight=False)
-    if root is None and unit_dir is None:
+    if manage:
         _systemctl("daemon-reload")
         _systemctl("enable", f"{name}.service")
         out.print(f"enabled: starts at boot. Now: sudo systemctl start {name}", highlight=False)

@@ -85,6 +85,13 @@ def test_a_refused_config_installs_nothing(tmp_path):
     assert not (tmp_path / "units").exists()
 
 
+def test_an_unknown_user_installs_nothing(tmp_path):
+    config = logged_vehicle(tmp_path / "aircraft.toml")
+    done = companion("service", "install", "-c", config, "--user", "no_such_user_h4x")
+    assert done.returncode == 2 and "no user 'no_such_user_h4x'" in done.stderr
+    assert not Path("/etc/systemd/system/companion.service").exists()
+
+
 def open_by(pid: int, path: Path) -> bool:
     try:
         return any(Path(f.path) == path for f in psutil.Process(pid).open_files())
