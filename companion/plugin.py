@@ -14,7 +14,7 @@ import os
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 if TYPE_CHECKING:
     from companion.bus.clock import VehicleClock
@@ -50,6 +50,39 @@ class Ports:
     outputs: tuple[str, ...] = ()
 
 
+class ProbeStream(Protocol):
+    """A device's bytes decoded as its plug-in decodes them, counted (``companion check``)."""
+
+    @property
+    def frames_ok(self) -> int:
+        """Frames (sentences) the plug-in's decoder accepted."""
+        ...
+
+    @property
+    def frames_bad(self) -> int:
+        """Frames refused: bad checksums, undecodable frames, stretches of garbage."""
+        ...
+
+    def feed(self, data: bytes, t_us: int) -> list[Any]:
+        """The readings completed by ``data``."""
+        ...
+
+
+@dataclass
+class DeviceProbe:
+    """One device of a plug-in as ``companion check`` tries it on the bench."""
+
+    device: str  # as the config gives it: a path, serial://PATH:BAUD or a pyserial URL
+    baud: int
+    stream: ProbeStream | None  # None: a device the vehicle only writes to
+    rate_hz: float = 0.0  # readings a second a healthy device sends (0: not known)
+    text: bool = False  # it speaks printable text (garbage is then told from a wrong baud)
+    framing: Mapping[str, Any] = field(default_factory=dict)  # pyserial's, when not 8N1
+    neutral: bytes = b""  # what a write-only device is sent: every output at its safe place
+    must_answer: bool = True  # False: silence is normal (a radio with no station on)
+    what: str = ""  # which of the plug-in's devices, when it has several
+
+
 @dataclass
 class HealthCounters:
     """Counters every plug-in keeps; the runner publishes them on system/plugin_stats."""
@@ -58,6 +91,7 @@ class HealthCounters:
     frames_bad: int = 0
     dropped: int = 0
     refused: int = 0  # well-formed input refused by its rules (NaN, out of range)
+    bytes_in: int = 0  # read from the plug-in's device (pre-arm tells silence from garbage)
 
     def ok(self, n: int = 1) -> None:
         """Count good frames (or samples) accepted."""
@@ -135,6 +169,18 @@ class Plugin(ABC):
     def prearm(cls, settings: Mapping[str, Any]) -> list[str]:
         """Why this ``flight`` plug-in could not fly now (its device missing...), checked by
         the supervisor before arming; each reason follows ``PreArm: ``."""
+        return []
+
+    @classmethod
+    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
+        """The devices ``companion check`` opens on the bench, each with this plug-in's own
+        decoder (none: the plug-in has no device)."""
+        return []
+
+    @classmethod
+    def bench_problems(cls, settings: Mapping[str, Any]) -> list[str]:
+        """What ``companion check`` finds wrong on this machine besides the devices (a key
+        file missing...); the config check cannot know, it may run on another computer."""
         return []
 
     def init(self, ctx: PluginContext) -> None:

@@ -33,6 +33,8 @@ def _help_rank(name: str) -> int:
 importlib.import_module("companion.cli.vehicle")
 for _entry in sorted(entry_points(group=COMMANDS_GROUP), key=lambda e: _help_rank(e.name)):
     importlib.import_module(_entry.value)
+importlib.import_module("companion.cli.hardware")
+importlib.import_module("companion.cli.service")
 importlib.import_module("companion.cli.bridge")
 
 

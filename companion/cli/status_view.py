@@ -52,7 +52,7 @@ def health_table(msg: SystemHealth) -> Table:
     table = Table(title=f"companion (supervisor pid {data['supervisor_pid']}, {armed})")
     for col in ("plug-in", "kind", "group", "state", "pid", "restarts", "CPU %", "RSS MiB"):
         table.add_column(col, justify="right" if col[0].isupper() or col == "pid" else "left")
-    for col in ("ok", "bad", "refused", "dropped", "step p50 µs", "p99 µs"):
+    for col in ("bytes in", "ok", "bad", "refused", "dropped", "step p50 µs", "p99 µs"):
         table.add_column(col, justify="right")
     for p in data["plugins"]:
         table.add_row(
@@ -64,6 +64,7 @@ def health_table(msg: SystemHealth) -> Table:
             str(p["restarts"]),
             f"{p['cpu_pct']:.1f}",
             f"{p['rss_kib'] / 1024:.0f}",
+            str(p["bytes_in"]),  # from the plug-in's device: 0 with frames 0 is a silent one
             str(p["frames_ok"]),
             str(p["frames_bad"]),
             str(p["refused"]),

@@ -54,6 +54,7 @@ class Readiness:
     mode: FlightMode = FlightMode.LOITER
     mission: list[MissionItem] = field(default_factory=list)
     fence: list[MissionItem] = field(default_factory=list)
+    devices: list[str] = field(default_factory=list)  # silent or garbled (DeviceWatch)
 
 
 class PlanVerdicts:
@@ -91,7 +92,8 @@ def failures(
     """Every reason arming is refused now (empty: ready), each without the prefix.
     ``plans`` keeps the plans' verdicts between calls (a fresh one judges them now)."""
     plans = plans or PlanVerdicts()
-    return [*_navigation(r), *_gps(r, params), *_fresh(r, params), *_plans(r, plans)]
+    fresh = [*_fresh(r, params), *r.devices]
+    return [*_navigation(r), *_gps(r, params), *fresh, *_plans(r, plans)]
 
 
 def _navigation(r: Readiness) -> list[str]:

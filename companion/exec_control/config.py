@@ -6,6 +6,7 @@ match when a name looks misspelt. The CLI turns it into exit status 2.
 
 from __future__ import annotations
 
+import os
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -21,6 +22,7 @@ from companion.plugin import Plugin, Ports, Setting
 GROUPS = ("core", "flight")
 CLOCKS = ("monotonic", "sim")
 SIM_REF = "sim://"
+STATE_ENV = "COMPANION_STATE_DIR"
 
 
 class ConfigError(Exception):
@@ -68,7 +70,8 @@ _VEHICLE_KEYS: dict[str, Setting] = {
         str,
         "",
         "where parameters and missions persist"
-        " (default ~/.local/state/companion/NAME/NAMESPACE: one vehicle's, never shared)",
+        " (default $COMPANION_STATE_DIR/NAME/NAMESPACE, or ~/.local/state/companion/..."
+        " without it: one vehicle's, never shared)",
     ),
 }
 # `companion sim` flies this many copies of the vehicle; `companion run` ignores the table.
@@ -167,7 +170,8 @@ def _vehicle_and_fleet(
         # Each bus namespace is one vehicle: two vehicles of one config on one machine
         # must never read each other's mission or parameters.
         ns = namespace or vehicle["namespace"] or default_namespace()
-        base = Path("~/.local/state/companion").expanduser()
+        # A service names its state directory (systemd's StateDirectory=) in the environment.
+        base = Path(os.environ.get(STATE_ENV) or "~/.local/state/companion").expanduser()
         vehicle["state_dir"] = str(base / vehicle["name"] / ns)
     return vehicle, _table(check, data, "fleet", _FLEET_KEYS)
 

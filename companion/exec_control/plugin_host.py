@@ -113,7 +113,7 @@ class PluginHost:
         # The plug-in's own losses (bytes, frames) plus its bus readers' overflows, added
         # here only: a plug-in must not add its readers' losses to health.dropped itself.
         msg.dropped = health.dropped + self.bus.total_lost()
-        msg.refused = health.refused
+        msg.refused, msg.bytes_in = health.refused, health.bytes_in
         msg.step_p50_us = self.timer.percentile(0.5)
         msg.step_p99_us = self.timer.percentile(0.99)
         self.stats.publish(msg)

@@ -12,6 +12,7 @@ from typing import Any
 from mavlink_dialect import companion as dialect
 
 __all__ = [
+    "MavlinkStream",
     "ParserCounters",
     "SigningMAVLink",
     "StreamParser",
@@ -224,3 +225,25 @@ def _checksum_ok(frame: bytearray) -> bool:
     msgid = frame[7] | frame[8] << 8 | frame[9] << 16 if frame[0] == V2 else frame[5]
     crc = dialect.x25crc(frame[1:end] + bytes([_KNOWN[msgid][0]]))
     return end >= header and crc.crc == int.from_bytes(frame[end : end + CRC_LEN], "little")
+
+
+class MavlinkStream:
+    """A radio's bytes counted as ``companion check`` counts every device's frames: what a
+    ground station sends through it, signed or not (the bench has no key to judge by)."""
+
+    def __init__(self) -> None:
+        self.parser = StreamParser()
+
+    def feed(self, data: bytes, t_us: int) -> list[object]:
+        """The MAVLink messages completed by ``data``."""
+        return self.parser.parse_buffer(data)
+
+    @property
+    def frames_ok(self) -> int:
+        """Messages that passed their checksum."""
+        return self.parser.counters.frames
+
+    @property
+    def frames_bad(self) -> int:
+        """Bad checksums and headers, truncated frames and runs of garbage."""
+        return self.parser.counters.rejected

@@ -373,3 +373,20 @@ def default_budget(endpoint: Endpoint) -> float:
         # drains and acknowledgements never wait behind a backlog.
         return endpoint.baud / 10.0 * SERIAL_SHARE
     return DEFAULT_NETWORK_BYTES_S
+
+
+def open_endpoints(urls: list[str]) -> list[Endpoint]:
+    """Every endpoint opened; RuntimeError naming the first that cannot be."""
+    endpoints: list[Endpoint] = []
+    for url in urls:
+        try:
+            endpoints.append(open_endpoint(url))
+        except (EndpointError, OSError) as exc:
+            raise RuntimeError(f"endpoint {url}: {exc}") from exc
+    return endpoints
+
+
+def serial_endpoints(urls: list[str]) -> list[tuple[str, int]]:
+    """The serial endpoints' paths and baud rates (radios: devices ``companion check`` opens)."""
+    bases = [split_options(str(url))[0] for url in urls]
+    return [parse_serial_url(base) for base in bases if base.startswith("serial://")]

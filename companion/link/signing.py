@@ -16,6 +16,7 @@ from __future__ import annotations
 import hashlib
 import re
 import time
+from pathlib import Path
 from typing import Any
 
 from companion.link.codec import dialect as d
@@ -55,6 +56,34 @@ def key_from(secret: str) -> bytes:
     if re.fullmatch(r"[0-9a-fA-F]{64}", secret):
         return bytes.fromhex(secret)
     return hashlib.sha256(secret.encode()).digest()
+
+
+def read_key_file(path: str) -> str:
+    """The secret in a key file (as ``key_from`` takes it), surrounding blanks removed.
+
+    Raises OSError when the file cannot be read and ValueError when it is empty: a vehicle
+    told to sign must not start without its key.
+    """
+    secret = Path(path).expanduser().read_text().strip()
+    if not secret:
+        raise ValueError(f"signing key file {path} is empty")
+    return secret
+
+
+def configured_secret(key: str, key_file: str) -> str:
+    """The secret a config gives, in ``key`` or in the file ``key_file`` ("": none)."""
+    return read_key_file(key_file) if key_file else key
+
+
+def key_file_problem(path: str) -> str | None:
+    """Why the key file cannot give a key (None: it can, or none is named)."""
+    if not path:
+        return None
+    try:
+        read_key_file(path)
+    except (OSError, ValueError) as exc:
+        return f"signing key file: {getattr(exc, 'strerror', None) or exc} ({path})"
+    return None
 
 
 def signing_timestamp(unix_s: float | None = None) -> int:

@@ -33,6 +33,7 @@ class PluginStats(Message):
         ("frames_bad", ctypes.c_uint64),  # checksum failures and garbage
         ("dropped", ctypes.c_uint64),  # samples lost on queue overflow
         ("refused", ctypes.c_uint64),  # well-formed input refused by its rules
+        ("bytes_in", ctypes.c_uint64),  # read from the plug-in's device
         ("step_p50_us", ctypes.c_double),
         ("step_p99_us", ctypes.c_double),
     ]
@@ -54,6 +55,7 @@ class PluginHealth(Message):
         ("frames_bad", ctypes.c_uint64),
         ("dropped", ctypes.c_uint64),
         ("refused", ctypes.c_uint64),
+        ("bytes_in", ctypes.c_uint64),  # read from its device: silence told from garbage
         ("step_p50_us", ctypes.c_double),
         ("step_p99_us", ctypes.c_double),
     ]

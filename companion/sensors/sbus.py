@@ -81,3 +81,24 @@ class SbusDecoder:
     def feed(self, data: bytes) -> list[SbusFrame]:
         """The frames completed by ``data``."""
         return self._scan.feed(data)
+
+
+class SbusStream:
+    """An SBUS line counted as ``companion check`` counts every device's frames."""
+
+    def __init__(self) -> None:
+        self.decoder = SbusDecoder()
+
+    def feed(self, data: bytes, t_us: int) -> list[SbusFrame]:
+        """The frames completed by ``data`` (an SBUS frame carries no time of its own)."""
+        return self.decoder.feed(data)
+
+    @property
+    def frames_ok(self) -> int:
+        """Frames that passed their check."""
+        return self.decoder.counters.ok
+
+    @property
+    def frames_bad(self) -> int:
+        """Headers whose frame did not pass it."""
+        return self.decoder.counters.bad_frames

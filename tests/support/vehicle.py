@@ -67,12 +67,16 @@ class Vehicle:
         # vehicle once 64 KiB of log lines have piled up (a link stopped before its first
         # heartbeat that way).
         self.log_path = tmp / "vehicle.log"
+        # Another way to start it (a systemd unit's ExecStart), and what else it is given.
+        self.command: list[str] | None = None
+        self.extra_env: dict[str, str] = {}
 
     def start(self) -> Vehicle:
+        command = self.command or [sys.executable, "-m", "companion", "run", "-c", str(self.config)]
         with self.log_path.open("w") as log:
             self.proc = subprocess.Popen(
-                [sys.executable, "-m", "companion", "run", "-c", str(self.config)],
-                env=companion_env(self.namespace),
+                command,
+                env={**companion_env(self.namespace), **self.extra_env},
                 cwd=REPO,
                 stdout=log,
                 stderr=subprocess.STDOUT,

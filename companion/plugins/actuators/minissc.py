@@ -15,7 +15,7 @@ from typing import Any
 from companion.actuators import minissc
 from companion.actuators.airframe import Airframe, AirframeError, load_airframe
 from companion.messages import ActuatorCommand, ServoOutput
-from companion.plugin import Plugin, PluginContext, Setting
+from companion.plugin import DeviceProbe, Plugin, PluginContext, Setting
 from companion.sensors.serial_port import ReopeningSerial, open_problem
 
 WAIT_S = 0.1  # also the refresh cadence when no command arrives
@@ -60,6 +60,13 @@ class MiniSscOutput(Plugin):
     def prearm(cls, settings: Mapping[str, Any]) -> list[str]:
         problem = open_problem(settings["device"], settings["baud"])
         return [] if problem is None else [f"servo device: {problem}"]
+
+    @classmethod
+    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
+        """The card only listens: it is sent every channel at its safe position."""
+        safe = load_airframe(settings["airframe"]).channels
+        neutral = b"".join(minissc.frame(c.servo, c.safe) for c in safe)
+        return [DeviceProbe(settings["device"], settings["baud"], None, neutral=neutral)]
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)

@@ -14,15 +14,16 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from companion.control.device_watch import DeviceWatch
 from companion.control.mission.store import MissionStore
 from companion.control.modes import INITIAL_MODE
 from companion.control.prearm import PREARM_PARAMS, Readiness, failures
 from companion.flight_log import LogDirectory
+from companion.link.codec import MavlinkStream, new_encoder
 from companion.link.codec import dialect as d
-from companion.link.codec import new_encoder
 from companion.link.command_service import CommandService
 from companion.link.commands import register_commands
-from companion.link.endpoints import Endpoint, EndpointError, endpoint_problems, open_endpoint
+from companion.link.endpoints import endpoint_problems, open_endpoints, serial_endpoints
 from companion.link.gcs_watch import GcsWatch
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
@@ -35,13 +36,13 @@ from companion.link.params_service import ParamsService
 from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
 from companion.link.service import Outgoing, refused_count
-from companion.link.signing import key_from
+from companion.link.signing import configured_secret, key_file_problem, key_from
 from companion.link.statustext import StatusTexts
 from companion.link.telemetry import Snapshot
 from companion.link.timesync import TimesyncService
 from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChange, VehicleCommand
 from companion.params import ParamDecl, ParamStore
-from companion.plugin import Plugin, PluginContext, Setting
+from companion.plugin import DeviceProbe, Plugin, PluginContext, Setting
 
 MAX_WAIT_S = 1.0  # longest sleep: a stream or a timer falling due, or a trigger, ends it
 PREARM_PERIOD_S = 1.0  # SYS_STATUS's ready-to-arm bit is judged once a second
@@ -79,6 +80,8 @@ class MavlinkLink(Plugin):
         # (companion.control.modes says why); generic: no guided action in QGroundControl.
         "autopilot": Setting(str, "px4", "MAV_AUTOPILOT reported", choices=tuple(AUTOPILOTS)),
         "signing_key": Setting(str, "", "signing key: 64 hex digits or a passphrase (SHA-256)"),
+        # Kept out of the config (which is shown and copied), readable by the vehicle only.
+        "signing_key_file": Setting(str, "", "file holding the signing key (as signing_key)"),
     }
     params = (
         ParamDecl("SR_ATTITUDE", 10.0, 0.0, 100.0, "Hz", "ATTITUDE rate on every endpoint"),
@@ -89,22 +92,11 @@ class MavlinkLink(Plugin):
         *PX4_PARAMS,
     )
     optional_inputs = (
-        "nav/state",
-        "sensors/gps",
-        "sensors/imu",
-        "sensors/mag",
-        "sensors/compass",
-        "sensors/baro",
-        "sensors/battery",
-        "sensors/range",
-        "actuators/servos",
-        "vehicle/status",
-        "system/health",
-        "link/command_acks",
-        "control/status",
-        "vehicle/statustext",
-        "sensors/rc",
-    )
+        "nav/state", "sensors/gps", "sensors/imu", "sensors/mag", "sensors/compass",
+        "sensors/baro", "sensors/battery", "sensors/range", "actuators/servos",
+        "vehicle/status", "system/health", "link/command_acks", "control/status",
+        "vehicle/statustext", "sensors/rc",
+    )  # fmt: skip
     outputs = (
         "link/commands",
         "params/changes",
@@ -115,19 +107,35 @@ class MavlinkLink(Plugin):
 
     @classmethod
     def validate(cls, settings: Mapping[str, Any]) -> list[str]:
-        return endpoint_problems(settings["endpoints"], settings["signing_key"])
+        key, key_file = settings["signing_key"], settings["signing_key_file"]
+        both = ["give signing_key or signing_key_file, not both"] if key and key_file else []
+        return both or endpoint_problems(settings["endpoints"], key or key_file)
+
+    @classmethod
+    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
+        """The radios (the ground station may be off: their silence is no failure)."""
+        radios = serial_endpoints(settings["endpoints"])
+        stream = MavlinkStream
+        return [DeviceProbe(p, b, stream(), must_answer=False, what="radio") for p, b in radios]
+
+    @classmethod
+    def bench_problems(cls, settings: Mapping[str, Any]) -> list[str]:
+        """The signing key file can be read."""
+        problem = key_file_problem(settings["signing_key_file"])
+        return [problem] if problem else []
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
         sysid = int(ctx.vehicle.get("sysid", 1))
         self.mav = new_encoder(sysid, ctx.settings["compid"])
-        self.endpoints = _open_endpoints(ctx.settings["endpoints"])
+        self.endpoints = open_endpoints(ctx.settings["endpoints"])
         autopilot = AUTOPILOTS[ctx.settings["autopilot"]]
         self.identity = IdentityService(self.mav, sysid, autopilot, CAPABILITIES)
         # The first heartbeat already names a mode (the commander's initial one).
         self.identity.state.custom_mode, self.identity.state.mode_flags = heartbeat_mode(None)
         self.commands = CommandService(self.mav, sysid, ctx.settings["compid"])
         self.snapshot = Snapshot()
+        self.devices = DeviceWatch(ctx.plugins)  # silent or garbled devices refuse arming
         self.boot_us = ctx.clock.now_us()
         bus = ctx.bus
         self.readers = self._readers(bus)
@@ -143,7 +151,7 @@ class MavlinkLink(Plugin):
             self.mav, lambda: ctx.clock.now_us() * 1000, sysid, ctx.settings["compid"]
         )
         services = [self.identity, self.commands, self.timesync]
-        secret = ctx.settings["signing_key"]
+        secret = configured_secret(ctx.settings["signing_key"], ctx.settings["signing_key_file"])
         key = key_from(secret) if secret else None
         self.refusal_text = RefusalTexts(self.statustext, time.monotonic)
         self.texts_out = StatusTexts(self.mav)
@@ -251,6 +259,7 @@ class MavlinkLink(Plugin):
     def _refresh_snapshot(self) -> None:
         s, r = self.snapshot, self.readers
         s.nav, s.health, s.servos = r["nav"].get(), r["health"].get(), r["servos"].get()
+        self.devices.update(s.health)
         s.status, s.rc, s.battery = r["status"].get(), r["rc"].get(), r["battery"].get()
         s.rangefinder = r["rangefinder"].get()
         s.control = self._fresh_control()
@@ -359,7 +368,7 @@ class MavlinkLink(Plugin):
         items = self.missions.store.items
         r = Readiness(
             now_us=self.ctx.clock.now_us(), nav=snap.nav, gps=snap.gps, imu=snap.imu, mode=mode,
-            mag=snap.mag, compass=snap.compass, baro=snap.baro,
+            mag=snap.mag, compass=snap.compass, baro=snap.baro, devices=self.devices.failures(),
             mission=items[d.MAV_MISSION_TYPE_MISSION], fence=items[d.MAV_MISSION_TYPE_FENCE],
         )  # fmt: skip
         return failures(r, self.store.values, self.missions.verdicts)
@@ -387,13 +396,3 @@ class MavlinkLink(Plugin):
         self.router.close()
         for endpoint in self.endpoints:
             endpoint.close()
-
-
-def _open_endpoints(urls: list[str]) -> list[Endpoint]:
-    endpoints: list[Endpoint] = []
-    for url in urls:
-        try:
-            endpoints.append(open_endpoint(url))
-        except (EndpointError, OSError) as exc:
-            raise RuntimeError(f"endpoint {url}: {exc}") from exc
-    return endpoints

@@ -42,7 +42,7 @@ BATTERY_PARAMS = (
 class BatteryMonitor(SerialSensor[MonitorReading]):
     """Publishes the gauge's view of the pack on sensors/battery."""
 
-    settings = serial_settings("serial:///dev/ttyAMA1:57600", 57600)
+    settings = serial_settings("serial:///dev/ttyAMA1:57600", 57600, 10.0)
     params = BATTERY_PARAMS
     outputs = ("sensors/battery",)
 

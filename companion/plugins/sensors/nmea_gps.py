@@ -14,7 +14,7 @@ from companion.sensors.nmea_gps import NmeaGpsDecoder
 class NmeaGps(SerialSensor[GpsFix]):
     """Reads sentences, publishes one GpsFix per epoch on sensors/gps."""
 
-    settings = serial_settings("serial:///dev/ttyUSB0:4800", 4800)
+    settings = serial_settings("serial:///dev/ttyUSB0:4800", 4800, 1.0)
     outputs = ("sensors/gps",)
 
     def init(self, ctx: PluginContext) -> None:

@@ -32,7 +32,7 @@ RANGEFINDER_PARAMS = (
 class Rangefinder(SerialSensor[RangeSample]):
     """Publishes each lidar frame on sensors/range."""
 
-    settings = serial_settings("serial:///dev/ttyAMA2:115200", 115200)
+    settings = serial_settings("serial:///dev/ttyAMA2:115200", 115200, 100.0)
     params = RANGEFINDER_PARAMS
     optional_inputs = ("params/changes",)
     outputs = ("sensors/range",)
@@ -46,7 +46,9 @@ class Rangefinder(SerialSensor[RangeSample]):
         return TfminiFramer()
 
     def make_decoder(self, settings: Mapping[str, Any]) -> TfminiDecoder:
-        v = self.live.values
+        # A plug-in never started (``companion check``'s) has the parameters' defaults.
+        live = getattr(self, "live", None)
+        v = live.values if live is not None else {p.name: p.default for p in self.params}
         self.tfmini = TfminiDecoder(v["RNGFND1_MIN"], v["RNGFND1_MAX"])
         return self.tfmini
 

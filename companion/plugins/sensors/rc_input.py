@@ -16,16 +16,18 @@ at start-up is only noted: the switch acts when it moves).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import serial
 
 from companion.messages import RC_MAX_CHANNELS, PilotFlags, PilotInput, PilotSource
 from companion.params.live import LiveParams
-from companion.plugin import Plugin, PluginContext
+from companion.plugin import DeviceProbe, Plugin, PluginContext
 from companion.plugins.sensors.serial_sensor import serial_settings
 from companion.sensors.rc_channels import RC_PARAMS, StickMap
-from companion.sensors.sbus import SbusDecoder, SbusFrame
+from companion.sensors.sbus import SbusDecoder, SbusFrame, SbusStream
 from companion.sensors.serial_port import ReopeningSerial
 
 SBUS_FRAMING = {"parity": serial.PARITY_EVEN, "stopbits": serial.STOPBITS_TWO}
@@ -37,10 +39,16 @@ _THROTTLE_LOW = int(PilotFlags.THROTTLE_LOW)
 class RcInput(Plugin):
     """Publishes the pilot's sticks and mode switch from every SBUS frame."""
 
-    settings = serial_settings("serial:///dev/ttyAMA0:100000", 100000)
+    settings = serial_settings("serial:///dev/ttyAMA0:100000", 100000, 70.0)
     params = RC_PARAMS
     optional_inputs = ("params/changes",)
     outputs = ("sensors/rc", "sensors/rc_switch")
+
+    @classmethod
+    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
+        """The receiver, framed 8E2 as on the aircraft."""
+        device, baud, rate = settings["device"], settings["baud"], settings["rate_hz"]
+        return [DeviceProbe(device, baud, SbusStream(), rate, framing=SBUS_FRAMING)]
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
@@ -71,6 +79,7 @@ class RcInput(Plugin):
         self.ctx.health.frames_ok = c.ok
         self.ctx.health.frames_bad = c.bad_frames
         self.ctx.health.dropped = c.garbage_bytes
+        self.ctx.health.bytes_in = self.port.bytes_in
 
     def _publish(self, frame: SbusFrame, t_us: int) -> None:
         pulses = frame.pulses_us()

@@ -34,7 +34,7 @@ class SerialImu(SerialSensor[VectorNavReading]):
     pressure (as height above the first reading) on sensors/baro."""
 
     settings = {
-        **serial_settings("serial:///dev/ttyUSB1:115200", 115200),
+        **serial_settings("serial:///dev/ttyUSB1:115200", 115200, 40.0),
         "publish_mag": Setting(bool, True, "also publish the magnetometer on sensors/mag"),
         "publish_baro": Setting(bool, True, "also publish $VNIMU's pressure on sensors/baro"),
     }

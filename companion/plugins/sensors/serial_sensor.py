@@ -9,55 +9,25 @@ from __future__ import annotations
 
 from abc import abstractmethod
 from collections.abc import Mapping
-from typing import Any, Generic, Protocol, TypeVar
+from typing import Any, Generic, TypeVar
 
-from companion.plugin import Plugin, PluginContext, Setting
+from companion.plugin import DeviceProbe, Plugin, PluginContext, Setting
+from companion.sensors.framed_stream import FramedStream, Framer, SentenceDecoder
 from companion.sensors.line_framer import LineFramer
 from companion.sensors.serial_port import ReopeningSerial
 
+__all__ = ["Framer", "SentenceDecoder", "SerialSensor", "serial_settings"]
+
 ReadingT = TypeVar("ReadingT")
-ReadingT_co = TypeVar("ReadingT_co", covariant=True)
 
 
-class DecoderCounters(Protocol):
-    """The counters every sentence decoder keeps."""
-
-    ok: int
-    bad_checksum: int
-    garbage: int
-
-
-class Framer(Protocol):
-    """Cuts a byte stream into the device's sentences or frames."""
-
-    @property
-    def rejected(self) -> int:
-        """How many stretches of bytes it has refused as not a sentence or frame."""
-        ...
-
-    def feed(self, data: bytes) -> list[bytes]:
-        """The whole sentences or frames completed by ``data``."""
-        ...
-
-
-class SentenceDecoder(Protocol[ReadingT_co]):
-    """A pure decoder: one sentence and its reception time in, a reading or None out."""
-
-    @property
-    def counters(self) -> DecoderCounters:
-        """What it has accepted and refused."""
-        ...
-
-    def decode(self, sentence: bytes, t_us: int) -> ReadingT_co | None:
-        """The reading in one sentence; None when refused (and counted)."""
-        ...
-
-
-def serial_settings(example_url: str, baud: int) -> dict[str, Setting]:
-    """The ``device`` and ``baud`` settings, with the device's usual URL and rate."""
+def serial_settings(example_url: str, baud: int, rate_hz: float) -> dict[str, Setting]:
+    """The ``device``, ``baud`` and ``rate_hz`` settings, with the device's usual URL, baud
+    rate and output rate (readings a second: what ``companion check`` expects to hear)."""
     return {
         "device": Setting(str, doc=f"{example_url}, a pty path or a pyserial URL"),
         "baud": Setting(int, baud, "baud rate when the URL does not give one", min=300),
+        "rate_hz": Setting(float, rate_hz, "readings a second the device sends", min=0.0),
     }
 
 
@@ -73,6 +43,16 @@ class SerialSensor(Plugin, Generic[ReadingT]):
         )
         self.framer = self.make_framer()
         self.decoder = self.make_decoder(ctx.settings)
+        self.stream = FramedStream(self.framer, self.decoder)
+
+    @classmethod
+    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
+        """The device, heard through this plug-in's own framer and decoder."""
+        sensor = cls()  # never started: only its framer and decoder are wanted
+        framer = sensor.make_framer()
+        stream = FramedStream(framer, sensor.make_decoder(settings))
+        device, baud, rate_hz = settings["device"], settings["baud"], settings["rate_hz"]
+        return [DeviceProbe(device, baud, stream, rate_hz, text=isinstance(framer, LineFramer))]
 
     def make_framer(self) -> Framer:
         """The device's framing: ``$``-sentences ending at CR or LF unless overridden."""
@@ -89,13 +69,11 @@ class SerialSensor(Plugin, Generic[ReadingT]):
     def step(self) -> None:
         with self.ctx.bus.idle:  # waiting for the device is not busy time
             data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
-        for sentence in self.framer.feed(data):
-            reading = self.decoder.decode(sentence, t_us)
-            if reading is not None:
-                self.publish(reading, t_us)
-        c = self.decoder.counters
-        self.ctx.health.frames_ok = c.ok
-        self.ctx.health.frames_bad = c.bad_checksum + c.garbage + self.framer.rejected
+        for reading in self.stream.feed(data, t_us):
+            self.publish(reading, t_us)
+        health = self.ctx.health
+        health.frames_ok, health.frames_bad = self.stream.frames_ok, self.stream.frames_bad
+        health.bytes_in = self.port.bytes_in
 
     def close(self) -> None:
         self.port.close()

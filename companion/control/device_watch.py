@@ -1,0 +1,77 @@
+"""Whether each device the vehicle reads is talking sense, for the pre-arm checks.
+
+The health table (``system/health``, once a second) carries every plug-in's bytes read and
+frames accepted and refused. A plug-in with a ``device`` setting that has read nothing for
+the last few seconds has a silent device; one that has read bytes but decoded nothing, or
+mostly bad frames, has a garbled one (a wrong baud rate, a noisy line). Either refuses
+arming with the plug-in's name, as ``companion check`` would say on the bench. Until a
+plug-in has run for the whole window there is no verdict: a device just opened has not
+had its chance (the navigator is still aligning then anyway). Pure: tables in, reasons out.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from companion.messages import PluginState, SystemHealth
+
+WINDOW_US = 3_000_000  # a 1 Hz GPS sends three fixes in it
+BAD_SHARE = 0.2  # more bad frames than this share of the window's frames: garbled
+MIN_BAD = 3  # and at least this many (one cut sentence at start-up is no fault)
+
+
+@dataclass(frozen=True)
+class _Counts:
+    t_us: int
+    pid: int
+    bytes_in: int
+    ok: int
+    bad: int
+
+
+class DeviceWatch:
+    """The device plug-ins' counters over the last window, from the health tables."""
+
+    def __init__(self, plugins: Mapping[str, Mapping[str, Any]]) -> None:
+        # plugins: every plug-in's settings by kind (PluginContext.plugins)
+        self.kinds = {kind for kind, settings in plugins.items() if "device" in settings}
+        self.history: dict[str, deque[_Counts]] = {}
+        self._last_t_us: int | None = None
+
+    def update(self, health: SystemHealth | None) -> None:
+        """Take a health table (the same one again is ignored)."""
+        if health is None or health.t_us == self._last_t_us:
+            return
+        self._last_t_us = health.t_us
+        for row in health.rows():
+            if row.kind.decode() not in self.kinds or row.group.decode() != "core":
+                continue
+            running = row.state == PluginState.RUNNING
+            now = _Counts(health.t_us, row.pid if running else 0, row.bytes_in,
+                          row.frames_ok, row.frames_bad)  # fmt: skip
+            history = self.history.setdefault(row.name.decode(), deque())
+            if history and history[-1].pid != now.pid:
+                history.clear()  # a new process counts from zero: judge it afresh
+            history.append(now)
+            # Keep the newest table at least a window old, and every one since.
+            while len(history) > 1 and now.t_us - history[1].t_us >= WINDOW_US:
+                history.popleft()
+
+    def failures(self) -> list[str]:
+        """Each silent or garbled device's plug-in, worded for ``PreArm: ``."""
+        found = []
+        for name, history in self.history.items():
+            first, last = history[0], history[-1]
+            if not last.pid or last.t_us - first.t_us < WINDOW_US:
+                continue
+            ok, bad = last.ok - first.ok, last.bad - first.bad
+            if last.bytes_in == first.bytes_in:
+                found.append(f"{name}: no data from its device")
+            elif ok == 0:
+                found.append(f"{name}: garbled data (wrong baud rate?)")
+            elif bad >= MIN_BAD and bad > BAD_SHARE * (ok + bad):
+                found.append(f"{name}: garbled data, {bad} of {ok + bad} frames bad")
+        return found
