@@ -217,6 +217,7 @@ class MavlinkLink(Plugin):
     def _serve_params(self, ctx: PluginContext, sysid: int) -> None:
         decls = vehicle_facts(ctx.param_decls or self.params, sysid, ctx.plugins)
         self.store = ParamStore(decls, Path(ctx.vehicle.get("state_dir", ".")) / "params.json")
+        self.store.migrate()  # the link owns the file: an old one takes the new form now
         service = ParamsService(self.mav, self.store, sysid, ctx.settings["compid"])
         service.on_refusal = self.refusal_text
         service.on_change = self._param_changed
