@@ -3,54 +3,23 @@
 A subclass names its decoder (``make_decoder``) and what a reading becomes on the bus
 (``publish``); the port, the framing (text lines unless ``make_framer`` says otherwise, as
 a binary protocol does), the time stamp and the health counters are here, once.
+
+The codecs' side of the contract (``Framer``, ``SentenceDecoder``) lives with the codecs,
+in ``companion.sensors.codec_types``.
 """
 
 from __future__ import annotations
 
 from abc import abstractmethod
 from collections.abc import Mapping
-from typing import Any, Generic, Protocol, TypeVar
+from typing import Any, Generic, TypeVar
 
 from companion.plugin import Plugin, PluginContext, Setting
+from companion.sensors.codec_types import Framer, SentenceDecoder
 from companion.sensors.line_framer import LineFramer
 from companion.sensors.serial_port import ReopeningSerial
 
 ReadingT = TypeVar("ReadingT")
-ReadingT_co = TypeVar("ReadingT_co", covariant=True)
-
-
-class DecoderCounters(Protocol):
-    """The counters every sentence decoder keeps."""
-
-    ok: int
-    bad_checksum: int
-    garbage: int
-
-
-class Framer(Protocol):
-    """Cuts a byte stream into the device's sentences or frames."""
-
-    @property
-    def rejected(self) -> int:
-        """How many stretches of bytes it has refused as not a sentence or frame."""
-        ...
-
-    def feed(self, data: bytes) -> list[bytes]:
-        """The whole sentences or frames completed by ``data``."""
-        ...
-
-
-class SentenceDecoder(Protocol[ReadingT_co]):
-    """A pure decoder: one sentence and its reception time in, a reading or None out."""
-
-    @property
-    def counters(self) -> DecoderCounters:
-        """What it has accepted and refused."""
-        ...
-
-    def decode(self, sentence: bytes, t_us: int) -> ReadingT_co | None:
-        """The reading in one sentence; None when refused (and counted)."""
-        ...
 
 
 def serial_settings(example_url: str, baud: int) -> dict[str, Setting]:
