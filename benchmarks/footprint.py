@@ -69,8 +69,8 @@ PYCACHE = Path(tempfile.gettempdir()) / "companion_footprint_pycache"
 COMPILED = ("companion", "ground", "mavlink_dialect")
 # The on-board program's dependencies (and the simulator's), compiled ahead like pip does.
 SITE_COMPILED = (
-    "numpy", "iceoryx2", "pymavlink", "shapely", "pyproj", "filterpy", "pynmea2", "serial",
-    "psutil", "typer", "rich", "click", "jsbsim", "pygeomag", "scipy", "typing_extensions",
+    "numpy", "iceoryx2", "pymavlink", "shapely", "pyproj", "pynmea2", "serial",
+    "psutil", "typer", "rich", "click", "jsbsim", "pygeomag", "typing_extensions",
     "shellingham", "markdown_it", "pygments", "mdurl",
 )  # fmt: skip
 ENV = dict(os.environ)

@@ -31,6 +31,7 @@ def _help_rank(name: str) -> int:
 
 
 importlib.import_module("companion.cli.vehicle")
+importlib.import_module("companion.cli.params")
 for _entry in sorted(entry_points(group=COMMANDS_GROUP), key=lambda e: _help_rank(e.name)):
     importlib.import_module(_entry.value)
 importlib.import_module("companion.cli.hardware")

@@ -1,4 +1,4 @@
-"""``companion run``, ``status``, ``graph``, and the stopped vehicle's parameters and missions."""
+"""``companion run``, ``status``, ``graph``, and the stopped vehicle's missions."""
 
 from __future__ import annotations
 
@@ -11,7 +11,6 @@ import typer
 
 from companion.cli.app import (
     CONFIG_OPT,
-    EXIT_CONFIG,
     NS_OPT,
     app,
     err,
@@ -70,49 +69,6 @@ def status(
         sys.stdout.write(json.dumps(health_dict(msg), indent=2) + "\n")
     else:
         out.print(health_table(msg))
-
-
-params_app = typer.Typer(help="Parameters in QGroundControl .params files (vehicle stopped).")
-app.add_typer(params_app, name="params")
-
-
-def _param_store(config: Path, namespace: str | None):
-    from companion.params import ParamStore
-
-    cfg = load_checked(config, namespace)
-    decls = [d for spec in cfg.plugins for d in spec.params]
-    return cfg, ParamStore(decls, Path(cfg.vehicle["state_dir"]) / "params.json")
-
-
-@params_app.command("save")
-def params_save(
-    file: Annotated[Path, typer.Argument(help=".params file to write")],
-    config: Annotated[Path, CONFIG_OPT],
-) -> None:
-    """Write the vehicle's stored parameters to a .params file."""
-    from companion.params.qgc_file import save_params
-
-    cfg, store = _param_store(config, None)
-    save_params(store, file, sysid=cfg.sysid)
-    out.print(f"{len(store)} parameters written to {file}")
-
-
-@params_app.command("load")
-def params_load(
-    file: Annotated[Path, typer.Argument(help=".params file to read")],
-    config: Annotated[Path, CONFIG_OPT],
-) -> None:
-    """Check a .params file against the config's declarations and store it (all or nothing)."""
-    from companion.params import ParamError
-    from companion.params.qgc_file import load_params
-
-    _, store = _param_store(config, None)
-    try:
-        count = load_params(store, file)
-    except (ParamError, OSError) as exc:
-        err.print(f"[red]params error:[/red] {exc}", highlight=False, soft_wrap=True)
-        raise typer.Exit(EXIT_CONFIG) from None
-    out.print(f"{count} parameters loaded from {file} into {store.path}")
 
 
 mission_app = typer.Typer(help="Missions in QGroundControl .plan files (vehicle stopped).")

@@ -1,5 +1,8 @@
 """What each accepted MAV_CMD's parameters may hold, checked before any handler runs.
 
+Every command the link answers has its row here, even an empty one (no parameter read):
+the command service refuses to register a handler without one.
+
 A rule names the parameter, its range, whether it is a whole number and whether NaN means
 "not given" (the spec gives NaN that meaning in DO_REPOSITION, NAV_LOITER_UNLIM and for
 unused parameters, which MAVSDK sends as NaN). Parameters a handler does not read have no
@@ -160,7 +163,7 @@ def refusal(args: CommandArgs) -> str | None:
     """Why this command's parameters are refused, or None if they may go to its handler."""
     if args.is_int and args.command in POSITION_COMMANDS and args.frame not in GLOBAL_FRAMES:
         return f"frame {args.frame} not supported (global frames only)"
-    for rule in RULES.get(args.command, ()):
+    for rule in RULES[args.command]:  # a handler exists only for a command with a rule
         problem = rule.problem(args.params[rule.index - 1])
         if problem is not None:
             return problem

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -74,9 +74,24 @@ class CommandService:
         self.refused = 0  # commands whose parameters broke their rule (answered DENIED)
         self.handler_errors = 0  # handlers that raised: bugs, which the tests look for
         self.check: Check | None = None
+        self.ruled: Collection[int] | None = None  # the commands ``check`` has a rule for
         self.on_refusal: Callable[[str], None] = lambda text: None
 
+    def guard(self, check: Check, ruled: Collection[int]) -> None:
+        """Check every command's parameters before its handler runs; from now on only a
+        command ``check`` has a rule for (``ruled``) may be registered."""
+        unruled = sorted(set(self.handlers) - set(ruled))
+        if unruled:
+            raise KeyError(f"no parameter rule for {', '.join(map(command_name, unruled))}")
+        self.check, self.ruled = check, ruled
+
     def register(self, command: int, handler: Handler) -> None:
+        """Answer ``command`` with ``handler``; KeyError when the service is guarded and the
+        command has no parameter rule (its parameters would reach the handler unchecked)."""
+        if self.ruled is not None and command not in self.ruled:
+            raise KeyError(
+                f"{command_name(command)}: no parameter rule (companion/link/command_rules.py)"
+            )
         self.handlers[command] = handler
 
     def _args(self, msg: Any, peer: Peer) -> CommandArgs:

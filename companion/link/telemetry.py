@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 from companion.link import flight_messages
@@ -38,29 +38,37 @@ from companion.messages import (
     VehicleStatus,
 )
 
-__all__ = ["STREAMS", "Snapshot", "sensor_bits"]
+__all__ = ["SNAPSHOT_CHANNELS", "STREAMS", "Snapshot", "sensor_bits"]
+
+
+def _newest(channel: str) -> Any:
+    """A snapshot field holding the newest value of a bus channel (None before the first);
+    its type is the channel's payload type (CHANNELS), as a test checks."""
+    return field(default=None, metadata={"channel": channel})
 
 
 @dataclass
 class Snapshot:
-    """The newest bus values the streams are built from."""
+    """The newest bus values the streams are built from (the link reads each field's
+    channel), and the link's own state they need."""
 
     time_boot_ms: int = 0
     unix_us: int = 0
     now_us: int = 0  # the vehicle clock when the snapshot was taken (sensor freshness)
-    nav: NavState | None = None
-    gps: GpsFix | None = None
-    imu: Imu | None = None
-    mag: Magnetometer | None = None
-    compass: Compass | None = None
-    baro: Baro | None = None
-    battery: Battery | None = None
-    health: SystemHealth | None = None
-    servos: ServoOutput | None = None
-    rc: PilotInput | None = None  # the RC receiver's newest frame
-    rangefinder: RangeReading | None = None  # the downward lidar's newest reading
-    status: VehicleStatus | None = None
-    control: ControlStatus | None = None  # None while the flight controller is not running
+    nav: NavState | None = _newest("nav/state")
+    gps: GpsFix | None = _newest("sensors/gps")
+    imu: Imu | None = _newest("sensors/imu")
+    mag: Magnetometer | None = _newest("sensors/mag")
+    compass: Compass | None = _newest("sensors/compass")
+    baro: Baro | None = _newest("sensors/baro")
+    battery: Battery | None = _newest("sensors/battery")
+    health: SystemHealth | None = _newest("system/health")
+    servos: ServoOutput | None = _newest("actuators/servos")
+    rc: PilotInput | None = _newest("sensors/rc")  # the RC receiver's newest frame
+    rangefinder: RangeReading | None = _newest("sensors/range")  # the downward lidar's
+    status: VehicleStatus | None = _newest("vehicle/status")
+    # None while the flight controller is not running (the link judges its freshness).
+    control: ControlStatus | None = _newest("control/status")
     home_alt_m: float = math.nan
     mission_seq: int = 0
     mission_total: int = 0
@@ -69,6 +77,11 @@ class Snapshot:
     health_cursor: int = 0  # PLUGIN_HEALTH sends one row at a time, round the table
     prearm_ok: bool | None = None  # the pre-arm checks pass (None: not judged yet)
 
+
+# Snapshot field -> the bus channel it holds: what the link reads for its streams.
+SNAPSHOT_CHANNELS: dict[str, str] = {
+    f.name: f.metadata["channel"] for f in fields(Snapshot) if "channel" in f.metadata
+}
 
 Builder = Callable[[Any, Snapshot], Any]
 

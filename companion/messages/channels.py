@@ -36,6 +36,9 @@ class Channel:
     depth: int = 1
     doc: str = ""
     many_producers: bool = False  # every plug-in may publish (e.g. system/plugin_stats)
+    # Why the flight log leaves this channel out by default ("": it records it). A new
+    # channel is recorded unless it says here why not.
+    unlogged: str = ""
 
 
 # Latest channels that change at up to 100 Hz keep this many values for a reader that
@@ -55,28 +58,65 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("sensors/baro", Baro, "queue", 32, "barometric altitude"),
     Channel("sensors/range", RangeReading, "latest", KEEP, doc="downward rangefinder's reading"),
     Channel("sensors/rc", PilotInput, "latest", KEEP, doc="the RC receiver's newest frame"),
-    Channel("sensors/rc_switch", PilotInput, "queue", 8, "frames where the mode switch moved"),
+    Channel(
+        "sensors/rc_switch",
+        PilotInput,
+        "queue",
+        8,
+        "frames where the mode switch moved",
+        unlogged="every receiver frame is in sensors/rc already",
+    ),
     Channel("link/manual_control", PilotInput, "latest", KEEP, doc="the ground station's joystick"),
     Channel(
         "sensors/battery", Battery, "latest", KEEP, doc="flight battery voltage, current, charge"
     ),
     Channel("nav/state", NavState, "latest", KEEP, doc="navigation solution"),
-    Channel("sim/truth", SimTruth, "latest", doc="simulator's true state"),
-    Channel("sim/clock", SimClock, "latest", doc="simulation time"),
+    Channel(
+        "sim/truth",
+        SimTruth,
+        "latest",
+        doc="simulator's true state",
+        unlogged="the simulator's, not the vehicle's (companion sim --truth writes it)",
+    ),
+    Channel(
+        "sim/clock",
+        SimClock,
+        "latest",
+        doc="simulation time",
+        unlogged="every sample's t_us is on the simulation's clock already",
+    ),
     Channel("vehicle/status", VehicleStatus, "latest", KEEP, doc="mode, home, guided target"),
     Channel("control/actuators", ActuatorCommand, "queue", 8, "normalised surfaces"),
     Channel("control/status", ControlStatus, "latest", KEEP, doc="guidance and mission progress"),
     Channel("actuators/servos", ServoOutput, "latest", KEEP, doc="servo outputs written"),
     Channel("link/commands", VehicleCommand, "queue", 16, "commands for the vehicle", True),
     Channel("link/command_acks", CommandAck, "queue", 16, "command outcomes"),
-    Channel("system/plugin_stats", PluginStats, "queue", 64, "per-plug-in counters", True),
+    Channel(
+        "system/plugin_stats",
+        PluginStats,
+        "queue",
+        64,
+        "per-plug-in counters",
+        True,
+        unlogged="system/health, recorded, carries every plug-in's counters",
+    ),
     Channel("system/health", SystemHealth, "latest", doc="the health table"),
-    Channel("system/logged", LogProgress, "latest", doc="how far the flight log has written"),
+    Channel(
+        "system/logged",
+        LogProgress,
+        "latest",
+        doc="how far the flight log has written",
+        unlogged="the flight log's own progress",
+    ),
     Channel("params/changes", ParamChange, "queue", 32, "parameters set from the ground"),
     Channel("link/status", LinkStatus, "latest", doc="ground-station heartbeats heard"),
     Channel("mission/changed", MissionChanged, "latest", doc="stored mission lists changed"),
     Channel("vehicle/statustext", StatusText, "queue", 16, "messages for the operator", True),
 )
+
+
+# What the flight log records unless its config names other channels.
+LOGGED: tuple[str, ...] = tuple(name for name, c in CHANNELS.items() if not c.unlogged)
 
 
 def channel(name: str) -> Channel:

@@ -1,9 +1,14 @@
 """The thesis's final navigator: attitude from the compass, position and velocity from GPS.
 
-Position and velocity are smoothed by a constant-velocity Kalman filter (filterpy) in a
+Position and velocity are smoothed by a constant-velocity Kalman filter in a
 local north-east-down frame about the first fix, predicted with the REAL time between
 fixes (the 2006 filter assumed exactly one second and blew up after outages). Without
 fixes the filter coasts and its uncertainty grows; the solution says so in its flags.
+
+The filter is written here with numpy alone: filterpy, which it used before, declares
+scipy and matplotlib as dependencies (~180 MB an on-board install has no other use for).
+Its equations are filterpy's ``KalmanFilter.predict``/``update`` (Joseph-form covariance)
+with the measurement matrix the identity, in the same order, so the figures are the same.
 """
 
 from __future__ import annotations
@@ -12,7 +17,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from filterpy.kalman import KalmanFilter
 
 from companion.messages import Compass, GpsFix, NavFlags, NavState
 from companion.navigation.rotations import euler_to_quaternion
@@ -31,13 +35,34 @@ class GpsCompassConfig:
     compass_timeout_s: float = 1.0
 
 
+class ConstantVelocityFilter:
+    """Linear Kalman filter whose state (x, column vector) is measured directly (H = I)."""
+
+    def __init__(self, dim: int) -> None:
+        self.x = np.zeros((dim, 1))
+        self.P = np.eye(dim)
+        self._eye = np.eye(dim)
+
+    def predict(self, f: np.ndarray, q: np.ndarray) -> None:
+        """Move the state through ``f``, adding process noise ``q``."""
+        self.x = f @ self.x
+        self.P = f @ self.P @ f.T + q
+
+    def update(self, z: np.ndarray, r: np.ndarray) -> None:
+        """Fuse a measurement ``z`` of the whole state with noise covariance ``r``."""
+        gain = self.P @ np.linalg.inv(self.P + r)
+        self.x = self.x + gain @ (z - self.x)
+        # Joseph form: stays symmetric and positive definite when the gain is rounded.
+        keep = self._eye - gain
+        self.P = keep @ self.P @ keep.T + gain @ r @ gain.T
+
+
 class GpsCompassNavigator:
     """Feed samples in time order; ``state(t_us)`` gives the solution at that time."""
 
     def __init__(self, config: GpsCompassConfig | None = None) -> None:
         self.cfg = config or GpsCompassConfig()
-        self.kf = KalmanFilter(dim_x=6, dim_z=6)
-        self.kf.H = np.eye(6)
+        self.kf = ConstantVelocityFilter(6)
         self.ref: tuple[float, float, float] | None = None  # lat, lon, alt of the first fix
         self.t_kf_us: int | None = None
         self.last_fix_us: int | None = None
@@ -60,7 +85,7 @@ class GpsCompassNavigator:
         if self.t_kf_us is None or t_us <= self.t_kf_us:
             return
         f, q = self._transition((t_us - self.t_kf_us) / 1e6)
-        self.kf.predict(F=f, Q=q)
+        self.kf.predict(f, q)
         self.t_kf_us = t_us
 
     def _predicted(self, t_us: int) -> tuple[np.ndarray, np.ndarray]:
@@ -97,7 +122,7 @@ class GpsCompassNavigator:
             self.t_kf_us = fix.t_us
         else:
             self._predict(fix.t_us)
-            self.kf.update(z.reshape(6, 1), R=r)
+            self.kf.update(z.reshape(6, 1), r)
         self.last_fix_us = fix.t_us
         self.fixes += 1
 

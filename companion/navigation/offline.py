@@ -11,6 +11,7 @@ from collections.abc import Callable, Iterable, Iterator
 from typing import Protocol
 
 from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer, Message, NavState
+from companion.navigation.gps_compass import GpsCompassNavigator
 from companion.navigation.ins_ekf import InsEkf, InsEkfConfig
 from companion.navigation.sample_order import PublishGrid, SampleOrder
 
@@ -53,10 +54,6 @@ class GpsCompassRunner:
     """``nav.gps_compass``'s navigator."""
 
     def __init__(self, declination_deg: float | None = None) -> None:
-        # Imported here: filterpy brings scipy.stats (~2.5 s of CPU), which the ins_ekf
-        # plug-in, importing this module for its own runner, must not pay at every start.
-        from companion.navigation.gps_compass import GpsCompassNavigator
-
         self.nav = GpsCompassNavigator()
 
     def feed(self, sample: Message) -> None:

@@ -20,7 +20,9 @@ def save_params(store: ParamStore, path: Path, sysid: int = 1, compid: int = 1) 
 def load_params(store: ParamStore, path: Path) -> int:
     """Apply a .params file; ParamError names the line and parameter of the first bad line.
 
-    Nothing is applied unless every line is good. An alias's line sets the parameters it
+    Nothing is applied unless every line is good. A line at the parameter's default stores
+    nothing (the parameter keeps following its default), so a whole file written by
+    ``save_params`` stores only the values that differ. An alias's line sets the parameters it
     stands for; two lines that would set one parameter to different values are an error.
     """
     updates: dict[str, tuple[float, str]] = {}  # stored name -> value, the line's name
@@ -47,7 +49,5 @@ def load_params(store: ParamStore, path: Path) -> int:
                 raise ParamError(f"{path}:{lineno}: {name} disagrees with {earlier[1]}")
             updates[own] = (own_value, name)
         count += 1
-    for own, (own_value, _) in updates.items():
-        store.values[own] = own_value
-    store.save()
+    store.apply({own: own_value for own, (own_value, _) in updates.items()})
     return count

@@ -2,10 +2,23 @@
 
 Every value is a float on the wire (MAV_PARAM_TYPE_REAL32, the one encoding QGroundControl,
 MAVSDK and MAVProxy agree on). A set outside a parameter's range, or not one of its
-enumerated values, is refused and the old value kept. Values persist atomically as JSON
-and are restored at start; a stored value that no longer fits its declaration, or a
-corrupt file, is logged and ignored. An alias (``companion.params.alias``) has no value
-of its own: it is read from, and written to, the parameters it stands for.
+enumerated values, is refused and the old value kept. An alias (``companion.params.alias``)
+has no value of its own: it is read from, and written to, the parameters it stands for.
+
+Only what the user set is stored (``params.json``: ``{"format": 2, "set": {...}}``), as
+ArduPilot and PX4 do; every other parameter follows its declared default or the airframe
+file's value, now and after either changes. Setting a parameter to its default takes it
+out of the stored set again (QGroundControl's "reset to default" sends the default), and a
+reset to defaults empties it. The file is written atomically and read at start; a stored
+value that no longer fits its declaration, or a corrupt file, is logged and ignored. A
+stored value of a parameter this config does not declare (its plug-in left out for now)
+is kept in the file, untouched.
+
+A file from before (a flat table of every parameter, each pinned) is read by one rule: a
+value equal to the parameter's current default (declared or airframe) is dropped, as one
+the user never changed; any other is kept as set. ``legacy`` then says what was done, and
+the owner of the file (the link) writes it back in the new form at once, so the rule
+meets each old file only once, against the defaults it was written with.
 """
 
 from __future__ import annotations
@@ -23,6 +36,12 @@ from companion.params.atomic import atomic_write_text
 
 log = logging.getLogger(__name__)
 MAX_NAME = 16
+FORMAT = 2  # params.json holds only the values the user set
+
+
+def same_value(a: float, b: float) -> bool:
+    """Equal as a float32 on the wire leaves them (a default sent back by a ground station)."""
+    return math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-9)
 
 
 class ParamError(ValueError):
@@ -42,6 +61,7 @@ class ParamDecl:
     reboot_required: bool = False
     values: tuple[tuple[float, str], ...] = ()  # an enumeration: (value, meaning); no other
     alias: Alias | None = None  # another name for the vehicle's own parameter(s)
+    origin: str = "default"  # where ``default`` comes from: "default" or "airframe NAME"
 
     def __post_init__(self) -> None:  # as JSON brings them back: lists and a table
         object.__setattr__(self, "values", tuple((float(v), str(t)) for v, t in self.values))
@@ -116,6 +136,9 @@ class ParamStore:
                 raise ParamError(f"default of {problem}")
         self.names = sorted(self.decls)
         self.values = {n: float(d.default) for n, d in self.decls.items() if n not in self.aliases}
+        self.stored: dict[str, float] = {}  # what the user set; ``values`` holds them too
+        self.foreign: dict[str, Any] = {}  # stored for parameters this config does not declare
+        self.legacy: tuple[list[str], list[str]] | None = None  # an old file: kept, dropped
         self.path = path
         if path is not None:
             self._restore(path)
@@ -152,9 +175,20 @@ class ParamStore:
     def write(self, name: str, value: float) -> dict[str, float]:
         """Set and persist; the stored values changed. ParamError: nothing changed."""
         updates = self.plan(name, value)
-        self.values.update(updates)
-        self.save()
+        self.apply(updates)
         return updates
+
+    def apply(self, updates: Mapping[str, float]) -> None:
+        """Store checked values (``plan``'s) as set by the user, and persist them. A value
+        equal to its default is not stored: the parameter follows its default again."""
+        for name, value in updates.items():
+            default = float(self.decls[name].default)
+            if same_value(value, default):
+                self.values[name] = default
+                self.stored.pop(name, None)
+            else:
+                self.values[name] = self.stored[name] = float(value)
+        self.save()
 
     def set(self, name: str, value: float) -> float:
         """Set and persist; the value now read. ParamError (old value kept) as ``plan``."""
@@ -170,8 +204,30 @@ class ParamStore:
             if value != self.decls[name].default
         }
         self.values.update(changed)
+        self.stored.clear()
         self.save()
         return changed
+
+    def migrate(self) -> None:
+        """An old file (every value pinned) rewritten as the stored set, once, by its owner."""
+        if self.legacy is None or self.path is None:
+            return
+        kept, dropped = self.legacy
+        kept_names = ", ".join(kept) or "none"
+        log.info(
+            "parameter file %s from an older version: %d values at their default dropped, "
+            "kept as set: %s", self.path, len(dropped), kept_names,
+        )  # fmt: skip
+        self.save()
+        self.legacy = None
+
+    def source(self, name: str) -> str:
+        """Where a value comes from: "stored" (set by the user), the declaration's origin
+        ("default", "airframe NAME"), or "alias of NAME..." (read from those parameters)."""
+        alias = self.aliases.get(name)
+        if alias is not None:
+            return f"alias of {', '.join(alias.sources)}"
+        return "stored" if name in self.stored else self.decls[name].origin
 
     def linked(self, name: str) -> list[str]:
         """The other names whose value follows ``name``'s: an alias's owners and their
@@ -184,30 +240,59 @@ class ParamStore:
         return sorted(related - {name})
 
     def save(self) -> None:
-        if self.path is not None:
-            atomic_write_text(self.path, json.dumps(self.values, indent=1, sort_keys=True))
+        """Write the stored set (only what the user set) atomically."""
+        if self.path is None:
+            return
+        if self.partial:  # it knows one owner's names: writing would drop the others'
+            raise ParamError("a partial parameter store is read-only")
+        table = {"format": FORMAT, "set": {**self.foreign, **self.stored}}
+        atomic_write_text(self.path, json.dumps(table, indent=1, sort_keys=True))
 
     def _restore(self, path: Path) -> None:
-        try:
-            stored = json.loads(path.read_text())
-        except FileNotFoundError:
+        table = self._read(path)
+        if table is None:
             return
-        except (OSError, ValueError) as exc:
-            log.warning("parameter file %s unreadable (%s): using defaults", path, exc)
-            return
-        if not isinstance(stored, dict):
-            log.warning("parameter file %s is not a table: using defaults", path)
-            return
-        for name, value in stored.items():
+        kept: list[str] = []
+        dropped: list[str] = []
+        for name, value in table.items():
             if name in self.aliases:  # a file from before it was an alias: its owner's holds
                 continue
             decl = self.decls.get(name)
-            if decl is None and self.partial:
+            if decl is None:
+                if not self.partial:
+                    log.warning("parameter file %s: %s is not declared here (kept)", path, name)
+                    self.foreign[name] = value
                 continue
-            if decl is None or not isinstance(value, int | float):
+            if not isinstance(value, int | float) or isinstance(value, bool):
                 log.warning("parameter file %s: ignoring %s = %r", path, name, value)
                 continue
             if (problem := decl.check(float(value))) is not None:
                 log.warning("parameter file %s: ignoring %s", path, problem)
                 continue
-            self.values[name] = float(value)
+            if self.legacy is not None and same_value(float(value), float(decl.default)):
+                dropped.append(name)  # an old file pinned every value: this one is a default
+                continue
+            kept.append(name)
+            self.values[name] = self.stored[name] = float(value)
+        if self.legacy is not None:
+            self.legacy = (kept, dropped)
+
+    def _read(self, path: Path) -> dict[str, Any] | None:
+        """The file's table of stored values (``legacy`` set for an old file), or None."""
+        try:
+            stored = json.loads(path.read_text())
+        except FileNotFoundError:
+            return None
+        except (OSError, ValueError) as exc:
+            log.warning("parameter file %s unreadable (%s): using defaults", path, exc)
+            return None
+        if not isinstance(stored, dict):
+            log.warning("parameter file %s is not a table: using defaults", path)
+            return None
+        if "format" not in stored:
+            self.legacy = ([], [])
+            return stored
+        if stored.get("format") != FORMAT or not isinstance(stored.get("set"), dict):
+            log.warning("parameter file %s: unknown format: using defaults", path)
+            return None
+        return stored["set"]

@@ -7,44 +7,13 @@ their reception time in, readings out.
 
 from __future__ import annotations
 
-from typing import Generic, Protocol, TypeVar
+from typing import Generic, TypeVar
+
+from companion.sensors.codec_types import Framer, SentenceDecoder
+
+__all__ = ["FramedStream", "Framer", "SentenceDecoder"]
 
 ReadingT = TypeVar("ReadingT")
-ReadingT_co = TypeVar("ReadingT_co", covariant=True)
-
-
-class DecoderCounters(Protocol):
-    """The counters every sentence decoder keeps."""
-
-    ok: int
-    bad_checksum: int
-    garbage: int
-
-
-class Framer(Protocol):
-    """Cuts a byte stream into the device's sentences or frames."""
-
-    @property
-    def rejected(self) -> int:
-        """How many stretches of bytes it has refused as not a sentence or frame."""
-        ...
-
-    def feed(self, data: bytes) -> list[bytes]:
-        """The whole sentences or frames completed by ``data``."""
-        ...
-
-
-class SentenceDecoder(Protocol[ReadingT_co]):
-    """A pure decoder: one sentence and its reception time in, a reading or None out."""
-
-    @property
-    def counters(self) -> DecoderCounters:
-        """What it has accepted and refused."""
-        ...
-
-    def decode(self, sentence: bytes, t_us: int) -> ReadingT_co | None:
-        """The reading in one sentence; None when refused (and counted)."""
-        ...
 
 
 class FramedStream(Generic[ReadingT]):

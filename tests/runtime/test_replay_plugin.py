@@ -71,7 +71,7 @@ def test_replayed_gps_and_compass_reach_nav_state_through_gps_compass(vehicle_fa
     )
     nav = vehicle.bus.latest_reader("nav/state")
     # Start the replay only once the navigator has its inputs open (its first step done):
-    # importing filterpy can take seconds on a loaded machine.
+    # starting a plug-in process can take seconds on a loaded machine.
     wait_for(lambda: (r := vehicle.row("nav")) is not None and r.step_p50_us > 0, 30, "nav up")
     vehicle.bus.writer("link/commands").publish(
         VehicleCommand(t_us=0, seq=1, command=int(CommandId.START))

@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 import pytest
+from pyulog import ULog
 
 from companion.control.mission.items import MissionItem
 from companion.control.mission.plan import checked_plan
@@ -116,3 +117,9 @@ def test_the_c172_lands_its_qgc_landing_pattern_in_a_crosswind_and_disarms(tmp_p
     # The simulated TFmini was in range: the flare flew on its height, not the navigator's.
     used = re.search(r"disarming \((\d+) landing steps on the rangefinder's height\)", out)
     assert used is not None and int(used.group(1)) > 0, out[-3000:]
+    # ... and the flight log has its readings (the logger records every channel by default):
+    # in range from the approach down to the wheels.
+    ranges = ULog(str(truth_path.with_suffix(".ulg")), ["sensors_range"])
+    data = ranges.get_dataset("sensors_range").data
+    valid = data["distance_m"][data["valid"] == 1]
+    assert len(valid) > 100 and valid.min() < 3.0, (len(valid), valid.min(initial=99))

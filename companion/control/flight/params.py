@@ -69,12 +69,18 @@ CONTROL_PARAMS = (
 BY_NAME = {p.name: p for p in CONTROL_PARAMS}
 
 
-def control_params(defaults: Mapping[str, float]) -> tuple[ParamDecl, ...]:
-    """The declarations with an airframe's defaults; unknown names raise KeyError."""
+def control_params(
+    defaults: Mapping[str, float], origin: str = "airframe"
+) -> tuple[ParamDecl, ...]:
+    """The declarations with an airframe's defaults (``origin`` names the airframe, for
+    ``companion params list``); unknown names raise KeyError."""
     unknown = sorted(set(defaults) - set(BY_NAME))
     if unknown:
         raise KeyError(f"unknown control parameter(s): {', '.join(unknown)}")
-    return tuple(replace(p, default=float(defaults.get(p.name, p.default))) for p in CONTROL_PARAMS)
+    return tuple(
+        replace(p, default=float(defaults[p.name]), origin=origin) if p.name in defaults else p
+        for p in CONTROL_PARAMS
+    )
 
 
 @dataclass(frozen=True)

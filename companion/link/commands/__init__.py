@@ -9,7 +9,7 @@ command service.
 from __future__ import annotations
 
 from companion.link.calibration import Calibration
-from companion.link.command_rules import refusal
+from companion.link.command_rules import RULES, refusal
 from companion.link.command_service import CommandService
 from companion.link.commands.arming import ArmingCommands
 from companion.link.commands.calibration import CalibrationCommands
@@ -43,8 +43,9 @@ def register_commands(
     params: ParamsService | None = None,
 ) -> None:
     """Register every supported MAV_CMD with ``service``, behind the parameter rules (the
-    sensor calibrations when there are parameters to keep their results)."""
-    service.check = refusal
+    sensor calibrations when there are parameters to keep their results). A command
+    without a rule in ``command_rules.RULES`` cannot be registered."""
+    service.guard(refusal, RULES)
     service.on_refusal = port.statustext
     ArmingCommands(port).register(service)
     ModeCommands(port, identity.autopilot).register(service)

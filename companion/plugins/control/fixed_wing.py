@@ -71,7 +71,8 @@ class FixedWingPlugin(Plugin):
 
     @classmethod
     def param_decls(cls, settings: Mapping[str, Any]) -> tuple[ParamDecl, ...]:
-        return control_params(load_airframe(settings["airframe"]).control)
+        airframe = load_airframe(settings["airframe"])
+        return control_params(airframe.control, f"airframe {Path(airframe.source).name}")
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)

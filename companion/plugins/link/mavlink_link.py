@@ -38,9 +38,10 @@ from companion.link.refusal_texts import RefusalTexts
 from companion.link.service import Outgoing, refused_count
 from companion.link.signing import configured_secret, key_file_problem, key_from
 from companion.link.statustext import StatusTexts
-from companion.link.telemetry import Snapshot
+from companion.link.telemetry import SNAPSHOT_CHANNELS, Snapshot
 from companion.link.timesync import TimesyncService
 from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChange, VehicleCommand
+from companion.messages.channels import CHANNELS
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import DeviceProbe, Plugin, PluginContext, Setting
 
@@ -91,12 +92,8 @@ class MavlinkLink(Plugin):
         *PREARM_PARAMS,
         *PX4_PARAMS,
     )
-    optional_inputs = (
-        "nav/state", "sensors/gps", "sensors/imu", "sensors/mag", "sensors/compass",
-        "sensors/baro", "sensors/battery", "sensors/range", "actuators/servos",
-        "vehicle/status", "system/health", "link/command_acks", "control/status",
-        "vehicle/statustext", "sensors/rc",
-    )  # fmt: skip
+    # What telemetry shows (the snapshot's channels), and the acks and texts it relays.
+    optional_inputs = (*SNAPSHOT_CHANNELS.values(), "link/command_acks", "vehicle/statustext")
     outputs = (
         "link/commands",
         "params/changes",
@@ -182,15 +179,14 @@ class MavlinkLink(Plugin):
 
     @staticmethod
     def _readers(bus: Any) -> dict[str, Any]:
-        latest = {"nav": "nav/state", "health": "system/health", "servos": "actuators/servos",
-                  "status": "vehicle/status", "control": "control/status",
-                  "rc": "sensors/rc", "battery": "sensors/battery",
-                  "rangefinder": "sensors/range"}  # fmt: skip
-        readers = {key: bus.latest_reader(name) for key, name in latest.items()}
-        # Telemetry shows the newest sensor sample: a buffer of one, not ~1300 copies a second.
-        for key in ("gps", "imu", "mag", "compass", "baro"):
-            readers[key] = bus.newest_reader(f"sensors/{key}")
-        return readers
+        """A reader per snapshot field. Telemetry shows a queue's newest sample: a buffer of
+        one, not ~1300 copies a second."""
+        return {
+            key: bus.newest_reader(name)
+            if CHANNELS[name].pattern == "queue"
+            else bus.latest_reader(name)
+            for key, name in SNAPSHOT_CHANNELS.items()
+        }
 
     def _serve_missions(self, ctx: PluginContext, sysid: int) -> None:
         store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
@@ -225,6 +221,7 @@ class MavlinkLink(Plugin):
     def _serve_params(self, ctx: PluginContext, sysid: int) -> None:
         decls = vehicle_facts(ctx.param_decls or self.params, sysid, ctx.plugins)
         self.store = ParamStore(decls, Path(ctx.vehicle.get("state_dir", ".")) / "params.json")
+        self.store.migrate()  # the link owns the file: an old one takes the new form now
         service = ParamsService(self.mav, self.store, sysid, ctx.settings["compid"])
         service.on_refusal = self.refusal_text
         service.on_change = self._param_changed
@@ -257,15 +254,12 @@ class MavlinkLink(Plugin):
         self.router.send(out, time.monotonic())
 
     def _refresh_snapshot(self) -> None:
-        s, r = self.snapshot, self.readers
-        s.nav, s.health, s.servos = r["nav"].get(), r["health"].get(), r["servos"].get()
+        s = self.snapshot
+        for key, reader in self.readers.items():
+            setattr(s, key, reader.get())
         self.devices.update(s.health)
-        s.status, s.rc, s.battery = r["status"].get(), r["rc"].get(), r["battery"].get()
-        s.rangefinder = r["rangefinder"].get()
-        s.control = self._fresh_control()
+        s.control = self._fresh_control(s.control)
         s.now_us = self.ctx.clock.now_us()
-        s.gps, s.imu, s.mag = r["gps"].get(), r["imu"].get(), r["mag"].get()
-        s.compass, s.baro = r["compass"].get(), r["baro"].get()
         if s.status is not None and s.status.home_valid:  # home is the commander's alone
             s.home = (s.status.home_lat_deg, s.status.home_lon_deg, s.status.home_alt_msl_m)
             s.home_alt_m = s.status.home_alt_msl_m
@@ -285,9 +279,8 @@ class MavlinkLink(Plugin):
             active = d.MAV_STATE_ACTIVE if s.health.flight_running else d.MAV_STATE_STANDBY
             self.identity.state.system_status = active
 
-    def _fresh_control(self) -> ControlStatus | None:
+    def _fresh_control(self, control: ControlStatus | None) -> ControlStatus | None:
         """The controller's status while it runs; MISSION_ITEM_REACHED when it grows."""
-        control = self.readers["control"].get()
         if control is None or not control.fresh(self.ctx.clock.now_us()):
             return None
         if control.reached_count != self.reached_count and control.last_reached >= 0:

@@ -18,7 +18,8 @@ from companion.messages import RangeReading
 from companion.params import ParamDecl
 from companion.params.live import LiveParams
 from companion.plugin import PluginContext
-from companion.plugins.sensors.serial_sensor import Framer, SerialSensor, serial_settings
+from companion.plugins.sensors.serial_sensor import SerialSensor, serial_settings
+from companion.sensors.codec_types import Framer
 from companion.sensors.tfmini import RangeSample, TfminiDecoder, TfminiFramer, signal_quality
 
 RANGEFINDER_PARAMS = (

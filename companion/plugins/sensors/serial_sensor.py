@@ -3,6 +3,9 @@
 A subclass names its decoder (``make_decoder``) and what a reading becomes on the bus
 (``publish``); the port, the framing (text lines unless ``make_framer`` says otherwise, as
 a binary protocol does), the time stamp and the health counters are here, once.
+
+The codecs' side of the contract (``Framer``, ``SentenceDecoder``) lives with the codecs,
+in ``companion.sensors.codec_types``.
 """
 
 from __future__ import annotations
@@ -12,7 +15,8 @@ from collections.abc import Mapping
 from typing import Any, Generic, TypeVar
 
 from companion.plugin import DeviceProbe, Plugin, PluginContext, Setting
-from companion.sensors.framed_stream import FramedStream, Framer, SentenceDecoder
+from companion.sensors.codec_types import Framer, SentenceDecoder
+from companion.sensors.framed_stream import FramedStream
 from companion.sensors.line_framer import LineFramer
 from companion.sensors.serial_port import ReopeningSerial
 

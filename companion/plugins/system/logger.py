@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 from companion import __version__
 from companion.flight_log import LogDirectory, LogRecorder, ULogWriter, topic_name
 from companion.messages import LogProgress
-from companion.messages.channels import CHANNELS
+from companion.messages.channels import CHANNELS, LOGGED
 from companion.params.live import RELOAD_ALL
 from companion.params.store import ParamStore
 from companion.plugin import Plugin, PluginContext, Ports, Setting
@@ -39,26 +39,8 @@ from companion.plugin import Plugin, PluginContext, Ports, Setting
 if TYPE_CHECKING:
     from companion.bus.channels import Reader
 
-DEFAULT_CHANNELS = [
-    "sensors/imu",
-    "sensors/mag",
-    "sensors/gps",
-    "sensors/compass",
-    "sensors/baro",
-    "sensors/rc",
-    "link/manual_control",
-    "sensors/battery",
-    "nav/state",
-    "control/actuators",
-    "control/status",
-    "actuators/servos",
-    "vehicle/status",
-    "link/commands",
-    "link/command_acks",
-    "params/changes",
-    "vehicle/statustext",
-    "system/health",
-]
+# Every registered channel but those that opt out in the registry, with their reason.
+DEFAULT_CHANNELS = list(LOGGED)
 MIN_PERIOD_S = 0.001
 # While data flows and no queue comes back a quarter full, the reads spread out to this:
 # the IMU's 64-deep queue holds 0.64 s at 100 Hz, a Latest channel 16 values (0.32 s at

@@ -1,11 +1,11 @@
-"""`companion params save/load` on a config's stored parameters."""
+"""`companion params` on a config's stored parameters: save/load, list/diff/set/reset."""
 
 from __future__ import annotations
 
 import subprocess
 import sys
 
-from tests.support.configs import link, vehicle_config
+from tests.support.configs import FAKE_NAV, link, plugin, vehicle_config
 from tests.support.vehicle import REPO
 
 
@@ -31,3 +31,37 @@ def test_save_edit_load_round_trip_and_a_bad_file_is_refused(tmp_path):
     saved.write_text("1\t1\tSR_GPS\t500\t9\n")
     bad = companion("params", "load", str(saved), "-c", str(config))
     assert bad.returncode == 2 and "v.params:1: SR_GPS: 500 outside" in bad.stderr
+
+
+def test_list_diff_set_and_reset_say_where_each_value_comes_from(tmp_path):
+    airframe = tmp_path / "J3Cub.toml"
+    shipped = (REPO / "companion" / "airframes" / "J3Cub.toml").read_text()
+    airframe.write_text(shipped)
+    control = plugin("control", "control.fixed_wing", group="flight", airframe=str(airframe))
+    config = tmp_path / "v.toml"
+    parts = (link("udpout://127.0.0.1:14999"), plugin("nav", FAKE_NAV), control)
+    config.write_text(vehicle_config("p", *parts, state_dir=tmp_path / "s"))
+    assert companion("params", "diff", "-c", str(config)).stdout.strip() == (
+        "every parameter at its default"
+    )
+    done = companion("params", "set", "WP_RADIUS", "45", "-c", str(config))
+    assert done.returncode == 0 and "WP_RADIUS = 45 (stored)" in done.stdout
+    airframe.write_text(shipped.replace("NAVL1_PERIOD = 14.0", "NAVL1_PERIOD = 17.0"))
+    listed = rows(companion("params", "list", "-c", str(config)).stdout)
+    assert listed["NAVL1_PERIOD"] == ["17", "airframe", "J3Cub.toml"]
+    assert listed["WP_RADIUS"] == ["45", "stored", "(default", "30,", "default)"]
+    assert listed["SR_GPS"] == ["2", "default"]
+    assert listed["RTL_RETURN_ALT"][1:] == ["alias", "of", "RTL_ALT_M"]
+    diff = companion("params", "diff", "-c", str(config)).stdout.splitlines()
+    assert [line.split() for line in diff] == [["WP_RADIUS", "45", "default", "30", "(default)"]]
+    refused = companion("params", "set", "WP_RADIUS", "0", "-c", str(config))
+    assert refused.returncode == 2 and "WP_RADIUS: 0 outside" in refused.stderr
+    assert companion("params", "reset", "-c", str(config)).returncode == 0
+    assert rows(companion("params", "list", "-c", str(config)).stdout)["WP_RADIUS"] == [
+        "30",
+        "default",
+    ]
+
+
+def rows(listing: str) -> dict[str, list[str]]:
+    return {line.split()[0]: line.split()[1:] for line in listing.splitlines()}
