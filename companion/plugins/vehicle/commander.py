@@ -19,6 +19,7 @@ from companion.control.battery_failsafe import BATTERY_FS_PARAMS, BatteryFailsaf
 from companion.control.commander import MODE_COMMANDS, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.control.flight.landing_flight import land_start
+from companion.control.ground_rules import ground_notice
 from companion.control.mission.fence import Fence
 from companion.control.mission.store import MissionStore, StoreFollower
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch
@@ -104,6 +105,8 @@ class CommanderPlugin(Plugin):
         self.next_failsafe_us = 0
         self.nav_seen: Any = None  # the last solution read, usable or not
         self.nav_good: Any = None  # the last usable one
+        self.arms = 0  # times armed, for the ground notice
+        self.told: tuple[int, int] = (-1, -1)  # (mode changes, arms) last told about
 
     def step(self) -> None:
         c = self.commander
@@ -111,14 +114,18 @@ class CommanderPlugin(Plugin):
         now = self.ctx.clock.now_us()
         nav = self._nav()
         if (health := self.health.get()) is not None:
+            self.arms += int(bool(health.flight_running) and not c.armed)
             c.on_armed(bool(health.flight_running))
         self.live.poll()
         if d.MAV_MISSION_TYPE_FENCE in self.follower.follow(self.mission_changes.get()):
             self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
-        if (control := self.control.get()) is not None:
-            c.land_phase = int(control.land_phase) if control.fresh(now) else 0
+        control = self.control.get()
+        fresh = control is not None and control.fresh(now)
+        c.land_phase = int(control.land_phase) if fresh else 0
+        c.landed = bool(c.armed and fresh and control.landed)
         acks = self._commands()
         changed = bool(acks) | self._mode_switch(now)
+        self._ground_notice(now, fresh)
         if now >= self.next_failsafe_us or now < self.next_failsafe_us - FAILSAFE_PERIOD_US:
             self.next_failsafe_us = now + FAILSAFE_PERIOD_US
             changed |= self._failsafes(now, nav)
@@ -131,6 +138,23 @@ class CommanderPlugin(Plugin):
         # the old mode, when this process was preempted between the two).
         for ack in acks:
             self.acks.publish(ack)
+
+    def _ground_notice(self, now: int, known: bool) -> None:
+        """Armed on the ground, say once per arming and per mode entered what the aircraft
+        will do from there (``companion.control.ground_rules``): never armed and silent.
+        A mode entered in the air is not told of when the aircraft lands in it."""
+        c = self.commander
+        key = (c.changes, self.arms)
+        if not (c.armed and known) or key == self.told:
+            return
+        self.told = key
+        if not c.landed:
+            return
+        items = self.store.items[d.MAV_MISSION_TYPE_MISSION]
+        text = ground_notice(c.mode, items, c.mission_first)
+        if text is not None:
+            self.ctx.log.info("%s", text)
+            self._say(now, text, d.MAV_SEVERITY_NOTICE)
 
     def _publish_status(self, status: VehicleStatus, armed: bool) -> None:
         """Disarmed, the same status again wakes nobody (the link would wake for it each
