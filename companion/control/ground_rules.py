@@ -17,9 +17,12 @@ silent (MAVSDK's mission.py waited for ever). The rules:
 
 from __future__ import annotations
 
+import math
+
+from companion.control.flight.controller import AIRBORNE_AGL_M, LANDED_SPEED
 from companion.control.mission.items import DO_COMMANDS, MissionItem
 from companion.control.modes import BY_MODE
-from companion.messages import FlightMode
+from companion.messages import FlightMode, NavState
 from mavlink_dialect import companion as d
 
 AIRBORNE_ONLY = frozenset({FlightMode.LOITER, FlightMode.GUIDED, FlightMode.RTL})
@@ -33,7 +36,17 @@ def name(mode: FlightMode) -> str:
 
 def refusal(mode: FlightMode) -> str:
     """Why a command for ``mode`` is refused while armed on the ground."""
-    return f"{name(mode)}: on the ground, take off first (Takeoff or Mission)"
+    return f"{name(mode)}: on the ground, take off first"
+
+
+def standing(nav: NavState | None, home_alt_msl: float | None) -> bool | None:
+    """Whether the aircraft stands on the ground by the flight controller's own measure
+    (near home's height, slower than a fixed wing flies), for the moments after arming
+    before the controller has said so; None when there is no solution or home yet."""
+    if nav is None or home_alt_msl is None:
+        return None
+    slow = math.hypot(nav.vn_m_s, nav.ve_m_s) < LANDED_SPEED
+    return slow and nav.alt_msl_m - home_alt_msl < AIRBORNE_AGL_M
 
 
 def first_to_fly(items: list[MissionItem], first: int) -> MissionItem | None:
@@ -53,12 +66,13 @@ def first_to_fly(items: list[MissionItem], first: int) -> MissionItem | None:
 
 
 def ground_notice(mode: FlightMode, items: list[MissionItem], first: int) -> str | None:
-    """What to tell the operator on arming, or on a mode entered, armed on the ground."""
+    """What to tell the operator on arming, or on a mode entered, armed on the ground (in
+    STATUSTEXT's 50 bytes, so every ground station shows it whole)."""
     if mode in AIRBORNE_ONLY:
-        return f"{name(mode)}: holding on the ground until Takeoff or Mission"
+        return f"{name(mode)}: on the ground until Takeoff or Mission"
     if mode != FlightMode.MISSION:
         return None
     item = first_to_fly(items, first)
     if item is None or item.command in (d.MAV_CMD_NAV_TAKEOFF, d.MAV_CMD_NAV_LAND):
         return None
-    return f"Mission: item {item.seq} is not a take-off: taking off ahead, then to it"
+    return f"Mission item {item.seq} not a take-off: taking off first"

@@ -97,7 +97,8 @@ def honoured(items: list[MissionItem]) -> tuple[list[MissionItem], list[str]]:
         if why is None:
             kept += zone
         else:
-            notes.append(f"Fence: {_zone_name(item)} (item {item.seq}) ignored: {why}")
+            # Within STATUSTEXT's 50 bytes: one message, whatever the ground station.
+            notes.append(f"Fence item {item.seq} ignored: {_zone_name(item)} {why}")
         i += len(zone)
     if notes and not any(it.command in POLYGONS or it.command in CIRCLES for it in kept):
         notes.append("Fence: no zone left, no fence installed")
@@ -108,9 +109,9 @@ def _empty(zone: list[MissionItem]) -> str | None:
     """Why a zone encloses nothing, or None."""
     first = zone[0]
     if first.command in CIRCLES and first.param1 == 0:  # NaN is refused by the checks
-        return "radius 0 m"
+        return "radius 0"
     if first.command in POLYGONS and math.isfinite(first.param1) and len(zone) < 3:
-        return f"{len(zone)} vertices"
+        return f"of {len(zone)} pts"
     return None
 
 

@@ -19,7 +19,7 @@ from companion.control.battery_failsafe import BATTERY_FS_PARAMS, BatteryFailsaf
 from companion.control.commander import MODE_COMMANDS, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.control.flight.landing_flight import land_start
-from companion.control.ground_rules import ground_notice
+from companion.control.ground_rules import ground_notice, standing
 from companion.control.mission.fence import Fence
 from companion.control.mission.store import MissionStore, StoreFollower
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch
@@ -122,10 +122,13 @@ class CommanderPlugin(Plugin):
         control = self.control.get()
         fresh = control is not None and control.fresh(now)
         c.land_phase = int(control.land_phase) if fresh else 0
-        c.landed = bool(c.armed and fresh and control.landed)
+        # Until the controller started at arming speaks, judged as it would judge it.
+        home_alt = c.home[2] if c.home is not None else None
+        landed = bool(control.landed) if fresh else standing(nav, home_alt)
+        c.landed = bool(c.armed and landed)
         acks = self._commands()
         changed = bool(acks) | self._mode_switch(now)
-        self._ground_notice(now, fresh)
+        self._ground_notice(now, landed is not None)
         if now >= self.next_failsafe_us or now < self.next_failsafe_us - FAILSAFE_PERIOD_US:
             self.next_failsafe_us = now + FAILSAFE_PERIOD_US
             changed |= self._failsafes(now, nav)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 from companion.control.commander import Commander
-from companion.control.ground_rules import first_to_fly, ground_notice
+from companion.control.ground_rules import first_to_fly, ground_notice, standing
 from companion.messages import CommandId, CommandResult, FlightMode, NavFlags, NavState
 from companion.messages import VehicleCommand as Cmd
 from mavlink_dialect import companion as d
@@ -49,7 +49,7 @@ def test_armed_on_the_ground_modes_that_cannot_fly_from_there_are_refused_with_t
     for command, params, name in AIRBORNE_ONLY:
         result, reason = _asks(c, command, *params)
         assert result == CommandResult.DENIED, command
-        assert reason == f"{name}: on the ground, take off first (Takeoff or Mission)"
+        assert reason == f"{name}: on the ground, take off first"
     assert c.mode == FlightMode.LOITER and c.status(0).changes == before  # nothing changed
     # What can fly from the runway is accepted: Mission and Takeoff.
     assert _asks(c, CommandId.MISSION_START, 0, 0)[0] == CommandResult.ACCEPTED
@@ -69,13 +69,24 @@ def test_what_the_operator_is_told_armed_on_the_ground():
     no_takeoff = [speed(0, 10.0), wp(1, (0.0, 900.0)), wp(2, (900.0, 900.0))]
     takeoff = [item(0, d.MAV_CMD_NAV_TAKEOFF, None, z=50.0), *no_takeoff[1:]]
     assert first_to_fly(no_takeoff, 0) == no_takeoff[1]  # the speed change passed
-    text = "Mission: item 1 is not a take-off: taking off ahead, then to it"
+    text = "Mission item 1 not a take-off: taking off first"
     assert ground_notice(FlightMode.MISSION, no_takeoff, 0) == text
     assert ground_notice(FlightMode.MISSION, takeoff, 0) is None  # it takes off as planned
     # Started at item 2 (MISSION_START's first item): that one is not a take-off either.
     assert ground_notice(FlightMode.MISSION, takeoff, 2) == text.replace("1", "2")
-    holding = "Loiter: holding on the ground until Takeoff or Mission"
+    holding = "Loiter: on the ground until Takeoff or Mission"
     assert ground_notice(FlightMode.LOITER, takeoff, 0) == holding
-    assert ground_notice(FlightMode.RTL, [], 0).startswith("Return: holding on the ground")
+    assert ground_notice(FlightMode.RTL, [], 0) == holding.replace("Loiter", "Return")
     assert ground_notice(FlightMode.TAKEOFF, [], 0) is None
     assert ground_notice(FlightMode.MANUAL, [], 0) is None
+
+
+def test_standing_is_judged_from_the_solution_until_the_controller_speaks():
+    nav = NavState(flags=int(NavFlags.POSITION_VALID))
+    nav.alt_msl_m = 81.0
+    assert standing(nav, 80.0) is True  # just armed on the runway
+    nav.vn_m_s = 25.0
+    assert standing(nav, 80.0) is False  # flying speed
+    nav.vn_m_s, nav.alt_msl_m = 0.0, 200.0
+    assert standing(nav, 80.0) is False  # far above home
+    assert standing(None, 80.0) is None and standing(nav, None) is None

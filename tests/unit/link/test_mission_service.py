@@ -100,7 +100,7 @@ def test_a_zone_that_encloses_nothing_is_left_out_and_named_the_rest_installed(b
     assert bench.upload([*polygon, placeholder], 1).type == d.MAV_MISSION_ACCEPTED
     stored = bench.service.store.items[1]
     assert [it.command for it in stored] == [poly] * 4 and [it.seq for it in stored] == [0, 1, 2, 3]
-    text = "Fence: inclusion circle (item 4) ignored: radius 0 m"
+    text = "Fence item 4 ignored: inclusion circle radius 0"
     assert said == [(text, d.MAV_SEVERITY_WARNING)]
     # Nothing but the placeholder: accepted as no fence, and said so.
     said.clear()
