@@ -94,6 +94,7 @@ class MissionExecutor:
         self._hold: Setpoint | None = None
         self._turn_radius = 0.0
         self.climb_to = math.nan  # an implicit take-off's height (take_off_first)
+        self._flown_back = False  # the current waypoint is one the climb flew past
 
     def start(self, first: int, pos: tuple[float, float], alt_msl: float) -> None:
         """Begin at item ``first`` from where the aircraft is."""
@@ -104,6 +105,7 @@ class MissionExecutor:
         self._hold = None
         self._loiter = _Loiter()
         self.climb_to = math.nan
+        self._flown_back = False
 
     def take_off_first(self, alt_msl: float) -> None:
         """On the ground with a mission whose next item is not a take-off: climb out along
@@ -139,7 +141,7 @@ class MissionExecutor:
             if alt_msl < self.climb_to - TAKEOFF_MARGIN_M:
                 return Setpoint(Kind.TAKEOFF, pos, pos, self.climb_to, speed=self.speed)
             self.climb_to = math.nan
-            self._prev, self._prev_alt = pos, alt_msl
+            self._climbed(self.current, pos, alt_msl)
         seen: set[tuple[int, tuple[tuple[int, int], ...]]] = set()
         for _ in range(MAX_JUMPS_PER_STEP):
             if self.current >= len(self.items):
@@ -161,6 +163,7 @@ class MissionExecutor:
             self.reached.append(self.items[self.current].seq)
         self.current += 1
         self._prev, self._prev_alt = pos, alt
+        self._flown_back = False
         self._loiter = _Loiter()
 
     def _end(self, pos: tuple[float, float]) -> Setpoint:
@@ -216,18 +219,27 @@ class MissionExecutor:
     def _takeoff(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
         target = self.alt_of(item)
         if alt >= target - TAKEOFF_MARGIN_M:
-            # The next leg starts where the climb ended (ArduPlane), not where the take-off
-            # began: from there a first waypoint the climb flew past lies ahead of the leg
-            # and is flown back to, not counted as passed (it was skipped, and the next leg
-            # joined 800 m from it, when the leg started on the runway).
-            self._advance(True, pos, target)
+            self._advance(True, self._prev, target)
+            self._climbed(self.current, pos, target)
             return None
         return Setpoint(Kind.TAKEOFF, pos, pos, target, speed=self.speed)
+
+    def _climbed(self, nxt: int, pos: tuple[float, float], alt: float) -> None:
+        """The climb has ended at ``pos``: the next leg starts here (ArduPlane), not where
+        the take-off began, from where a first waypoint the climb flew past counted as passed
+        (the next leg was joined 800 m from it). Such a waypoint is flown back to and must be
+        reached: no turn lead, which before a reversal is 1.7 turn radii (370 m, c172p)."""
+        item = self.items[nxt] if nxt < len(self.items) else None
+        began = self._prev
+        self._prev, self._prev_alt = pos, alt
+        if item is not None and item.command == d.MAV_CMD_NAV_WAYPOINT:
+            self._flown_back = past_point(began, self.point_of(item, pos), pos)
 
     def _waypoint(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
         b = self.point_of(item, pos)
         radius = item.acceptance_m(self.config.wp_radius)
-        radius = max(radius, self._turn_lead(self._prev, b))
+        if not self._flown_back:
+            radius = max(radius, self._turn_lead(self._prev, b))
         if _distance(pos, b) <= radius or past_point(self._prev, b, pos):
             self._advance(True, b, self.alt_of(item))
             return None

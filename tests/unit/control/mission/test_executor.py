@@ -79,9 +79,11 @@ def test_a_waypoint_the_climb_flew_past_on_the_next_legs_line_is_flown_back_to()
     assert sp.kind == Kind.LINE
     assert sp.a == pytest.approx((0.0, 1_400.0), abs=0.05)
     assert sp.b == pytest.approx((0.0, 900.0), abs=0.05)
-    # Turning back towards it, still 300 m off: not reached.
-    sp = ex.step((-150.0, 1_200.0), HOME_ALT + 100.0, 60.0, turn_radius=150.0)
-    assert ex.drain_reached() == [] and sp.b == pytest.approx((0.0, 900.0), abs=0.05)
+    # Turning back towards it, still 300 m off, then 100 m short on its line: not reached
+    # (the lead before the reversal onto the next leg, 250 m here, does not count).
+    for k, pos in enumerate([(-150.0, 1_200.0), (0.0, 1_000.0)]):
+        sp = ex.step(pos, HOME_ALT + 100.0, 60.0 + k, turn_radius=150.0)
+        assert ex.drain_reached() == [] and sp.b == pytest.approx((0.0, 900.0), abs=0.05)
     # Passed within the acceptance radius: reached, and the next leg starts at it.
     sp = ex.step((0.0, 880.0), HOME_ALT + 100.0, 80.0)
     assert ex.drain_reached() == [1]
