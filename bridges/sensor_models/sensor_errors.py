@@ -44,9 +44,26 @@ class NoiseModel:
     mag_soft_iron: tuple[float, float, float] = (1.0, 1.0, 1.0)
     mag_throttle_gauss: tuple[float, float, float] = (0.0, 0.0, 0.0)  # at full throttle
     # Vibration (a propeller's, at vibration_hz): a point-sampled IMU at 10-25 Hz aliases it.
+    # The amplitudes are at cruise power and above (vibration_throttle). A propeller's
+    # imbalance force grows as the square of its speed, which runs from vibration_idle of
+    # full speed with the throttle closed (c172p 770 of 2700 rpm, J3Cub 580 of 2300): idling
+    # on the ground the airframe shakes at a tenth or so of the amplitude. Shaking at the
+    # whole of it there gave 0.35 m/s² of accelerometer spread standing still, and no gyro
+    # or level calibration could pass (issue 42.4).
     accel_vibration_m_s2: float = 0.0
     gyro_vibration_rad_s: float = 0.0
     vibration_hz: float = 87.0
+    vibration_idle: float = 0.3
+    vibration_throttle: float = 0.6
+
+    def vibration_gain(self, throttle: float | None) -> float:
+        """The fraction of the vibration amplitudes at this throttle (None: not known, all)."""
+        if throttle is None:
+            return 1.0
+        idle = self.vibration_idle
+        speed = idle + (1.0 - idle) * min(1.0, max(0.0, throttle))
+        cruise = idle + (1.0 - idle) * self.vibration_throttle
+        return min(1.0, (speed / cruise) ** 2)
 
     @classmethod
     def installed(cls, scale: float = 1.0, calibrated: bool = True) -> NoiseModel:
@@ -143,8 +160,11 @@ class SensorErrors:
             np.array([self.m.gps_horizontal_m, self.m.gps_horizontal_m, self.m.gps_vertical_m]) * k
         )
 
-    def imu(self, s: TrueState, dt: float, pressure_kpa: float, throttle: float = 0.0) -> ImuSample:
-        """One IMU sample; the biases walk by ``dt`` seconds first."""
+    def imu(
+        self, s: TrueState, dt: float, pressure_kpa: float, throttle: float | None = None
+    ) -> ImuSample:
+        """One IMU sample; the biases walk by ``dt`` seconds first. ``throttle`` (0-1) sets
+        the propeller's vibration and the motor's field (None: full vibration, no field)."""
         m = self.m
         root = math.sqrt(max(dt, 0.0))
         # One draw for all sixteen: the IMU runs at 100 Hz and more.
@@ -155,9 +175,10 @@ class SensorErrors:
         gyro = np.array((s.p, s.q, s.r)) + self.gyro_bias + z[9:12] * m.gyro_noise_rad_s
         if m.accel_vibration_m_s2 or m.gyro_vibration_rad_s:
             shake = np.sin(math.tau * m.vibration_hz * s.t_s + self.vibration_phase)
-            accel += shake * m.accel_vibration_m_s2 * m.scale
-            gyro += shake * m.gyro_vibration_rad_s * m.scale
-        mag = self.airframe_field(s, throttle) + z[12:15] * m.mag_noise_gauss
+            shake *= m.scale * m.vibration_gain(throttle)
+            accel += shake * m.accel_vibration_m_s2
+            gyro += shake * m.gyro_vibration_rad_s
+        mag = self.airframe_field(s, throttle or 0.0) + z[12:15] * m.mag_noise_gauss
         pressure_kpa += z[15] * m.baro_noise_pa / 1000.0
         return ImuSample(accel, gyro, mag, 25.0, pressure_kpa)
 

@@ -18,6 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from companion.control.flight_state import FlightState
+from companion.control.ground_rules import AIRBORNE_ONLY, refusal
 from companion.control.inputs import position_usable
 from companion.control.mission.items import MAX_ALT_M
 from companion.control.modes import INITIAL_MODE
@@ -56,6 +57,13 @@ MODE_COMMANDS = frozenset(
         CommandId.GO_AROUND,
     }
 )
+# Commands that fly a mode a fixed wing cannot fly from the runway.
+_AIRBORNE_COMMANDS = {
+    CommandId.RETURN_TO_LAUNCH: FlightMode.RTL,
+    CommandId.REPOSITION: FlightMode.GUIDED,
+    CommandId.LOITER: FlightMode.LOITER,
+    CommandId.ORBIT: FlightMode.LOITER,
+}
 NO_POINT = (math.nan, math.nan, math.nan)
 LANDING_PHASES = (1, 2)  # LandPhase APPROACH and FLARE: a go-around can still be flown
 
@@ -79,6 +87,7 @@ class Commander:
         self.position: tuple[float, float, float] | None = None
         self.go_arounds = 0
         self.land_phase = 0  # the flight controller's, from its status
+        self.landed = False  # armed and the flight controller says it stands on the ground
         self.rejected_nav = 0  # solutions whose "valid" position was not a place
 
     def on_nav(self, nav: NavState) -> bool:
@@ -112,7 +121,9 @@ class Commander:
                 mode = FlightMode(_whole(p[0], -1))
             except ValueError:
                 return Decision(CommandResult.DENIED, f"unknown mode {p[0]:g}")
-            return self._enter(mode)
+            return self._grounded(mode) or self._enter(mode)
+        if (grounded := self._grounded(_AIRBORNE_COMMANDS.get(kind))) is not None:
+            return grounded
         if kind == CommandId.MISSION_START:
             decision = self._enter(FlightMode.MISSION)
             if decision.result == CommandResult.ACCEPTED:
@@ -131,6 +142,13 @@ class Commander:
                 return Decision(CommandResult.DENIED, "Go around: not landing")
             self.go_arounds += 1
             return ACCEPTED
+        return None
+
+    def _grounded(self, mode: FlightMode | None) -> Decision | None:
+        """Refused: a mode that cannot fly from the runway, asked for armed on the ground
+        (``companion.control.ground_rules``)."""
+        if mode in AIRBORNE_ONLY and self.armed and self.landed:
+            return Decision(CommandResult.DENIED, refusal(mode))
         return None
 
     def _go_to(self, kind: CommandId, p: list[float]) -> Decision:

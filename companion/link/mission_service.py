@@ -14,6 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from companion.control.mission.fence import honoured
 from companion.control.mission.items import MISSION_TYPES, MissionItem, check_mission
 from companion.control.mission.store import MissionStore
 from companion.control.prearm import PlanVerdicts
@@ -69,6 +70,7 @@ class MissionService:
         self.uploads: dict[int, _Upload] = {}
         self.current = 0
         self.on_change: Callable[[int], None] = lambda mission_type: None
+        self.say: Callable[[str, int], None] = lambda text, severity: None  # STATUSTEXT
         # The stored mission was flown to its end: MISSION_CURRENT says so after the flight
         # controller stops (landed and disarmed), as PX4's does, until the mission changes.
         self.completed = False
@@ -151,11 +153,17 @@ class MissionService:
         if len(upload.items) < upload.count:
             return [self._request(upload, now_s)]
         del self.uploads[mission_type]
-        result = check_mission(upload.items)
+        items, notes = upload.items, []
+        if mission_type == d.MAV_MISSION_TYPE_FENCE:  # zones that enclose nothing: left out
+            items, notes = honoured(items)
+        result = check_mission(items)
         if result == d.MAV_MISSION_ACCEPTED:
-            self.store.replace(mission_type, upload.items)
+            self.store.replace(mission_type, items)
             self.current = 0 if mission_type == 0 else self.current
             self._changed(mission_type)
+            for note in notes:
+                log.warning("%s", note)
+                self.say(note, d.MAV_SEVERITY_WARNING)
         else:
             self.refused += 1
             log.warning("mission upload refused: %s", d.enums["MAV_MISSION_RESULT"][result].name)

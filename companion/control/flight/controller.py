@@ -31,6 +31,9 @@ from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 
 AIRBORNE_AGL_M = 10.0
+# An implicit take-off (a mission without one, started on the ground) climbs at least this
+# high before it turns towards the first item: a take-off's wings-level climb-out and more.
+IMPLICIT_TAKEOFF_AGL_M = 25.0
 LANDED_SPEED = 8.0  # m/s: slower than this near the ground is "on the ground"
 # Turns are planned at this fraction of the bank limit: the rest is for gusts and for
 # the airspeed a turn gains or loses.
@@ -241,11 +244,16 @@ class FlightController(LandingFlight, PilotFlight):
             ex.start(status.mission_first, pos, nav.alt_msl_m)
             self.executor = ex
         setpoint = ex.step(pos, nav.alt_msl_m, t_s, self._turn_radius())
+        if self.landed and setpoint.kind not in (Kind.TAKEOFF, Kind.LAND):
+            if ex.finished:
+                return None  # flown to its end: nothing more to take off for
+            # No take-off item ahead on the ground (MAVSDK's mission plug-in adds none):
+            # take off towards the item rather than sit armed and silent on the runway.
+            ex.take_off_first(max(setpoint.alt_msl, self.home_alt + IMPLICIT_TAKEOFF_AGL_M))
+            setpoint = ex.step(pos, nav.alt_msl_m, t_s, self._turn_radius())
         out.mission_seq = ex.current
         out.mission_finished = ex.finished
         out.reached = ex.drain_reached()
-        if self.landed and setpoint.kind not in (Kind.TAKEOFF, Kind.LAND):
-            return None  # a mission must start with a take-off from the ground
         return setpoint
 
     def _mode_target(

@@ -3,11 +3,12 @@
 Pure and replayable: positions in, a ``Setpoint`` and events out. Items as ArduPlane and
 PX4 fly them: NAV_TAKEOFF climbs to its altitude; NAV_WAYPOINT is reached inside its
 acceptance radius or when the aircraft crosses the line through the waypoint square to
-the leg (an overshoot never makes it circle back, but a first one the take-off's climb
-flew past may be flown back to); loiters circle their point (radius param3, negative for
-counter-clockwise) forever, for param1 seconds or param1 turns once on the circle;
-NAV_RETURN_TO_LAUNCH flies home and circles there; DO_CHANGE_SPEED and DO_JUMP act at
-once. After the last item the aircraft circles the last point (PX4).
+the leg (an overshoot never makes it circle back; the leg after a take-off starts where
+the climb ended, so a first waypoint the climb flew past is flown back to); loiters
+circle their point (radius param3, negative for counter-clockwise) forever, for param1
+seconds or param1 turns once on the circle; NAV_RETURN_TO_LAUNCH flies home and circles
+there; DO_CHANGE_SPEED and DO_JUMP act at once. After the last item the aircraft circles
+the last point (PX4).
 """
 
 from __future__ import annotations
@@ -92,6 +93,8 @@ class MissionExecutor:
         self._prev_alt = self.home_alt_msl
         self._hold: Setpoint | None = None
         self._turn_radius = 0.0
+        self.climb_to = math.nan  # an implicit take-off's height (take_off_first)
+        self._flown_back = False  # the current waypoint is one the climb flew past
 
     def start(self, first: int, pos: tuple[float, float], alt_msl: float) -> None:
         """Begin at item ``first`` from where the aircraft is."""
@@ -101,6 +104,14 @@ class MissionExecutor:
         self.finished = False
         self._hold = None
         self._loiter = _Loiter()
+        self.climb_to = math.nan
+        self._flown_back = False
+
+    def take_off_first(self, alt_msl: float) -> None:
+        """On the ground with a mission whose next item is not a take-off: climb out along
+        the runway to ``alt_msl`` first, as a NAV_TAKEOFF there would, then fly that item
+        from where the climb ended (an implicit take-off, which the commander announces)."""
+        self.climb_to = alt_msl
 
     def drain_reached(self) -> list[int]:
         """Items reached since the last call (for MISSION_ITEM_REACHED)."""
@@ -126,6 +137,11 @@ class MissionExecutor:
         the next leg ends on that leg instead of overshooting it.
         """
         self._turn_radius = turn_radius
+        if not math.isnan(self.climb_to):
+            if alt_msl < self.climb_to - TAKEOFF_MARGIN_M:
+                return Setpoint(Kind.TAKEOFF, pos, pos, self.climb_to, speed=self.speed)
+            self.climb_to = math.nan
+            self._climbed(self.current, pos, alt_msl)
         seen: set[tuple[int, tuple[tuple[int, int], ...]]] = set()
         for _ in range(MAX_JUMPS_PER_STEP):
             if self.current >= len(self.items):
@@ -147,6 +163,7 @@ class MissionExecutor:
             self.reached.append(self.items[self.current].seq)
         self.current += 1
         self._prev, self._prev_alt = pos, alt
+        self._flown_back = False
         self._loiter = _Loiter()
 
     def _end(self, pos: tuple[float, float]) -> Setpoint:
@@ -202,36 +219,27 @@ class MissionExecutor:
     def _takeoff(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
         target = self.alt_of(item)
         if alt >= target - TAKEOFF_MARGIN_M:
-            # The next leg starts where the take-off did (PX4), not where the climb ended:
-            # a climb ended beside the first waypoint left a leg of a few metres pointing back.
             self._advance(True, self._prev, target)
-            self._turn_back_if_overflown(pos)
+            self._climbed(self.current, pos, target)
             return None
         return Setpoint(Kind.TAKEOFF, pos, pos, target, speed=self.speed)
 
-    def _turn_back_if_overflown(self, pos: tuple[float, float]) -> None:
-        """A first waypoint the climb flew past, off the next leg by more than the
-        acceptance radius, is flown back to (PX4 flies to each waypoint): with the wind
-        behind, the J3Cub was 700 m past the zigzag's first one and met the next leg 1.1 km
-        down it; the c172p, 60 m past, swung 25 m about it at 49° of bank."""
-        if self.current >= len(self.items):
-            return
-        item = self.items[self.current]
-        if item.command != d.MAV_CMD_NAV_WAYPOINT:
-            return
-        first = self.point_of(item, pos)
-        if not past_point(self._prev, first, pos):
-            return
-        radius = item.acceptance_m(self.config.wp_radius)
-        nxt = self._next_point(first)
-        off = _distance(pos, first) if nxt is None else abs(_cross(first, nxt, pos))
-        if off > radius:
-            self._prev = pos
+    def _climbed(self, nxt: int, pos: tuple[float, float], alt: float) -> None:
+        """The climb has ended at ``pos``: the next leg starts here (ArduPlane), not where
+        the take-off began, from where a first waypoint the climb flew past counted as passed
+        (the next leg was joined 800 m from it). Such a waypoint is flown back to and must be
+        reached: no turn lead, which before a reversal is 1.7 turn radii (370 m, c172p)."""
+        item = self.items[nxt] if nxt < len(self.items) else None
+        began = self._prev
+        self._prev, self._prev_alt = pos, alt
+        if item is not None and item.command == d.MAV_CMD_NAV_WAYPOINT:
+            self._flown_back = past_point(began, self.point_of(item, pos), pos)
 
     def _waypoint(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
         b = self.point_of(item, pos)
         radius = item.acceptance_m(self.config.wp_radius)
-        radius = max(radius, self._turn_lead(self._prev, b))
+        if not self._flown_back:
+            radius = max(radius, self._turn_lead(self._prev, b))
         if _distance(pos, b) <= radius or past_point(self._prev, b, pos):
             self._advance(True, b, self.alt_of(item))
             return None
@@ -381,15 +389,6 @@ def tangent_angle(
 
 def _distance(a: tuple[float, float], b: tuple[float, float]) -> float:
     return math.hypot(b[0] - a[0], b[1] - a[1])
-
-
-def _cross(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> float:
-    """How far ``pos`` is beside the line a→b, m (+ right of it)."""
-    leg = (b[0] - a[0], b[1] - a[1])
-    length = math.hypot(*leg)
-    if length < 1.0:
-        return _distance(pos, a)
-    return ((pos[1] - a[1]) * leg[0] - (pos[0] - a[0]) * leg[1]) / length
 
 
 def past_point(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> bool:

@@ -8,7 +8,7 @@ in a north/east frame in metres around the first fence point (companion.control.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from companion.control.mission.items import MissionItem
 from companion.control.mission.zones import CircleZone, PolygonZone, Zone
@@ -71,6 +71,56 @@ class Fence:
         if any(zone.contains(here) for zone in self.exclusions):
             return "inside an exclusion zone"
         return None
+
+
+def honoured(items: list[MissionItem]) -> tuple[list[MissionItem], list[str]]:
+    """The fence items without the zones that enclose nothing, and why each was left out.
+
+    MAVSDK's geofence plug-in sends a placeholder circle of radius 0 at 0,0 beside the
+    user's polygon; refusing the whole upload for it left the aircraft with no fence at
+    all (issue 47.2). A circle of no radius or a polygon of fewer than three vertices is
+    left out, the rest kept (renumbered) and checked as before; the texts tell the ground
+    station which zone was ignored, and when no zone is left, that no fence is installed.
+    """
+    kept: list[MissionItem] = []
+    notes: list[str] = []
+    i = 0
+    while i < len(items):
+        item = items[i]
+        zone = [item]
+        if item.command in POLYGONS:
+            # param1 counts the vertices; a count under 3 (0: not given) is no count at all.
+            count = round(item.param1) if math.isfinite(item.param1) else 1
+            zone = items[i : i + count] if count >= 3 else items[i:]
+            zone = zone[: next((k for k, v in enumerate(zone) if v.command != item.command), None)]
+        why = _empty(zone)
+        if why is None:
+            kept += zone
+        else:
+            # Within STATUSTEXT's 50 bytes: one message, whatever the ground station.
+            notes.append(f"Fence item {item.seq} ignored: {_zone_name(item)} {why}")
+        i += len(zone)
+    if notes and not any(it.command in POLYGONS or it.command in CIRCLES for it in kept):
+        notes.append("Fence: no zone left, no fence installed")
+    return [replace(it, seq=k) for k, it in enumerate(kept)], notes
+
+
+def _empty(zone: list[MissionItem]) -> str | None:
+    """Why a zone encloses nothing, or None."""
+    first = zone[0]
+    if first.command in CIRCLES and first.param1 == 0:  # NaN is refused by the checks
+        return "radius 0"
+    if first.command in POLYGONS and math.isfinite(first.param1) and len(zone) < 3:
+        return f"of {len(zone)} pts"
+    return None
+
+
+def _zone_name(item: MissionItem) -> str:
+    kind = "polygon" if item.command in POLYGONS else "circle"
+    inclusion = POLYGONS.get(item.command, CIRCLES.get(item.command))
+    if inclusion is None:
+        return "return point"
+    return f"{'inclusion' if inclusion else 'exclusion'} {kind}"
 
 
 def _without_repeats(vertices: list[tuple[float, float]]) -> tuple[tuple[float, float], ...]:

@@ -194,7 +194,7 @@ class MavlinkLink(Plugin):
         self.router.add_service(self.missions)
         # The other plug-ins follow the stored lists through this, not the files' times.
         self.mission_changes = ctx.bus.writer("mission/changed")
-        self.missions.on_change = self._mission_changed
+        self.missions.on_change, self.missions.say = self._mission_changed, self.statustext
         self._mission_changed(0)
 
     def _serve_logs(self, ctx: PluginContext, sysid: int) -> None:

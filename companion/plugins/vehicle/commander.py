@@ -20,6 +20,7 @@ from companion.control.commander import MODE_COMMANDS, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.control.flight.landing_flight import land_start
 from companion.control.flight_state import in_the_air, load_flight_state, save_flight_state
+from companion.control.ground_rules import ground_notice, standing
 from companion.control.mission.fence import Fence
 from companion.control.mission.store import MissionStore, StoreFollower
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch, ReceiverProcess
@@ -121,6 +122,8 @@ class CommanderPlugin(Plugin):
         self.next_failsafe_us = 0
         self.nav_seen: Any = None  # the last solution read, usable or not
         self.nav_good: Any = None  # the last usable one
+        self.arms = 0  # times armed, for the ground notice
+        self.told: tuple[int, int] = (-1, -1)  # (mode changes, arms) last told about
 
     def step(self) -> None:
         c = self.commander
@@ -131,14 +134,21 @@ class CommanderPlugin(Plugin):
         if self.saved is not None and not self._resume(now, nav, health):
             return  # no status until it is known whether the flight goes on
         if health is not None and (health.flight_running or now >= self.rearm_until_us):
+            self.arms += int(bool(health.flight_running) and not c.armed)
             c.on_armed(bool(health.flight_running))
         self.live.poll()
         if d.MAV_MISSION_TYPE_FENCE in self.follower.follow(self.mission_changes.get()):
             self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
-        if (control := self.control.get()) is not None:
-            c.land_phase = int(control.land_phase) if control.fresh(now) else 0
+        control = self.control.get()
+        fresh = control is not None and control.fresh(now)
+        c.land_phase = int(control.land_phase) if fresh else 0
+        # Until the controller started at arming speaks, judged as it would judge it.
+        home_alt = c.home[2] if c.home is not None else None
+        landed = bool(control.landed) if fresh else standing(nav, home_alt)
+        c.landed = bool(c.armed and landed)
         acks = self._commands()
         changed = bool(acks) | self._mode_switch(now)
+        self._ground_notice(now, landed is not None)
         if now >= self.next_failsafe_us or now < self.next_failsafe_us - FAILSAFE_PERIOD_US:
             self.next_failsafe_us = now + FAILSAFE_PERIOD_US
             changed |= self._failsafes(now, nav)
@@ -204,6 +214,23 @@ class CommanderPlugin(Plugin):
         if text != self.written:
             save_flight_state(self.state_dir, state)
             self.written = text
+
+    def _ground_notice(self, now: int, known: bool) -> None:
+        """Armed on the ground, say once per arming and per mode entered what the aircraft
+        will do from there (``companion.control.ground_rules``): never armed and silent.
+        A mode entered in the air is not told of when the aircraft lands in it."""
+        c = self.commander
+        key = (c.changes, self.arms)
+        if not (c.armed and known) or key == self.told:
+            return
+        self.told = key
+        if not c.landed:
+            return
+        items = self.store.items[d.MAV_MISSION_TYPE_MISSION]
+        text = ground_notice(c.mode, items, c.mission_first)
+        if text is not None:
+            self.ctx.log.info("%s", text)
+            self._say(now, text, d.MAV_SEVERITY_NOTICE)
 
     def _publish_status(self, status: VehicleStatus, armed: bool) -> None:
         """Disarmed, the same status again wakes nobody (the link would wake for it each

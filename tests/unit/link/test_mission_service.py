@@ -87,6 +87,34 @@ def test_fence_and_rally_are_separate_lists(bench):
     assert [len(bench.service.store.items[t]) for t in (0, 1, 2)] == [0, 4, 1]
 
 
+def test_a_zone_that_encloses_nothing_is_left_out_and_named_the_rest_installed(bench):
+    """MAVSDK's geofence.py: its polygon, then the placeholder circle MAVSDK's API needs
+    (radius 0 at 0,0). The whole upload used to be refused (INVALID_PARAM5_X), leaving no
+    fence at all (issue 47.2); now the polygon is installed and the circle named."""
+    said = []
+    bench.service.say = lambda text, severity: said.append((text, severity))
+    poly = d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION
+    circle = d.MAV_CMD_NAV_FENCE_CIRCLE_INCLUSION
+    polygon = [bench.item(i, poly, mission_type=1, p1=4) for i in range(4)]
+    placeholder = bench.item(4, circle, x=0, y=0, mission_type=1, p1=0.0)
+    assert bench.upload([*polygon, placeholder], 1).type == d.MAV_MISSION_ACCEPTED
+    stored = bench.service.store.items[1]
+    assert [it.command for it in stored] == [poly] * 4 and [it.seq for it in stored] == [0, 1, 2, 3]
+    text = "Fence item 4 ignored: inclusion circle radius 0"
+    assert said == [(text, d.MAV_SEVERITY_WARNING)]
+    # Nothing but the placeholder: accepted as no fence, and said so.
+    said.clear()
+    assert bench.upload([bench.item(0, circle, x=0, y=0, mission_type=1)], 1).type == (
+        d.MAV_MISSION_ACCEPTED
+    )
+    assert bench.service.store.items[1] == []
+    assert [t for t, _ in said][-1] == "Fence: no zone left, no fence installed"
+    # A zone that is broken, not empty, still refuses the upload (a NaN radius).
+    said.clear()
+    broken = bench.item(0, circle, mission_type=1, p1=float("nan"))
+    assert bench.upload([broken], 1).type == d.MAV_MISSION_INVALID_PARAM1 and said == []
+
+
 def test_interrupted_upload_retries_then_gives_up_keeping_the_old_mission(bench):
     bench.upload([bench.item(0)])
     bench.send(bench.gcs.mission_count_encode(1, 1, 3, 0), now=10.0)

@@ -65,11 +65,15 @@ def test_no_mode_but_take_off_opens_the_throttle_on_the_ground(mode, flags):
         assert (out.aileron, out.elevator, out.rudder) == (0.0, 0.0, 0.0)  # trim
 
 
-def test_a_mission_opens_the_throttle_only_with_its_take_off_item():
+def test_a_mission_takes_off_with_or_without_its_take_off_item():
+    """Without a take-off item (MAVSDK's mission plug-in adds none) the mission used to hold
+    idle on the runway, armed and silent, for ever (issue 47.1): now it takes off, a
+    take-off as the ground station sees it (take-off phase 1, the roll)."""
     square = load_plan(REPO / "qgc_plans" / "square.plan")[0]
     assert max(o.throttle for o in _outputs(_controller(square), FlightMode.MISSION)) > 0.5
-    no_takeoff = square[1:]
-    assert max(o.throttle for o in _outputs(_controller(no_takeoff), FlightMode.MISSION)) == 0.0
+    outs = _outputs(_controller(square[1:]), FlightMode.MISSION)
+    assert max(o.throttle for o in outs) > 0.5
+    assert all(o.takeoff_phase == 1 and o.mission_seq == 0 for o in outs[1:])
 
 
 def test_take_off_opens_the_throttle():

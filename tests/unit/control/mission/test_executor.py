@@ -41,7 +41,7 @@ def test_takeoff_climbs_until_within_5_m_then_flies_on():
     sp = ex.step(pos, 125.1, 5.0)
     assert ex.drain_reached() == [0]
     assert sp.kind == Kind.LINE
-    assert sp.a == (0.0, 0.0)  # the leg starts where the take-off did
+    assert sp.a == (100.0, 0.0)  # the leg starts where the climb ended (ArduPlane)
     assert sp.b == pytest.approx((1_000.0, 0.0), abs=0.05)
     assert sp.alt_msl == pytest.approx(HOME_ALT + 100.0)
 
@@ -69,18 +69,48 @@ def test_a_waypoint_the_climb_flew_past_is_flown_back_to():
     assert ex.drain_reached() == [] and sp.b == pytest.approx((0.0, 900.0), abs=0.05)
 
 
-def test_a_waypoint_the_climb_flew_past_on_the_next_legs_line_is_reached():
-    # Climbing east along the runway, the take-off ends 500 m beyond the first waypoint,
-    # on the line of the next leg (straight on east): that one counts as reached and the
-    # next leg is flown at once.
+def test_a_waypoint_the_climb_flew_past_on_the_next_legs_line_is_flown_back_to():
+    """Issue 42.7: climbing east along the runway, the take-off ends 500 m beyond the first
+    waypoint, on the line of the next leg (straight on east). The leg to it used to start
+    at the take-off item, so the aircraft counted it as passed and joined the next leg
+    500 m beyond it; from where the climb ended (ArduPlane) it is flown back to."""
     ex, sp = climb_ending_at((0.0, 1_400.0), (0.0, 2_400.0))
-    assert ex.drain_reached() == [0, 1]
+    assert ex.drain_reached() == [0]
     assert sp.kind == Kind.LINE
+    assert sp.a == pytest.approx((0.0, 1_400.0), abs=0.05)
+    assert sp.b == pytest.approx((0.0, 900.0), abs=0.05)
+    # Turning back towards it, still 300 m off, then 100 m short on its line: not reached
+    # (the lead before the reversal onto the next leg, 250 m here, does not count).
+    for k, pos in enumerate([(-150.0, 1_200.0), (0.0, 1_000.0)]):
+        sp = ex.step(pos, HOME_ALT + 100.0, 60.0 + k, turn_radius=150.0)
+        assert ex.drain_reached() == [] and sp.b == pytest.approx((0.0, 900.0), abs=0.05)
+    # Passed within the acceptance radius: reached, and the next leg starts at it.
+    sp = ex.step((0.0, 880.0), HOME_ALT + 100.0, 80.0)
+    assert ex.drain_reached() == [1]
     assert sp.a == pytest.approx((0.0, 900.0), abs=0.05)
     assert sp.b == pytest.approx((0.0, 2_400.0), abs=0.05)
     # Not yet at the waypoint when the climb ends: it is flown to, as before.
     ex, sp = climb_ending_at((0.0, 600.0), (0.0, 2_400.0), turn_radius=0.0)
     assert ex.drain_reached() == [0]
+    assert sp.b == pytest.approx((0.0, 900.0), abs=0.05)
+
+
+def test_an_implicit_take_off_climbs_ahead_then_flies_the_first_waypoint():
+    """Issue 47.1: a mission without a take-off item, started on the ground (MAVSDK's
+    mission.py): told to take off first, the executor climbs along the runway, then
+    flies the first waypoint from where the climb ended."""
+    items = [speed(0, 25.0), wp(1, (0.0, 900.0), z=60.0), wp(2, (900.0, 900.0), z=60.0)]
+    ex = executor(items, alt=HOME_ALT)
+    ex.take_off_first(HOME_ALT + 60.0)
+    for k, alt in enumerate([HOME_ALT, HOME_ALT + 20.0, HOME_ALT + 54.0]):
+        sp = ex.step((0.0, 300.0 * k), alt, float(k))
+        assert sp.kind == Kind.TAKEOFF and sp.alt_msl == pytest.approx(HOME_ALT + 60.0)
+        assert ex.current == 0 and ex.drain_reached() == []
+    # Climbed (within 5 m) 1.2 km down the runway, past the first waypoint: flown back to.
+    sp = ex.step((0.0, 1_200.0), HOME_ALT + 56.0, 5.0)
+    assert ex.drain_reached() == []  # the waypoint is not counted as passed
+    assert sp.kind == Kind.LINE and ex.current == 1 and ex.speed == 25.0
+    assert sp.a == pytest.approx((0.0, 1_200.0), abs=0.05)
     assert sp.b == pytest.approx((0.0, 900.0), abs=0.05)
 
 
