@@ -153,25 +153,31 @@ def test_start_mission_then_every_in_flight_action(qgc):
     here = settled(status, lambda s: s.mode == FlightMode.LOITER, "paused")
     assert (here.target_lat_deg, here.target_lon_deg) == pytest.approx((FakeNav.LAT, FakeNav.LON))
     # Change altitude: the same circle, 30 m higher.
-    assert reposition(gcs, NAN, NAN, FakeNav.ALT + 30.0) == m.MAV_RESULT_ACCEPTED
-    higher = settled(status, lambda s: s.target_alt_msl_m == FakeNav.ALT + 30.0, "climbing")
+    assert reposition(gcs, NAN, NAN, FakeNav.ALT + 70.0) == m.MAV_RESULT_ACCEPTED
+    higher = settled(status, lambda s: s.target_alt_msl_m == FakeNav.ALT + 70.0, "climbing")
     assert higher.mode == FlightMode.LOITER
     assert higher.target_lat_deg == pytest.approx(FakeNav.LAT)
-    # Go to location (a click on the map): Guided, its own mode and name.
+    # Go to location (a click on the map): Guided, its own mode and name. QGroundControl
+    # sends the vehicle's present altitude: on the stand-in's ground, under the floor
+    # (GUIDED_ALT_MIN above home), so refused with the reason; in flight, accepted.
     lat, lon = FakeNav.LAT + 0.004, FakeNav.LON + 0.003
+    low = command_int(gcs, m.MAV_CMD_DO_REPOSITION, -1, CHANGE_MODE, 0, NAN,
+                      lat=lat, lon=lon, alt=FakeNav.ALT)  # fmt: skip
+    assert low == m.MAV_RESULT_DENIED
+    assert "below GUIDED_ALT_MIN" in gcs.recv("STATUSTEXT", 3.0).text
     go = command_int(gcs, m.MAV_CMD_DO_REPOSITION, -1, CHANGE_MODE, 0, NAN,
-                     lat=lat, lon=lon, alt=FakeNav.ALT)  # fmt: skip
+                     lat=lat, lon=lon, alt=FakeNav.ALT + 80.0)  # fmt: skip
     assert go == m.MAV_RESULT_ACCEPTED
     shown(gcs, FlightMode.GUIDED)
     there = settled(status, lambda s: s.mode == FlightMode.GUIDED, "going")
     assert (there.target_lat_deg, there.target_lon_deg) == pytest.approx((lat, lon))
     # Change altitude on the way: still going there, at the new height.
-    assert reposition(gcs, NAN, NAN, FakeNav.ALT + 10.0) == m.MAV_RESULT_ACCEPTED
-    going = settled(status, lambda s: s.target_alt_msl_m == FakeNav.ALT + 10.0, "lower")
+    assert reposition(gcs, NAN, NAN, FakeNav.ALT + 50.0) == m.MAV_RESULT_ACCEPTED
+    going = settled(status, lambda s: s.target_alt_msl_m == FakeNav.ALT + 50.0, "lower")
     assert going.mode == FlightMode.GUIDED and going.target_lat_deg == pytest.approx(lat)
     # Orbit: circle that point at the radius asked for.
     orbit = command_int(gcs, m.MAV_CMD_DO_ORBIT, 150.0, NAN, NAN, NAN,
-                        lat=lat, lon=lon, alt=FakeNav.ALT + 20.0)  # fmt: skip
+                        lat=lat, lon=lon, alt=FakeNav.ALT + 60.0)  # fmt: skip
     assert orbit == m.MAV_RESULT_ACCEPTED
     shown(gcs, FlightMode.LOITER)
     assert (

@@ -109,10 +109,18 @@ class ModeCommands:
         return self.to_commander(CommandId.SET_HOME, (use_current, *args.params[1:]))
 
     def point(self, args: CommandArgs) -> tuple[float, float, float]:
-        """(lat, lon, alt AMSL) of params 5-7; NaN where not given (0, 0 = here)."""
+        """(lat, lon, alt AMSL) of params 5-7; NaN where not given.
+
+        Latitude and longitude 0, 0 mean "here" and altitude 0 "the present altitude", as
+        ArduPilot reads them: a command sent with every parameter 0 (QGroundControl's custom
+        actions, MAVProxy's defaults) names no point, and read as 0 m above sea level it
+        had sent the aircraft into the ground. The commander refuses a real altitude under
+        its floor (GUIDED_ALT_MIN above home)."""
         lat, lon, alt = args.params[4:7]
         if not (math.isfinite(lat) and math.isfinite(lon)) or (lat == 0 and lon == 0):
             lat = lon = math.nan
+        if alt == 0:
+            alt = math.nan
         status = self.port.snapshot.status
         if args.frame in RELATIVE_FRAMES and status is not None and status.home_valid:
             alt += status.home_alt_msl_m
