@@ -116,3 +116,42 @@ def test_qgroundcontrol_takeoff_change_altitude_and_go_to_fly(tmp_path):
         proc.terminate()
         finish(proc, namespace, 60)
         qgc.conn.close()
+
+
+@pytest.mark.timeout(900)
+def test_qgc_custom_loiter_action_holds_the_height_it_is_sent_at(tmp_path):
+    """The shipped custom action "Loiter" (qgc/companion-actions.*.json): COMMAND_LONG
+    NAV_LOITER_UNLIM with every parameter 0. Read as 0 m above sea level it had the
+    aircraft descending from 99 m to 40 m above the ground in 20 s; now it circles here at
+    the height it had."""
+    port = free_udp_port()
+    proc, namespace, _truth = start_sim(
+        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "900"
+    )
+    qgc = Qgc(port)
+    try:
+        home = qgc.conn.recv_match(type="HOME_POSITION", blocking=True, timeout=60)
+        assert home is not None, "no home position"
+        qgc.pump_until(lambda: qgc.position is not None, "a position")
+        takeoff = (-1, 0, 0, NAN, NAN, NAN, home.altitude / 1000.0 + 100.0)
+        assert qgc.command(d.MAV_CMD_NAV_TAKEOFF, *takeoff) == d.MAV_RESULT_ACCEPTED
+        arm = d.MAV_CMD_COMPONENT_ARM_DISARM
+        qgc.pump_until(lambda: qgc.command(arm, 1, 0, 0, 0, 0, 0, 0) == 0, "armed")
+        qgc.pump_until(lambda: qgc.position.relative_alt > 95_000, "at the take-off height")
+        sent_at = qgc.position.relative_alt / 1000.0
+        assert qgc.command(d.MAV_CMD_NAV_LOITER_UNLIM, 0, 0, 0, 0, 0, 0, 0) == 0
+        qgc.pump_until(lambda: qgc.in_mode(FlightMode.LOITER), "in Hold (our Loiter)")
+        start_ms, lowest = qgc.position.time_boot_ms, sent_at
+
+        def watched() -> bool:
+            nonlocal lowest
+            lowest = min(lowest, qgc.position.relative_alt / 1000.0)
+            return qgc.position.time_boot_ms - start_ms > 40_000
+
+        qgc.pump_until(watched, "40 s in Hold")
+        assert qgc.in_mode(FlightMode.LOITER)
+        assert lowest > sent_at - 10.0, (sent_at, lowest)
+    finally:
+        proc.terminate()
+        finish(proc, namespace, 60)
+        qgc.conn.close()
