@@ -15,6 +15,7 @@ from companion.link import flight_messages
 from companion.link.codec import dialect as d
 from companion.link.flight_messages import landed_state, mission_current, nav_controller_output
 from companion.link.mode_messages import available_modes_monitor, current_mode
+from companion.link.rate_messages import attitude_target, highres_imu
 from companion.link.system_messages import (
     battery_status,
     distance_sensor,
@@ -306,6 +307,8 @@ STREAMS: dict[int, Stream] = {
         Stream("SERVO_OUTPUT_RAW", d.MAVLINK_MSG_ID_SERVO_OUTPUT_RAW, 2.0, _servo_output),
         Stream("RC_CHANNELS", d.MAVLINK_MSG_ID_RC_CHANNELS, 2.0, flight_messages.rc_channels),
         Stream("SCALED_IMU", d.MAVLINK_MSG_ID_SCALED_IMU, 2.0, _scaled_imu),
+        Stream("HIGHRES_IMU", d.MAVLINK_MSG_ID_HIGHRES_IMU, 0.0, highres_imu),
+        Stream("ATTITUDE_TARGET", d.MAVLINK_MSG_ID_ATTITUDE_TARGET, 0.0, attitude_target),
         Stream("EXTENDED_SYS_STATE", d.MAVLINK_MSG_ID_EXTENDED_SYS_STATE, 1.0, _extended_sys_state),
         Stream("MISSION_CURRENT", d.MAVLINK_MSG_ID_MISSION_CURRENT, 1.0, _mission_current),
         Stream(
