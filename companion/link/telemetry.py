@@ -66,6 +66,7 @@ class Snapshot:
     mission_seq: int = 0
     mission_total: int = 0
     mission_completed: bool = False  # flown to its end since it was stored
+    mission_paused: bool = False  # flown since it was stored, left before its end
     home: tuple[float, float, float] | None = None  # lat_deg, lon_deg, alt_msl_m
     health_cursor: int = 0  # PLUGIN_HEALTH sends one row at a time, round the table
     prearm_ok: bool | None = None  # the pre-arm checks pass (None: not judged yet)
@@ -222,7 +223,9 @@ def _extended_sys_state(mav: Any, s: Snapshot) -> Any:
 
 
 def _mission_current(mav: Any, s: Snapshot) -> Any:
-    return mission_current(mav, s.mission_seq, s.mission_total, s.control, s.mission_completed)
+    return mission_current(
+        mav, s.mission_seq, s.mission_total, s.control, s.mission_completed, s.mission_paused
+    )
 
 
 def _home_position(mav: Any, s: Snapshot) -> Any:
