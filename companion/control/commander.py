@@ -3,9 +3,9 @@
 Pure: commands and navigation in, decisions and a ``VehicleStatus`` out. The
 ``vehicle.commander`` plug-in wraps it; the link reports what it decides.
 Rules (as PX4 and ArduPilot have them): MISSION needs a stored mission; RTL needs a home;
-GUIDED and LOITER need a position (or a given point); LAND (PX4's Land, which a fixed
-wing flies as the mission's landing from its DO_LAND_START) needs a stored mission with a
-DO_LAND_START; home is the first valid position, and is set again at arming.
+GUIDED and LOITER need a position (or a given point); LAND (PX4's Land: the mission's
+landing from its DO_LAND_START, else back onto the take-off runway at home) needs one of
+the two; home is the first valid position, and is set again at arming.
 A reposition without a point (QGroundControl's Pause and Change altitude, PX4's
 DO_REPOSITION with NaN latitude/longitude) keeps the point being flown to, or circles here,
 at the altitude given (or the present one).
@@ -203,8 +203,8 @@ class Commander:
     def _enter(
         self, mode: FlightMode, point: tuple[float, ...] | None = None, radius: float = math.nan
     ) -> Decision:
-        if mode == FlightMode.LAND and not self.mission_lands():
-            return Decision(CommandResult.DENIED, "Land: the mission has no DO_LAND_START")
+        if mode == FlightMode.LAND and not self.mission_lands() and self.home is None:
+            return Decision(CommandResult.DENIED, "Land: no home runway yet, no mission landing")
         if mode == FlightMode.MISSION and self.mission_count() == 0:
             return Decision(CommandResult.DENIED, "Mission: no mission stored")
         if mode == FlightMode.RTL and self.home is None:

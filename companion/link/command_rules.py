@@ -123,6 +123,7 @@ RULES: dict[int, tuple[Param, ...]] = {
         *POINT,
     ),
     d.MAV_CMD_NAV_TAKEOFF: (Param(1, "pitch", -90, 90, optional=True), _yaw(4), *POINT),
+    d.MAV_CMD_NAV_LAND: (_yaw(4), *POINT),
     d.MAV_CMD_DO_ORBIT: (
         Param(1, "radius", -1e4, 1e4, optional=True),
         Param(2, "velocity", -1e3, 1e3, optional=True),
@@ -151,6 +152,7 @@ POSITION_COMMANDS = frozenset(
         d.MAV_CMD_NAV_LOITER_UNLIM,
         d.MAV_CMD_DO_SET_HOME,
         d.MAV_CMD_NAV_TAKEOFF,
+        d.MAV_CMD_NAV_LAND,
         d.MAV_CMD_DO_ORBIT,
     }
 )

@@ -189,10 +189,21 @@ def test_start_mission_then_every_in_flight_action(qgc):
     assert set_mode(gcs, FlightMode.MISSION) == m.MAV_RESULT_ACCEPTED
     shown(gcs, FlightMode.MISSION)
     # Land is never offered for a fixed wing; asked anyway, it lands the mission's landing
-    # from its DO_LAND_START, and this plan (the square) has none: refused with a reason.
-    assert set_mode(gcs, FlightMode.LAND) == m.MAV_RESULT_DENIED
-    assert "Land" in gcs.recv("STATUSTEXT", 3.0).text
-    assert status.get().mode == FlightMode.MISSION
+    # from its DO_LAND_START, and this plan (the square) has none: back on the runway at
+    # home (tests/sitl/test_mavsdk_land.py flies it).
+    assert set_mode(gcs, FlightMode.LAND) == m.MAV_RESULT_ACCEPTED
+    shown(gcs, FlightMode.LAND)
+    # MAVSDK's land() (NAV_LAND, no position) too; a point to land on is refused, said why.
+    gcs.command(m.MAV_CMD_NAV_LAND, NAN, NAN, NAN, NAN, FakeNav.LAT, FakeNav.LON, NAN)
+    said = [gcs.recv(["STATUSTEXT", "COMMAND_ACK"], 3.0)]  # the refusal's text comes first
+    while said[-1].get_type() != "COMMAND_ACK":
+        said.append(gcs.recv(["STATUSTEXT", "COMMAND_ACK"], 3.0))
+    assert said[-1].result == m.MAV_RESULT_DENIED
+    assert any("given point" in x.text for x in said[:-1]), [x.text for x in said[:-1]]
+    assert set_mode(gcs, FlightMode.MISSION) == m.MAV_RESULT_ACCEPTED
+    gcs.command(m.MAV_CMD_NAV_LAND, *[NAN] * 7)
+    assert gcs.ack(m.MAV_CMD_NAV_LAND).result == m.MAV_RESULT_ACCEPTED
+    settled(status, lambda s: s.mode == FlightMode.LAND, "landing")
     assert arm(gcs, False, force=True) == m.MAV_RESULT_ACCEPTED
 
 
