@@ -119,11 +119,13 @@ def test_qgroundcontrol_takeoff_change_altitude_and_go_to_fly(tmp_path):
 
 
 @pytest.mark.timeout(900)
-def test_qgc_custom_loiter_action_holds_the_height_it_is_sent_at(tmp_path):
-    """The shipped custom action "Loiter" (qgc/companion-actions.*.json): COMMAND_LONG
-    NAV_LOITER_UNLIM with every parameter 0. Read as 0 m above sea level it had the
-    aircraft descending from 99 m to 40 m above the ground in 20 s; now it circles here at
-    the height it had."""
+def test_qgc_custom_takeoff_and_loiter_actions_fly_and_hold_the_height(tmp_path):
+    """The shipped custom actions (qgc/companion-actions.*.json) send their command with
+    every parameter 0 (COMMAND_LONG). "Takeoff" (NAV_TAKEOFF), then the toolbar's Arm:
+    QGroundControl 4.4.5 greys out its own Takeoff for a fixed wing, and this takes off to
+    the return height (RTL_ALT_M, 100 m). "Loiter" (NAV_LOITER_UNLIM), read as 0 m above
+    sea level, had the aircraft descending from 99 m to 40 m above the ground in 20 s; now
+    it circles here at the height it had."""
     port = free_udp_port()
     proc, namespace, _truth = start_sim(
         tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "900"
@@ -133,11 +135,11 @@ def test_qgc_custom_loiter_action_holds_the_height_it_is_sent_at(tmp_path):
         home = qgc.conn.recv_match(type="HOME_POSITION", blocking=True, timeout=60)
         assert home is not None, "no home position"
         qgc.pump_until(lambda: qgc.position is not None, "a position")
-        takeoff = (-1, 0, 0, NAN, NAN, NAN, home.altitude / 1000.0 + 100.0)
-        assert qgc.command(d.MAV_CMD_NAV_TAKEOFF, *takeoff) == d.MAV_RESULT_ACCEPTED
+        assert qgc.command(d.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 0) == d.MAV_RESULT_ACCEPTED
+        qgc.pump_until(lambda: qgc.in_mode(FlightMode.TAKEOFF), "in Takeoff")
         arm = d.MAV_CMD_COMPONENT_ARM_DISARM
         qgc.pump_until(lambda: qgc.command(arm, 1, 0, 0, 0, 0, 0, 0) == 0, "armed")
-        qgc.pump_until(lambda: qgc.position.relative_alt > 95_000, "at the take-off height")
+        qgc.pump_until(lambda: qgc.position.relative_alt > 95_000, "at the return height")
         sent_at = qgc.position.relative_alt / 1000.0
         assert qgc.command(d.MAV_CMD_NAV_LOITER_UNLIM, 0, 0, 0, 0, 0, 0, 0) == 0
         qgc.pump_until(lambda: qgc.in_mode(FlightMode.LOITER), "in Hold (our Loiter)")
