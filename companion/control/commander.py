@@ -212,7 +212,7 @@ class Commander:
         if mode in (FlightMode.GUIDED, FlightMode.LOITER):
             target = self._target(point)
             if target is None:
-                name = "Go to" if mode == FlightMode.GUIDED else "Loiter"
+                name = "Go to" if mode == FlightMode.GUIDED else "Hold"
                 return Decision(CommandResult.DENIED, f"{name}: no position yet")
             self.target, self.radius = target, radius
         else:
