@@ -138,6 +138,10 @@ def _home_needs_a_point(args: CommandArgs) -> str | None:
         return None
     if any(math.isnan(v) for v in args.params[4:7]):
         return "param5-7 (home position) not given"
+    if args.params[4] == 0 and args.params[5] == 0:
+        # Every parameter 0 (a custom action, a default): read as a place, home would be in
+        # the Gulf of Guinea at sea level, and Return and the height floor would follow it.
+        return "param5-6 (home position) 0, 0 is no home"
     return None
 
 

@@ -9,6 +9,7 @@ import math
 from pymavlink.dialects.v20 import common as m
 
 from companion.control.commander import Commander
+from companion.link.command_rules import refusal
 from companion.link.commands import ModeCommands
 from companion.messages import (
     CommandId,
@@ -86,3 +87,12 @@ def test_the_link_reads_every_parameter_zero_as_here_at_the_present_altitude():
         handler(args(command))
         _, point = vehicle.published[0]
         assert all(math.isnan(v) for v in point[:3]), (command, point)
+
+
+def test_a_home_at_0_0_is_refused_as_every_parameter_0_sends_it():
+    """DO_SET_HOME sent with every parameter 0 would move home (and with it Return and the
+    height floor) to 0°, 0° at sea level; "use current" (param1 1) or a real point pass."""
+    home = m.MAV_CMD_DO_SET_HOME
+    assert "0, 0 is no home" in (refusal(args(home)) or "")
+    assert refusal(args(home, 1)) is None
+    assert refusal(args(home, 0, 0, 0, 0, HOME[0], HOME[1], HOME[2])) is None
