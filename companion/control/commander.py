@@ -3,12 +3,17 @@
 Pure: commands and navigation in, decisions and a ``VehicleStatus`` out. The
 ``vehicle.commander`` plug-in wraps it; the link reports what it decides.
 Rules (as PX4 and ArduPilot have them): MISSION needs a stored mission; RTL needs a home;
-GUIDED and LOITER need a position (or a given point); LAND (PX4's Land, which a fixed
-wing flies as the mission's landing from its DO_LAND_START) needs a stored mission with a
-DO_LAND_START; home is the first valid position, and is set again at arming.
+GUIDED and LOITER need a position (or a given point); LAND (PX4's Land: the mission's
+landing from its DO_LAND_START, else back onto the take-off runway at home) needs one of
+the two; home is the first valid position, and is set again at arming.
 A reposition without a point (QGroundControl's Pause and Change altitude, PX4's
 DO_REPOSITION with NaN latitude/longitude) keeps the point being flown to, or circles here,
 at the altitude given (or the present one).
+
+No command sends the aircraft below a safe height (``GUIDED_ALT_MIN`` above home: the
+vehicle has no terrain data, so home's height stands for the ground's). A target given
+under it is refused with the reason; a target without an altitude is flown at the present
+altitude, or at that minimum if the aircraft is lower.
 """
 
 from __future__ import annotations
@@ -31,8 +36,15 @@ from companion.messages import (
     VehicleCommand,
     VehicleStatus,
 )
+from companion.params import ParamDecl
 
 MAX_RADIUS_M = 10_000.0  # an orbit wider than this is a mistake, not a plan
+MIN_ALT_PARAM = "GUIDED_ALT_MIN"
+COMMANDER_PARAMS = (
+    ParamDecl(MIN_ALT_PARAM, 30.0, 0.0, 1000.0, "m",
+              "least height above home a command may send the aircraft to (go to, hold, "
+              "change altitude, orbit, take-off)"),
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -73,10 +85,14 @@ class Commander:
     ``mission_lands`` whether the stored mission has a DO_LAND_START."""
 
     def __init__(
-        self, mission_count: Callable[[], int], mission_lands: Callable[[], bool] = lambda: False
+        self,
+        mission_count: Callable[[], int],
+        mission_lands: Callable[[], bool] = lambda: False,
+        min_height: Callable[[], float] = lambda: COMMANDER_PARAMS[0].default,
     ) -> None:
         self.mission_count = mission_count
         self.mission_lands = mission_lands
+        self.min_height = min_height
         self.mode = INITIAL_MODE
         self.armed = False
         self.home: tuple[float, float, float] | None = None
@@ -157,10 +173,29 @@ class Commander:
         radius = p[3] if kind == CommandId.ORBIT else math.nan
         if not (math.isnan(radius) or 0 < abs(radius) <= MAX_RADIUS_M):
             return Decision(CommandResult.DENIED, "Orbit: radius out of range")
+        names = {CommandId.REPOSITION: "Go to", CommandId.LOITER: "Hold"}
+        low = self._too_low(names.get(kind, "Orbit"), p[2])
+        if low is not None:
+            return low
         if kind == CommandId.REPOSITION and math.isnan(p[0]) and math.isnan(p[1]):
             return self._pause(p[2])
         mode = FlightMode.GUIDED if kind == CommandId.REPOSITION else FlightMode.LOITER
         return self._enter(mode, (p[0], p[1], p[2]), abs(radius))
+
+    def floor(self) -> float:
+        """The least altitude (AMSL) a command may ask for; -inf before there is a home."""
+        if self.home is None:
+            return -math.inf
+        return self.home[2] + max(0.0, self.min_height())
+
+    def _too_low(self, what: str, alt: float) -> Decision | None:
+        """Refuse an altitude under the floor (NaN: not given, never too low)."""
+        if not alt < self.floor():
+            return None
+        assert self.home is not None
+        height, least = alt - self.home[2], self.floor() - self.home[2]
+        reason = f"{what}: {height:.0f} m above home is below {MIN_ALT_PARAM} {least:.0f} m"
+        return Decision(CommandResult.DENIED, reason)
 
     def _pause(self, alt: float) -> Decision:
         """Keep flying to (or circling) the present point, else circle here; new height."""
@@ -172,6 +207,9 @@ class Commander:
     def _takeoff(self, alt: float) -> Decision:
         if not math.isnan(alt) and not (math.isfinite(alt) and abs(alt) <= MAX_ALT_M):
             return Decision(CommandResult.DENIED, "Takeoff: altitude out of range")
+        low = self._too_low("Takeoff", alt)
+        if low is not None:
+            return low
         decision = self._enter(FlightMode.TAKEOFF)
         if decision.result == CommandResult.ACCEPTED:
             self.target = (math.nan, math.nan, alt)
@@ -184,8 +222,8 @@ class Commander:
     def _enter(
         self, mode: FlightMode, point: tuple[float, ...] | None = None, radius: float = math.nan
     ) -> Decision:
-        if mode == FlightMode.LAND and not self.mission_lands():
-            return Decision(CommandResult.DENIED, "Land: the mission has no DO_LAND_START")
+        if mode == FlightMode.LAND and not self.mission_lands() and self.home is None:
+            return Decision(CommandResult.DENIED, "Land: no home runway yet, no mission landing")
         if mode == FlightMode.MISSION and self.mission_count() == 0:
             return Decision(CommandResult.DENIED, "Mission: no mission stored")
         if mode == FlightMode.RTL and self.home is None:
@@ -193,7 +231,7 @@ class Commander:
         if mode in (FlightMode.GUIDED, FlightMode.LOITER):
             target = self._target(point)
             if target is None:
-                name = "Go to" if mode == FlightMode.GUIDED else "Loiter"
+                name = "Go to" if mode == FlightMode.GUIDED else "Hold"
                 return Decision(CommandResult.DENIED, f"{name}: no position yet")
             self.target, self.radius = target, radius
         else:
@@ -206,12 +244,17 @@ class Commander:
 
     def _target(self, point: tuple[float, ...] | None) -> tuple[float, float, float] | None:
         here = self.position
+        # No altitude given: the present one, but never under the floor (a hold asked for
+        # just after take-off circles at the safe height, not at 10 m).
+        present = max(here[2], self.floor()) if here is not None else math.nan
         if point is not None and math.isfinite(point[0]) and math.isfinite(point[1]):
-            alt = point[2] if math.isfinite(point[2]) else (here[2] if here else math.nan)
+            alt = point[2] if math.isfinite(point[2]) else present
             return (point[0], point[1], alt)
-        if here is not None and point is not None and math.isfinite(point[2]):
+        if here is None:
+            return None
+        if point is not None and math.isfinite(point[2]):
             return (here[0], here[1], point[2])  # here, at the height asked for
-        return here
+        return (here[0], here[1], present)
 
     def _set_home(self, p: list[float]) -> Decision:
         if _whole(p[0], 0) == 1:

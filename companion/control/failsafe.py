@@ -139,9 +139,13 @@ class Failsafes:
         if self.gcs_lost and not silent:
             self.gcs_lost = False
             resume = p["FS_GCS_RESUME"] >= 0.5 and self.mode_before_gcs == FlightMode.MISSION
+            # Good news at NOTICE: QGroundControl shows CRITICAL and worse as a "Vehicle
+            # Error" banner, which had announced the resumed mission as a fault.
+            notice = d.MAV_SEVERITY_NOTICE
             if resume and s.mode == FlightMode.RTL and s.flying:
-                return [Action(FlightMode.MISSION, "Ground station back: resuming the mission")]
-            return [Action(None, "Ground station back", d.MAV_SEVERITY_NOTICE)]
+                back = "Ground station back: resuming the mission"
+                return [Action(FlightMode.MISSION, back, notice)]
+            return [Action(None, "Ground station back", notice)]
         return []
 
     def _gps(self, s: Situation) -> list[Action]:

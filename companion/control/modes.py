@@ -8,20 +8,32 @@ the one that offers every guided action for a fixed wing (Takeoff, Start/Continu
 Pause, Return, Go to, Change altitude, Orbit; src/FirmwarePlugin/PX4/PX4FirmwarePlugin.cc,
 isCapable); its ArduPilot plug-in offers no take-off for a plane and its generic one no
 guided action at all. Every mode has a custom_mode of its own: the PX4 ones QGroundControl
-(both 4.4 and 5), MAVSDK and MAVProxy already name (Loiter is PX4's "Hold", MAVProxy's
+(both 4.4 and 5), MAVSDK and MAVProxy already name (our Loiter is PX4's "Hold", MAVProxy's
 LOITER), and Guided, which PX4 has no built-in mode for, is PX4's first *external* mode
 (AUTO, sub mode 11): the slot PX4 gives a mode that a companion computer adds, named by
-AVAILABLE_MODES (QGroundControl 5 shows "Guided"; a 4.4 release build does not read
-AVAILABLE_MODES and shows it as "Unknown").
+AVAILABLE_MODES ("Guided" in QGroundControl 4.4.5 and 5).
 
 The modes a pilot flies from the sticks are PX4's fixed-wing ones, because QGroundControl
 4.4 offers every one of them from its own fixed table whatever the vehicle says:
 Manual, Stabilized, Altitude, Position, Acro and Rattitude (PILOT_MODES).
 
-Standard modes: only the ones that mean what we fly, as PX4 reports its fixed-wing modes
-(Mission, Return = SAFE_RECOVERY, Take-off, Land, Altitude = ALTITUDE_HOLD, Position =
-CRUISE: the track held against the wind); our Loiter is automatic, not MAVLink's
-pilot-driven ORBIT (which QGroundControl 5 would also rename "Orbit").
+Names are the ones QGroundControl's PX4 plug-in asks for by name from its buttons in 4.4
+(src/FirmwarePlugin/PX4/PX4FirmwarePlugin.cc: Pause and Go to ask for "Hold", Return for
+"Return", Start Mission for "Mission", Land for "Land", Takeoff for "Takeoff", Take
+control for "Manual"). QGroundControl 4.4.5 reads AVAILABLE_MODES and, once it has them,
+looks every name up in that list alone (src/Vehicle/StandardModes.cc, setFlightMode),
+renaming a mode that carries a standard mode after the standard mode (SAFE_RECOVERY
+"Safe Recovery", CRUISE "Cruise", ALTITUDE_HOLD "Altitude", MISSION "Mission", LAND
+"Land", TAKEOFF "Takeoff"); QGroundControl 5 looks its buttons' modes up by PX4's
+custom_mode instead, so the numbers must be PX4's. Hence our Loiter is named "Hold" (the
+ArduPlane and MAVProxy name, LOITER, stays by number), and Return carries no standard
+mode: with SAFE_RECOVERY, 4.4.5's Return button asked for a "Return" it could not find.
+DO_SET_STANDARD_MODE SAFE_RECOVERY is still flown as Return.
+
+Standard modes otherwise as PX4 reports its fixed-wing modes (Mission, Take-off, Land,
+Altitude = ALTITUDE_HOLD, Position = CRUISE: the track held against the wind; QGroundControl
+4.4.5 shows it as "Cruise"); our Hold is automatic, not MAVLink's pilot-driven ORBIT
+(which QGroundControl would also rename "Orbit").
 
 ``decode_set_mode`` reads DO_SET_MODE / SET_MODE in either encoding:
 1. a full 32-bit PX4 custom_mode (≥ 65536) → PX4;
@@ -94,10 +106,11 @@ MODES: tuple[ModeInfo, ...] = (
              NO_ARDUPLANE, _NONE, _STAB | _PILOT),
     ModeInfo(FlightMode.MISSION, "Mission", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_MISSION), 10,
              d.MAV_STANDARD_MODE_MISSION, _STAB | _AUTO),
-    ModeInfo(FlightMode.LOITER, "Loiter", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_LOITER), 12,
+    ModeInfo(FlightMode.LOITER, "Hold", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_LOITER), 12,
              _NONE, _STAB | _AUTO),
+    # Not SAFE_RECOVERY: QGroundControl 4.4 would rename it "Safe Recovery" (see above).
     ModeInfo(FlightMode.RTL, "Return", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_RTL), 11,
-             d.MAV_STANDARD_MODE_SAFE_RECOVERY, _STAB | _AUTO),
+             _NONE, _STAB | _AUTO),
     ModeInfo(FlightMode.GUIDED, "Guided", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_EXTERNAL1), 15,
              _NONE, _STAB | d.MAV_MODE_FLAG_GUIDED_ENABLED),
     ModeInfo(FlightMode.TAKEOFF, "Takeoff", px4_custom_mode(PX4_MAIN_AUTO, PX4_SUB_TAKEOFF), 13,
@@ -116,6 +129,7 @@ _ARDUPLANE = {m.arduplane: m.mode for m in MODES if m.arduplane != NO_ARDUPLANE}
 _PX4 = {m.px4: m.mode for m in MODES}
 _STANDARD = {m.standard: m.mode for m in MODES if m.standard != d.MAV_STANDARD_MODE_NON_STANDARD}
 _STANDARD[d.MAV_STANDARD_MODE_ORBIT] = FlightMode.LOITER  # the nearest we fly
+_STANDARD[d.MAV_STANDARD_MODE_SAFE_RECOVERY] = FlightMode.RTL  # asked for, still flown
 
 
 def from_px4(main: int, sub: int) -> FlightMode | None:

@@ -126,6 +126,7 @@ RULES: dict[int, tuple[Param, ...]] = {
         *POINT,
     ),
     d.MAV_CMD_NAV_TAKEOFF: (Param(1, "pitch", -90, 90, optional=True), _yaw(4), *POINT),
+    d.MAV_CMD_NAV_LAND: (_yaw(4), *POINT),
     d.MAV_CMD_DO_ORBIT: (
         Param(1, "radius", -1e4, 1e4, optional=True),
         Param(2, "velocity", -1e3, 1e3, optional=True),
@@ -140,6 +141,10 @@ def _home_needs_a_point(args: CommandArgs) -> str | None:
         return None
     if any(math.isnan(v) for v in args.params[4:7]):
         return "param5-7 (home position) not given"
+    if args.params[4] == 0 and args.params[5] == 0:
+        # Every parameter 0 (a custom action, a default): read as a place, home would be in
+        # the Gulf of Guinea at sea level, and Return and the height floor would follow it.
+        return "param5-6 (home position) 0, 0 is no home"
     return None
 
 
@@ -154,6 +159,7 @@ POSITION_COMMANDS = frozenset(
         d.MAV_CMD_NAV_LOITER_UNLIM,
         d.MAV_CMD_DO_SET_HOME,
         d.MAV_CMD_NAV_TAKEOFF,
+        d.MAV_CMD_NAV_LAND,
         d.MAV_CMD_DO_ORBIT,
     }
 )

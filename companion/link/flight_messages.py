@@ -37,16 +37,23 @@ def nav_controller_output(mav: Any, c: ControlStatus | None) -> Any:
 
 
 def mission_current(
-    mav: Any, stored_seq: int, total: int, c: ControlStatus | None, completed: bool = False
+    mav: Any,
+    stored_seq: int,
+    total: int,
+    c: ControlStatus | None,
+    completed: bool = False,
+    paused: bool = False,
 ) -> Any:
     """MISSION_CURRENT: the executor's item and state while it runs, else the stored one
-    (complete at its last item once it was flown to the end)."""
+    (complete at its last item once it was flown to the end; paused at the item it was
+    at once it was flown and left, as PX4 and ArduPilot keep it)."""
     if total == 0:
         return mav.mission_current_encode(stored_seq, 0, d.MISSION_STATE_NO_MISSION)
     if c is None and completed:
         return mav.mission_current_encode(total - 1, total, d.MISSION_STATE_COMPLETE)
     if c is None or c.mission_state == MissionState.NOT_STARTED:
-        return mav.mission_current_encode(stored_seq, total, d.MISSION_STATE_NOT_STARTED)
+        state = d.MISSION_STATE_PAUSED if paused else d.MISSION_STATE_NOT_STARTED
+        return mav.mission_current_encode(stored_seq, total, state)
     seq = max(0, min(int(c.mission_seq), total - 1))
     return mav.mission_current_encode(seq, total, int(c.mission_state))
 

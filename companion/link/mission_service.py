@@ -74,6 +74,9 @@ class MissionService:
         # The stored mission was flown to its end: MISSION_CURRENT says so after the flight
         # controller stops (landed and disarmed), as PX4's does, until the mission changes.
         self.completed = False
+        # Flown since it was stored and left before its end: MISSION_CURRENT keeps the item
+        # it was at (PAUSED), as PX4 and ArduPilot do, where it had fallen back to item 0.
+        self.paused = False
         self.refused = 0
         self.rejected_target = 0  # for another component of this system
         self.verdicts = PlanVerdicts()  # the pre-arm checks' view of the stored plans
@@ -204,14 +207,18 @@ class MissionService:
         self.refused += 1
         return [Outgoing(self.mission_current(), peer)]
 
-    def follow(self, mission_state: int) -> None:
-        """The flight controller's MissionState of the stored mission, while it runs."""
+    def follow(self, mission_state: int, seq: int = -1) -> None:
+        """The flight controller's MissionState of the stored mission and its item, while
+        it runs: the item it flies becomes the current one."""
+        if mission_state == MissionState.ACTIVE and 0 <= seq < len(self.store.items[0]):
+            self.current, self.paused = seq, True
         if mission_state != MissionState.NOT_STARTED:
             self.completed = mission_state == MissionState.COMPLETE
+            self.paused = self.paused and not self.completed
 
     def _changed(self, mission_type: int) -> None:
         if mission_type == 0:
-            self.completed = False
+            self.completed = self.paused = False
         self.on_change(mission_type)
 
     def mission_current(self) -> Any:

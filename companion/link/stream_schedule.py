@@ -13,6 +13,11 @@ from companion.link.codec import dialect as d
 from companion.link.telemetry import STREAMS
 
 NAV_HOLD_S = 0.05  # two and a half navigation periods at 50 Hz
+# The most any stream is served at: a rate asked beyond it (MAVSDK's highres_imu example
+# asks 200 Hz) is accepted and served at this one, which GET_MESSAGE_INTERVAL and the
+# MESSAGE_INTERVAL sent with the ack report, as PX4 does. Twice the navigator's 50 Hz,
+# and QGroundControl's tuning pages' 100 Hz: more would repeat the same samples.
+MAX_RATE_HZ = 100.0
 FOLLOWS_NAV = frozenset(
     (
         d.MAVLINK_MSG_ID_ATTITUDE,
@@ -45,7 +50,8 @@ class StreamSchedule:
         self.last_sent = dict.fromkeys(STREAMS, 0.0)
 
     def set_interval(self, msg_id: int, interval_us: float) -> bool:
-        """MAV_CMD_SET_MESSAGE_INTERVAL semantics: -1 off, 0 default, else µs."""
+        """MAV_CMD_SET_MESSAGE_INTERVAL semantics: -1 off, 0 default, else µs (at most
+        ``MAX_RATE_HZ``). False for a message the vehicle cannot send at all."""
         if msg_id not in STREAMS:
             return False
         if interval_us < 0:
@@ -53,7 +59,7 @@ class StreamSchedule:
         elif interval_us == 0:
             self.period_s[msg_id] = _default_period(msg_id)
         else:
-            self.period_s[msg_id] = interval_us / 1e6
+            self.period_s[msg_id] = max(interval_us / 1e6, 1.0 / MAX_RATE_HZ)
         self.next_due[msg_id] = 0.0
         return True
 

@@ -15,6 +15,7 @@ from companion.link import flight_messages
 from companion.link.codec import dialect as d
 from companion.link.flight_messages import landed_state, mission_current, nav_controller_output
 from companion.link.mode_messages import available_modes_monitor, current_mode
+from companion.link.rate_messages import attitude_target, highres_imu
 from companion.link.system_messages import (
     battery_status,
     distance_sensor,
@@ -73,6 +74,7 @@ class Snapshot:
     mission_seq: int = 0
     mission_total: int = 0
     mission_completed: bool = False  # flown to its end since it was stored
+    mission_paused: bool = False  # flown since it was stored, left before its end
     home: tuple[float, float, float] | None = None  # lat_deg, lon_deg, alt_msl_m
     health_cursor: int = 0  # PLUGIN_HEALTH sends one row at a time, round the table
     prearm_ok: bool | None = None  # the pre-arm checks pass (None: not judged yet)
@@ -234,7 +236,9 @@ def _extended_sys_state(mav: Any, s: Snapshot) -> Any:
 
 
 def _mission_current(mav: Any, s: Snapshot) -> Any:
-    return mission_current(mav, s.mission_seq, s.mission_total, s.control, s.mission_completed)
+    return mission_current(
+        mav, s.mission_seq, s.mission_total, s.control, s.mission_completed, s.mission_paused
+    )
 
 
 def _home_position(mav: Any, s: Snapshot) -> Any:
@@ -319,6 +323,8 @@ STREAMS: dict[int, Stream] = {
         Stream("SERVO_OUTPUT_RAW", d.MAVLINK_MSG_ID_SERVO_OUTPUT_RAW, 2.0, _servo_output),
         Stream("RC_CHANNELS", d.MAVLINK_MSG_ID_RC_CHANNELS, 2.0, flight_messages.rc_channels),
         Stream("SCALED_IMU", d.MAVLINK_MSG_ID_SCALED_IMU, 2.0, _scaled_imu),
+        Stream("HIGHRES_IMU", d.MAVLINK_MSG_ID_HIGHRES_IMU, 0.0, highres_imu),
+        Stream("ATTITUDE_TARGET", d.MAVLINK_MSG_ID_ATTITUDE_TARGET, 0.0, attitude_target),
         Stream("EXTENDED_SYS_STATE", d.MAVLINK_MSG_ID_EXTENDED_SYS_STATE, 1.0, _extended_sys_state),
         Stream("MISSION_CURRENT", d.MAVLINK_MSG_ID_MISSION_CURRENT, 1.0, _mission_current),
         Stream(

@@ -63,7 +63,7 @@ def test_modes_are_listed_and_reported(station):
     selectable = {
         x.mode_name for x in listed if not x.properties & m.MAV_MODE_PROPERTY_NOT_USER_SELECTABLE
     }
-    assert "Land" not in selectable and {"Loiter", "Guided", "Return", "Mission"} <= selectable
+    assert "Land" not in selectable and {"Hold", "Guided", "Return", "Mission"} <= selectable
     mission = 1 + [info.mode for info in MODES].index(FlightMode.MISSION)
     gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AVAILABLE_MODES, mission)  # QGC 5.0
     assert gcs.recv("AVAILABLE_MODES", 3.0, mode_index=mission).mode_name == "Mission"

@@ -120,7 +120,9 @@ def test_first_heartbeat_names_a_mode_and_qgc5_reads_every_mode(qgc):
     # custom_modes and takes ours for the rest: Guided must not collide with any of them.
     assert guided.custom_mode not in {x.custom_mode for x in modes if x is not guided}
     assert guided.standard_mode == m.MAV_STANDARD_MODE_NON_STANDARD  # keeps its own name
-    assert by_name["Return"].standard_mode == m.MAV_STANDARD_MODE_SAFE_RECOVERY
+    # Not SAFE_RECOVERY: QGroundControl 4.4.5 would name it "Safe Recovery" and its Return
+    # button, asking for "Return", would find nothing (tests/protocol/test_qgc_mode_lookup.py).
+    assert by_name["Return"].standard_mode == m.MAV_STANDARD_MODE_NON_STANDARD
 
 
 def test_takeoff_then_arm_as_qgroundcontrol_does(qgc):
@@ -151,25 +153,31 @@ def test_start_mission_then_every_in_flight_action(qgc):
     here = settled(status, lambda s: s.mode == FlightMode.LOITER, "paused")
     assert (here.target_lat_deg, here.target_lon_deg) == pytest.approx((FakeNav.LAT, FakeNav.LON))
     # Change altitude: the same circle, 30 m higher.
-    assert reposition(gcs, NAN, NAN, FakeNav.ALT + 30.0) == m.MAV_RESULT_ACCEPTED
-    higher = settled(status, lambda s: s.target_alt_msl_m == FakeNav.ALT + 30.0, "climbing")
+    assert reposition(gcs, NAN, NAN, FakeNav.ALT + 70.0) == m.MAV_RESULT_ACCEPTED
+    higher = settled(status, lambda s: s.target_alt_msl_m == FakeNav.ALT + 70.0, "climbing")
     assert higher.mode == FlightMode.LOITER
     assert higher.target_lat_deg == pytest.approx(FakeNav.LAT)
-    # Go to location (a click on the map): Guided, its own mode and name.
+    # Go to location (a click on the map): Guided, its own mode and name. QGroundControl
+    # sends the vehicle's present altitude: on the stand-in's ground, under the floor
+    # (GUIDED_ALT_MIN above home), so refused with the reason; in flight, accepted.
     lat, lon = FakeNav.LAT + 0.004, FakeNav.LON + 0.003
+    low = command_int(gcs, m.MAV_CMD_DO_REPOSITION, -1, CHANGE_MODE, 0, NAN,
+                      lat=lat, lon=lon, alt=FakeNav.ALT)  # fmt: skip
+    assert low == m.MAV_RESULT_DENIED
+    assert "below GUIDED_ALT_MIN" in gcs.recv("STATUSTEXT", 3.0).text
     go = command_int(gcs, m.MAV_CMD_DO_REPOSITION, -1, CHANGE_MODE, 0, NAN,
-                     lat=lat, lon=lon, alt=FakeNav.ALT)  # fmt: skip
+                     lat=lat, lon=lon, alt=FakeNav.ALT + 80.0)  # fmt: skip
     assert go == m.MAV_RESULT_ACCEPTED
     shown(gcs, FlightMode.GUIDED)
     there = settled(status, lambda s: s.mode == FlightMode.GUIDED, "going")
     assert (there.target_lat_deg, there.target_lon_deg) == pytest.approx((lat, lon))
     # Change altitude on the way: still going there, at the new height.
-    assert reposition(gcs, NAN, NAN, FakeNav.ALT + 10.0) == m.MAV_RESULT_ACCEPTED
-    going = settled(status, lambda s: s.target_alt_msl_m == FakeNav.ALT + 10.0, "lower")
+    assert reposition(gcs, NAN, NAN, FakeNav.ALT + 50.0) == m.MAV_RESULT_ACCEPTED
+    going = settled(status, lambda s: s.target_alt_msl_m == FakeNav.ALT + 50.0, "lower")
     assert going.mode == FlightMode.GUIDED and going.target_lat_deg == pytest.approx(lat)
     # Orbit: circle that point at the radius asked for.
     orbit = command_int(gcs, m.MAV_CMD_DO_ORBIT, 150.0, NAN, NAN, NAN,
-                        lat=lat, lon=lon, alt=FakeNav.ALT + 20.0)  # fmt: skip
+                        lat=lat, lon=lon, alt=FakeNav.ALT + 60.0)  # fmt: skip
     assert orbit == m.MAV_RESULT_ACCEPTED
     shown(gcs, FlightMode.LOITER)
     assert (
@@ -181,10 +189,21 @@ def test_start_mission_then_every_in_flight_action(qgc):
     assert set_mode(gcs, FlightMode.MISSION) == m.MAV_RESULT_ACCEPTED
     shown(gcs, FlightMode.MISSION)
     # Land is never offered for a fixed wing; asked anyway, it lands the mission's landing
-    # from its DO_LAND_START, and this plan (the square) has none: refused with a reason.
-    assert set_mode(gcs, FlightMode.LAND) == m.MAV_RESULT_DENIED
-    assert "Land" in gcs.recv("STATUSTEXT", 3.0).text
-    assert status.get().mode == FlightMode.MISSION
+    # from its DO_LAND_START, and this plan (the square) has none: back on the runway at
+    # home (tests/sitl/test_mavsdk_land.py flies it).
+    assert set_mode(gcs, FlightMode.LAND) == m.MAV_RESULT_ACCEPTED
+    shown(gcs, FlightMode.LAND)
+    # MAVSDK's land() (NAV_LAND, no position) too; a point to land on is refused, said why.
+    gcs.command(m.MAV_CMD_NAV_LAND, NAN, NAN, NAN, NAN, FakeNav.LAT, FakeNav.LON, NAN)
+    said = [gcs.recv(["STATUSTEXT", "COMMAND_ACK"], 3.0)]  # the refusal's text comes first
+    while said[-1].get_type() != "COMMAND_ACK":
+        said.append(gcs.recv(["STATUSTEXT", "COMMAND_ACK"], 3.0))
+    assert said[-1].result == m.MAV_RESULT_DENIED
+    assert any("given point" in x.text for x in said[:-1]), [x.text for x in said[:-1]]
+    assert set_mode(gcs, FlightMode.MISSION) == m.MAV_RESULT_ACCEPTED
+    gcs.command(m.MAV_CMD_NAV_LAND, *[NAN] * 7)
+    assert gcs.ack(m.MAV_CMD_NAV_LAND).result == m.MAV_RESULT_ACCEPTED
+    settled(status, lambda s: s.mode == FlightMode.LAND, "landing")
     assert arm(gcs, False, force=True) == m.MAV_RESULT_ACCEPTED
 
 

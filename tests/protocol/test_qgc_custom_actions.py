@@ -86,8 +86,10 @@ def load_qgc5(path: Path) -> list[tuple[str, int, int, tuple[float, ...]]]:
 
 
 EXPECTED = {
+    "Takeoff": FlightMode.TAKEOFF,  # 4.4.5 greys out its own Takeoff for a fixed wing
     "Start Mission": FlightMode.MISSION,
     "Return": FlightMode.RTL,
+    "Land": FlightMode.LAND,  # neither version offers its own Land for a fixed wing
     "Loiter": FlightMode.LOITER,
     "Stabilized": FlightMode.STABILIZED,
 }

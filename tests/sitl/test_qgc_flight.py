@@ -116,3 +116,44 @@ def test_qgroundcontrol_takeoff_change_altitude_and_go_to_fly(tmp_path):
         proc.terminate()
         finish(proc, namespace, 60)
         qgc.conn.close()
+
+
+@pytest.mark.timeout(900)
+def test_qgc_custom_takeoff_and_loiter_actions_fly_and_hold_the_height(tmp_path):
+    """The shipped custom actions (qgc/companion-actions.*.json) send their command with
+    every parameter 0 (COMMAND_LONG). "Takeoff" (NAV_TAKEOFF), then the toolbar's Arm:
+    QGroundControl 4.4.5 greys out its own Takeoff for a fixed wing, and this takes off to
+    the return height (RTL_ALT_M, 100 m). "Loiter" (NAV_LOITER_UNLIM), read as 0 m above
+    sea level, had the aircraft descending from 99 m to 40 m above the ground in 20 s; now
+    it circles here at the height it had."""
+    port = free_udp_port()
+    proc, namespace, _truth = start_sim(
+        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "900"
+    )
+    qgc = Qgc(port)
+    try:
+        home = qgc.conn.recv_match(type="HOME_POSITION", blocking=True, timeout=60)
+        assert home is not None, "no home position"
+        qgc.pump_until(lambda: qgc.position is not None, "a position")
+        assert qgc.command(d.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 0) == d.MAV_RESULT_ACCEPTED
+        qgc.pump_until(lambda: qgc.in_mode(FlightMode.TAKEOFF), "in Takeoff")
+        arm = d.MAV_CMD_COMPONENT_ARM_DISARM
+        qgc.pump_until(lambda: qgc.command(arm, 1, 0, 0, 0, 0, 0, 0) == 0, "armed")
+        qgc.pump_until(lambda: qgc.position.relative_alt > 95_000, "at the return height")
+        sent_at = qgc.position.relative_alt / 1000.0
+        assert qgc.command(d.MAV_CMD_NAV_LOITER_UNLIM, 0, 0, 0, 0, 0, 0, 0) == 0
+        qgc.pump_until(lambda: qgc.in_mode(FlightMode.LOITER), "in Hold (our Loiter)")
+        start_ms, lowest = qgc.position.time_boot_ms, sent_at
+
+        def watched() -> bool:
+            nonlocal lowest
+            lowest = min(lowest, qgc.position.relative_alt / 1000.0)
+            return qgc.position.time_boot_ms - start_ms > 40_000
+
+        qgc.pump_until(watched, "40 s in Hold")
+        assert qgc.in_mode(FlightMode.LOITER)
+        assert lowest > sent_at - 10.0, (sent_at, lowest)
+    finally:
+        proc.terminate()
+        finish(proc, namespace, 60)
+        qgc.conn.close()

@@ -200,6 +200,7 @@ class FlightController(LandingFlight, PilotFlight):
         key = (int(mode), int(status.changes))
         entered = key != self._mode_key
         self._mode_key = key
+        self._leave_home_landing(mode)
         if mode == FlightMode.MISSION:
             return self._mission(status, pos, nav, t_s, entered, out)
         if mode in (FlightMode.RTL, FlightMode.LAND) and (not self.landed or self.landing):
@@ -294,7 +295,7 @@ class FlightController(LandingFlight, PilotFlight):
         out: ControlOutput,
     ) -> ControlOutput:
         if self.takeoff is None:
-            self.takeoff = RunwayTakeoff(pos, nav.yaw_rad, self.home_alt)
+            self.takeoff = self.runway = RunwayTakeoff(pos, nav.yaw_rad, self.home_alt)
             self.attitude.reset()
         to = self.takeoff
         demand = to.step(pos, nav.alt_msl_m, nav.yaw_rad, nav.yaw_rate_rad_s, airspeed, self.config)

@@ -1,6 +1,6 @@
 """How the flight controller flies a landing: the glide by the energy controller, the flare
-and rollout by attitude, a go-around and its second approach, and Return ending in a
-landing (ArduPlane's ``RTL_AUTOLAND``).
+and rollout by attitude, a go-around and its second approach, Return ending in a landing
+(ArduPlane's ``RTL_AUTOLAND``), and Land without a landing in the mission (``home_landing``).
 
 A mix-in of ``FlightController`` (companion/control/flight/controller.py), kept apart so
 each file stays one subject; the landing itself is ``Landing`` (landing.py).
@@ -23,9 +23,15 @@ from mavlink_dialect import companion as d
 if TYPE_CHECKING:
     from companion.control.flight.controller import FlightController
     from companion.control.flight.output import ControlOutput
+    from companion.control.flight.takeoff import RunwayTakeoff
+    from companion.geodesy import LocalFrame
 
 FLARE_PITCH_GAIN = 2.5
 GO_AROUND_MARGIN_M = 5.0  # this close to the go-around height: come round again
+# Land without a landing in the mission: QGroundControl's fixed-wing landing pattern, as
+# the benchmark plans fly it (a loiter down to 50 m, 800 m out, left on the tangent).
+HOME_APPROACH_M, HOME_APPROACH_AGL_M, HOME_LOITER_RADIUS_M = 800.0, 50.0, 250.0
+HOME_TOUCHDOWN_M = 100.0  # down the runway from where the take-off roll began
 
 
 def land_start(items: list[MissionItem]) -> int | None:
@@ -45,12 +51,33 @@ def approach_start(items: list[MissionItem], land_index: int) -> int:
     return land_index
 
 
+def home_landing(frame: LocalFrame, base: tuple[float, float], heading: float) -> list[MissionItem]:
+    """The landing pattern onto a runway: touchdown ``HOME_TOUCHDOWN_M`` from ``base`` (m
+    north and east of home) along ``heading``, the loiter down to its right, clockwise."""
+    un, ue = math.cos(heading), math.sin(heading)
+    touchdown = (base[0] + HOME_TOUCHDOWN_M * un, base[1] + HOME_TOUCHDOWN_M * ue)
+    back, side = HOME_APPROACH_M, HOME_LOITER_RADIUS_M
+    centre = (touchdown[0] - back * un - side * ue, touchdown[1] - back * ue + side * un)
+
+    def item(seq: int, command: int, point: tuple[float, float], agl: float, *p: float):
+        lat, lon = frame.latlon(*point)
+        return MissionItem(seq, d.MAV_FRAME_GLOBAL_RELATIVE_ALT, command, 0, 1, *p,
+                           round(lat * 1e7), round(lon * 1e7), agl)  # fmt: skip
+
+    return [
+        item(0, d.MAV_CMD_NAV_LOITER_TO_ALT, centre, HOME_APPROACH_AGL_M, 1.0, side, 0.0, 1.0),
+        item(1, d.MAV_CMD_NAV_LAND, touchdown, 0.0, 0.0, 0.0, 0.0, math.nan),
+    ]
+
+
 class LandingFlight:
     """The landing half of the flight controller (see the module's docstring)."""
 
     # The rangefinder's newest reading, set by whoever steps the controller (None: none).
     range_reading: RangeReading | None = None
     range_steps = 0  # landing steps that flew on the rangefinder's height
+    runway: RunwayTakeoff | None = None  # this flight's take-off roll, kept after the climb
+    landing_home = False  # the executor flies ``home_landing``, not the stored mission
 
     def _fly_landing(
         self: FlightController,
@@ -85,7 +112,7 @@ class LandingFlight:
                 weight = self.config["TECS_LAND_SPDWGT"]
                 self.tecs.gains = replace(self.config.tecs, speed_weight=weight)
             return self._fly(line, pos, vel, nav, airspeed, dt, out, dem.speed, dem.climb_ff)
-        if dem.disarm and self.executor is not None:
+        if dem.disarm and self.executor is not None and not self.landing_home:
             self.executor.land_complete()
             out.mission_finished = True
             out.reached += self.executor.drain_reached()
@@ -156,6 +183,8 @@ class LandingFlight:
         Land (PX4's Land, as a fixed wing flies it): at once. Return with RTL_AUTOLAND: 2
         at once, 1 once home is reached (as ArduPlane)."""
         first = land_start(self.items)
+        if first is None and mode == FlightMode.LAND:
+            return self._land_at_home(pos, nav, t_s)
         autoland = 2 if mode == FlightMode.LAND else round(self.config["RTL_AUTOLAND"])
         if first is None or autoland not in (1, 2):
             return None
@@ -173,3 +202,31 @@ class LandingFlight:
             ex.start(first, pos, nav.alt_msl_m)
             self.executor = ex
         return self._mission(status, pos, nav, t_s, False, out)
+
+    def _land_at_home(
+        self: FlightController, pos: tuple[float, float], nav: NavState, t_s: float
+    ) -> Setpoint:
+        """Land (MAVSDK's land(), MAV_CMD_NAV_LAND without a position) with no landing in
+        the mission: back onto the runway of this flight's take-off, along its roll; without
+        one (started in the air), straight in from here to home. PX4 loiters down where the
+        aircraft is; a fixed wing with wheels needs a runway, and this one is known."""
+        if not self.landing_home or self.executor is None:
+            assert self.frame is not None
+            if self.runway is not None:
+                base, heading = self.runway.start, self.runway.heading
+            elif math.hypot(*pos) > HOME_TOUCHDOWN_M:
+                base, heading = (0.0, 0.0), math.atan2(-pos[1], -pos[0])
+            else:
+                base, heading = (0.0, 0.0), nav.yaw_rad
+            items = home_landing(self.frame, base, heading)
+            ex = MissionExecutor(items, self.frame, self.home_alt, self.config.executor)
+            ex.start(0, pos, nav.alt_msl_m)
+            self.executor, self.landing_home, self.landing = ex, True, None
+        sp = self.executor.step(pos, nav.alt_msl_m, t_s, self._turn_radius())
+        self.executor.drain_reached()  # not the stored mission's items: nothing to report
+        return sp
+
+    def _leave_home_landing(self: FlightController, mode: FlightMode) -> None:
+        """Another mode: the stored mission's executor is made afresh when it is flown."""
+        if self.landing_home and mode != FlightMode.LAND:
+            self.executor, self.landing_home = None, False

@@ -62,9 +62,14 @@ class MessageRequests:
         return Outcome(extra=[self.identity.autopilot_version()])
 
     def set_interval(self, args: CommandArgs) -> Outcome:
+        """Accepted for every message the vehicle streams, at the rate it can serve (said
+        in a MESSAGE_INTERVAL after the ack); UNSUPPORTED only for one it cannot send."""
+        msg_id = round(args.params[0])
         schedule = self.router.schedules[args.peer.endpoint]
-        ok = schedule.set_interval(round(args.params[0]), args.params[1])
-        return Outcome(d.MAV_RESULT_ACCEPTED if ok else d.MAV_RESULT_UNSUPPORTED)
+        if not schedule.set_interval(msg_id, args.params[1]):
+            return Outcome(d.MAV_RESULT_UNSUPPORTED)
+        served = self.mav.message_interval_encode(msg_id, schedule.interval_us(msg_id))
+        return Outcome(extra=[served])
 
     def get_interval(self, args: CommandArgs) -> Outcome:
         msg_id = round(args.params[0])

@@ -22,7 +22,7 @@ RELATIVE_FRAMES = frozenset(
 
 class ModeCommands:
     """DO_SET_MODE, DO_SET_STANDARD_MODE, SET_MODE, MISSION_START, RTL, DO_REPOSITION,
-    NAV_LOITER_UNLIM, DO_ORBIT, NAV_TAKEOFF, DO_SET_HOME and DO_GO_AROUND."""
+    NAV_LOITER_UNLIM, DO_ORBIT, NAV_TAKEOFF, NAV_LAND, DO_SET_HOME and DO_GO_AROUND."""
 
     def __init__(self, port: VehiclePort, autopilot: int) -> None:
         self.port = port
@@ -41,6 +41,7 @@ class ModeCommands:
         service.register(d.MAV_CMD_DO_SET_HOME, self.set_home)
         service.register(d.MAV_CMD_DO_ORBIT, self.orbit)
         service.register(d.MAV_CMD_NAV_TAKEOFF, self.takeoff)
+        service.register(d.MAV_CMD_NAV_LAND, self.land)
         service.register(d.MAV_CMD_DO_GO_AROUND, self.go_around)
 
     def to_commander(self, command: CommandId, params: tuple[float, ...] = ()) -> Outcome:
@@ -104,15 +105,33 @@ class ModeCommands:
         """Take off and climb to param7 (AMSL, or above home in a relative frame)."""
         return self.to_commander(CommandId.TAKEOFF, (math.nan, math.nan, self.point(args)[2]))
 
+    def land(self, args: CommandArgs) -> Outcome:
+        """Land now (MAVSDK's land(): no position): the Land mode, which flies the mission's
+        landing, else lands back on the take-off runway. A fixed wing cannot land on a point
+        it is given (it needs a runway and an approach to it): refused with the reason."""
+        lat, lon, _ = self.point(args)
+        if math.isfinite(lat) or math.isfinite(lon):
+            self._refuse("Land: no landing at a given point; send it without one (runway)")
+            return Outcome(d.MAV_RESULT_DENIED)
+        return self.set_mode(FlightMode.LAND, "Land")
+
     def set_home(self, args: CommandArgs) -> Outcome:
         use_current = float(whole_or(args.params[0], 0))
         return self.to_commander(CommandId.SET_HOME, (use_current, *args.params[1:]))
 
     def point(self, args: CommandArgs) -> tuple[float, float, float]:
-        """(lat, lon, alt AMSL) of params 5-7; NaN where not given (0, 0 = here)."""
+        """(lat, lon, alt AMSL) of params 5-7; NaN where not given.
+
+        Latitude and longitude 0, 0 mean "here" and altitude 0 "the present altitude", as
+        ArduPilot reads them: a command sent with every parameter 0 (QGroundControl's custom
+        actions, MAVProxy's defaults) names no point, and read as 0 m above sea level it
+        had sent the aircraft into the ground. The commander refuses a real altitude under
+        its floor (GUIDED_ALT_MIN above home)."""
         lat, lon, alt = args.params[4:7]
         if not (math.isfinite(lat) and math.isfinite(lon)) or (lat == 0 and lon == 0):
             lat = lon = math.nan
+        if alt == 0:
+            alt = math.nan
         status = self.port.snapshot.status
         if args.frame in RELATIVE_FRAMES and status is not None and status.home_valid:
             alt += status.home_alt_msl_m

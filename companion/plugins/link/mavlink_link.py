@@ -270,7 +270,7 @@ class MavlinkLink(Plugin):
             s.prearm_ok = armed or not checks or not self.prearm_failures()
         s.mission_seq = self.missions.current
         s.mission_total = len(self.missions.store.items[0])
-        s.mission_completed = self.missions.completed
+        s.mission_completed, s.mission_paused = self.missions.completed, self.missions.paused
         s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
         s.unix_us = time.time_ns() // 1000
         self._mode_changes(s)
@@ -287,7 +287,7 @@ class MavlinkLink(Plugin):
             msg = self.mav.mission_item_reached_encode(control.last_reached)
             self.router.send([Outgoing(msg, None)], time.monotonic())
         self.reached_count = control.reached_count
-        self.missions.follow(control.mission_state)
+        self.missions.follow(control.mission_state, control.mission_seq)
         return control
 
     def _mode_changes(self, s: Snapshot) -> None:

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from companion.control.battery_failsafe import BATTERY_FS_PARAMS, BatteryFailsafe
-from companion.control.commander import MODE_COMMANDS, Commander
+from companion.control.commander import COMMANDER_PARAMS, MIN_ALT_PARAM, MODE_COMMANDS, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.control.flight.landing_flight import land_start
 from companion.control.flight_state import in_the_air, load_flight_state, save_flight_state
@@ -60,7 +60,7 @@ RC_PLUGIN = b"sensors.rc_input"  # whose process the RC failsafe names when it i
 class CommanderPlugin(Plugin):
     """Mode state for the link and the flight controller."""
 
-    params = (*FAILSAFE_PARAMS, *PILOT_PARAMS, *BATTERY_FS_PARAMS)
+    params = (*COMMANDER_PARAMS, *FAILSAFE_PARAMS, *PILOT_PARAMS, *BATTERY_FS_PARAMS)
     inputs = ("link/commands",)
     optional_inputs = (
         "nav/state",
@@ -88,11 +88,12 @@ class CommanderPlugin(Plugin):
         self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
         # The link stores missions in its own process and says so on mission/changed.
         self.follower = StoreFollower(self.store)
+        self.live = LiveParams(ctx.bus, self.params, state_dir)
         self.commander = Commander(
             lambda: len(self.store.items[d.MAV_MISSION_TYPE_MISSION]),
             lambda: land_start(self.store.items[d.MAV_MISSION_TYPE_MISSION]) is not None,
+            lambda: self.live[MIN_ALT_PARAM],
         )
-        self.live = LiveParams(ctx.bus, self.params, state_dir)
         self.failsafes = Failsafes(self.live.values)
         self.pilot = PilotWatch(self.live.values)
         self.battery_failsafe = BatteryFailsafe(self.live.values)

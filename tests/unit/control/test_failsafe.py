@@ -6,6 +6,7 @@ import pytest
 
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Hysteresis, Situation
 from companion.messages import FlightMode, NavFlags
+from mavlink_dialect import companion as d
 
 GOOD = int(NavFlags.POSITION_VALID | NavFlags.ATTITUDE_VALID)
 DEAD = GOOD | int(NavFlags.DEAD_RECKONING)
@@ -132,3 +133,18 @@ def test_a_lost_ground_station_still_silent_takes_back_a_mode_change():
     assert _modes(fs, [_at(0.1, FlightMode.LOITER, silence=6.1)]) == [FlightMode.RTL]
     assert _modes(fs, [_at(0.2, FlightMode.RTL, silence=6.2)]) == []  # its own change
     assert _modes(fs, [_at(0.3, FlightMode.STABILIZED, silence=6.3)]) == []
+
+
+def test_good_news_is_said_at_notice_and_bad_news_at_critical():
+    """QGroundControl shows CRITICAL and worse as a "Vehicle Error" banner: a failsafe that
+    acts is one; the link, GPS or fence coming back (and the mission resumed) is not."""
+    fs = _failsafes(FS_GCS_TIMEOUT=5.0)
+    (lost,) = fs.step(_at(0.0, FlightMode.MISSION, silence=6.0))
+    assert lost.severity <= d.MAV_SEVERITY_CRITICAL
+    (back,) = fs.step(_at(0.1, FlightMode.RTL, silence=0.5))
+    assert back.text == "Ground station back: resuming the mission"
+    assert back.mode == FlightMode.MISSION and back.severity == d.MAV_SEVERITY_NOTICE
+    fence = _failsafes()
+    fence.step(_at(0.0, FlightMode.MISSION, "fence"))
+    (inside,) = fence.step(_at(0.1, FlightMode.RTL))
+    assert inside.severity == d.MAV_SEVERITY_NOTICE

@@ -9,7 +9,7 @@ from companion.link.codec import new_encoder, new_parser
 from companion.link.flight_messages import mission_current
 from companion.link.mission_service import MAX_RETRIES, MissionService
 from companion.link.service import Peer
-from companion.messages import MissionState
+from companion.messages import ControlStatus, MissionState
 from mavlink_dialect import companion as d
 
 GCS = Peer(255, 190, 0)
@@ -180,3 +180,27 @@ def test_a_flown_mission_stays_complete_after_the_controller_stops_until_it_chan
     service.follow(MissionState.COMPLETE)
     bench.upload([bench.item(i) for i in range(3)])  # a new plan is not flown yet
     assert state() == (0, d.MISSION_STATE_NOT_STARTED)
+
+
+def test_leaving_the_mission_keeps_its_item_as_px4_and_ardupilot_do(bench):
+    """MISSION_CURRENT had fallen back to item 0 whenever the aircraft left Mission (Pause,
+    Return, a failsafe), and QGroundControl then showed the plan as not started."""
+    bench.upload([bench.item(i) for i in range(4)])
+    service = bench.service
+
+    def state(control: ControlStatus | None) -> tuple[int, int]:
+        msg = mission_current(bench.vehicle, service.current, 4, control, service.completed,
+                              service.paused)  # fmt: skip
+        return msg.seq, msg.mission_state
+
+    flying = ControlStatus(mission_seq=2, mission_state=MissionState.ACTIVE)
+    service.follow(flying.mission_state, flying.mission_seq)
+    assert state(flying) == (2, d.MISSION_STATE_ACTIVE)
+    left = ControlStatus(mission_seq=0, mission_state=MissionState.NOT_STARTED)  # Pause
+    service.follow(left.mission_state, left.mission_seq)
+    assert state(left) == (2, d.MISSION_STATE_PAUSED)
+    assert state(None) == (2, d.MISSION_STATE_PAUSED)  # landed and disarmed elsewhere
+    service.follow(MissionState.COMPLETE, 3)
+    assert state(None) == (3, d.MISSION_STATE_COMPLETE)
+    bench.upload([bench.item(i) for i in range(4)])  # a new plan: not started
+    assert state(None) == (0, d.MISSION_STATE_NOT_STARTED)
