@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import time
 
 import pytest
 
@@ -45,8 +46,9 @@ def command(**surfaces: float) -> ActuatorCommand:
 def start_servos(vehicle_factory, tmp_path, airframe: str):
     pty = Pty(tmp_path / "ttyServo")
     servos = plugin(
-        "servos", "actuators.minissc", "flight", device=pty.link, airframe=airframe, stale_s=0.3
-    )
+        "servos", "actuators.minissc", "flight", device=pty.link, airframe=airframe,
+        stale_s=0.3, flight_hold_s=1.5,
+    )  # fmt: skip
     vehicle = vehicle_factory(vehicle_config("servos", servos))
     card = CardEnd(pty)
     commands = vehicle.bus.writer("link/commands")
@@ -85,7 +87,13 @@ def test_commands_reach_the_card_through_the_channel_map(vehicle_factory, tmp_pa
     assert written.pulse_us[ail.servo] == pulse_us(ail.max)
     assert written.position[elev.servo] == elev.max
 
-    # Input goes stale: every channel back to safe, throttle off.
+    # Armed input stops (a controller restarting in flight): the last positions are held
+    # past stale_s, then every channel goes back to safe, throttle off.
+    stopped = time.monotonic()
+    time.sleep(0.8)
+    held = card.poll()
+    if time.monotonic() - stopped < 1.2:  # judged only when this test was not held up itself
+        assert held[thr.servo] in (want[thr.servo], want[thr.servo] + 1), held
     wait_for(lambda: card.poll() == safe, 5, "safe positions once commands stop")
 
     wait_for(

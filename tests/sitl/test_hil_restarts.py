@@ -33,7 +33,7 @@ from tests.support.vehicle import REPO
 PLAN = REPO / "qgc_plans" / "short_leg.plan"
 # Killed in turn, one every KILL_EVERY_S from KILL_FROM_S of the mission (the climb-out is
 # over by then); then the supervisor.
-VICTIMS = ("commander", "control", "servos", "nav", "imu", "gps", "compass", "link")
+VICTIMS = ("commander", "control", "servos", "nav", "imu", "gps", "compass", "rc", "link")
 KILL_FROM_S, KILL_EVERY_S = 35.0, 3.0
 
 

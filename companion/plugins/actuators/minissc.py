@@ -2,7 +2,9 @@
 
 Group ``flight``: it runs while the vehicle is started (armed). On STOP (its process is
 stopped), when its command input goes stale, or when a command says disarmed, every
-channel goes to its safe position: throttle off, surfaces at trim. When the supervisor
+channel goes to its safe position: throttle off, surfaces at trim. Armed, the last
+positions are held a while longer (``flight_hold_s``) before the input counts as stale, so
+that a controller restarting in flight finds the aircraft as it left it. When the supervisor
 itself dies, the card keeps its last positions for the restarted vehicle to take over.
 """
 
@@ -43,6 +45,13 @@ class MiniSscOutput(Plugin):
         "baud": Setting(int, 9600, "the card's jumper setting", choices=(2400, 9600)),
         "airframe": Setting(str, "c172p", "airframe name (companion/airframes) or TOML path"),
         "stale_s": Setting(float, 0.5, "no command for this long: safe positions", min=0.05),
+        "flight_hold_s": Setting(
+            float,
+            2.0,
+            "armed, no command for this long: safe positions; until then the last are held"
+            " (a controller restarting in flight answers within it)",
+            min=0.05,
+        ),
     }
     optional_inputs = ("control/actuators",)
     outputs = ("actuators/servos",)
@@ -85,6 +94,7 @@ class MiniSscOutput(Plugin):
         self.last_command_at = ctx.clock.now_us() / 1e6
         self.cycle_s = CYCLE_MAX_S
         self.stale = True
+        self.flying = False  # the last command was armed
         # Every channel safe at once, so the first command finds the same card every time.
         if self._send(len(self.safe)):
             self._publish(-1)
@@ -100,7 +110,8 @@ class MiniSscOutput(Plugin):
             self.last_command_at = now
             self.wanted = self._positions(received[-1])
             self.stale = False
-        elif not self.stale and now - self.last_command_at > self.ctx.settings["stale_s"]:
+            self.flying = bool(received[-1].armed)
+        elif not self.stale and now - self.last_command_at > self._stale_after_s():
             self.ctx.log.warning(
                 "no command for %.2f s: safe positions", now - self.last_command_at
             )
@@ -124,6 +135,16 @@ class MiniSscOutput(Plugin):
                 self._publish(-1)
         self.waiter.close()
         self.port.close()
+
+    def _stale_after_s(self) -> float:
+        """Armed, throttle off and trimmed surfaces would put the aircraft into a glide or a
+        dive while its controller restarts: the last positions are held for longer."""
+        settings = self.ctx.settings
+        return (
+            max(settings["stale_s"], settings["flight_hold_s"])
+            if self.flying
+            else settings["stale_s"]
+        )
 
     def _positions(self, cmd: ActuatorCommand) -> dict[int, int]:
         if not cmd.armed:
