@@ -21,7 +21,8 @@ from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate as read_truth
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
-from tests.sitl.test_missions import HOME, _fly_plan
+from tests.sitl.test_missions import HOME
+from tests.support.mavsdk_flight import fly_plan
 
 FIRST = (0.0, 400.0)  # north, east of home (m): on the runway's line
 SECOND = (30.0, 3_000.0)  # the climb ends within WP_RADIUS of the line to it
@@ -61,7 +62,7 @@ def test_a_first_waypoint_the_climb_flew_past_is_flown_back_to_at_height(tmp_pat
         tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "420"
     )
     try:
-        seen = asyncio.run(_fly_plan(port, _plan(tmp_path / "behind.plan"), 300.0))
+        seen = asyncio.run(fly_plan(port, _plan(tmp_path / "behind.plan"), 300.0))
     finally:
         out = finish(proc, namespace, 300)
     assert seen["finished"], out[-3000:]
