@@ -12,10 +12,11 @@ As ArduPlane and PX4 do it:
 Each is announced once when it triggers and once when it clears. A failsafe that still
 holds is acted on again when the operator changes the mode (as ArduPlane re-triggers its
 fence action), unless the operator takes Manual or Stabilized: that is taking control.
-The GPS is judged by
-the navigator's time stamps with hysteresis (``Hysteresis``), never by one flag on one
-sample nor by how late a process ran, so it cannot flap; a failsafe never fires on the
-ground or during a take-off roll (``flying`` is false there).
+The GPS is judged by the navigator's time stamps with hysteresis (``Hysteresis``), never
+by one flag on one sample nor by how late a process ran, so it cannot flap; a navigator
+aligning again (its process restarted in flight) is not a lost GPS for its first ten
+seconds; a failsafe never fires on the ground or during a take-off roll (``flying`` is
+false there).
 """
 
 from __future__ import annotations
@@ -101,6 +102,11 @@ class Situation:
     nav_t_us: int | None = None  # the navigation solution's own time stamp
 
 
+# A navigator restarted in the air aligns again from the GPS's course and the IMU; until it
+# has, it publishes no position, which is not the GPS lost. Longer than this, it is.
+ALIGN_GRACE_US = 10_000_000
+
+
 class Failsafes:
     """Remembers which failsafes are active so each is announced once."""
 
@@ -110,6 +116,7 @@ class Failsafes:
         self.mode_before_gcs: FlightMode | None = None
         self.mode_seen: FlightMode | None = None  # the mode at the last step
         self.gps = Hysteresis(params["FS_GPS_LOST_S"], params["FS_GPS_BACK_S"])
+        self.aligning_since_us: int | None = None
 
     def step(self, s: Situation) -> list[Action]:
         """The actions this situation calls for (usually none)."""
@@ -152,7 +159,7 @@ class Failsafes:
         gps = self.gps
         gps.lost_us = round(self.params["FS_GPS_LOST_S"] * 1e6)
         gps.back_us = round(self.params["FS_GPS_BACK_S"] * 1e6)
-        if s.nav_t_us is None:
+        if s.nav_t_us is None or self._realigning(s):
             return []
         usable = not s.nav_flags & NavFlags.DEAD_RECKONING and s.nav_flags & NavFlags.POSITION_VALID
         gps.update(s.nav_t_us, bool(usable))
@@ -167,6 +174,17 @@ class Failsafes:
                 return [Action(FlightMode.LOITER, "GPS back: loitering here", notice)]
             return [Action(None, "GPS back", notice)]
         return []
+
+    def _realigning(self, s: Situation) -> bool:
+        """A navigator that is aligning (restarted in flight: its first seconds) says
+        nothing of the GPS; only one that stays so for ``ALIGN_GRACE_US`` counts as lost."""
+        if not s.nav_flags & NavFlags.ALIGNING:
+            self.aligning_since_us = None
+            return False
+        assert s.nav_t_us is not None
+        if self.aligning_since_us is None:
+            self.aligning_since_us = s.nav_t_us
+        return s.nav_t_us - self.aligning_since_us < ALIGN_GRACE_US
 
     def _fence(self, s: Situation) -> list[Action]:
         enabled = self.params["FENCE_ENABLE"] >= 0.5

@@ -81,6 +81,18 @@ def test_a_transient_shorter_than_the_hold_does_not_undo_the_mission():
     assert _texts(fs, samples) == []
 
 
+def test_a_navigator_restarted_in_flight_is_not_a_lost_gps_while_it_aligns():
+    fs = _failsafes(FS_GPS_LOST_S=1.0)
+    period = 20_000
+    aligning = int(NavFlags.ALIGNING)
+    samples = [(i * period, GOOD, True) for i in range(100)]
+    samples += [(i * period, aligning, True) for i in range(100, 250)]  # 3 s re-aligning
+    samples += [(i * period, GOOD, True) for i in range(250, 400)]
+    assert _texts(fs, samples) == []
+    stuck = [(i * period, aligning, True) for i in range(400, 1100)]  # 14 s: never aligns
+    assert _texts(fs, stuck) == ["Failsafe: GPS lost, holding heading and height"]
+
+
 def test_no_gps_failsafe_on_the_ground_or_in_the_take_off_roll():
     fs = _failsafes()
     period = 20_000
