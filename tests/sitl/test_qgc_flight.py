@@ -13,12 +13,14 @@ import time
 import pytest
 from pymavlink import mavutil
 
+from companion.control.mission.plan import checked_plan
 from companion.control.modes import BY_MODE
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
+from tests.support.vehicle import REPO
 
 NAN = math.nan
 WAIT_S = 240.0  # wall seconds for any one stage: generous, for a loaded machine
@@ -33,6 +35,7 @@ class Qgc:
         self.mode = -1
         self.position = None
         self.acks: dict[int, int] = {}
+        self.mission_current = None
 
     def pump_until(self, predicate, what: str) -> None:
         deadline = time.monotonic() + WAIT_S
@@ -54,6 +57,8 @@ class Qgc:
             self.position = msg
         elif kind == "COMMAND_ACK":
             self.acks[msg.command] = msg.result
+        elif kind == "MISSION_CURRENT":
+            self.mission_current = msg
 
     def command(self, command: int, *params: float) -> int:
         self.acks.pop(command, None)
@@ -153,6 +158,67 @@ def test_qgc_custom_takeoff_and_loiter_actions_fly_and_hold_the_height(tmp_path)
         qgc.pump_until(watched, "40 s in Hold")
         assert qgc.in_mode(FlightMode.LOITER)
         assert lowest > sent_at - 10.0, (sent_at, lowest)
+    finally:
+        proc.terminate()
+        finish(proc, namespace, 60)
+        qgc.conn.close()
+
+
+def _upload(qgc: Qgc, plan: str) -> None:
+    """The Plan view's Upload: MISSION_COUNT, then each item as the vehicle asks for it."""
+    items = checked_plan(REPO / "qgc_plans" / plan)[d.MAV_MISSION_TYPE_MISSION]
+    qgc.conn.mav.mission_count_send(1, 1, len(items), d.MAV_MISSION_TYPE_MISSION)
+    for _ in items:
+        req = qgc.conn.recv_match(type="MISSION_REQUEST_INT", blocking=True, timeout=10)
+        assert req is not None, "the vehicle asked for no item"
+        it = items[req.seq]
+        qgc.conn.mav.mission_item_int_send(
+            1, 1, it.seq, it.frame, it.command, 0, it.autocontinue, it.param1, it.param2,
+            it.param3, it.param4, it.x, it.y, it.z, d.MAV_MISSION_TYPE_MISSION,
+        )  # fmt: skip
+    ack = qgc.conn.recv_match(type="MISSION_ACK", blocking=True, timeout=10)
+    assert ack is not None and ack.type == d.MAV_MISSION_ACCEPTED
+
+
+@pytest.mark.timeout(900)
+def test_pause_keeps_the_mission_item_and_continue_mission_resumes_it(tmp_path):
+    """MISSION_CURRENT had fallen to item 0 when the aircraft left Mission, so
+    QGroundControl showed the plan as not started; now it keeps the item, PAUSED."""
+    port = free_udp_port()
+    proc, namespace, _truth = start_sim(
+        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "900"
+    )
+    qgc = Qgc(port)
+    try:
+        assert qgc.conn.recv_match(type="HEARTBEAT", blocking=True, timeout=60) is not None
+        _upload(qgc, "square.plan")
+        mission = BY_MODE[FlightMode.MISSION].px4
+        flag = d.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+        assert qgc.command(d.MAV_CMD_DO_SET_MODE, flag, mission, 0, 0, 0, 0, 0) == 0
+        arm = d.MAV_CMD_COMPONENT_ARM_DISARM
+        qgc.pump_until(lambda: qgc.command(arm, 1, 0, 0, 0, 0, 0, 0) == 0, "armed")
+        qgc.pump_until(lambda: qgc.mission_current is not None and qgc.mission_current.seq >= 2,
+                       "flying to the second waypoint")  # fmt: skip
+        # Pause (PX4FirmwarePlugin::pauseVehicle): Hold, the plan still at its item.
+        assert qgc.command(d.MAV_CMD_DO_REPOSITION, -1, 1, 0, NAN, NAN, NAN, NAN) == 0
+        qgc.pump_until(lambda: qgc.in_mode(FlightMode.LOITER), "in Hold")
+        paused = d.MISSION_STATE_PAUSED
+        qgc.pump_until(lambda: qgc.mission_current.mission_state == paused, "said PAUSED")
+        at = qgc.mission_current.seq
+        assert at >= 2
+        paused_at = qgc.position.time_boot_ms
+
+        def ten_seconds_paused() -> bool:
+            current = qgc.mission_current
+            assert (current.seq, current.mission_state) == (at, paused)
+            return qgc.position.time_boot_ms - paused_at > 10_000
+
+        qgc.pump_until(ten_seconds_paused, "10 s paused")
+        # Continue Mission: the same item again, flown on.
+        assert qgc.command(d.MAV_CMD_DO_SET_MODE, flag, mission, 0, 0, 0, 0, 0) == 0
+        qgc.pump_until(lambda: qgc.mission_current.mission_state == d.MISSION_STATE_ACTIVE,
+                       "the mission active again")  # fmt: skip
+        assert qgc.mission_current.seq >= at
     finally:
         proc.terminate()
         finish(proc, namespace, 60)
