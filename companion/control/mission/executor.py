@@ -27,7 +27,6 @@ ON_CIRCLE = 0.25  # within this fraction of the radius the aircraft counts as ci
 TAKEOFF_MARGIN_M = 5.0
 MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
 
-
 # Markers and camera stops: nothing to fly (DO_LAND_START only marks where a landing begins).
 SKIPPED = CAMERA_STOPS | {d.MAV_CMD_DO_LAND_START}
 LOITER_ALT_MARGIN_M = 5.0  # LOITER_TO_ALT: this close to its height counts as there
@@ -93,8 +92,8 @@ class MissionExecutor:
         self._prev_alt = self.home_alt_msl
         self._hold: Setpoint | None = None
         self._turn_radius = 0.0
-        self.climb_to = math.nan  # an implicit take-off's height (take_off_first)
-        self._flown_back = False  # the current waypoint is one the climb flew past
+        # An implicit take-off's height (take_off_first); the waypoint the climb flew past.
+        self.climb_to, self._flown_back = math.nan, False
 
     def start(self, first: int, pos: tuple[float, float], alt_msl: float) -> None:
         """Begin at item ``first`` from where the aircraft is."""
@@ -104,13 +103,11 @@ class MissionExecutor:
         self.finished = False
         self._hold = None
         self._loiter = _Loiter()
-        self.climb_to = math.nan
-        self._flown_back = False
+        self.climb_to, self._flown_back = math.nan, False
 
     def take_off_first(self, alt_msl: float) -> None:
-        """On the ground with a mission whose next item is not a take-off: climb out along
-        the runway to ``alt_msl`` first, as a NAV_TAKEOFF there would, then fly that item
-        from where the climb ended (an implicit take-off, which the commander announces)."""
+        """On the ground, the next item not a take-off: climb to ``alt_msl`` first as a
+        NAV_TAKEOFF would, then fly it (an implicit take-off; the commander says so)."""
         self.climb_to = alt_msl
 
     def drain_reached(self) -> list[int]:
@@ -131,11 +128,8 @@ class MissionExecutor:
     def step(
         self, pos: tuple[float, float], alt_msl: float, t_s: float, turn_radius: float = 0.0
     ) -> Setpoint:
-        """The setpoint for now; advances through items that are done.
-
-        ``turn_radius`` (m) lets a waypoint count as reached early enough that the turn onto
-        the next leg ends on that leg instead of overshooting it.
-        """
+        """The setpoint for now; advances through items that are done. ``turn_radius`` (m)
+        lets a waypoint count as reached early enough for the turn to end on the next leg."""
         self._turn_radius = turn_radius
         if not math.isnan(self.climb_to):
             if alt_msl < self.climb_to - TAKEOFF_MARGIN_M:
@@ -225,15 +219,22 @@ class MissionExecutor:
         return Setpoint(Kind.TAKEOFF, pos, pos, target, speed=self.speed)
 
     def _climbed(self, nxt: int, pos: tuple[float, float], alt: float) -> None:
-        """The climb has ended at ``pos``: the next leg starts here (ArduPlane), not where
-        the take-off began, from where a first waypoint the climb flew past counted as passed
-        (the next leg was joined 800 m from it). Such a waypoint is flown back to and must be
-        reached: no turn lead, which before a reversal is 1.7 turn radii (370 m, c172p)."""
+        """The climb has ended at ``pos``: the next leg starts here (ArduPlane), so a first
+        waypoint the climb flew past is flown back to (it counted as passed: the next leg
+        joined 800 m from it), reached inside its acceptance radius, not a turn's lead (370 m
+        before a reversal). Within a turn radius of it, it is passed: no swing round it."""
         item = self.items[nxt] if nxt < len(self.items) else None
         began = self._prev
         self._prev, self._prev_alt = pos, alt
-        if item is not None and item.command == d.MAV_CMD_NAV_WAYPOINT:
-            self._flown_back = past_point(began, self.point_of(item, pos), pos)
+        if item is None or item.command != d.MAV_CMD_NAV_WAYPOINT:
+            return
+        point = self.point_of(item, pos)
+        if _distance(pos, point) <= max(
+            item.acceptance_m(self.config.wp_radius), self._turn_radius
+        ):
+            self._advance(True, point, self.alt_of(item))
+        else:
+            self._flown_back = past_point(began, point, pos)
 
     def _waypoint(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
         b = self.point_of(item, pos)

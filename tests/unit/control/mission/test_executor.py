@@ -60,13 +60,24 @@ def test_a_waypoint_the_climb_flew_past_is_flown_back_to():
     met 1 km down the next leg, that leg was flown 400 m off its line. Past the waypoint
     and off the next leg by more than the acceptance radius, the aircraft now turns back
     and flies the waypoint, from which the next leg starts on its line."""
-    ex, sp = climb_ending_at((0.0, 1_000.0), (1_500.0, 2_400.0))
+    ex, sp = climb_ending_at((0.0, 1_200.0), (1_500.0, 2_400.0))
     assert ex.drain_reached() == [0]
     assert sp.kind == Kind.LINE
-    assert sp.a == pytest.approx((0.0, 1_000.0), abs=0.05)  # from here, back to it
+    assert sp.a == pytest.approx((0.0, 1_200.0), abs=0.05)  # from here, back to it
     assert sp.b == pytest.approx((0.0, 900.0), abs=0.05)
-    sp = ex.step((0.0, 1_000.0), HOME_ALT + 100.0, 41.0, turn_radius=150.0)
+    sp = ex.step((0.0, 1_200.0), HOME_ALT + 100.0, 41.0, turn_radius=150.0)
     assert ex.drain_reached() == [] and sp.b == pytest.approx((0.0, 900.0), abs=0.05)
+
+
+def test_a_climb_that_ends_within_a_turn_radius_of_the_first_waypoint_has_passed_it():
+    """The c172p's zigzag climb ended 30 m beside its first waypoint: a leg from there back
+    to it made the aircraft swing 270 m round it. Within a turn radius (150 m here) of it,
+    past it or not, it counts as reached and the next leg starts at it."""
+    for end in ((40.0, 920.0), (0.0, 1_040.0)):
+        ex, sp = climb_ending_at(end, (1_500.0, 2_400.0))
+        assert ex.drain_reached() == [0, 1]
+        assert sp.a == pytest.approx((0.0, 900.0), abs=0.05)
+        assert sp.b == pytest.approx((1_500.0, 2_400.0), abs=0.05)
 
 
 def test_a_waypoint_the_climb_flew_past_on_the_next_legs_line_is_flown_back_to():
