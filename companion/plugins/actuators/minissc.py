@@ -56,7 +56,6 @@ class MiniSscOutput(Plugin):
     outputs = ("actuators/servos",)
 
     @classmethod
-    @classmethod
     def prearm(
         cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
     ) -> list[str]:
