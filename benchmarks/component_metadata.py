@@ -33,9 +33,11 @@ from tests.support.configs import client_vehicle, plugin  # noqa: E402
 
 
 def start_vehicle(port: int, tmp: Path, namespace: str) -> subprocess.Popen[bytes]:
-    flight = plugin("control", "control.fixed_wing", "flight", airframe="c172p")
+    flight = plugin("control", "control.fixed_wing", "flight")
     config = tmp / "vehicle.toml"
-    config.write_text(client_vehicle(f"udpin://127.0.0.1:{port}", tmp, flight=flight))
+    config.write_text(
+        client_vehicle(f"udpin://127.0.0.1:{port}", tmp, flight=flight, airframe="c172p")
+    )
     env = {**os.environ, "COMPANION_BUS": namespace, "PYTHONPATH": str(REPO)}
     cmd = [sys.executable, "-m", "companion", "run", "-c", str(config), "--log-level", "WARNING"]
     return subprocess.Popen(cmd, env=env, cwd=REPO)

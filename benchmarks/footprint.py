@@ -256,15 +256,13 @@ def fly_once(cpu_s: float) -> dict[str, object]:
 
 def bench_config(tmp: Path) -> tuple[Path, list[tuple[int, int]]]:
     """The sim config for ``companion run``: every ``sim://`` device a silent pty of its own
-    (whatever devices the config has), the airframe c172p, the host's clock, no links out."""
+    (whatever devices the config has), its [vehicle] airframe, the host's clock, no links
+    out."""
     text = (REPO / "companion" / "configs" / "sim.toml").read_text()
     ptys: list[tuple[int, int]] = []
     for name in sorted(set(re.findall(r'"sim://([^"]+)"', text))):
-        if name == "airframe":
-            path = "c172p"
-        else:
-            ptys.append(os.openpty())
-            path = os.ttyname(ptys[-1][1])
+        ptys.append(os.openpty())
+        path = os.ttyname(ptys[-1][1])
         text = text.replace(f'"sim://{name}"', f'"{path}"')
     text = text.replace('clock = "sim"', "")
     text = text.replace("[vehicle]", f'[vehicle]\nstate_dir = "{tmp / "state"}"', 1)

@@ -45,8 +45,9 @@ def vehicle(endpoint: str, state: Path) -> str:
         endpoint,
         state,
         extra=(plugin("imu", TICKER, rate_hz=200.0),),
-        flight=plugin("control", "control.fixed_wing", "flight", airframe="c172p"),
+        flight=plugin("control", "control.fixed_wing", "flight"),
         name="linkbench",
+        airframe="c172p",
     )
 
 

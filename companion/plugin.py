@@ -14,6 +14,7 @@ import os
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 if TYPE_CHECKING:
@@ -22,6 +23,9 @@ if TYPE_CHECKING:
     from companion.params import ParamDecl
 
 REQUIRED: Any = object()
+# The classmethods below get the config's [vehicle] table beside the plug-in's settings:
+# what belongs to the whole vehicle (its airframe) is named once, there.
+NO_VEHICLE: Mapping[str, Any] = MappingProxyType({})
 
 
 @dataclass(frozen=True)
@@ -156,29 +160,39 @@ class Plugin(ABC):
         return Ports(cls.inputs, cls.optional_inputs, cls.outputs)
 
     @classmethod
-    def param_decls(cls, settings: Mapping[str, Any]) -> tuple[ParamDecl, ...]:
+    def param_decls(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> tuple[ParamDecl, ...]:
         """The parameters this instance serves (``params``, unless they depend on settings)."""
         return tuple(cls.params)
 
     @classmethod
-    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
+    def validate(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
         """Problems with the settings taken together (checked before anything starts)."""
         return []
 
     @classmethod
-    def prearm(cls, settings: Mapping[str, Any]) -> list[str]:
+    def prearm(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
         """Why this ``flight`` plug-in could not fly now (its device missing...), checked by
         the supervisor before arming; each reason follows ``PreArm: ``."""
         return []
 
     @classmethod
-    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
+    def probe(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[DeviceProbe]:
         """The devices ``companion check`` opens on the bench, each with this plug-in's own
         decoder (none: the plug-in has no device)."""
         return []
 
     @classmethod
-    def bench_problems(cls, settings: Mapping[str, Any]) -> list[str]:
+    def bench_problems(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
         """What ``companion check`` finds wrong on this machine besides the devices (a key
         file missing...); the config check cannot know, it may run on another computer."""
         return []

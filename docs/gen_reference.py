@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import ctypes
+import functools
 import importlib
 import math
 import re
@@ -70,7 +71,7 @@ def plugin_table() -> dict[str, tuple[type, dict[str, Any]]]:
     from companion.exec_control.registry import load, registered
 
     refs = {name: f"/dev/{name}" for name in ("gps", "compass", "imu", "rc", "battery")}
-    refs |= {"range": "/dev/range", "servos": "/dev/servos", "airframe": "c172p"}
+    refs |= {"range": "/dev/range", "servos": "/dev/servos"}
     config = load_config(SIM_CONFIG, namespace="docs", sim_refs=refs)
     configured = {spec.kind: dict(spec.settings) for spec in config.plugins}
     table_: dict[str, tuple[type, dict[str, Any]]] = {}
@@ -79,6 +80,15 @@ def plugin_table() -> dict[str, tuple[type, dict[str, Any]]]:
         settings = configured.get(name) or defaults(cls.settings)
         table_[name] = (cls, settings)
     return table_
+
+
+@functools.cache
+def sim_vehicle() -> dict[str, Any]:
+    """The shipped sim config's [vehicle] table (its airframe gives the controller's
+    parameter defaults)."""
+    from companion.exec_control.config import load_sections
+
+    return load_sections(SIM_CONFIG, namespace="docs")[0]
 
 
 def defaults(declared: Mapping[str, Any]) -> dict[str, Any]:
@@ -114,7 +124,7 @@ def param_rows(plugins: Mapping[str, tuple[Any, dict[str, Any]]]) -> str:
             answers.setdefault(target, []).append(decl.name)
     rows = []
     for owner, (cls, settings) in plugins.items():
-        for decl in cls.param_decls(settings):
+        for decl in cls.param_decls(settings, sim_vehicle()):
             if decl.name in px4:
                 continue
             px4_names = ", ".join(sorted(answers.get(decl.name, [])))
@@ -140,7 +150,7 @@ def px4_rows(plugins: Mapping[str, tuple[Any, dict[str, Any]]]) -> str:
     from companion.link.px4_compat import PX4_PARAMS
     from companion.params.store import bind
 
-    own = {d.name: d for cls, s in plugins.values() for d in cls.param_decls(s)}
+    own = {d.name: d for cls, s in plugins.values() for d in cls.param_decls(s, sim_vehicle())}
     own = {name: d for name, d in own.items() if d.alias is None}
     rows = []
     for decl in sorted(PX4_PARAMS, key=lambda d: d.name):
@@ -206,7 +216,7 @@ def plugins_page(plugins: Mapping[str, tuple[Any, dict[str, Any]]]) -> str:
         parts.append(f"- inputs: {code_list(ports.inputs)}\n")
         parts.append(f"- optional inputs: {code_list(ports.optional_inputs)}\n")
         parts.append(f"- outputs: {code_list(ports.outputs)}\n")
-        n = len(cls.param_decls(settings))
+        n = len(cls.param_decls(settings, sim_vehicle()))
         parts.append(f"- parameters declared: {n}\n\n")
         parts.append(setting_rows(cls.settings) if cls.settings else "No settings.\n")
     return "".join(parts)

@@ -32,6 +32,7 @@ from typing import Any
 POSITION_MAX = 254  # 255 is the Mini SSC sync byte
 SERVO_IDS = range(8)
 AIRFRAMES_DIR = Path(__file__).resolve().parent.parent / "airframes"
+DEFAULT_AIRFRAME = "c172p"  # a config's [vehicle] airframe when it names none
 ONE_SIDED = frozenset({"throttle", "brakes"})  # commands in [0, 1]
 # A stopped vehicle holds its wheel brakes at the channel's trim (full unless the airframe
 # file says less: a light tail dragger noses over on full brakes in a crosswind).

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 
 from companion.exec_control.vehicle_process import EXIT_CONFIG
 
@@ -31,7 +32,8 @@ def load_checked(config: Path, namespace: str | None):
         cfg = load_config(config, namespace)
         check_topology(cfg)
     except ConfigError as exc:
-        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
+        # Escaped: a message may quote a table ("[vehicle]"), which is not markup.
+        err.print(f"[red]config error:[/red] {escape(str(exc))}", highlight=False, soft_wrap=True)
         raise typer.Exit(EXIT_CONFIG) from None
     return cfg
 

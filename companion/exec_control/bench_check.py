@@ -87,8 +87,12 @@ def check_config(cfg: VehicleConfig, seconds: float = LISTEN_S) -> CheckResult:
     result = CheckResult()
     for spec in cfg.plugins:
         cls = load(spec.kind)
-        result.devices += [DeviceReport(spec.name, p) for p in cls.probe(spec.settings)]
-        result.problems += [f"{spec.name}: {p}" for p in cls.bench_problems(spec.settings)]
+        result.devices += [
+            DeviceReport(spec.name, p) for p in cls.probe(spec.settings, cfg.vehicle)
+        ]
+        result.problems += [
+            f"{spec.name}: {p}" for p in cls.bench_problems(spec.settings, cfg.vehicle)
+        ]
     result.problems += _shared_devices(result.devices)
     threads = [
         threading.Thread(target=_try_device, args=(r, seconds), name=f"check-{r.plugin}")

@@ -6,6 +6,7 @@ match when a name looks misspelt. The CLI turns it into exit status 2.
 
 from __future__ import annotations
 
+import json
 import os
 import tomllib
 from collections.abc import Mapping
@@ -14,6 +15,7 @@ from difflib import get_close_matches
 from pathlib import Path
 from typing import Any
 
+from companion.actuators.airframe import DEFAULT_AIRFRAME, AirframeError, load_airframe
 from companion.bus.namespace import default_namespace, validate_namespace
 from companion.exec_control.config_locator import KeyPath, line_of, locate
 from companion.exec_control.registry import PluginLoadError, load
@@ -66,6 +68,12 @@ _VEHICLE_KEYS: dict[str, Setting] = {
     "sysid": Setting(int, 1, "MAVLink system id", min=1, max=255),
     "namespace": Setting(str, "", "bus namespace (default: $COMPANION_BUS or 'companion')"),
     "clock": Setting(str, "monotonic", "vehicle time base", choices=CLOCKS),
+    "airframe": Setting(
+        str,
+        DEFAULT_AIRFRAME,
+        "airframe name (companion/airframes) or TOML path: the controller's gains, the servo"
+        " map and the flight log's INFO all come from it (`companion sim --aircraft` replaces it)",
+    ),
     "state_dir": Setting(
         str,
         "",
@@ -84,6 +92,9 @@ _FLEET_KEYS: dict[str, Setting] = {
 }
 _TABLES = ["vehicle", "plugins", "fleet"]
 _PLUGIN_KEYS = ("name", "plugin", "group", "settings")
+# Settings that belong to the whole vehicle: once a plug-in setting each, now named once in
+# [vehicle], so two plug-ins can never disagree (the J3Cub's gains on the Cessna's servos).
+_VEHICLE_WIDE = ("airframe",)
 
 
 class _Checker:
@@ -163,9 +174,15 @@ def _table(check: _Checker, data: dict[str, Any], name: str, decl: dict[str, Set
 
 
 def _vehicle_and_fleet(
-    check: _Checker, data: dict[str, Any], namespace: str | None = None
+    check: _Checker, data: dict[str, Any], namespace: str | None = None, airframe: str | None = None
 ) -> tuple[dict, dict]:
     vehicle = _table(check, data, "vehicle", _VEHICLE_KEYS)
+    if airframe is not None:
+        vehicle["airframe"] = airframe
+    try:
+        load_airframe(vehicle["airframe"])
+    except AirframeError as exc:
+        raise check.error(("vehicle", "airframe"), str(exc)) from None
     if not vehicle["state_dir"]:
         # Each bus namespace is one vehicle: two vehicles of one config on one machine
         # must never read each other's mission or parameters.
@@ -188,24 +205,28 @@ def load_sections(
 
 
 def load_config(
-    path: str | Path, namespace: str | None = None, sim_refs: Mapping[str, str] | None = None
+    path: str | Path,
+    namespace: str | None = None,
+    sim_refs: Mapping[str, str] | None = None,
+    airframe: str | None = None,
 ) -> VehicleConfig:
     """Read, parse and check the config; raise ConfigError on the first problem.
 
     A setting written ``"sim://NAME"`` takes the value ``sim_refs[NAME]``: the simulator's
-    device paths and the airframe, known only once ``companion sim`` has started it.
+    device paths, known only once ``companion sim`` has started it. ``airframe`` replaces
+    ``[vehicle] airframe`` (``companion sim --aircraft``: the simulator flies that one).
     """
     path = Path(path)
     check, data = _parse(path)
     check.sim_refs = sim_refs
-    vehicle, fleet = _vehicle_and_fleet(check, data, namespace)
+    vehicle, fleet = _vehicle_and_fleet(check, data, namespace, airframe)
     ns = namespace or vehicle["namespace"] or None
     if ns is not None:
         try:
             validate_namespace(ns)
         except ValueError as exc:
             raise check.error(("vehicle", "namespace"), str(exc)) from None
-    specs = _plugin_specs(check, data.get("plugins", []))
+    specs = _plugin_specs(check, data.get("plugins", []), vehicle)
     return VehicleConfig(
         path=path,
         name=vehicle["name"],
@@ -229,14 +250,14 @@ def _sim_ref(check: _Checker, value: Any, where: KeyPath) -> Any:
     return check.sim_refs[name]
 
 
-def _plugin_specs(check: _Checker, entries: Any) -> list[PluginSpec]:
+def _plugin_specs(check: _Checker, entries: Any, vehicle: Mapping[str, Any]) -> list[PluginSpec]:
     if not isinstance(entries, list):
         raise check.error(("plugins",), "must be an array of tables: [[plugins]]")
     specs: list[PluginSpec] = []
     seen: set[str] = set()
     for index, entry in enumerate(entries):
         where: KeyPath = ("plugins", index)
-        spec = _plugin_spec(check, entry, where)
+        spec = _plugin_spec(check, entry, where, vehicle)
         if spec.name in seen:
             raise check.error((*where, "name"), f"plug-in name {spec.name!r} is used twice")
         seen.add(spec.name)
@@ -244,7 +265,9 @@ def _plugin_specs(check: _Checker, entries: Any) -> list[PluginSpec]:
     return specs
 
 
-def _plugin_spec(check: _Checker, entry: Any, where: KeyPath) -> PluginSpec:
+def _plugin_spec(
+    check: _Checker, entry: Any, where: KeyPath, vehicle: Mapping[str, Any]
+) -> PluginSpec:
     if not isinstance(entry, dict):
         raise check.error(where, "each plug-in must be a table")
     check.unknown_keys(entry, list(_PLUGIN_KEYS), where)
@@ -265,12 +288,13 @@ def _plugin_spec(check: _Checker, entry: Any, where: KeyPath) -> PluginSpec:
     raw_settings = entry.get("settings", {})
     if not isinstance(raw_settings, dict):
         raise check.error((*where, "settings"), "must be a table")
+    _refuse_vehicle_wide(check, raw_settings, (*where, "settings"))
     raw_settings = {
         key: _sim_ref(check, value, (*where, "settings", key))
         for key, value in raw_settings.items()
     }
     settings = check.values(raw_settings, cls.settings, (*where, "settings"))
-    for problem in cls.validate(settings):
+    for problem in cls.validate(settings, vehicle):
         raise check.error((*where, "settings"), problem)
     return PluginSpec(
         name=entry["name"],
@@ -279,5 +303,21 @@ def _plugin_spec(check: _Checker, entry: Any, where: KeyPath) -> PluginSpec:
         settings=settings,
         ports=cls.ports(settings),
         line=line_of(check.lines, where),
-        params=cls.param_decls(settings),
+        params=cls.param_decls(settings, vehicle),
     )
+
+
+def _refuse_vehicle_wide(check: _Checker, settings: dict[str, Any], where: KeyPath) -> None:
+    """A vehicle-wide key among a plug-in's settings: refused with the line that replaces it
+    (a config written before it moved must not fly two airframes, nor silently one)."""
+    for key in _VEHICLE_WIDE:
+        if key not in settings:
+            continue
+        value = settings[key]
+        if isinstance(value, str) and value.startswith(SIM_REF):
+            line = f"delete it ([vehicle] {key}, default {_VEHICLE_KEYS[key].default!r}; "
+            line += "`companion sim --aircraft` chooses the simulated one)"
+        else:
+            line = f"move it to [vehicle] {key} = {json.dumps(value)}"
+        message = f"the {key} is named once, in [vehicle]: {line}"
+        raise check.error((*where, key), message)

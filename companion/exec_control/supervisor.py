@@ -97,7 +97,7 @@ class Supervisor:
     def prearm_problem(self) -> str:
         """The first reason a flight plug-in gives for not arming ("" when none)."""
         for child in self.group("flight"):
-            for reason in load(child.spec.kind).prearm(child.spec.settings):
+            for reason in load(child.spec.kind).prearm(child.spec.settings, self.cfg.vehicle):
                 return f"PreArm: {reason}"
         return ""
 

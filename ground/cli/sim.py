@@ -49,12 +49,14 @@ def _single_links(link: list[str] | None, api_port_base: int | None) -> list[str
 
 
 def _fleet_settings(config: Path, namespace: str) -> tuple[dict, dict]:
+    from rich.markup import escape
+
     from companion.exec_control.config import ConfigError, load_sections
 
     try:
         return load_sections(config, namespace)
     except ConfigError as exc:
-        err.print(f"[red]config error:[/red] {exc}", highlight=False, soft_wrap=True)
+        err.print(f"[red]config error:[/red] {escape(str(exc))}", highlight=False, soft_wrap=True)
         raise typer.Exit(EXIT_CONFIG) from None
 
 
@@ -77,7 +79,12 @@ def _run_one(req, opts, log_level: str, logs_dir: Path, truth: Path | None) -> N
 
 @app.command()
 def sim(
-    aircraft: Annotated[str, typer.Option(help="airframe: c172p, J3Cub, or a TOML path")] = "c172p",
+    aircraft: Annotated[
+        str | None,
+        typer.Option(
+            help="airframe: c172p, J3Cub, or a TOML path (default: the config's [vehicle] airframe)"
+        ),
+    ] = None,
     plan: Annotated[Path | None, typer.Option(help="QGroundControl .plan to preload")] = None,
     speed: Annotated[str, typer.Option(help="1 = real time, N = N times, max = lockstep")] = "1",
     link: Annotated[
@@ -173,7 +180,8 @@ def sim(
     vehicle, fleet = _fleet_settings(config, namespace or default_namespace())
     try:
         opts = BridgeOptions(
-            airframe=aircraft, home=_home(home), airborne=airborne, speed=_speed(speed),
+            airframe=aircraft or vehicle["airframe"], home=_home(home), airborne=airborne,
+            speed=_speed(speed),
             wind_ned=_triple(wind), turbulence=turbulence,
             outages=[_outage(o) for o in gps_outage or []], noise_scale=noise, seed=seed,
             gps_wander_m=gps_wander,

@@ -102,8 +102,9 @@ class BridgeProcess:
 
 
 def vehicle_config(req: SimRequest, opts: BridgeOptions, devices: dict[str, str]) -> VehicleConfig:
-    """The sim config with the bridge's ptys, the airframe and the requested links in."""
-    cfg = load_config(req.config, opts.namespace, sim_refs={**devices, "airframe": opts.airframe})
+    """The sim config with the bridge's ptys, the airframe and the requested links in: the
+    airframe JSBSim flies is the vehicle's ([vehicle] airframe), for every plug-in."""
+    cfg = load_config(req.config, opts.namespace, sim_refs=devices, airframe=opts.airframe)
     for spec in cfg.plugins:
         if spec.kind == "link.mavlink" and req.links:
             spec.settings["endpoints"] = list(req.links)

@@ -46,10 +46,9 @@ def command(**surfaces: float) -> ActuatorCommand:
 def start_servos(vehicle_factory, tmp_path, airframe: str):
     pty = Pty(tmp_path / "ttyServo")
     servos = plugin(
-        "servos", "actuators.minissc", "flight", device=pty.link, airframe=airframe,
-        stale_s=0.3, flight_hold_s=1.5,
-    )  # fmt: skip
-    vehicle = vehicle_factory(vehicle_config("servos", servos))
+        "servos", "actuators.minissc", "flight", device=pty.link, stale_s=0.3, flight_hold_s=1.5
+    )
+    vehicle = vehicle_factory(vehicle_config("servos", servos, airframe=airframe))
     card = CardEnd(pty)
     commands = vehicle.bus.writer("link/commands")
     wait_for(vehicle.health, 60, "the execution control's health table")

@@ -32,12 +32,14 @@ def test_an_airframe_edit_reaches_a_parameter_the_user_never_set(
     assert "NAVL1_PERIOD = 14.0" in SHIPPED
     state = tmp_path / "state"
     state.mkdir()
-    control = plugin("control", "control.fixed_wing", group="flight", airframe=str(airframe))
+    control = plugin("control", "control.fixed_wing", group="flight")
 
     def config(port: int, state_dir) -> str:
-        return client_vehicle(f"udpin://127.0.0.1:{port}", state_dir, flight=control)
+        return client_vehicle(
+            f"udpin://127.0.0.1:{port}", state_dir, flight=control, airframe=str(airframe)
+        )
 
-    decls = FixedWingPlugin.param_decls({"airframe": str(airframe)})
+    decls = FixedWingPlugin.param_decls({}, {"airframe": str(airframe)})
     if history.startswith("old"):  # as the previous version wrote it: every value
         pinned = {d.name: d.default for d in decls} | {"WP_RADIUS": 45.0}
         (state / "params.json").write_text(json.dumps(pinned))
@@ -53,7 +55,7 @@ def test_an_airframe_edit_reaches_a_parameter_the_user_never_set(
     assert read(gcs, "NAVL1_PERIOD") == 17.0
     assert read(gcs, "WP_RADIUS") == 45.0  # what the user set is kept
     # The controller, started in flight, reads its parameters as this does.
-    decls = FixedWingPlugin.param_decls({"airframe": str(airframe)})
+    decls = FixedWingPlugin.param_decls({}, {"airframe": str(airframe)})
     flying = LiveParams(vehicle.bus, decls, state)
     assert flying["NAVL1_PERIOD"] == 17.0 and flying["WP_RADIUS"] == 45.0
     assert json.loads((state / "params.json").read_text()) == {

@@ -35,7 +35,7 @@ def _vehicle(vehicle_factory, tmp_path, servo: str, aligning=False, fix_type=3, 
             plugin("nav", FAKE_NAV, aligning=aligning),
             plugin("gps", FAKE_GPS, fix_type=fix_type),
             plugin("commander", "vehicle.commander"),
-            plugin("servos", "actuators.minissc", group="flight", device=servo, airframe="c172p"),
+            plugin("servos", "actuators.minissc", group="flight", device=servo),
             state_dir=state,
         )
     )

@@ -117,8 +117,8 @@ def whole_vehicle(port: int, state) -> str:
         plugin("imu", "sensors.serial_imu", device=ABSENT_DEVICE, publish_baro=False),
         plugin("compass", "sensors.os3000", device=ABSENT_DEVICE),
     )
-    control = plugin("control", "control.fixed_wing", group="flight", airframe="c172p")
-    return client_vehicle(f"udpin://127.0.0.1:{port}", state, extra, control)
+    control = plugin("control", "control.fixed_wing", group="flight")
+    return client_vehicle(f"udpin://127.0.0.1:{port}", state, extra, control, airframe="c172p")
 
 
 def bare_vehicle(port: int, state) -> str:

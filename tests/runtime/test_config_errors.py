@@ -151,7 +151,7 @@ def test_an_unknown_simulated_device_is_named(tmp_path):
 def test_the_shipped_sim_config_loads_with_the_bridge_devices():
     devices = ("gps", "compass", "imu", "rc", "range", "battery", "servos")  # the bridge's ptys
     refs = {n: f"/dev/pts/{i}" for i, n in enumerate(devices)}
-    cfg = load_config(REPO / "companion/configs/sim.toml", sim_refs={**refs, "airframe": "J3Cub"})
+    cfg = load_config(REPO / "companion/configs/sim.toml", sim_refs=refs, airframe="J3Cub")
     check_topology(cfg)
     servos = next(p for p in cfg.plugins if p.kind == "actuators.minissc")
-    assert servos.group == "flight" and servos.settings["airframe"] == "J3Cub"
+    assert servos.group == "flight" and cfg.vehicle["airframe"] == "J3Cub"

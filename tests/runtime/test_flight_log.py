@@ -96,10 +96,11 @@ def test_an_armed_flight_is_logged_and_readable_after_kill_9(vehicle_factory, tm
     vehicle = vehicle_factory(
         vehicle_config(
             "logged",
-            plugin("logger", "system.logger", flush_s=flush_s, airframe="x8"),
+            plugin("logger", "system.logger", flush_s=flush_s),
             # In the flight group: it plays (in a loop) once armed, as sensors would fly.
             plugin("replay", "sensors.replay", group="flight", file=sensor_log, loop=True),
             state_dir=state,
+            airframe="J3Cub",
         )
     )
     # Armed only once the logger reads (its first step done), so it sees the first sample.
@@ -132,6 +133,7 @@ def test_an_armed_flight_is_logged_and_readable_after_kill_9(vehicle_factory, tm
     assert ulog is not None
     assert ulog.msg_info_dict["vehicle_name"] == "logged"
     assert ulog.msg_info_dict["sys_name"] == "companion"
+    assert ulog.msg_info_dict["airframe"] == "J3Cub"  # the vehicle's, [vehicle] airframe
     gps = ulog.get_dataset("sensors_gps").data
     assert len(gps["timestamp"]) >= ROWS // 10
     assert [round(float(x), 5) for x in gps["lon_deg"][:3]] == [145.134, 145.1341, 145.1342]

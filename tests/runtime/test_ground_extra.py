@@ -46,7 +46,7 @@ def test_the_vehicle_commands_work_without_the_ground_extra(tmp_path) -> None:
     # The shipped vehicle, on real serial devices instead of the simulator's.
     shipped = (REPO / "companion" / "configs" / "sim.toml").read_text()
     config = tmp_path / "aircraft.toml"
-    aircraft = shipped.replace("sim://airframe", "c172p").replace('clock = "sim"', "")
+    aircraft = shipped.replace('clock = "sim"', "")
     config.write_text(re.sub(r"sim://(\w+)", r"/dev/tty_\1", aircraft))
     done = run_without(["jsbsim", "ray"], "graph", "--config", str(config))
     assert done.returncode == 0, done.stderr

@@ -45,7 +45,7 @@ def logged_vehicle(path: Path) -> Path:
     """A logger, and an IMU in the flight group (a replay, stopped as a sensor would be)."""
     samples = path.with_suffix(".csv")
     make_sensor_log(samples)
-    logger = plugin("logger", "system.logger", flush_s=1.0, airframe="c172p")
+    logger = plugin("logger", "system.logger", flush_s=1.0)
     imu = plugin("imu", "sensors.replay", group="flight", file=samples, loop=True)
     path.write_text(vehicle_config("svc", logger, imu))
     return path

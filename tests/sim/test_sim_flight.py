@@ -10,10 +10,12 @@ import pytest
 
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink import mavutil
+from pyulog import ULog
 
 from companion.navigation.estimate_csv import read_estimate as read_truth
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
+from tests.support.vehicle import REPO
 
 EARTH_RADIUS_M = 6378137.0
 
@@ -96,3 +98,34 @@ def test_the_cub_waits_on_the_runway(tmp_path):
     # On the ground at home: Monash Clayton, the runway 80 m above sea level.
     assert truth["lat"][-1] == pytest.approx(-37.9105, abs=1e-4)
     assert truth["alt"][-1] == pytest.approx(80.0, abs=3.0)
+
+
+@pytest.mark.timeout(300)
+def test_a_config_naming_the_cub_flies_it_in_every_plug_in(tmp_path):
+    """``[vehicle] airframe = "J3Cub"`` and no ``--aircraft``: JSBSim flies the Cub, the
+    controller its gains and speeds, the servo card its channel map, the log names it."""
+    shipped = (REPO / "companion" / "configs" / "sim.toml").read_text()
+    assert 'airframe = "c172p"' in shipped
+    config = tmp_path / "cub.toml"
+    config.write_text(shipped.replace('airframe = "c172p"', 'airframe = "J3Cub"'))
+    proc, namespace, truth_path = start_sim(
+        tmp_path, f"udpout://127.0.0.1:{free_udp_port()}", "--config", str(config),
+        "--plan", str(REPO / "qgc_plans" / "square.plan"), "--airborne", "--start-at", "2",
+        "--exact", "--duration", "60",
+    )  # fmt: skip
+    out = finish(proc, namespace, 240)
+    truth = read_truth(truth_path)
+    speed = np.hypot(np.array(truth["vn"]), np.array(truth["ve"]))
+    alt = np.array(truth["alt"])
+    # Started at the Cub's cruise (31 m/s; the Cessna's is 51), then armed on the mission
+    # and flown at its AIRSPEED_CRUISE (26; the Cessna's 36) up to the plan's 100 m above
+    # home (where it armed, in the air) within the bank limit: the surfaces move as the
+    # Cub's servo map says.
+    assert speed[0] == pytest.approx(31.0, abs=2.0), out[-2000:]
+    assert 20.0 < speed[-2000:].mean() < 30.0, out[-2000:]
+    assert alt[-1] - alt[0] == pytest.approx(100.0, abs=15.0), out[-2000:]
+    assert np.all(np.abs(np.array(truth["roll"])) < math.radians(50))
+    ulog = ULog(str(truth_path.with_suffix(".ulg")))
+    assert ulog.msg_info_dict["airframe"] == "J3Cub"
+    initial = ulog.initial_parameters
+    assert initial["AIRSPEED_CRUISE"] == pytest.approx(26.0)

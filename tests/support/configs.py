@@ -113,9 +113,11 @@ def client_vehicle(
     flight: PluginEntry | None = None,
     name: str = "client",
     autopilot: str = "px4",
+    **vehicle: Any,
 ) -> str:
     """A link on ``endpoint``, a known navigation solution, ``extra``, the commander, and
-    ``flight`` in the flight group (a stand-in by default)."""
+    ``flight`` in the flight group (a stand-in by default); ``vehicle``: more ``[vehicle]``
+    keys (``airframe="J3Cub"``)."""
     return vehicle_config(
         name,
         link(endpoint, autopilot=autopilot),
@@ -125,4 +127,5 @@ def client_vehicle(
         plugin("commander", "vehicle.commander"),
         flight or flight_group(),
         state_dir=state,
+        **vehicle,
     )

@@ -15,9 +15,9 @@ from collections.abc import Mapping
 from typing import Any
 
 from companion.actuators import minissc
-from companion.actuators.airframe import Airframe, AirframeError, load_airframe
+from companion.actuators.airframe import Airframe, load_airframe
 from companion.messages import ActuatorCommand, ServoOutput
-from companion.plugin import DeviceProbe, Plugin, PluginContext, Setting
+from companion.plugin import NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
 from companion.sensors.serial_port import ReopeningSerial, open_problem
 
 WAIT_S = 0.1  # also the refresh cadence when no command arrives
@@ -43,7 +43,6 @@ class MiniSscOutput(Plugin):
     settings = {
         "device": Setting(str, doc="serial:///dev/ttyS1:9600, a pty path or a pyserial URL"),
         "baud": Setting(int, 9600, "the card's jumper setting", choices=(2400, 9600)),
-        "airframe": Setting(str, "c172p", "airframe name (companion/airframes) or TOML path"),
         "stale_s": Setting(float, 0.5, "no command for this long: safe positions", min=0.05),
         "flight_hold_s": Setting(
             float,
@@ -57,29 +56,25 @@ class MiniSscOutput(Plugin):
     outputs = ("actuators/servos",)
 
     @classmethod
-    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
-        """The airframe file must load."""
-        try:
-            load_airframe(settings["airframe"])
-        except AirframeError as exc:
-            return [f"airframe: {exc}"]
-        return []
-
-    @classmethod
-    def prearm(cls, settings: Mapping[str, Any]) -> list[str]:
+    def prearm(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
         problem = open_problem(settings["device"], settings["baud"])
         return [] if problem is None else [f"servo device: {problem}"]
 
     @classmethod
-    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
-        """The card only listens: it is sent every channel at its safe position."""
-        safe = load_airframe(settings["airframe"]).channels
+    def probe(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[DeviceProbe]:
+        """The card only listens: it is sent every channel at its safe position (the
+        vehicle's airframe says where that is)."""
+        safe = load_airframe(vehicle["airframe"]).channels
         neutral = b"".join(minissc.frame(c.servo, c.safe) for c in safe)
         return [DeviceProbe(settings["device"], settings["baud"], None, neutral=neutral)]
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
-        self.airframe: Airframe = load_airframe(ctx.settings["airframe"])
+        self.airframe: Airframe = load_airframe(ctx.vehicle["airframe"])
         self.port = ReopeningSerial(ctx.settings["device"], ctx.settings["baud"])
         self.per_second = minissc.frames_per_second(ctx.settings["baud"])
         # The reader before the writer: the controller takes this writer as the sign that

@@ -34,7 +34,7 @@ from companion.messages import (
 )
 from companion.params import ParamDecl
 from companion.params.live import LiveParams
-from companion.plugin import Plugin, PluginContext, Setting
+from companion.plugin import NO_VEHICLE, Plugin, PluginContext, Setting
 from mavlink_dialect import companion as d
 
 WAIT_S = 0.5
@@ -46,9 +46,9 @@ STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item 
 class FixedWingPlugin(Plugin):
     """Guidance, energy and attitude control for one airframe."""
 
-    settings = {
-        "airframe": Setting(str, "c172p", "airframe name (companion/airframes) or TOML path"),
-    }
+    # The airframe (gains, limits, speeds as parameter defaults) is the vehicle's:
+    # [vehicle] airframe, the same file the servo output and the flight log read.
+    settings: dict[str, Setting] = {}
     inputs = ("nav/state",)
     optional_inputs = (
         "vehicle/status",
@@ -62,21 +62,26 @@ class FixedWingPlugin(Plugin):
     outputs = ("control/actuators", "control/status", "link/commands")
 
     @classmethod
-    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
+    def validate(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
+        """The airframe's [control] table must name only the controller's parameters."""
         try:
-            control_params(load_airframe(settings["airframe"]).control)
+            control_params(load_airframe(vehicle["airframe"]).control)
         except (AirframeError, KeyError) as exc:
             return [f"airframe: {exc}"]
         return []
 
     @classmethod
-    def param_decls(cls, settings: Mapping[str, Any]) -> tuple[ParamDecl, ...]:
-        airframe = load_airframe(settings["airframe"])
+    def param_decls(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> tuple[ParamDecl, ...]:
+        airframe = load_airframe(vehicle["airframe"])
         return control_params(airframe.control, f"airframe {Path(airframe.source).name}")
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
-        decls = self.param_decls(ctx.settings)
+        decls = self.param_decls(ctx.settings, ctx.vehicle)
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
         self.params = LiveParams(ctx.bus, decls, state_dir)
         self.missions = MissionStore(state_dir / "missions")

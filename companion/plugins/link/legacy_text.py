@@ -21,7 +21,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from bridges.text_link.bridge import LegacyTextBridge, LegacyTextOptions
-from companion.plugin import Plugin, PluginContext, Setting
+from companion.plugin import NO_VEHICLE, Plugin, PluginContext, Setting
 
 WAIT_S = 0.5
 
@@ -43,7 +43,9 @@ class LegacyTextPlugin(Plugin):
     }
 
     @classmethod
-    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
+    def validate(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
         """The URLs must parse and the rates must fit the line."""
         try:
             cls._options(settings).check()

@@ -43,7 +43,7 @@ from companion.link.timesync import TimesyncService
 from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChange, VehicleCommand
 from companion.messages.channels import CHANNELS
 from companion.params import ParamDecl, ParamStore
-from companion.plugin import DeviceProbe, Plugin, PluginContext, Setting
+from companion.plugin import NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
 
 MAX_WAIT_S = 1.0  # longest sleep: a stream or a timer falling due, or a trigger, ends it
 PREARM_PERIOD_S = 1.0  # SYS_STATUS's ready-to-arm bit is judged once a second
@@ -103,20 +103,26 @@ class MavlinkLink(Plugin):
     )
 
     @classmethod
-    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
+    def validate(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
         key, key_file = settings["signing_key"], settings["signing_key_file"]
         both = ["give signing_key or signing_key_file, not both"] if key and key_file else []
         return both or endpoint_problems(settings["endpoints"], key or key_file)
 
     @classmethod
-    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
+    def probe(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[DeviceProbe]:
         """The radios (the ground station may be off: their silence is no failure)."""
         radios = serial_endpoints(settings["endpoints"])
         stream = MavlinkStream
         return [DeviceProbe(p, b, stream(), must_answer=False, what="radio") for p, b in radios]
 
     @classmethod
-    def bench_problems(cls, settings: Mapping[str, Any]) -> list[str]:
+    def bench_problems(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
         """The signing key file can be read."""
         problem = key_file_problem(settings["signing_key_file"])
         return [problem] if problem else []

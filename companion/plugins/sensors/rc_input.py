@@ -24,7 +24,7 @@ import serial
 
 from companion.messages import RC_MAX_CHANNELS, PilotFlags, PilotInput, PilotSource
 from companion.params.live import LiveParams
-from companion.plugin import DeviceProbe, Plugin, PluginContext
+from companion.plugin import NO_VEHICLE, DeviceProbe, Plugin, PluginContext
 from companion.plugins.sensors.serial_sensor import serial_settings
 from companion.sensors.rc_channels import RC_PARAMS, StickMap
 from companion.sensors.sbus import SbusDecoder, SbusFrame, SbusStream
@@ -45,7 +45,9 @@ class RcInput(Plugin):
     outputs = ("sensors/rc", "sensors/rc_switch")
 
     @classmethod
-    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
+    def probe(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[DeviceProbe]:
         """The receiver, framed 8E2 as on the aircraft."""
         device, baud, rate = settings["device"], settings["baud"], settings["rate_hz"]
         return [DeviceProbe(device, baud, SbusStream(), rate, framing=SBUS_FRAMING)]

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
+from typing import Any
 
 from companion.messages import Message
 from companion.navigation.offline import true_headings
-from companion.plugin import Plugin, PluginContext, Setting
+from companion.plugin import NO_VEHICLE, Plugin, PluginContext, Setting
 from companion.sensors.sensorlog import CHANNEL_OF, LogStats, read_sensor_log
 
 
@@ -32,7 +33,9 @@ class ReplaySensors(Plugin):
     outputs = tuple(CHANNEL_OF.values())
 
     @classmethod
-    def validate(cls, settings: dict) -> list[str]:  # type: ignore[override]
+    def validate(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
         path = Path(settings["file"]).expanduser()
         return [] if path.is_file() else [f"sensor log {path} does not exist"]
 

@@ -14,7 +14,7 @@ from abc import abstractmethod
 from collections.abc import Mapping
 from typing import Any, Generic, TypeVar
 
-from companion.plugin import DeviceProbe, Plugin, PluginContext, Setting
+from companion.plugin import NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
 from companion.sensors.codec_types import Framer, SentenceDecoder
 from companion.sensors.framed_stream import FramedStream
 from companion.sensors.line_framer import LineFramer
@@ -50,7 +50,9 @@ class SerialSensor(Plugin, Generic[ReadingT]):
         self.stream = FramedStream(self.framer, self.decoder)
 
     @classmethod
-    def probe(cls, settings: Mapping[str, Any]) -> list[DeviceProbe]:
+    def probe(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[DeviceProbe]:
         """The device, heard through this plug-in's own framer and decoder."""
         sensor = cls()  # never started: only its framer and decoder are wanted
         framer = sensor.make_framer()

@@ -34,7 +34,7 @@ from companion.messages import LogProgress
 from companion.messages.channels import CHANNELS, LOGGED
 from companion.params.live import RELOAD_ALL
 from companion.params.store import ParamStore
-from companion.plugin import Plugin, PluginContext, Ports, Setting
+from companion.plugin import NO_VEHICLE, Plugin, PluginContext, Ports, Setting
 
 if TYPE_CHECKING:
     from companion.bus.channels import Reader
@@ -115,7 +115,6 @@ class LoggerPlugin(Plugin):
         "prearm_samples": Setting(
             int, 1000, "samples before arming kept for the flight's log", min=0, max=100_000
         ),
-        "airframe": Setting(str, "", "airframe name or file, for the log's INFO"),
     }
     wants_vehicle_tables = True  # it records the parameters and the navigator's settings
 
@@ -127,7 +126,9 @@ class LoggerPlugin(Plugin):
         )
 
     @classmethod
-    def validate(cls, settings: Mapping[str, Any]) -> list[str]:
+    def validate(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
         return [
             f"channels: unknown bus channel {name!r}"
             for name in settings["channels"]
@@ -160,8 +161,8 @@ class LoggerPlugin(Plugin):
             "sys_name": "companion",
             "ver_sw": __version__,
             "vehicle_name": str(ctx.vehicle.get("name", "")),
-            # The airframe's name: a file (as ``companion sim`` gives) by its stem.
-            "airframe": Path(s["airframe"]).stem if s["airframe"] else "",
+            # The vehicle's airframe by name: a file (a TOML path) by its stem.
+            "airframe": Path(str(ctx.vehicle.get("airframe", ""))).stem,
             "sys_id": int(ctx.vehicle.get("sysid", 1)),
             **navigator_info(ctx.plugins),
         }

@@ -37,10 +37,10 @@ def test_list_diff_set_and_reset_say_where_each_value_comes_from(tmp_path):
     airframe = tmp_path / "J3Cub.toml"
     shipped = (REPO / "companion" / "airframes" / "J3Cub.toml").read_text()
     airframe.write_text(shipped)
-    control = plugin("control", "control.fixed_wing", group="flight", airframe=str(airframe))
+    control = plugin("control", "control.fixed_wing", group="flight")
     config = tmp_path / "v.toml"
     parts = (link("udpout://127.0.0.1:14999"), plugin("nav", FAKE_NAV), control)
-    config.write_text(vehicle_config("p", *parts, state_dir=tmp_path / "s"))
+    config.write_text(vehicle_config("p", *parts, state_dir=tmp_path / "s", airframe=airframe))
     assert companion("params", "diff", "-c", str(config)).stdout.strip() == (
         "every parameter at its default"
     )

@@ -50,7 +50,7 @@ def test_each_sensor_probe_decodes_its_own_frames_and_refuses_corrupted_ones(kin
 
 def test_the_servo_card_is_sent_its_safe_positions_and_the_link_its_radios_only():
     (servos,) = load("actuators.minissc").probe(
-        settings_of("actuators.minissc", device="/dev/ttyS", airframe="J3Cub")
+        settings_of("actuators.minissc", device="/dev/ttyS"), {"airframe": "J3Cub"}
     )
     assert servos.stream is None and len(servos.neutral) == 15  # J3Cub: five channels
     assert servos.neutral[:3] == bytes((0xFF, 0, 10))  # throttle (servo 0) at its minimum

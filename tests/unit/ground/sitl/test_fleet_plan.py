@@ -123,5 +123,5 @@ def test_two_vehicles_of_one_config_never_share_a_default_state_dir():
     refs = {
         name: "/dev/null" for name in ("gps", "compass", "imu", "rc", "range", "battery", "servos")
     }
-    config = load_config(SIM_TOML, "bravo", sim_refs={**refs, "airframe": "c172p"})
+    config = load_config(SIM_TOML, "bravo", sim_refs=refs)
     assert config.vehicle["state_dir"] == two["state_dir"]
