@@ -33,12 +33,12 @@ def _asks(c: Commander, command: CommandId, *params: float) -> tuple[CommandResu
 
 
 AIRBORNE_ONLY = [
-    (CommandId.SET_MODE, (float(FlightMode.LOITER),), "Loiter"),
+    (CommandId.SET_MODE, (float(FlightMode.LOITER),), "Hold"),
     (CommandId.SET_MODE, (float(FlightMode.RTL),), "Return"),
     (CommandId.RETURN_TO_LAUNCH, (), "Return"),
-    (CommandId.REPOSITION, (HERE[0] + 0.01, HERE[1], 100.0), "Guided"),
-    (CommandId.LOITER, (HERE[0], HERE[1], 100.0), "Loiter"),
-    (CommandId.ORBIT, (HERE[0], HERE[1], 100.0, 200.0), "Loiter"),
+    (CommandId.REPOSITION, (HERE[0] + 0.01, HERE[1], 200.0), "Guided"),
+    (CommandId.LOITER, (HERE[0], HERE[1], 200.0), "Hold"),
+    (CommandId.ORBIT, (HERE[0], HERE[1], 200.0, 200.0), "Hold"),
 ]
 
 
@@ -53,7 +53,7 @@ def test_armed_on_the_ground_modes_that_cannot_fly_from_there_are_refused_with_t
     assert c.mode == FlightMode.LOITER and c.status(0).changes == before  # nothing changed
     # What can fly from the runway is accepted: Mission and Takeoff.
     assert _asks(c, CommandId.MISSION_START, 0, 0)[0] == CommandResult.ACCEPTED
-    assert _asks(c, CommandId.TAKEOFF, 0, 0, 50.0)[0] == CommandResult.ACCEPTED
+    assert _asks(c, CommandId.TAKEOFF, 0, 0, 200.0)[0] == CommandResult.ACCEPTED
     assert c.mode == FlightMode.TAKEOFF
 
 
@@ -74,9 +74,9 @@ def test_what_the_operator_is_told_armed_on_the_ground():
     assert ground_notice(FlightMode.MISSION, takeoff, 0) is None  # it takes off as planned
     # Started at item 2 (MISSION_START's first item): that one is not a take-off either.
     assert ground_notice(FlightMode.MISSION, takeoff, 2) == text.replace("1", "2")
-    holding = "Loiter: on the ground until Takeoff or Mission"
+    holding = "Hold: on the ground until Takeoff or Mission"  # Loiter, as QGroundControl names it
     assert ground_notice(FlightMode.LOITER, takeoff, 0) == holding
-    assert ground_notice(FlightMode.RTL, [], 0) == holding.replace("Loiter", "Return")
+    assert ground_notice(FlightMode.RTL, [], 0) == holding.replace("Hold", "Return")
     assert ground_notice(FlightMode.TAKEOFF, [], 0) is None
     assert ground_notice(FlightMode.MANUAL, [], 0) is None
 
