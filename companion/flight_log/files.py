@@ -13,6 +13,8 @@ import re
 from pathlib import Path
 from typing import BinaryIO
 
+from companion.params.atomic import fsync_directory
+
 log = logging.getLogger(__name__)
 
 _NAME = re.compile(r"^(\d{4,})_[A-Za-z0-9_-]*\.ulg$")
@@ -38,7 +40,7 @@ class LogDirectory:
         cut must not take the directory, and every log in it, away)."""
         if not self.path.is_dir():
             self.path.mkdir(parents=True, exist_ok=True)
-            _fsync_dir(self.path.parent)
+            fsync_directory(self.path.parent)
         numbers = [int(m.group(1)) for p in self.files() if (m := _NAME.match(p.name))]
         number = max(numbers, default=0) + 1
         safe = re.sub(r"[^A-Za-z0-9_-]", "_", label)
@@ -51,7 +53,7 @@ class LogDirectory:
     def publish(self, partial: Path, path: Path) -> None:
         """Rename a partial log into view, durably (the directory is fsynced too)."""
         os.rename(partial, path)
-        _fsync_dir(self.path)
+        fsync_directory(self.path)
 
     def remove_partial(self) -> list[Path]:
         """Remove partial logs nobody writes (cut off before their header was on disk)."""
@@ -122,14 +124,6 @@ def being_written(path: Path) -> bool:
     except OSError:
         return False
     return False
-
-
-def _fsync_dir(path: Path) -> None:
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
 
 
 def _size(path: Path) -> int:

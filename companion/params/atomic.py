@@ -29,9 +29,9 @@ def atomic_write_text(path: Path, text: str) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    _fsync_directory(path.parent)
+    fsync_directory(path.parent)
     if created:
-        _fsync_directory(path.parent.parent)
+        fsync_directory(path.parent.parent)
     remove_orphans(path)
 
 
@@ -47,7 +47,8 @@ def remove_orphans(path: Path, now: float | None = None) -> list[Path]:
     return removed
 
 
-def _fsync_directory(directory: Path) -> None:
+def fsync_directory(directory: Path) -> None:
+    """Make the directory's entries (a new or renamed file in it) survive a power cut."""
     dir_fd = os.open(directory, os.O_RDONLY)
     try:
         os.fsync(dir_fd)
