@@ -78,12 +78,7 @@ class CommanderPlugin(Plugin):
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
-        self.state_dir = state_dir
-        # The flight this commander's last process left (None: none, or nothing to resume).
-        self.saved = load_flight_state(state_dir)
-        self.resume_until_us: int | None = None
-        self.rearm_until_us = 0  # asked to be armed again: armed, whatever the table says yet
-        self.written = ""  # the flight state last written
+        self._read_flight_state(state_dir)
         self.store = MissionStore(state_dir / "missions")
         self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
         # The link stores missions in its own process and says so on mission/changed.
@@ -164,6 +159,16 @@ class CommanderPlugin(Plugin):
             self.acks.publish(ack)
         self._keep_flight_state(now)
 
+    def _read_flight_state(self, state_dir: Path) -> None:
+        self.state_dir = state_dir
+        # The flight this commander's last process left (None: none, or nothing to resume).
+        self.saved = load_flight_state(state_dir)
+        self.resume_until_us: int | None = None
+        self.rearm_until_us = 0  # asked to be armed again: armed, whatever the table says yet
+        self.written = ""  # the flight state last written
+        # Whether the file says armed (a start on the ground after a flight rewrites it).
+        self.written_armed = self.saved is not None and self.saved.armed
+
     def _resume(self, now: int, nav: Any, health: Any) -> bool:
         """Carry on the flight the last process left, if it is still on; False: not known yet.
 
@@ -212,9 +217,11 @@ class CommanderPlugin(Plugin):
             c.mission_first = max(0, int(control.mission_seq))
         state = c.snapshot()
         text = state.to_json()
-        if text != self.written:
+        # Disarmed, the file changes only to say a flight has ended: a vehicle on the bench
+        # writes nothing to its state directory (nothing to resume from there).
+        if text != self.written and (state.armed or self.written_armed):
             save_flight_state(self.state_dir, state)
-            self.written = text
+            self.written, self.written_armed = text, state.armed
 
     def _ground_notice(self, now: int, known: bool) -> None:
         """Armed on the ground, say once per arming and per mode entered what the aircraft
