@@ -170,7 +170,7 @@ def test_mavsdk_mission_without_take_off_flies_and_its_geofence_acts(tmp_path):
         out = finish(proc, namespace, 60)
     texts = seen["texts"]
     assert "Fence item 4 ignored: inclusion circle radius 0" in fence_texts, fence_texts
-    assert "Loiter: on the ground until Takeoff or Mission" in texts, texts  # at arming
+    assert "Hold: on the ground until Takeoff or Mission" in texts, texts  # at arming (Loiter)
     assert seen["refused"] == [ActionResult.COMMAND_DENIED] * 2
     assert "Return: on the ground, take off first" in texts, texts
     assert "Mission item 0 not a take-off: taking off first" in texts, texts
