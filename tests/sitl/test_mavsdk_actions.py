@@ -19,21 +19,13 @@ from mavsdk.plugins.telemetry import FlightMode
 from companion.geodesy import LocalFrame
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
+from tests.support.mavsdk_flight import until
 
 WAIT_S = 240.0  # wall seconds for any one stage: generous, for a loaded machine
 
 
 async def _until(gen, predicate, what: str):
-    async def first():
-        async for value in gen:
-            if predicate(value):
-                return value
-        return None
-
-    try:
-        return await asyncio.wait_for(first(), WAIT_S)
-    except TimeoutError:
-        raise AssertionError(f"MAVSDK never saw {what}") from None
+    return await until(gen, predicate, what, WAIT_S)
 
 
 async def _flight(port: int) -> dict:

@@ -36,6 +36,7 @@ from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
+from tests.support.mavsdk_flight import until
 
 WAIT_S = 300.0  # wall seconds for any one stage: generous, for a loaded machine
 FENCE_M = 2_000.0  # the inclusion square reaches this far north, south, east and west
@@ -45,16 +46,7 @@ WAYPOINTS = [(1_000.0, 0.0), (1_000.0, 1_000.0), (0.0, 3_000.0)]
 
 
 async def _until(gen, predicate, what: str, texts: list[str]):
-    async def first():
-        async for value in gen:
-            if predicate(value):
-                return value
-        return None
-
-    try:
-        return await asyncio.wait_for(first(), WAIT_S)
-    except TimeoutError:
-        raise AssertionError(f"MAVSDK never saw {what}; texts: {texts}") from None
+    return await until(gen, predicate, what, WAIT_S, lambda: f"; texts: {texts}")
 
 
 def _mission_item(frame: LocalFrame, ne: tuple[float, float]) -> MissionItem:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import asyncio
 import time
+from collections.abc import AsyncIterator, Callable
+from typing import Any
 
 from mavsdk.asyncio import Configuration, Mavsdk
 from mavsdk.asyncio.plugins.action import ActionAsync
@@ -39,3 +41,25 @@ async def fly_plan(port: int, plan: str, deadline_s: float) -> dict:
         except ActionError as exc:
             seen["disarm"] = exc.result.name
     return seen
+
+
+async def until(
+    stream: AsyncIterator[Any],
+    predicate: Callable[[Any], bool],
+    what: str,
+    timeout_s: float,
+    detail: Callable[[], str] = lambda: "",
+) -> Any:
+    """The first value of a MAVSDK stream that ``predicate`` accepts, within ``timeout_s``;
+    an AssertionError naming ``what`` (and ``detail()``) otherwise."""
+
+    async def first() -> Any:
+        async for value in stream:
+            if predicate(value):
+                return value
+        return None
+
+    try:
+        return await asyncio.wait_for(first(), timeout_s)
+    except TimeoutError:
+        raise AssertionError(f"MAVSDK never saw {what}{detail()}") from None
