@@ -17,14 +17,15 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
+from companion.control.flight.controller import LANDED_SPEED
 from companion.messages import FlightMode, NavFlags
 from companion.params.atomic import atomic_write_text
 
 log = logging.getLogger(__name__)
 
 FILE_NAME = "flight_state.json"
-# In the air, judged by the navigator: faster than any taxi, or well above home.
-AIRBORNE_SPEED_M_S = 8.0
+# In the air, judged by the navigator: faster than the controller's on-the-ground speed, or
+# well above home (higher than its 10 m: a resumed flight is armed without pre-arm checks).
 AIRBORNE_HEIGHT_M = 15.0
 
 
@@ -93,7 +94,7 @@ def in_the_air(nav: Any, home: tuple[float, float, float] | None) -> bool:
     """Whether the navigator says the aircraft flies: fast, or high above home."""
     if nav is None or not nav.flags & NavFlags.POSITION_VALID:
         return False
-    if math.hypot(nav.vn_m_s, nav.ve_m_s) >= AIRBORNE_SPEED_M_S:
+    if math.hypot(nav.vn_m_s, nav.ve_m_s) >= LANDED_SPEED:
         return True
     return home is not None and nav.alt_msl_m - home[2] >= AIRBORNE_HEIGHT_M
 
