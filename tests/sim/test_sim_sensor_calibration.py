@@ -7,6 +7,10 @@ m/s² a calibration allows, and both calibrations always failed ("the aircraft m
 it still"). At idle the vibration is now the propeller's at idle speed. Sent as
 QGroundControl's Sensors page sends them (tests/protocol/test_qgc_sensor_calibration.py
 has the bench).
+
+JSBSim drops the aircraft onto its gear at the start: it rocks for about 5 s of its time
+(2° of pitch). A calibration asked then fails, rightly; as a person would, the test waits
+for Ready To Fly (pre-arm passing, which needs the navigator aligned on a still aircraft).
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ from mavlink_dialect import companion as m
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.protocol.test_qgc_sensor_calibration import PROGRESS, calibrate, param
 from tests.sim.sim_run import finish, start_sim
+from tests.support.vehicle import wait_for
 
 
 @pytest.mark.timeout(300)
@@ -31,8 +36,11 @@ def test_gyro_and_level_calibrations_pass_on_the_idling_aircraft(tmp_path):
     gcs = GroundStation(port)
     try:
         gcs.connect(120.0)
-        # As a person would, once the vehicle is up: its IMU in the telemetry.
+        # As a person would, once QGroundControl shows Ready To Fly.
         gcs.recv("SCALED_IMU", 120.0)
+        healthy = m.MAV_SYS_STATUS_PREARM_CHECK
+        wait_for(lambda: gcs.recv("SYS_STATUS", 5.0).onboard_control_sensors_health & healthy,
+                 120, "pre-arm checks passing")  # fmt: skip
         result, texts = calibrate(gcs, 1, 0, 0, 0, 0, 0, 0)  # gyro
         assert result == m.MAV_RESULT_ACCEPTED, texts
         assert texts == ["calibration started: 2 gyro", *PROGRESS, "calibration done: gyro"]
