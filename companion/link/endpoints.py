@@ -124,8 +124,8 @@ class UdpIn(UdpOut):
     def read_ready(self, fd: int) -> list[tuple[Remote, bytes]]:
         got = super().read_ready(fd)
         for addr, _ in got:
-            if addr not in self.remotes:
-                self.remotes.append(addr)  # type: ignore[arg-type]
+            if isinstance(addr, tuple) and addr not in self.remotes:  # (UDP: always a tuple)
+                self.remotes.append(addr)
                 log.info("%s: new remote %s:%d", self.url, *addr)
         return got
 
