@@ -204,6 +204,7 @@ class Flight:
         f = self.fdm
         mass = f["inertia/mass-slugs"]
         yaw = math.remainder(f["attitude/psi-rad"], math.tau)
+        fx, fy, fz = (f[f"forces/fb{a}-total-lbs"] / mass * FT for a in "xyz")
         return TrueState(
             t_s=self.t_s,
             lat_deg=f["position/lat-geod-deg"],
@@ -219,7 +220,7 @@ class Flight:
             p=f["velocities/p-rad_sec"],
             q=f["velocities/q-rad_sec"],
             r=f["velocities/r-rad_sec"],
-            f_body=tuple(f[f"forces/fb{a}-total-lbs"] / mass * FT for a in "xyz"),
+            f_body=(fx, fy, fz),
             airspeed_m_s=f["velocities/vtrue-fps"] * FT,
         )
 

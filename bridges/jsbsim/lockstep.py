@@ -5,10 +5,8 @@ from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
-
-from bridges.jsbsim.ptys import PtyPort
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
     from companion.bus.channels import LatestReader, Reader
@@ -29,6 +27,14 @@ START_FLIGHT_S = 20.0  # the flight plug-ins' start-up after START, at most
 STALL_FLIGHT_S = 5.0  # a running flight plug-in that stops answering is waited for this long
 
 
+class SensorLine(Protocol):
+    """What is waited on of a line: a pty, or a real serial line in hardware in the loop."""
+
+    @property
+    def name(self) -> str: ...
+    def unread(self) -> int: ...
+
+
 class Lockstep:
     """Waits, each frame, until every sensor line is drained by its driver.
 
@@ -38,7 +44,7 @@ class Lockstep:
     driver slows the simulation down once instead of on every frame.
     """
 
-    def __init__(self, ports: list[PtyPort], stall_s: float = STALL_S) -> None:
+    def __init__(self, ports: Sequence[SensorLine], stall_s: float = STALL_S) -> None:
         self.ports = ports
         self.stall_s = stall_s
         self.waiting_for = {p.name: True for p in ports}

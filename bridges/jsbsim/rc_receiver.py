@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import bisect
 import csv
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 SIGNALS = ("ok", "silent", "failsafe")
@@ -69,16 +69,18 @@ def load_pilot(path: str | Path) -> list[PilotRow]:
 
 def _row(raw: dict[str, str]) -> PilotRow:
     given = {k.strip(): v.strip() for k, v in raw.items() if k and v and v.strip()}
-    row = PilotRow(t_s=float(given["t"]))
-    for name in ("roll", "pitch", "yaw", "throttle"):
-        if name in given:
-            row = replace(row, **{name: float(given[name])})
-    if "switch" in given:
-        row = replace(row, switch=int(given["switch"]))
-    signal = given.get("signal", "ok")
-    if signal not in SIGNALS or not 1 <= row.switch <= 6:
+    row = PilotRow(
+        t_s=float(given["t"]),
+        roll=float(given.get("roll", 0.0)),
+        pitch=float(given.get("pitch", 0.0)),
+        yaw=float(given.get("yaw", 0.0)),
+        throttle=float(given.get("throttle", 0.0)),
+        switch=int(given.get("switch", 1)),
+        signal=given.get("signal", "ok"),
+    )
+    if row.signal not in SIGNALS or not 1 <= row.switch <= 6:
         raise ValueError(f"signal must be one of {SIGNALS} and switch 1..6")
-    return replace(row, signal=signal)
+    return row
 
 
 def sbus_frame(pulses_us: list[int], flags: int = 0) -> bytes:

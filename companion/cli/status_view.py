@@ -30,7 +30,8 @@ def health_dict(msg: SystemHealth) -> dict[str, Any]:
         item = row.as_dict()
         item["state"] = PluginState(row.state).name.lower()
         for key in ("step_p50_us", "step_p99_us"):
-            if isinstance(item[key], float) and math.isnan(item[key]):
+            value = item[key]
+            if isinstance(value, float) and math.isnan(value):
                 item[key] = None
         rows.append(item)
     return {

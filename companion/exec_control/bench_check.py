@@ -18,7 +18,7 @@ import serial
 from companion.exec_control.config import VehicleConfig
 from companion.exec_control.registry import load
 from companion.plugin import DeviceProbe
-from companion.sensors.serial_port import split_device
+from companion.sensors.serial_port import SerialPort, split_device
 
 log = logging.getLogger(__name__)
 
@@ -138,7 +138,7 @@ def _try_device(report: DeviceReport, seconds: float) -> None:
         port.close()
 
 
-def _listen(port: serial.SerialBase, report: DeviceReport, seconds: float) -> None:
+def _listen(port: SerialPort, report: DeviceReport, seconds: float) -> None:
     stream = report.probe.stream
     assert stream is not None
     start = time.monotonic()
@@ -157,7 +157,7 @@ def _listen(port: serial.SerialBase, report: DeviceReport, seconds: float) -> No
     report.seconds = time.monotonic() - start
 
 
-def _write_neutral(port: serial.SerialBase, report: DeviceReport) -> None:
+def _write_neutral(port: SerialPort, report: DeviceReport) -> None:
     start = time.monotonic()
     report.written = port.write(report.probe.neutral) or 0
     while time.monotonic() - start < DRAIN_TIMEOUT_S:

@@ -67,9 +67,9 @@ class Child:
 
     def reap(self, now: float) -> bool:
         """If the process died unasked, schedule its restart; True when it did."""
-        if self.proc is None or self.proc.poll() is None:
+        code = self.proc.poll() if self.proc is not None else None
+        if code is None:
             return False
-        code = self.proc.returncode
         self.proc = None
         self._ps = None
         if not self.wanted:

@@ -142,6 +142,8 @@ class _Checker:
             hint = get_close_matches(str(value), [str(c) for c in setting.choices], n=1)
             tip = f"; did you mean {hint[0]!r}?" if hint else ""
             raise self.error(where, f"{value!r} is not one of {list(setting.choices)}{tip}")
+        if not isinstance(value, int | float):  # the bounds are a number's
+            return value
         if setting.min is not None and value < setting.min:
             raise self.error(where, f"{value!r} is below the minimum {setting.min}")
         if setting.max is not None and value > setting.max:

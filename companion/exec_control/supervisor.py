@@ -13,7 +13,7 @@ import signal
 import time
 from dataclasses import asdict
 
-from companion.bus.channels import Reader
+from companion.bus.channels import Reader, Writer
 from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
 from companion.bus.namespace import cleanup_namespace
 from companion.bus.node import BusNode
@@ -127,7 +127,7 @@ class Supervisor:
             return None
         return CommandResult.ACCEPTED
 
-    def publish_health(self, writer: object) -> None:
+    def publish_health(self, writer: Writer[SystemHealth]) -> None:
         msg = SystemHealth(t_us=self.clock.now_us(), supervisor_pid=os.getpid())
         msg.flight_running = int(self.flight_running)
         msg.count = len(self.children)
@@ -137,7 +137,7 @@ class Supervisor:
         # Arming, a plug-in starting, dying or restarting wakes the readers that wait on
         # the table (commander, link, logger); the counters alone, once a second, do not.
         shape = (msg.flight_running, *((r.state, r.pid, r.restarts) for r in msg.rows()))
-        writer.publish(msg, wake=shape != self._health_shape)  # type: ignore[attr-defined]
+        writer.publish(msg, wake=shape != self._health_shape)
         self._health_shape = shape
 
     def absorb_stats(self, stats: Reader[PluginStats]) -> None:

@@ -17,7 +17,7 @@ import re
 import struct
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 from companion.messages.base import Message
 
@@ -53,12 +53,14 @@ def _type_name(cls: type) -> str:
     return re.sub(r"(?<!^)(?=[A-Z])", "_", cls.__name__).lower()
 
 
-def _element(ctype: type) -> tuple[type, int]:
+def _element(ctype: type[Any]) -> tuple[type[Any], int]:
     """The element type of a (possibly multi-dimensional) array and its total count (0: none)."""
     count = 0
     while issubclass(ctype, ctypes.Array):
-        count = (count or 1) * ctype._length_
-        ctype = ctype._type_
+        # typeshed has _length_ and _type_ as an instance's properties; read on the class
+        # they are what ctypes set: the length and the element type.
+        count = (count or 1) * ctype._length_  # type: ignore[operator]
+        ctype = ctype._type_  # type: ignore[assignment]
     return ctype, count
 
 

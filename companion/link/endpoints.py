@@ -18,7 +18,7 @@ from urllib.parse import parse_qs, urlparse
 
 import serial
 
-from companion.sensors.serial_port import FIRST_RETRY_S, MAX_RETRY_S, open_port
+from companion.sensors.serial_port import FIRST_RETRY_S, MAX_RETRY_S, SerialPort, open_port
 
 log = logging.getLogger(__name__)
 # What pyserial raises when a device is gone (TypeError: a port closed under a read).
@@ -124,8 +124,8 @@ class UdpIn(UdpOut):
     def read_ready(self, fd: int) -> list[tuple[Remote, bytes]]:
         got = super().read_ready(fd)
         for addr, _ in got:
-            if addr not in self.remotes:
-                self.remotes.append(addr)  # type: ignore[arg-type]
+            if isinstance(addr, tuple) and addr not in self.remotes:  # (UDP: always a tuple)
+                self.remotes.append(addr)
                 log.info("%s: new remote %s:%d", self.url, *addr)
         return got
 
@@ -161,11 +161,11 @@ class TcpIn(Endpoint):
     def read_ready(self, fd: int) -> list[tuple[Remote, bytes]]:
         if fd == self.server.fileno():
             try:
-                conn, addr = self.server.accept()
+                client, addr = self.server.accept()
             except OSError:
                 return []
-            conn.setblocking(False)
-            self.clients[conn.fileno()] = conn
+            client.setblocking(False)
+            self.clients[client.fileno()] = client
             log.info("%s: client %s:%d connected", self.url, *addr)
             return []
         conn = self.clients.get(fd)
@@ -222,9 +222,9 @@ class SerialEndpoint(Endpoint):
         self.reopens = 0
         self._retry_s = FIRST_RETRY_S
         self._next_try = 0.0
-        self.port: serial.SerialBase | None = self._open()
+        self.port: SerialPort | None = self._open()
 
-    def _open(self) -> serial.SerialBase:
+    def _open(self) -> SerialPort:
         # open_port: a radio at a custom rate reopens after a restart (pyserial issue #805).
         return open_port(self.path, baudrate=self.baud, timeout=0, write_timeout=0)
 
@@ -232,7 +232,7 @@ class SerialEndpoint(Endpoint):
         port = self.port if self.port is not None else self._reopen()
         return [port.fileno()] if port is not None else []
 
-    def _reopen(self) -> serial.SerialBase | None:
+    def _reopen(self) -> SerialPort | None:
         now = time.monotonic()
         if now < self._next_try:
             return None
@@ -356,7 +356,12 @@ def open_endpoint(url: str) -> Endpoint:
     """Open the endpoint a URL names; EndpointError for an unknown scheme or option."""
     base, options = split_options(url)
     scheme = base.split("://", 1)[0] if "://" in base else ""
-    kinds = {"udpout": UdpOut, "udpin": UdpIn, "tcpin": TcpIn, "serial": SerialEndpoint}
+    kinds: dict[str, type[Endpoint]] = {
+        "udpout": UdpOut,
+        "udpin": UdpIn,
+        "tcpin": TcpIn,
+        "serial": SerialEndpoint,
+    }
     if scheme not in kinds:
         raise EndpointError(f"{url!r}: scheme must be one of {sorted(SCHEMES)}")
     endpoint = kinds[scheme](base)

@@ -213,12 +213,17 @@ class LogTransferService:
             self.tokens = min(capacity, self.tokens + max(0.0, now_s - self.last_s) * rate)
         self.last_s = now_s
 
+    def _served(self) -> Peer | None:
+        """Whom the pacing serves now: the listing's asker, else the transfer's; None: idle."""
+        if self.listing:
+            return self.listing[0][1]
+        return self.transfer.peer if self.transfer is not None else None
+
     def tick(self, now_s: float) -> list[Outgoing]:
-        busy = self.listing or self.transfer is not None
-        if not busy:
+        peer = self._served()
+        if peer is None:
             self.last_s = None  # idle: the next transfer starts with a full bucket
             return []
-        peer = self.listing[0][1] if self.listing else self.transfer.peer  # type: ignore[union-attr]
         self._refill(now_s, self.rate_bytes_s(peer.endpoint) * SHARE)
         out: list[Outgoing] = []
         entries = self.entries or []
@@ -270,9 +275,9 @@ class LogTransferService:
 
     def next_due(self) -> float:
         """When the pacing allows the next frame (the link waits no longer than that)."""
-        if self.last_s is None or not (self.listing or self.transfer is not None):
+        peer = self._served()
+        if self.last_s is None or peer is None:
             return float("inf")
-        peer = self.listing[0][1] if self.listing else self.transfer.peer  # type: ignore[union-attr]
         rate = self.rate_bytes_s(peer.endpoint) * SHARE
         missing = max(0.0, FRAME_BYTES - self.tokens)
         return self.last_s + (missing / rate if rate > 0 else 1.0)

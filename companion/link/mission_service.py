@@ -156,7 +156,8 @@ class MissionService:
         if len(upload.items) < upload.count:
             return [self._request(upload, now_s)]
         del self.uploads[mission_type]
-        items, notes = upload.items, []
+        items = upload.items
+        notes: list[str] = []
         if mission_type == d.MAV_MISSION_TYPE_FENCE:  # zones that enclose nothing: left out
             items, notes = honoured(items)
         result = check_mission(items)

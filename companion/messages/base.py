@@ -13,6 +13,10 @@ NAME_LEN = 24
 class Message(ctypes.Structure):
     """Base of every bus payload; subclasses declare ``_fields_`` starting with ``t_us``."""
 
+    # The field every payload has, declared for the type checker (to which a field of
+    # _fields_ is Any); the field itself is each subclass's.
+    t_us: int
+
     def as_dict(self) -> dict[str, object]:
         """Plain-Python view of the fields (arrays become lists, names become str)."""
         out: dict[str, object] = {}

@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -42,7 +43,7 @@ class EarthField:
 
 
 @functools.lru_cache(maxsize=3)
-def _model(coefficients: str):  # type: ignore[no-untyped-def]
+def _model(coefficients: str) -> Any:  # a pygeomag GeoMag: pygeomag has no types
     from pygeomag import GeoMag
 
     return GeoMag(coefficients_file=coefficients)

@@ -95,8 +95,9 @@ class GpsCompassNavigator:
         f, q = self._transition(dt)
         return f @ self.kf.x, f @ self.kf.P @ f.T + q
 
-    def _to_ned(self, lat: float, lon: float, alt: float) -> np.ndarray:
-        lat0, lon0, alt0 = self.ref  # type: ignore[misc]
+    @staticmethod
+    def _to_ned(ref: tuple[float, float, float], lat: float, lon: float, alt: float) -> np.ndarray:
+        lat0, lon0, alt0 = ref
         north = math.radians(lat - lat0) * EARTH_RADIUS_M
         east = math.radians(lon - lon0) * EARTH_RADIUS_M * math.cos(math.radians(lat0))
         return np.array([north, east, -(alt - alt0)])
@@ -109,7 +110,7 @@ class GpsCompassNavigator:
         alt = fix.alt_msl_m if math.isfinite(fix.alt_msl_m) else 0.0
         if self.ref is None:
             self.ref = (fix.lat_deg, fix.lon_deg, alt)
-        pos = self._to_ned(fix.lat_deg, fix.lon_deg, alt)
+        pos = self._to_ned(self.ref, fix.lat_deg, fix.lon_deg, alt)
         vel = np.array([fix.vn_m_s, fix.ve_m_s, fix.vd_m_s])
         z = np.concatenate([pos, np.nan_to_num(vel)])
         pos_std = fix.eph_m if math.isfinite(fix.eph_m) else self.cfg.default_pos_std_m
@@ -143,15 +144,15 @@ class GpsCompassNavigator:
         for field in ("roll_rate_rad_s", "pitch_rate_rad_s", "yaw_rate_rad_s"):
             setattr(msg, field, math.nan)
         if self.ref is not None and self.t_kf_us is not None:
-            flags |= self._fill_position(msg, t_us)
+            flags |= self._fill_position(msg, t_us, self.ref)
         msg.flags = int(flags)
         msg.gps_rejected = self.rejected
         return msg
 
-    def _fill_position(self, msg: NavState, t_us: int) -> int:
+    def _fill_position(self, msg: NavState, t_us: int, ref: tuple[float, float, float]) -> int:
         x_col, p = self._predicted(t_us)
         x = x_col.ravel()
-        lat0, lon0, alt0 = self.ref  # type: ignore[misc]
+        lat0, lon0, alt0 = ref
         msg.lat_deg = lat0 + math.degrees(x[0] / EARTH_RADIUS_M)
         msg.lon_deg = lon0 + math.degrees(x[1] / (EARTH_RADIUS_M * math.cos(math.radians(lat0))))
         msg.alt_msl_m = alt0 - x[2]

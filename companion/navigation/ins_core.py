@@ -125,22 +125,23 @@ class InsCore:
         self.cov_dt = 0.0
 
     # -- updates --------------------------------------------------------------------
-    def _update(  # type: ignore[no-untyped-def]
-        self, y: np.ndarray, h: np.ndarray | list[int], r: np.ndarray, k_mask=None,
-        gate: bool = True,
+    def _update(
+        self, y: np.ndarray, h: np.ndarray | list[int], r: np.ndarray,
+        k_mask: np.ndarray | None = None, gate: bool = True,
     ) -> bool:  # fmt: skip
         """Gate (unless told not to), then correct; False when the innovation was rejected.
         ``h``: the Jacobian, or the list of states measured directly (rows of the identity:
         picking them out gives the same numbers as multiplying, with fewer numpy calls).
         ``k_mask`` (15 booleans) limits which error states this measurement may correct."""
         self._flush_covariance()
-        rows = _picker(h) if isinstance(h, list) else None
-        if rows is None:
-            ph = self.P @ h.T
-            s = h @ ph + r
-        else:
+        rows = None
+        if isinstance(h, list):
+            rows = _picker(h)
             ph = self.P[:, rows]
             s = ph[rows] + r
+        else:
+            ph = self.P @ h.T
+            s = h @ ph + r
         s_inv = 1.0 / s if len(y) == 1 else np.linalg.inv(s)  # 1×1: inv is 1/s exactly
         if gate and float(y @ s_inv @ y) > CHI2_9999[len(y)]:
             return False

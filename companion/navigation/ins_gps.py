@@ -55,8 +55,8 @@ class StateHistory:
                 w = (t_us - t0) / (t1 - t0) if t1 > t0 else 1.0
                 p = np.add(np.multiply(p0, 1 - w), np.multiply(p1, w))
                 return p, np.add(np.multiply(v0, 1 - w), np.multiply(v1, w))
-        _, p, v = rows[0]
-        return np.array(p), np.array(v)
+        _, first_p, first_v = rows[0]
+        return np.array(first_p), np.array(first_v)
 
     def velocities(self) -> tuple[np.ndarray, np.ndarray]:
         """Times (µs) and velocities (N×3) of the history, as arrays."""

@@ -15,6 +15,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from companion.geodesy import E2, A
 
@@ -76,10 +77,10 @@ class LocalFrame:
 
     def __init__(self, lat_deg: float, lon_deg: float, alt_m: float) -> None:
         self.ref = (lat_deg, lon_deg, alt_m)
-        self.origin = np.array(ecef(lat_deg, lon_deg, alt_m))
+        self.origin: npt.NDArray[np.float64] = np.array(ecef(lat_deg, lon_deg, alt_m))
         lat, lon = math.radians(lat_deg), math.radians(lon_deg)
         sl, cl, so, co = math.sin(lat), math.cos(lat), math.sin(lon), math.cos(lon)
-        self.ecef_to_ned = np.array(
+        self.ecef_to_ned: npt.NDArray[np.float64] = np.array(
             [[-sl * co, -sl * so, cl], [-so, co, 0.0], [-cl * co, -cl * so, -sl]]
         )
         self._origin = tuple(self.origin.tolist())

@@ -6,6 +6,7 @@ Plain floats and small numpy arrays: this is the INS hot path.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -79,7 +80,7 @@ def rotation_matrix(q: Quat) -> np.ndarray:
     return np.array(rotation_matrix_rows(q))
 
 
-def skew(v: np.ndarray) -> np.ndarray:
+def skew(v: Sequence[float] | np.ndarray) -> np.ndarray:
     """The cross-product matrix [v]×."""
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 

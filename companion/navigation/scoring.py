@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 EARTH_RADIUS_M = 6_378_137.0
 
@@ -34,21 +35,21 @@ def _p95(x: np.ndarray) -> float:
 
 
 def score(
-    est: dict[str, np.ndarray],
-    truth: dict[str, np.ndarray],
+    est: dict[str, npt.NDArray[np.float64]],
+    truth: dict[str, npt.NDArray[np.float64]],
     outage: tuple[float, float] | None = None,
     settle_s: float = 30.0,
 ) -> Errors:
     """Compare the estimate with the truth interpolated to its times, after ``settle_s``."""
     t = est["t"]
-    keep = (t >= truth["t"][0] + settle_s) & (t <= truth["t"][-1])
+    keep: npt.NDArray[np.bool_] = (t >= truth["t"][0] + settle_s) & (t <= truth["t"][-1])
     keep &= np.isfinite(est["lat"]) & np.isfinite(est["roll"])
     t = t[keep]
 
-    def true(col: str) -> np.ndarray:
+    def true(col: str) -> npt.NDArray[np.float64]:
         return np.interp(t, truth["t"], np.unwrap(truth[col]) if col == "yaw" else truth[col])
 
-    def err(col: str) -> np.ndarray:
+    def err(col: str) -> npt.NDArray[np.float64]:
         return np.remainder(est[col][keep] - true(col) + math.pi, math.tau) - math.pi
 
     tilt = np.degrees(np.concatenate([err("roll"), err("pitch")]))

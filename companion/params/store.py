@@ -97,8 +97,8 @@ def bind(decl: ParamDecl, decls: Mapping[str, ParamDecl]) -> ParamDecl:
     if missing:
         doc = f"{decl.doc} [fixed: no {', '.join(missing)} on this vehicle]"
         values = tuple(v for v in decl.values if v[0] == decl.default)
-        fixed = {"min": decl.default, "max": decl.default, "values": values}
-        return replace(decl, alias=None, doc=doc, **fixed)
+        fixed = decl.default
+        return replace(decl, alias=None, doc=doc, min=fixed, max=fixed, values=values)
     lo, hi = decl.min, decl.max
     if alias.linear_only:  # the owner's range, scaled, narrowed by the alias's
         own = decls[alias.targets[0]]
@@ -292,7 +292,8 @@ class ParamStore:
         if "format" not in stored:
             self.legacy = ([], [])
             return stored
-        if stored.get("format") != FORMAT or not isinstance(stored.get("set"), dict):
+        table = stored.get("set")
+        if stored.get("format") != FORMAT or not isinstance(table, dict):
             log.warning("parameter file %s: unknown format: using defaults", path)
             return None
-        return stored["set"]
+        return table

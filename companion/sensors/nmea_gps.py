@@ -54,7 +54,8 @@ MISSES_TO_FORGET = 3
 _DAY_US = 86_400_000_000
 _UNIX_DAY0 = dt.date(1970, 1, 1).toordinal()
 _TAU = 2.0 * math.pi
-_EXTRACT: dict[str, Callable[[pynmea2.TalkerSentence], object]] = {
+_Fields = GgaData | RmcData | VtgData | GsaData
+_EXTRACT: dict[str, Callable[[pynmea2.TalkerSentence], _Fields]] = {
     "GGA": nmea_fields.gga,
     "RMC": nmea_fields.rmc,
     "VTG": nmea_fields.vtg,

@@ -26,7 +26,7 @@ import select
 import threading
 import time
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import Any, Protocol
 
 import serial
 
@@ -39,6 +39,21 @@ SCHEME = "serial://"
 # What pyserial raises when a device is gone or cannot be opened (SerialException is an
 # OSError; ValueError for a malformed URL; TypeError when a port closes under a read).
 _PORT_ERRORS = (serial.SerialException, OSError, ValueError, TypeError)
+
+
+class SerialPort(Protocol):
+    """What is used of an open pyserial port, whichever class its URL opened: a device's
+    ``serial.Serial`` or the classes of ``loop://``, ``socket://``, ``rfc2217://``, which
+    share only pyserial's ``SerialBase`` (whose stubs leave these out)."""
+
+    @property
+    def in_waiting(self) -> int: ...
+    @property
+    def out_waiting(self) -> int: ...
+    def read(self, size: int = 1) -> bytes: ...
+    def write(self, b: bytes, /) -> int | None: ...
+    def fileno(self) -> int: ...
+    def close(self) -> None: ...
 
 
 def split_device(url: str, baud: int) -> tuple[str, int]:
@@ -65,7 +80,7 @@ def open_problem(url: str, baud: int) -> str | None:
     return None
 
 
-def open_port(path: str, **settings: Any) -> serial.SerialBase:
+def open_port(path: str, **settings: Any) -> SerialPort:
     """Open a device path or pyserial URL with pyserial's settings (``baudrate``, ...).
 
     A device path opens with ``termios2_serial.port_class()``: pyserial 3.5 cannot reopen a
@@ -77,7 +92,7 @@ def open_port(path: str, **settings: Any) -> serial.SerialBase:
     return port_class()(path, **settings)
 
 
-def _read_port(port: serial.SerialBase, now_us: Callable[[], int], size: int) -> tuple[bytes, int]:
+def _read_port(port: SerialPort, now_us: Callable[[], int], size: int) -> tuple[bytes, int]:
     """Any pyserial port (socket://, loop://): the first byte, the time, then the rest."""
     # pyserial's read(size) waits until size bytes or the timeout: at 4800 baud that
     # would hold every sentence back by the whole timeout and blur its time stamp.
@@ -120,8 +135,9 @@ class ReopeningSerial:
         self.opens = 0  # successful opens, the first included
         self.bytes_in = 0
         self.bytes_out = 0
-        self._port: serial.SerialBase | None = None
-        self._poll: select.poll | None = None  # for a port with a file descriptor
+        self._port: SerialPort | None = None
+        self._fd: int | None = None  # a device's descriptor, read and written directly
+        self._poll: select.poll | None = None  # on _fd (and stop_fd)
         self._timeout_ms = max(0, round(read_timeout_s * 1000))
         self._retry_s = FIRST_RETRY_S
         self._next_try = 0.0  # time.monotonic() of the next open attempt
@@ -149,8 +165,8 @@ class ReopeningSerial:
         if port is None or size <= 0:
             return b"", now_us()
         try:
-            if self._poll is not None:
-                data, t_us = self._read_fd(port.fd, now_us, size)
+            if self._fd is not None:
+                data, t_us = self._read_fd(self._fd, now_us, size)
             else:
                 data, t_us = _read_port(port, now_us, size)
         except _PORT_ERRORS as exc:
@@ -191,7 +207,9 @@ class ReopeningSerial:
         if port is None:
             return 0
         try:
-            written = _write_fd(port, data) if self._poll is not None else port.write(data) or 0
+            written = (
+                _write_fd(self._fd, port, data) if self._fd is not None else port.write(data) or 0
+            )
         except serial.SerialTimeoutException:
             log.debug("%s: write timed out", self.url)
             return 0
@@ -216,7 +234,7 @@ class ReopeningSerial:
         self._closed.set()
         self._drop_port()
 
-    def _ensure_open(self, wait: bool) -> serial.SerialBase | None:
+    def _ensure_open(self, wait: bool) -> SerialPort | None:
         if self._port is not None:
             return self._port
         self._closed.clear()
@@ -247,7 +265,8 @@ class ReopeningSerial:
         self.opens += 1
         self._retry_s = FIRST_RETRY_S
         self._port = port
-        self._poll = _poll_for(port, self.stop_fd)
+        self._fd = _descriptor(port)
+        self._poll = _poll_for(self._fd, self.stop_fd) if self._fd is not None else None
         return port
 
     def _lost(self, exc: BaseException) -> None:
@@ -257,7 +276,7 @@ class ReopeningSerial:
         self._next_try = time.monotonic() + self._retry_s
 
     def _drop_port(self) -> None:
-        port, self._port, self._poll = self._port, None, None
+        port, self._port, self._fd, self._poll = self._port, None, None, None
         if port is not None:
             try:
                 port.close()
@@ -265,12 +284,12 @@ class ReopeningSerial:
                 pass  # already gone; nothing more to release
 
 
-def _write_fd(port: serial.SerialBase, data: bytes) -> int:
+def _write_fd(fd: int, port: SerialPort, data: bytes) -> int:
     """Straight to the descriptor; what does not fit at once goes through pyserial, which
     waits for room up to the write timeout (it also waits, with a select, after a write
     that fitted)."""
     try:
-        written = os.write(port.fd, data)
+        written = os.write(fd, data)
     except BlockingIOError:
         written = 0
     if written == len(data):
@@ -278,12 +297,14 @@ def _write_fd(port: serial.SerialBase, data: bytes) -> int:
     return written + (port.write(data[written:]) or 0)
 
 
-def _poll_for(port: serial.SerialBase, stop_fd: int | None) -> select.poll | None:
-    """A poll on the port's descriptor (and ``stop_fd``) when it is a POSIX serial port (or
-    pty), else None."""
+def _descriptor(port: SerialPort) -> int | None:
+    """The port's descriptor when it is a POSIX serial port (or pty), else None."""
     fd = getattr(port, "fd", None)
-    if not isinstance(port, serial.Serial) or not isinstance(fd, int):
-        return None
+    return fd if isinstance(port, serial.Serial) and isinstance(fd, int) else None
+
+
+def _poll_for(fd: int, stop_fd: int | None) -> select.poll:
+    """A poll on a device's descriptor (and ``stop_fd``)."""
     poll = select.poll()
     poll.register(fd, select.POLLIN)
     if stop_fd is not None:

@@ -81,16 +81,21 @@ def apply_rate_and_framing(fd: int, baud: int, bytesize: int, parity: str) -> in
 class Termios2Serial(serial.Serial):
     """``serial.Serial`` whose rate, character size and parity go through ``TCSETS2``."""
 
+    # pyserial's private settings and _reconfigure_port, which types-pyserial leaves out.
+    _baudrate: int
+    _bytesize: int
+    _parity: str
+
     def _reconfigure_port(self, force_update: bool = False) -> None:
         if self.fd is None:  # pyserial's own refusal
-            super()._reconfigure_port(force_update)
+            super()._reconfigure_port(force_update)  # type: ignore[misc]
             return
         asked = (self._baudrate, self._bytesize, self._parity)
         if speed_constant(self._baudrate) is None:
             self._baudrate = PLACEHOLDER_BAUD
         self._bytesize, self._parity = serial.EIGHTBITS, serial.PARITY_NONE
         try:
-            super()._reconfigure_port(force_update)
+            super()._reconfigure_port(force_update)  # type: ignore[misc]
         finally:
             self._baudrate, self._bytesize, self._parity = asked
         apply_rate_and_framing(self.fd, *asked)

@@ -183,7 +183,8 @@ class MissionExecutor:
             self._advance(False, self._prev, self._prev_alt)
             return None
         if cmd == d.MAV_CMD_DO_JUMP:
-            return self._jump(item)
+            self._jump(item)
+            return None
         if cmd in SKIPPED:
             self._advance(False, self._prev, self._prev_alt)
             return None
@@ -208,7 +209,6 @@ class MissionExecutor:
             self.current = max(0, min(round(item.param1), len(self.items)))
         else:
             self.current += 1
-        return None
 
     def _takeoff(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
         target = self.alt_of(item)
@@ -326,7 +326,7 @@ class MissionExecutor:
         exit_angle = None
         if nxt is not None and item.param1 >= 0.5:
             exit_angle = tangent_angle(centre, nominal, clockwise, nxt)
-        if exit_angle is None:
+        if exit_angle is None or nxt is None:  # (exit_angle is None whenever nxt is)
             self._advance(True, pos, target_alt)
             return None
         # The leg starts at the tangent point of the circle as planned. The circle flown

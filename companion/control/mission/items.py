@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import Any
 
 from mavlink_dialect import companion as d
 
@@ -108,10 +109,10 @@ class MissionItem:
     mission_type: int = 0
 
     @classmethod
-    def from_message(cls, msg: object) -> MissionItem:
+    def from_message(cls, msg: Any) -> MissionItem:  # a pymavlink message: untyped
         """From MISSION_ITEM_INT, or legacy MISSION_ITEM (float degrees)."""
-        x, y = msg.x, msg.y  # type: ignore[attr-defined]
-        if msg.get_type() == "MISSION_ITEM":  # type: ignore[attr-defined]
+        x, y = msg.x, msg.y
+        if msg.get_type() == "MISSION_ITEM":
             x, y = round(x * 1e7), round(y * 1e7)
         fields = {k: getattr(msg, k) for k in cls.__dataclass_fields__ if k not in ("x", "y")}
         return cls(**{**fields, "x": int(x), "y": int(y)})

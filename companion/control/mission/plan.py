@@ -58,6 +58,8 @@ def _landing(raw: dict[str, Any]) -> list[dict[str, Any]]:
         else d.MAV_FRAME_GLOBAL
     )  # fmt: skip
     approach = raw.get("landingApproachCoordinate", raw.get("loiterCoordinate"))
+    if approach is None:  # else a TypeError about None would be the plan's error
+        raise KeyError("landingApproachCoordinate")
     land = raw["landCoordinate"]
     out = [{"command": d.MAV_CMD_DO_LAND_START, "frame": d.MAV_FRAME_MISSION, "params": [0] * 7}]
     if raw.get("stopTakingPhotos", False):

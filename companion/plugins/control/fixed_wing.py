@@ -16,7 +16,7 @@ import math
 import time
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from companion.actuators.airframe import AirframeError, load_airframe
 from companion.control.flight.controller import ControlOutput, FlightController
@@ -48,7 +48,7 @@ class FixedWingPlugin(Plugin):
 
     # The airframe (gains, limits, speeds as parameter defaults) is the vehicle's:
     # [vehicle] airframe, the same file the servo output and the flight log read.
-    settings: dict[str, Setting] = {}
+    settings: ClassVar[dict[str, Setting]] = {}
     inputs = ("nav/state",)
     optional_inputs = (
         "vehicle/status",
@@ -83,11 +83,12 @@ class FixedWingPlugin(Plugin):
         super().init(ctx)
         decls = self.param_decls(ctx.settings, ctx.vehicle)
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
-        self.params = LiveParams(ctx.bus, decls, state_dir)
+        # Not self.params: that is the class's declarations (Plugin.params).
+        self.live_params = LiveParams(ctx.bus, decls, state_dir)
         self.missions = MissionStore(state_dir / "missions")
         self.follower = StoreFollower(self.missions)
         self.controller = FlightController(
-            flight_config(self.params.values), self.missions.items[0]
+            flight_config(self.live_params.values), self.missions.items[0]
         )
         bus = ctx.bus
         self.nav = bus.latest_reader("nav/state")
@@ -112,8 +113,8 @@ class FixedWingPlugin(Plugin):
         self.default_status = VehicleStatus(mode=int(FlightMode.LOITER), armed=1)
 
     def _follow_changes(self, now_us: int) -> None:
-        if self.params.poll():
-            self.controller.set_config(flight_config(self.params.values))
+        if self.live_params.poll():
+            self.controller.set_config(flight_config(self.live_params.values))
         # Only a different mission restarts it: the same list stored again changes nothing.
         if d.MAV_MISSION_TYPE_MISSION in self.follower.follow(self.mission_changes.get()):
             self.controller.set_mission(self.missions.items[d.MAV_MISSION_TYPE_MISSION])
@@ -199,8 +200,9 @@ class FixedWingPlugin(Plugin):
         msg.xtrack_error_m, msg.airspeed_m_s = out.xtrack, out.airspeed
         msg.wind_n_m_s, msg.wind_e_m_s = self.controller.wind.wind_ne
         msg.throttle = out.throttle
-        running = self.controller.executor is not None
-        msg.mission_seq = self.controller.executor.current if running else 0
+        executor = self.controller.executor
+        running = executor is not None
+        msg.mission_seq = executor.current if executor is not None else 0
         if out.mission_finished:
             msg.mission_state = MissionState.COMPLETE
         elif running and status.mode == FlightMode.MISSION:

@@ -35,7 +35,7 @@ from companion.link.mode_messages import current_mode, heartbeat_mode
 from companion.link.params_service import ParamsService
 from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
-from companion.link.service import Outgoing, refused_count
+from companion.link.service import Outgoing, Service, refused_count
 from companion.link.signing import configured_secret, key_file_problem, key_from
 from companion.link.statustext import StatusTexts
 from companion.link.telemetry import SNAPSHOT_CHANNELS, Snapshot
@@ -153,7 +153,7 @@ class MavlinkLink(Plugin):
         self.timesync = TimesyncService(
             self.mav, lambda: ctx.clock.now_us() * 1000, sysid, ctx.settings["compid"]
         )
-        services = [self.identity, self.commands, self.timesync]
+        services: list[Service] = [self.identity, self.commands, self.timesync]
         secret = configured_secret(ctx.settings["signing_key"], ctx.settings["signing_key_file"])
         key = key_from(secret) if secret else None
         self.refusal_text = RefusalTexts(self.statustext, time.monotonic)

@@ -140,7 +140,8 @@ class LoggerPlugin(Plugin):
         s = ctx.settings
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
         self.params_path = state_dir / "params.json"
-        self.params = self._stored_params()
+        # Not self.params: that is the class's declarations (Plugin.params).
+        self.param_values = self._stored_params()
         names = list(dict.fromkeys(s["channels"]))
         self.readers = {name: _reader(ctx, name) for name in names}
         self.topics = {name: topic_name(name) for name in names}
@@ -157,7 +158,7 @@ class LoggerPlugin(Plugin):
         self.depths = {n: CHANNELS[n].depth for n in names if CHANNELS[n].depth > 1}
         self.period_s = s["period_s"]
         self.quiet = False  # the last read found nothing at all
-        info = {
+        info: dict[str, str | int | float] = {
             "sys_name": "companion",
             "ver_sw": __version__,
             "vehicle_name": str(ctx.vehicle.get("name", "")),
@@ -171,7 +172,7 @@ class LoggerPlugin(Plugin):
         max_bytes = int(min(s["file_mb"], s["budget_mb"] / 2) * 1e6)
         logs = LogDirectory(state_dir / "logs", int(s["budget_mb"] * 1e6))
         topics = [(topic_name(name), CHANNELS[name].type) for name in names]
-        self.recorder = LogRecorder(logs, topics, info, self.params, max_bytes)
+        self.recorder = LogRecorder(logs, topics, info, self.param_values, max_bytes)
         self.last_us: dict[str, int] = {}  # each channel's last sample, to time a gap
         # What came before the arming was seen (the health table lags the first samples).
         self.recent: deque[tuple[str, Any]] = deque(maxlen=s["prearm_samples"])
@@ -300,11 +301,11 @@ class LoggerPlugin(Plugin):
         key = msg.name.decode(errors="replace")
         if key == RELOAD_ALL:
             stored = self._stored_params()
-            changes = {k: v for k, v in stored.items() if self.params.get(k) != v}
+            changes = {k: v for k, v in stored.items() if self.param_values.get(k) != v}
         else:
-            changes = {key: float(msg.value)} if key in self.params else {}
+            changes = {key: float(msg.value)} if key in self.param_values else {}
         for k, value in changes.items():
-            self.params[k] = value
+            self.param_values[k] = value
             if self.writer is not None:
                 self.writer.parameter(k, value)
 

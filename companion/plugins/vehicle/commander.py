@@ -136,11 +136,12 @@ class CommanderPlugin(Plugin):
         if d.MAV_MISSION_TYPE_FENCE in self.follower.follow(self.mission_changes.get()):
             self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
         control = self.control.get()
-        fresh = control is not None and control.fresh(now)
-        c.land_phase = int(control.land_phase) if fresh else 0
+        if control is not None and not control.fresh(now):
+            control = None  # a stopped controller's last status says nothing now
+        c.land_phase = int(control.land_phase) if control is not None else 0
         # Until the controller started at arming speaks, judged as it would judge it.
         home_alt = c.home[2] if c.home is not None else None
-        landed = bool(control.landed) if fresh else standing(nav, home_alt)
+        landed = bool(control.landed) if control is not None else standing(nav, home_alt)
         c.landed = bool(c.armed and landed)
         acks = self._commands()
         changed = bool(acks) | self._mode_switch(now)

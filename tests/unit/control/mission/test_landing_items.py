@@ -14,7 +14,7 @@ import pytest
 
 from companion.control.mission.executor import Kind
 from companion.control.mission.items import check_mission
-from companion.control.mission.plan import checked_plan
+from companion.control.mission.plan import PlanError, checked_plan
 from mavlink_dialect import companion as d
 from tests.unit.control.mission.executor_flying import (
     HOME,
@@ -75,6 +75,13 @@ def test_a_pattern_without_loiter_ends_with_a_waypoint_then_the_landing(tmp_path
         d.MAV_CMD_DO_LAND_START, d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_NAV_LAND,
     ]  # fmt: skip
     assert math.isnan(items[2].param4)
+
+
+def test_a_pattern_without_an_approach_is_refused_naming_what_is_missing(tmp_path):
+    pattern = _pattern()
+    del pattern["landingApproachCoordinate"]
+    with pytest.raises(PlanError, match="mission item 1: 'landingApproachCoordinate'"):
+        _plan(tmp_path, pattern)
 
 
 def test_a_landing_without_a_place_to_land_is_refused():
