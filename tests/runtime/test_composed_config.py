@@ -1,0 +1,65 @@
+"""The config check refuses groupings of plug-ins into processes it could not run as meant."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from companion.exec_control.composition import processes
+from companion.exec_control.config import ConfigError, load_config
+from tests.support.configs import RELAY, TICKER, WAITING, plugin, vehicle_config
+
+
+def load(tmp_path: Path, *entries):
+    path = tmp_path / "v.toml"
+    path.write_text(vehicle_config("v", *entries))
+    return load_config(path)
+
+
+def refused(tmp_path: Path, *entries) -> str:
+    with pytest.raises(ConfigError) as info:
+        load(tmp_path, *entries)
+    return str(info.value)
+
+
+def test_plugins_naming_one_process_share_it_and_the_others_keep_their_own(tmp_path):
+    cfg = load(
+        tmp_path,
+        replace(plugin("imu", TICKER), process="sensors"),
+        plugin("idle", WAITING),
+        replace(plugin("relay", RELAY), process="sensors"),
+    )
+    layout = [(name, [s.name for s in specs]) for name, specs in processes(cfg.plugins)]
+    assert layout == [("sensors", ["imu", "relay"]), ("", ["idle"])]
+
+
+def test_a_process_of_core_and_flight_plugins_is_refused(tmp_path):
+    message = refused(
+        tmp_path,
+        replace(plugin("imu", TICKER), process="all"),
+        replace(plugin("relay", RELAY, group="flight"), process="all"),
+    )
+    assert "plugins[1].process" in message
+    assert "one group" in message and "'imu'" in message and "'relay'" in message
+
+
+@pytest.mark.parametrize("name", ["", "Core", "1st", "a-very-long-process-name", "exec_control"])
+def test_a_process_name_that_is_no_fit_name_is_refused(tmp_path, name):
+    message = refused(tmp_path, replace(plugin("imu", TICKER), process=name))
+    assert "plugins[0].process" in message and "1-15 characters" in message
+
+
+def test_a_process_named_after_a_plugin_it_does_not_hold_is_refused(tmp_path):
+    message = refused(
+        tmp_path,
+        replace(plugin("imu", TICKER), process="relay"),
+        plugin("relay", RELAY),
+    )
+    assert "has the name of a plug-in it does not hold" in message
+
+
+def test_a_process_named_after_its_only_plugin_is_fine(tmp_path):
+    cfg = load(tmp_path, replace(plugin("imu", TICKER), process="imu"))
+    assert cfg.plugins[0].process == "imu"
