@@ -63,3 +63,19 @@ def test_a_process_named_after_a_plugin_it_does_not_hold_is_refused(tmp_path):
 def test_a_process_named_after_its_only_plugin_is_fine(tmp_path):
     cfg = load(tmp_path, replace(plugin("imu", TICKER), process="imu"))
     assert cfg.plugins[0].process == "imu"
+
+
+def test_the_shipped_composed_config_is_sim_toml_in_two_processes():
+    import tomllib
+
+    from tests.support.vehicle import REPO
+
+    configs = REPO / "companion" / "configs"
+    own = tomllib.loads((configs / "sim.toml").read_text())
+    composed = tomllib.loads((configs / "sim_composed.toml").read_text())
+    assert {k: v for k, v in composed.items() if k != "plugins"} == {
+        k: v for k, v in own.items() if k != "plugins"
+    }
+    for a, b in zip(own["plugins"], composed["plugins"], strict=True):
+        assert b.pop("process") == ("flight" if a.get("group") == "flight" else "core")
+        assert a == b, "sim_composed.toml must fly the vehicle sim.toml flies"
