@@ -108,8 +108,8 @@ class Vehicle:
         names = {self.proc.pid: "supervisor"}
         if table is not None:
             for row in table.rows():
-                if row.pid:
-                    names[row.pid] = row.name.decode(errors="replace")
+                if row.pid:  # plug-ins sharing a process: the process's name
+                    names[row.pid] = (row.process or row.name).decode(errors="replace")
         return names
 
     def labelled(self) -> dict[str, int]:

@@ -1,6 +1,6 @@
 """From an IMU sample's first byte on the wire to the servo bytes and to ATTITUDE.
 
-    uv run python benchmarks/latency.py [--seconds 60]
+    uv run python benchmarks/latency.py [--seconds 60] [--config CONFIG.toml]
 
 Flies ``companion sim`` in real time on a mission, with the vehicle on the hardware time
 base (monotonic µs, as on an aircraft) so that every ``t_us`` is a wall-clock stamp: the
@@ -38,17 +38,22 @@ WARM_UP_S = 15.0
 STALL_US = 20_000
 
 
-def vehicle_config(tmp: Path) -> Path:
-    """The shipped simulation vehicle on the monotonic (hardware) time base."""
-    text = (REPO / "companion" / "configs" / "sim.toml").read_text()
+SIM_CONFIG = REPO / "companion" / "configs" / "sim.toml"
+
+
+def vehicle_config(tmp: Path, source: Path = SIM_CONFIG) -> Path:
+    """A shipped simulation vehicle on the monotonic (hardware) time base."""
+    text = source.read_text()
     path = tmp / "latency.toml"
     path.write_text(text.replace('clock = "sim"', 'clock = "monotonic"'))
     return path
 
 
-def start_sim(tmp: Path, namespace: str, port: int, seconds: float) -> subprocess.Popen[bytes]:
+def start_sim(
+    tmp: Path, namespace: str, port: int, seconds: float, source: Path = SIM_CONFIG
+) -> subprocess.Popen[bytes]:
     cmd = [
-        sys.executable, "-m", "companion", "sim", "-c", str(vehicle_config(tmp)),
+        sys.executable, "-m", "companion", "sim", "-c", str(vehicle_config(tmp, source)),
         "--plan", "qgc_plans/square.plan", "--airborne", "--start-at", "2",
         "--duration", str(seconds + WARM_UP_S + 5), "--namespace", namespace,
         "--state-dir", str(tmp / "state"), "--link", f"udpout://127.0.0.1:{port}",
@@ -133,10 +138,11 @@ def summary(name: str, values: list[int]) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seconds", type=float, default=60.0)
+    ap.add_argument("--config", type=Path, default=SIM_CONFIG, help="the vehicle (sim_composed)")
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="latency"))
     namespace, sock = f"lat{os.getpid()}", listen(0)
-    sim = start_sim(tmp, namespace, sock.getsockname()[1], args.seconds)
+    sim = start_sim(tmp, namespace, sock.getsockname()[1], args.seconds, args.config)
     try:
         stages = measure(namespace, sock, args.seconds)
     finally:

@@ -51,7 +51,8 @@ def health_table(msg: SystemHealth) -> Table:
     data = health_dict(msg)
     armed = "flight group RUNNING" if data["flight_running"] else "flight group stopped"
     table = Table(title=f"companion (supervisor pid {data['supervisor_pid']}, {armed})")
-    for col in ("plug-in", "kind", "group", "state", "pid", "restarts", "CPU %", "RSS MiB"):
+    cols = ("plug-in", "kind", "group", "process", "state", "pid", "restarts", "CPU %", "RSS MiB")
+    for col in cols:
         table.add_column(col, justify="right" if col[0].isupper() or col == "pid" else "left")
     for col in ("bytes in", "ok", "bad", "refused", "dropped", "step p50 µs", "p99 µs"):
         table.add_column(col, justify="right")
@@ -60,6 +61,7 @@ def health_table(msg: SystemHealth) -> Table:
             p["name"],
             p["kind"],
             p["group"],
+            p["process"] or "(own)",  # the OS process it shares, set by the config
             p["state"],
             str(p["pid"] or "-"),
             str(p["restarts"]),

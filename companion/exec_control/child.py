@@ -123,6 +123,17 @@ class Child:
         except psutil.Error:
             self.cpu_pct, self.rss_kib = 0.0, 0
 
+    def absorb(self, stats: PluginStats) -> bool:
+        """Keep the plug-in's counters when they are this process's; True when kept."""
+        if stats.name.decode(errors="replace") != self.spec.name or stats.pid != self.pid:
+            return False
+        self.stats = stats
+        return True
+
+    def health_rows(self) -> list[PluginHealth]:
+        """The process's rows of the health table: its plug-in's."""
+        return [self.health_row()]
+
     def health_row(self) -> PluginHealth:
         row = PluginHealth(state=int(self.state), pid=self.pid, restarts=self.restarts)
         row.name = self.spec.name.encode()[: NAME_LEN - 1]

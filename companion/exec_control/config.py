@@ -17,6 +17,7 @@ from typing import Any
 
 from companion.actuators.airframe import DEFAULT_AIRFRAME, AirframeError, load_airframe
 from companion.bus.namespace import default_namespace, validate_namespace
+from companion.exec_control.composition import check_processes, process_name
 from companion.exec_control.config_locator import KeyPath, line_of, locate
 from companion.exec_control.registry import PluginLoadError, load
 from companion.plugin import Plugin, Ports, Setting
@@ -47,6 +48,7 @@ class PluginSpec:
     ports: Ports
     line: int | None = None
     params: tuple[Any, ...] = ()  # the plug-in class's ParamDecl declarations
+    process: str = ""  # the OS process it shares with others ("": a process of its own)
 
 
 @dataclass(frozen=True)
@@ -91,7 +93,7 @@ _FLEET_KEYS: dict[str, Setting] = {
     ),
 }
 _TABLES = ["vehicle", "plugins", "fleet"]
-_PLUGIN_KEYS = ("name", "plugin", "group", "settings")
+_PLUGIN_KEYS = ("name", "plugin", "group", "settings", "process")
 # Settings that belong to the whole vehicle: once a plug-in setting each, now named once in
 # [vehicle], so two plug-ins can never disagree (the J3Cub's gains on the Cessna's servos).
 _VEHICLE_WIDE = ("airframe",)
@@ -264,6 +266,7 @@ def _plugin_specs(check: _Checker, entries: Any, vehicle: Mapping[str, Any]) -> 
             raise check.error((*where, "name"), f"plug-in name {spec.name!r} is used twice")
         seen.add(spec.name)
         specs.append(spec)
+    check_processes(check, specs)
     return specs
 
 
@@ -306,6 +309,7 @@ def _plugin_spec(
         ports=cls.ports(settings),
         line=line_of(check.lines, where),
         params=cls.param_decls(settings, vehicle),
+        process=process_name(check, entry, where),
     )
 
 

@@ -18,11 +18,12 @@ import time
 from collections import deque
 from typing import Any
 
+from companion.bus.channels import Writer
 from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
 from companion.bus.node import BusNode
 from companion.exec_control.profiling import run_profiled
 from companion.exec_control.registry import load
-from companion.messages import NAME_LEN, PluginStats
+from companion.messages import NAME_LEN, PluginState, PluginStats
 from companion.params import ParamDecl
 from companion.plugin import Plugin, PluginContext
 
@@ -75,14 +76,32 @@ def _signal_pipe() -> int:
 
 
 class PluginHost:
-    """Runs one plug-in instance until stopped."""
+    """Runs one plug-in instance until stopped.
 
-    def __init__(self, spec: dict[str, Any]) -> None:
+    ``stop_fd``: the plug-in's stop descriptor when it shares its process with others
+    (``composed_host``: one per plug-in, written when that one is to stop); a process of
+    its own makes it from its signals. ``restarts``: how often its host restarted it there;
+    ``stats``: where its counters go then.
+    """
+
+    def __init__(
+        self,
+        spec: dict[str, Any],
+        stop_fd: int | None = None,
+        restarts: int = 0,
+        stats: Writer[PluginStats] | None = None,
+    ) -> None:
         self.spec = spec
         self.stopping = False
+        self.composed = stop_fd is not None
+        self.restarts = restarts
+        self.failed = False
+        self._cpu_mark = (time.thread_time(), time.monotonic())
         self.bus = BusNode(spec["namespace"], spec["name"])
         self.timer = StepTimer()
-        self.stats = self.bus.writer("system/plugin_stats")
+        # A composed plug-in's host gives a writer that outlives this instance: the counters
+        # of one that failed at once must not vanish with its bus node, unread.
+        self.stats = stats or self.bus.writer("system/plugin_stats")
         self.clock = self._clock(spec["vehicle"].get("clock", "monotonic"))
         self.ctx = PluginContext(
             name=spec["name"],
@@ -93,7 +112,7 @@ class PluginHost:
             vehicle=spec["vehicle"],
             param_decls=tuple(ParamDecl(**d) for d in spec.get("param_decls", [])),
             plugins=spec.get("plugins", {}),
-            stop_fd=_signal_pipe(),
+            stop_fd=_signal_pipe() if stop_fd is None else stop_fd,
             supervisor_pid=os.getppid(),  # adopted by the supervisor before the host starts
         )
 
@@ -116,6 +135,13 @@ class PluginHost:
         msg.refused, msg.bytes_in = health.refused, health.bytes_in
         msg.step_p50_us = self.timer.percentile(0.5)
         msg.step_p99_us = self.timer.percentile(0.99)
+        if self.composed:
+            # The process's CPU is shared: this plug-in's share is its own thread's.
+            cpu, wall = time.thread_time(), time.monotonic()
+            msg.cpu_pct = 100 * (cpu - self._cpu_mark[0]) / max(wall - self._cpu_mark[1], 1e-3)
+            self._cpu_mark = (cpu, wall)
+            msg.restarts = self.restarts + int(self.failed)
+            msg.state = PluginState.BACKOFF if self.failed else PluginState.RUNNING
         self.stats.publish(msg)
 
     def run(self, plugin: Plugin) -> int:
@@ -123,6 +149,9 @@ class PluginHost:
             plugin.init(self.ctx)
         except Exception:
             log.exception("%s: init failed", self.spec["name"])
+            self.failed = True
+            if self.composed:  # its row says BACKOFF; a process of its own just dies
+                self.publish_stats()
             return EXIT_INIT_FAILED
         code = 0
         # Up: the health table has the new process's own counters before its first step,
@@ -145,6 +174,7 @@ class PluginHost:
         except Exception:
             log.exception("%s: step failed", self.spec["name"])
             code = EXIT_STEP_FAILED
+            self.failed = True
         finally:
             try:
                 plugin.close()
@@ -158,6 +188,10 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of a plug-in process; argv[0] is the JSON spec from the supervisor."""
     args = sys.argv[1:] if argv is None else argv
     spec = json.loads(args[0])
+    if "members" in spec:  # several plug-ins in this process (``process`` in the config)
+        from companion.exec_control.composed_host import main as composed_main
+
+        return composed_main(spec)
     logging.basicConfig(
         level=spec.get("log_level", "INFO"),
         format=f"%(asctime)s {spec['name']}[%(process)d] %(levelname)s %(message)s",

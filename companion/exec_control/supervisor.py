@@ -18,6 +18,8 @@ from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
 from companion.bus.namespace import cleanup_namespace
 from companion.bus.node import BusNode
 from companion.exec_control.child import FIRST_BACKOFF_S, Child
+from companion.exec_control.composed_child import ComposedChild
+from companion.exec_control.composition import processes
 from companion.exec_control.config import VehicleConfig
 from companion.exec_control.registry import load
 from companion.exec_control.zygote import READY_TIMEOUT_S, ForkServer, become_subreaper
@@ -54,10 +56,14 @@ class Supervisor:
             "param_decls": [asdict(d) for spec in cfg.plugins for d in spec.params],
             "plugins": {spec.kind: spec.settings for spec in cfg.plugins},
         }
-        self.children = [
-            Child(spec, {**base, **tables} if load(spec.kind).wants_vehicle_tables else base)
-            for spec in cfg.plugins
-        ]
+        self.children: list[Child] = []
+        for process, specs in processes(cfg.plugins):
+            wants = any(load(spec.kind).wants_vehicle_tables for spec in specs)
+            args = {**base, **tables} if wants else base
+            if process:
+                self.children.append(ComposedChild(process, specs, args))
+            else:
+                self.children.append(Child(specs[0], args))
         # A fork server started early (while the simulator loads) may be handed in.
         self.forker = forker or ForkServer(sorted({s.kind for s in cfg.plugins}), log_level)
         self.next_forker_at = 0.0
@@ -96,8 +102,8 @@ class Supervisor:
 
     def prearm_problem(self) -> str:
         """The first reason a flight plug-in gives for not arming ("" when none)."""
-        for child in self.group("flight"):
-            for reason in load(child.spec.kind).prearm(child.spec.settings, self.cfg.vehicle):
+        for spec in (s for s in self.cfg.plugins if s.group == "flight"):
+            for reason in load(spec.kind).prearm(spec.settings, self.cfg.vehicle):
                 return f"PreArm: {reason}"
         return ""
 
@@ -130,10 +136,13 @@ class Supervisor:
     def publish_health(self, writer: Writer[SystemHealth]) -> None:
         msg = SystemHealth(t_us=self.clock.now_us(), supervisor_pid=os.getpid())
         msg.flight_running = int(self.flight_running)
-        msg.count = len(self.children)
-        for i, child in enumerate(self.children):
+        rows = []
+        for child in self.children:
             child.sample_usage()
-            msg.plugins[i] = child.health_row()
+            rows += child.health_rows()
+        msg.count = len(rows)
+        for i, row in enumerate(rows):
+            msg.plugins[i] = row
         # Arming, a plug-in starting, dying or restarting wakes the readers that wait on
         # the table (commander, link, logger); the counters alone, once a second, do not.
         shape = (msg.flight_running, *((r.state, r.pid, r.restarts) for r in msg.rows()))
@@ -141,11 +150,10 @@ class Supervisor:
         self._health_shape = shape
 
     def absorb_stats(self, stats: Reader[PluginStats]) -> None:
-        by_name = {c.spec.name: c for c in self.children}
         for msg in stats.drain():
-            child = by_name.get(msg.name.decode(errors="replace"))
-            if child is not None and child.pid == msg.pid:
-                child.stats = msg
+            for child in self.children:
+                if child.absorb(msg):
+                    break
 
     def supervise_forker(self) -> None:
         """Restart a dead fork server (plug-ins are spawned meanwhile, and never lost)."""

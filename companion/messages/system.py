@@ -36,6 +36,11 @@ class PluginStats(Message):
         ("bytes_in", ctypes.c_uint64),  # read from the plug-in's device
         ("step_p50_us", ctypes.c_double),
         ("step_p99_us", ctypes.c_double),
+        # Of a plug-in sharing its process with others (``process`` in the config), whose
+        # host restarts it alone: its restarts there, its state, and its thread's CPU share.
+        ("restarts", ctypes.c_uint32),
+        ("state", ctypes.c_uint8),  # PluginState; 0 from a process of its own
+        ("cpu_pct", ctypes.c_double),
     ]
 
 
@@ -58,6 +63,7 @@ class PluginHealth(Message):
         ("bytes_in", ctypes.c_uint64),  # read from its device: silence told from garbage
         ("step_p50_us", ctypes.c_double),
         ("step_p99_us", ctypes.c_double),
+        ("process", ctypes.c_char * NAME_LEN),  # the OS process it shares ("": its own)
     ]
 
 

@@ -34,12 +34,15 @@ class PluginEntry:
     kind: str  # the ``plugin`` key: a registered name or module:Class
     group: str | None = None
     settings: dict[str, Any] = field(default_factory=dict)
+    process: str | None = None  # the OS process it shares with others
 
     def toml(self) -> str:
         """The table as TOML lines."""
         lines = ["[[plugins]]", f"name = {_value(self.name)}", f"plugin = {_value(self.kind)}"]
         if self.group is not None:
             lines.append(f"group = {_value(self.group)}")
+        if self.process is not None:
+            lines.append(f"process = {_value(self.process)}")
         if self.settings:
             lines.append(f"settings = {_value(self.settings)}")
         return "\n".join(lines) + "\n"

@@ -1,0 +1,139 @@
+"""An OS process that hosts several plug-ins (``process = "NAME"`` in the config).
+
+Each hosted plug-in runs on a thread of its own, in the loop a process of its own runs
+(``PluginHost``: init, step until stopped, close, counters on ``system/plugin_stats``), on
+a bus node of its own. Threads, not one executor waiting on every plug-in's trigger,
+because the contract's ``step()`` blocks on the plug-in's own inputs (a bus wait, a device
+read) and a plug-in's code must not know whether it is composed; the waits release the
+interpreter lock, so a thread asleep costs nothing and the one woken runs at once
+(``docs/dev/process_model.md`` says more).
+
+A plug-in that raises is closed, its bus node released, and started again on its thread
+with the back-off the supervisor gives a process (at once, then 0.1 s doubling to 5 s,
+afresh after 10 s of running), while the others keep running; its restarts and state go
+in its counters. SIGTERM/SIGINT stop every plug-in: each has its own stop descriptor,
+written then, which its device waits watch (``PluginContext.stop_fd``), and a bus wait
+ends within its timeout.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import select
+import signal
+import threading
+import time
+from typing import Any
+
+from companion.bus.channels import Writer
+from companion.bus.node import BusNode
+from companion.exec_control.child import MAX_BACKOFF_S, SECOND_BACKOFF_S, STABLE_AFTER_S
+from companion.exec_control.plugin_host import EXIT_INIT_FAILED, PluginHost, _signal_pipe
+from companion.exec_control.registry import load
+from companion.messages import PluginStats
+
+JOIN_GRACE_S = 1.0  # the supervisor kills the process 1.2 s after its SIGTERM
+
+log = logging.getLogger("companion.composed_host")
+
+
+class Member:
+    """One hosted plug-in: its thread, restarted in place when the plug-in fails."""
+
+    def __init__(self, spec: dict[str, Any]) -> None:
+        self.spec = spec
+        self.name: str = spec["name"]
+        self._stop_r, self._stop_w = os.pipe()
+        self.stopping = False
+        self.restarts = 0
+        self.host: PluginHost | None = None
+        self.thread = threading.Thread(target=self.run, name=self.name, daemon=True)
+
+    def stop(self) -> None:
+        """Ask the plug-in to stop after its current step (its stop descriptor turns
+        readable and stays so)."""
+        self.stopping = True
+        if self.host is not None:
+            self.host.stopping = True
+        os.write(self._stop_w, b"s")
+
+    def run(self) -> None:
+        """The thread: run the plug-in, and again after each failure, until stopped."""
+        with BusNode(self.spec["namespace"], f"{self.name}_stats") as node:
+            self.loop(node.writer("system/plugin_stats"))
+
+    def loop(self, stats: Writer[PluginStats]) -> None:
+        backoff_s = 0.0
+        while not self.stopping:
+            started = time.monotonic()
+            code = self.run_once(stats)
+            if self.stopping:
+                break
+            if time.monotonic() - started >= STABLE_AFTER_S:
+                backoff_s = 0.0
+            self.restarts += 1
+            log.warning("%s failed (status %d); restart in %.1f s", self.name, code, backoff_s)
+            # Waits on the stop descriptor: a stop during the back-off ends it.
+            select.select([self._stop_r], [], [], backoff_s)
+            backoff_s = min(max(backoff_s * 2, SECOND_BACKOFF_S), MAX_BACKOFF_S)
+
+    def run_once(self, stats: Writer[PluginStats]) -> int:
+        """Init, steps and close of one instance on a fresh bus node; its exit status."""
+        try:
+            host = PluginHost(self.spec, self._stop_r, self.restarts, stats)
+        except Exception:
+            log.exception("%s: no bus node", self.name)
+            return EXIT_INIT_FAILED
+        self.host = host
+        host.stopping = self.stopping  # a stop that came while it was being made
+        try:
+            return host.run(load(self.spec["kind"])())
+        except BaseException:  # a plug-in's SystemExit ends its thread, not the others
+            log.exception("%s failed", self.name)
+            return EXIT_INIT_FAILED
+        finally:
+            self.host = None
+            host.bus.close()
+
+
+def member_specs(spec: dict[str, Any]) -> list[dict[str, Any]]:
+    """Each hosted plug-in's spec as a process of its own would get it."""
+    shared = {k: v for k, v in spec.items() if k not in ("members", "name", "kind", "group")}
+    tables = {k: shared.pop(k) for k in ("param_decls", "plugins") if k in shared}
+    out = []
+    for member in spec["members"]:
+        wants = load(member["kind"]).wants_vehicle_tables
+        out.append({**shared, **(tables if wants else {}), **member})
+    return out
+
+
+def main(spec: dict[str, Any]) -> int:
+    """Run the hosted plug-ins until SIGTERM/SIGINT; the process's exit status."""
+    logging.basicConfig(
+        level=spec.get("log_level", "INFO"),
+        format=f"%(asctime)s {spec['name']}[%(process)d] %(threadName)s %(levelname)s %(message)s",
+    )
+    from companion.exec_control.plugin_host import die_with_parent
+
+    die_with_parent()
+    stopping = threading.Event()
+    wake = _signal_pipe()  # readable once a signal has come
+    for sig in (signal.SIGTERM, signal.SIGINT):
+        signal.signal(sig, lambda *_: stopping.set())
+    members = [Member(s) for s in member_specs(spec)]
+    for member in members:
+        member.thread.start()
+    # The main thread sleeps until a signal: the plug-ins' threads do the work.
+    while not stopping.is_set():
+        select.select([wake], [], [])
+        try:
+            os.read(wake, 64)
+        except BlockingIOError:
+            pass
+    for member in members:
+        member.stop()
+    deadline = time.monotonic() + JOIN_GRACE_S
+    for member in members:
+        member.thread.join(max(0.0, deadline - time.monotonic()))
+    return 0

@@ -1,0 +1,79 @@
+"""Plug-ins composed into fewer OS processes, as the config asks (``process = "NAME"``).
+
+A plug-in entry without ``process`` runs in an OS process of its own, as always. Entries
+that name the same process share one: the supervisor starts it as one child, and inside it
+each plug-in runs on its own thread with the same init/step/close contract, bus channels
+and health row (``composed_host``). These are the config's checks of such a grouping.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import defaultdict
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from companion.exec_control.config import PluginSpec, _Checker
+    from companion.exec_control.config_locator import KeyPath
+
+# Linux shows 15 characters of a process name (ps, top); the name is also in bus node names.
+PROCESS_NAME = re.compile(r"[a-z][a-z0-9_-]{0,14}")
+RESERVED = ("exec_control", "fork_server")
+
+
+def process_name(check: _Checker, entry: dict[str, Any], where: KeyPath) -> str:
+    """The entry's ``process`` ("" when it has none), refused when it is no fit name."""
+    if "process" not in entry:
+        return ""
+    name = entry["process"]
+    if not isinstance(name, str) or not PROCESS_NAME.fullmatch(name) or name in RESERVED:
+        raise check.error(
+            (*where, "process"),
+            f"process {name!r} must be 1-15 characters of a-z, 0-9, '_' or '-', starting"
+            f" with a letter, and none of {list(RESERVED)}",
+        )
+    return name
+
+
+def check_processes(check: _Checker, specs: list[PluginSpec]) -> None:
+    """Refuse groupings the supervisor could not run as the config means them."""
+    members: dict[str, list[int]] = defaultdict(list)
+    for index, spec in enumerate(specs):
+        if spec.process:
+            members[spec.process].append(index)
+    names = {spec.name for spec in specs}
+    for process, indexes in members.items():
+        first = specs[indexes[0]]
+        for index in indexes[1:]:
+            spec = specs[index]
+            if spec.group != first.group:
+                # START and STOP start and stop whole processes: half a process cannot be.
+                raise check.error(
+                    ("plugins", index, "process"),
+                    f"process {process!r} would hold the {first.group} plug-in {first.name!r}"
+                    f" and the {spec.group} plug-in {spec.name!r}: a process holds plug-ins of"
+                    " one group (START and STOP start and stop the flight group's processes)",
+                )
+        hosted = {specs[i].name for i in indexes}
+        if process in names and process not in hosted:
+            raise check.error(
+                ("plugins", indexes[0], "process"),
+                f"process {process!r} has the name of a plug-in it does not hold;"
+                " `companion status` would be ambiguous",
+            )
+
+
+def processes(specs: list[PluginSpec]) -> list[tuple[str, list[PluginSpec]]]:
+    """The OS processes of a config in order of first appearance: (name, its plug-ins).
+    A plug-in of no named process is a process of its own, named ""."""
+    out: list[tuple[str, list[PluginSpec]]] = []
+    shared: dict[str, list[PluginSpec]] = {}
+    for spec in specs:
+        if not spec.process:
+            out.append(("", [spec]))
+        elif spec.process in shared:
+            shared[spec.process].append(spec)
+        else:
+            shared[spec.process] = [spec]
+            out.append((spec.process, shared[spec.process]))
+    return out

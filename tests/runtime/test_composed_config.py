@@ -1,0 +1,81 @@
+"""The config check refuses groupings of plug-ins into processes it could not run as meant."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from companion.exec_control.composition import processes
+from companion.exec_control.config import ConfigError, load_config
+from tests.support.configs import RELAY, TICKER, WAITING, plugin, vehicle_config
+
+
+def load(tmp_path: Path, *entries):
+    path = tmp_path / "v.toml"
+    path.write_text(vehicle_config("v", *entries))
+    return load_config(path)
+
+
+def refused(tmp_path: Path, *entries) -> str:
+    with pytest.raises(ConfigError) as info:
+        load(tmp_path, *entries)
+    return str(info.value)
+
+
+def test_plugins_naming_one_process_share_it_and_the_others_keep_their_own(tmp_path):
+    cfg = load(
+        tmp_path,
+        replace(plugin("imu", TICKER), process="sensors"),
+        plugin("idle", WAITING),
+        replace(plugin("relay", RELAY), process="sensors"),
+    )
+    layout = [(name, [s.name for s in specs]) for name, specs in processes(cfg.plugins)]
+    assert layout == [("sensors", ["imu", "relay"]), ("", ["idle"])]
+
+
+def test_a_process_of_core_and_flight_plugins_is_refused(tmp_path):
+    message = refused(
+        tmp_path,
+        replace(plugin("imu", TICKER), process="all"),
+        replace(plugin("relay", RELAY, group="flight"), process="all"),
+    )
+    assert "plugins[1].process" in message
+    assert "one group" in message and "'imu'" in message and "'relay'" in message
+
+
+@pytest.mark.parametrize("name", ["", "Core", "1st", "a-very-long-process-name", "exec_control"])
+def test_a_process_name_that_is_no_fit_name_is_refused(tmp_path, name):
+    message = refused(tmp_path, replace(plugin("imu", TICKER), process=name))
+    assert "plugins[0].process" in message and "1-15 characters" in message
+
+
+def test_a_process_named_after_a_plugin_it_does_not_hold_is_refused(tmp_path):
+    message = refused(
+        tmp_path,
+        replace(plugin("imu", TICKER), process="relay"),
+        plugin("relay", RELAY),
+    )
+    assert "has the name of a plug-in it does not hold" in message
+
+
+def test_a_process_named_after_its_only_plugin_is_fine(tmp_path):
+    cfg = load(tmp_path, replace(plugin("imu", TICKER), process="imu"))
+    assert cfg.plugins[0].process == "imu"
+
+
+def test_the_shipped_composed_config_is_sim_toml_in_two_processes():
+    import tomllib
+
+    from tests.support.vehicle import REPO
+
+    configs = REPO / "companion" / "configs"
+    own = tomllib.loads((configs / "sim.toml").read_text())
+    composed = tomllib.loads((configs / "sim_composed.toml").read_text())
+    assert {k: v for k, v in composed.items() if k != "plugins"} == {
+        k: v for k, v in own.items() if k != "plugins"
+    }
+    for a, b in zip(own["plugins"], composed["plugins"], strict=True):
+        assert b.pop("process") == ("flight" if a.get("group") == "flight" else "core")
+        assert a == b, "sim_composed.toml must fly the vehicle sim.toml flies"

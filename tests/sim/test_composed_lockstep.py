@@ -1,0 +1,51 @@
+"""The same exact-lockstep mission flown with one process per plug-in and with the plug-ins
+composed into two processes (``companion/configs/sim_composed.toml``) is the same flight:
+the same seed writes the same truth file, so the mission scores the same to the centimetre.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from companion.navigation.estimate_csv import read_estimate as read_truth
+from tests.protocol.mav_client import free_udp_port
+from tests.sim.sim_run import finish, start_sim
+from tests.support.vehicle import REPO
+
+PLAN = str(REPO / "qgc_plans" / "short_leg.plan")
+COMPOSED = str(REPO / "companion" / "configs" / "sim_composed.toml")
+ARGS = ("--exact", "--start-at", "5", "--plan", PLAN, "--wind", "3,2,0",
+        "--turbulence", "moderate", "--seed", "11", "--duration", "45")  # fmt: skip
+
+
+def _fly(tmp_path, name: str, *config: str) -> tuple[dict, str]:
+    folder = tmp_path / name
+    folder.mkdir()
+    link = f"udpout://127.0.0.1:{free_udp_port()}"
+    proc, namespace, truth = start_sim(folder, link, *ARGS, *config)
+    out = finish(proc, namespace, 600)  # exact lockstep runs at the pace of a busy machine
+    assert "START accepted" in out and "MISSION_START accepted" in out, out
+    assert "control stalls 0" in out, out
+    return read_truth(truth), out
+
+
+def _track(truth: dict) -> np.ndarray:
+    return np.column_stack([truth["lat"], truth["lon"], truth["alt"]])
+
+
+@pytest.mark.timeout(1300)
+def test_the_composed_layout_flies_the_same_flight(tmp_path):
+    own, _ = _fly(tmp_path, "own_processes")
+    composed, _ = _fly(tmp_path, "composed", "--config", COMPOSED)
+    assert np.array(own["alt"])[-1] - np.array(own["alt"])[0] > 20, "the aircraft took off"
+    a, b = _track(own), _track(composed)
+    assert a.shape == b.shape, "the flights lasted different numbers of frames"
+    # Degrees to metres near the plan (1e-7 deg ~ 1 cm): the centimetre, frame by frame.
+    north = np.abs(a[:, 0] - b[:, 0]) * 111_320
+    east = np.abs(a[:, 1] - b[:, 1]) * 111_320 * np.cos(np.radians(a[:, 0]))
+    worst = float(np.max(np.hypot(north, east))), float(np.max(np.abs(a[:, 2] - b[:, 2])))
+    assert worst < (0.01, 0.01), f"the layouts' flights differ by up to {worst} m"
+    assert (tmp_path / "own_processes" / "truth.csv").read_bytes() == (
+        tmp_path / "composed" / "truth.csv"
+    ).read_bytes()
