@@ -38,7 +38,8 @@ Altitude = ALTITUDE_HOLD, Position = CRUISE: the track held against the wind; QG
 ``decode_set_mode`` reads DO_SET_MODE / SET_MODE in either encoding:
 1. a full 32-bit PX4 custom_mode (≥ 65536) → PX4;
 2. a sub mode (param3) → PX4 main/sub (MAVSDK, pymavlink for PX4);
-3. reporting PX4, a main mode alone → PX4 (ArduPlane's number if PX4 has no such mode);
+3. reporting PX4, a main mode alone → PX4 (ArduPlane's number if PX4 has no such mode,
+   except PX4's Offboard, 6, which is refused rather than read as ArduPlane's FBWB);
 4. otherwise ArduPlane's numbers (MAVProxy's ``mode AUTO``: 10), except 1 and 7, which are
    PX4's MANUAL and STABILIZED as MAVSDK sends them (ArduPlane's CIRCLE and CRUISE, which
    we do not fly, lose out);
@@ -56,6 +57,11 @@ PX4_MAIN_MANUAL, PX4_MAIN_ALTCTL, PX4_MAIN_POSCTL, PX4_MAIN_AUTO = 1, 2, 3, 4
 PX4_MAIN_ACRO, PX4_MAIN_STABILIZED, PX4_MAIN_RATTITUDE = 5, 7, 8
 PX4_SUB_TAKEOFF, PX4_SUB_LOITER, PX4_SUB_MISSION, PX4_SUB_RTL, PX4_SUB_LAND = 2, 3, 4, 5, 6
 PX4_SUB_EXTERNAL1 = 11  # PX4's first mode added from outside (a companion computer)
+# PX4's Offboard (setpoints streamed by a script: MAVSDK's offboard examples), which this
+# aircraft does not fly. Its number is ArduPlane's FBWB too, and MAVSDK's Offboard.start()
+# was taken for Altitude, reported accepted, and the script went on streaming setpoints
+# nobody followed; reporting PX4, it is refused by name.
+PX4_MAIN_OFFBOARD = 6
 
 
 # The mode the commander starts in (PX4's "Hold": a fixed wing without a pilot circles);
@@ -149,7 +155,7 @@ def decode_set_mode(
         return from_px4((custom >> 16) & 0xFF, (custom >> 24) & 0xFF)
     if sub or reporting_px4 or custom in (PX4_MAIN_MANUAL, PX4_MAIN_STABILIZED):
         mode = from_px4(custom, sub)
-        if mode is not None or sub:
+        if mode is not None or sub or (reporting_px4 and custom == PX4_MAIN_OFFBOARD):
             return mode
     return _ARDUPLANE.get(custom)
 

@@ -77,6 +77,14 @@ def _path(request: Packet) -> str:
 Client = tuple[int, int]  # the requesting station's system and component id
 
 
+def _entry(rest: str, content: bytes) -> str:
+    """A listing's entry for a file ``rest`` below the listed folder: the file itself, or
+    the first folder on its way."""
+    if "/" in rest:
+        return f"D{rest.split('/', 1)[0]}"
+    return f"F{rest}\t{len(content)}"
+
+
 @dataclass
 class FtpServer:
     """Read-only sessions over ``files`` (path without leading slash → content)."""
@@ -181,16 +189,18 @@ class FtpServer:
         return [self._reply(request)]
 
     def _list(self, request: Packet) -> list[bytes]:
-        """Entries ``F<name>\\t<size>``, NUL-separated, from entry number ``offset``."""
+        """Entries ``F<name>\\t<size>`` and ``D<name>`` (a folder on the way to a file: MAVSDK's
+        ftp_list_dir.py lists "/" and found nothing while every file sat in metadata/),
+        NUL-separated, from entry number ``offset``."""
         folder = _path(request)
         prefix = f"{folder}/" if folder else ""
-        inside = (p for p in self.files if p.startswith(prefix))
-        names = sorted(p for p in inside if "/" not in p[len(prefix) :])
-        if not names and folder:
+        entries = sorted({_entry(p[len(prefix) :], self.files[p]) for p in self.files
+                          if p.startswith(prefix)})  # fmt: skip
+        if not entries and folder:
             return [self._nak(request, ERR_FILE_NOT_FOUND)]
         data = b""
-        for name in names[request.offset :]:
-            entry = f"F{name[len(prefix) :]}\t{len(self.files[name])}".encode() + b"\0"
+        for text in entries[request.offset :]:
+            entry = text.encode() + b"\0"
             if len(data) + len(entry) > DATA_MAX:
                 break
             data += entry

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import socket
 import time
 from typing import Any
 
@@ -11,15 +10,12 @@ os.environ.setdefault("MAVLINK20", "1")
 
 from pymavlink import mavutil
 
+from companion.testing.processes import free_udp_port
 from mavlink_dialect import companion as d
 from mavlink_dialect import companion as dialect
 from tests.support.configs import FAKE_NAV, link, plugin, vehicle_config
 
-
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
+__all__ = ["GroundStation", "free_udp_port", "two_stations", "upload_mission"]
 
 
 class GroundStation:

@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from companion.control.modes import MODES, FlightMode
+from companion.testing.bench import write_circle_log
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import GroundStation, free_udp_port, upload_mission
 from tests.support.configs import PluginEntry, flight_group, link, plugin, vehicle_config
@@ -55,23 +56,8 @@ def legacy_vehicle(
 
 def write_flight_log(path: Path, seconds: float = 120.0) -> None:
     """A circle at 20 m/s: compass at 20 Hz (rolling, pitching, turning through north and
-    through negative angles), GPS at 5 Hz."""
-    header = "t,kind,ax,ay,az,gx,gy,gz,lat,lon,alt_m,vn,ve,vd,fix,hdop,mx,my,mz,baro_alt_m,"
-    lines = [header + "heading_deg,pitch_deg,roll_deg"]
-    for i in range(int(seconds * 20)):
-        t = i * 0.05
-        heading = (300.0 + 6.0 * t) % 360.0
-        roll, pitch = 30.0 * math.sin(0.7 * t), -8.0 * math.cos(0.4 * t)
-        lines.append(f"{t:.2f},compass,,,,,,,,,,,,,,,,,,,{heading:.2f},{pitch:.2f},{roll:.2f}")
-        if i % 4 == 0:
-            a = math.radians(6.0 * t)
-            lat = -37.9105 + 190.0 * math.sin(a) / 111_320.0
-            lon = 145.1340 + 190.0 * (1 - math.cos(a)) / 87_800.0
-            vn, ve = 20.0 * math.cos(a), 20.0 * math.sin(a)
-            lines.append(
-                f"{t:.2f},gps,,,,,,,{lat:.8f},{lon:.8f},100,{vn:.2f},{ve:.2f},,3,0.8,,,,,,,"
-            )
-    path.write_text("\n".join(lines) + "\n")
+    through negative angles), GPS at 5 Hz: the plug-in's bench vehicle's log."""
+    write_circle_log(path, seconds)
 
 
 class OldGroundStation:

@@ -1,4 +1,8 @@
-"""Run ``companion sim`` for a test: its own namespace, ports, state and truth file."""
+"""Run ``companion sim`` for a test: its own namespace, ports, state and truth file.
+
+The process, namespace and teardown code is the pytest plug-in's (companion.testing);
+this keeps the API the flight tests were written against. New tests can take the
+plug-in's ``sim`` fixture instead."""
 
 from __future__ import annotations
 
@@ -7,22 +11,16 @@ import sys
 from pathlib import Path
 
 from companion.bus.namespace import cleanup_namespace, leftover_files
+from companion.testing.processes import LoggedProcess
 from tests.support.vehicle import REPO, companion_env, unique_namespace
 
 
-class SimRun(subprocess.Popen[str]):
-    """``companion sim`` with its output in a file: a pipe nobody reads until the end would
-    block the simulation once 64 KiB of log lines had piled up (a long flight with a
-    warning a second fills it)."""
+class SimRun(LoggedProcess):
+    """``companion sim`` with its output in a file (the plug-in's LoggedProcess, run from
+    the repository so that the tests' own plug-in modules import)."""
 
     def __init__(self, cmd: list[str], log_path: Path, env: dict[str, str]) -> None:
-        self.log_path = log_path
-        with log_path.open("w") as log:
-            super().__init__(cmd, env=env, cwd=REPO, text=True, stdout=log,
-                             stderr=subprocess.STDOUT)  # fmt: skip
-
-    def output(self) -> str:
-        return self.log_path.read_text(errors="replace")
+        super().__init__(cmd, log_path, env, cwd=REPO)
 
 
 def start_sim(tmp: Path, link: str, *args: str) -> tuple[SimRun, str, Path]:

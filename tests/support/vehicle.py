@@ -7,7 +7,6 @@ teardown checks that nothing is left running or in /dev/shm.
 from __future__ import annotations
 
 import contextlib
-import itertools
 import os
 import signal
 import subprocess
@@ -18,20 +17,15 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
-import psutil
-
 from companion.bus.namespace import cleanup_namespace, leftover_files
 from companion.bus.node import BusNode
 from companion.messages import SystemHealth
+from companion.testing import processes
+from companion.testing.processes import LoggedProcess, unique_namespace
 
 REPO = Path(__file__).resolve().parents[2]
-_counter = itertools.count()
 T = TypeVar("T")
-
-
-def unique_namespace(tag: str = "t") -> str:
-    """A bus namespace no other test (or test run) uses."""
-    return f"{tag}{os.getpid()}_{next(_counter)}"
+__all__ = ["REPO", "Vehicle", "assert_clean", "companion_env", "unique_namespace", "wait_for"]
 
 
 def wait_for(predicate: Callable[[], T], timeout_s: float, what: str, period_s: float = 0.05) -> T:
@@ -47,10 +41,8 @@ def wait_for(predicate: Callable[[], T], timeout_s: float, what: str, period_s: 
 
 
 def companion_env(namespace: str) -> dict[str, str]:
-    env = dict(os.environ)
-    env["COMPANION_BUS"] = namespace
-    env["PYTHONPATH"] = os.pathsep.join([str(REPO), env.get("PYTHONPATH", "")])
-    return env
+    """The plug-in's environment, with the repository importable (the tests' plug-ins)."""
+    return processes.companion_env(namespace, [REPO])
 
 
 class Vehicle:
@@ -60,7 +52,7 @@ class Vehicle:
         self.namespace = namespace or unique_namespace()
         self.config = tmp / "vehicle.toml"
         self.config.write_text(textwrap.dedent(config_text))
-        self.proc: subprocess.Popen[str] | None = None
+        self.proc: LoggedProcess | None = None
         self.bus: BusNode | None = None
         self._health: Any = None
         # The vehicle's output goes to a file: a pipe nobody reads until the end blocks the
@@ -73,15 +65,8 @@ class Vehicle:
 
     def start(self) -> Vehicle:
         command = self.command or [sys.executable, "-m", "companion", "run", "-c", str(self.config)]
-        with self.log_path.open("w") as log:
-            self.proc = subprocess.Popen(
-                command,
-                env={**companion_env(self.namespace), **self.extra_env},
-                cwd=REPO,
-                stdout=log,
-                stderr=subprocess.STDOUT,
-                text=True,
-            )
+        env = {**companion_env(self.namespace), **self.extra_env}
+        self.proc = LoggedProcess(command, self.log_path, env, cwd=REPO)
         self.bus = BusNode(self.namespace, "test")
         self._health = self.bus.latest_reader("system/health")
         return self
@@ -100,13 +85,7 @@ class Vehicle:
         return wait_for(lambda: (r := self.row(name)) is not None and r.pid, timeout_s, name)
 
     def all_pids(self) -> list[int]:
-        if self.proc is None:
-            return []
-        try:
-            kids = psutil.Process(self.proc.pid).children(recursive=True)
-        except psutil.NoSuchProcess:
-            return []
-        return [self.proc.pid, *(k.pid for k in kids)]
+        return self.proc.tree() if self.proc is not None else []
 
     def stop(self, sig: int = signal.SIGTERM, timeout_s: float = 5.0) -> float:
         """Signal the supervisor and wait for it; return how long the shutdown took."""

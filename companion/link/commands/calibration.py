@@ -16,6 +16,8 @@ whose ack must be ACCEPTED (anything else is shown as an error). The Sensors pag
 
 from __future__ import annotations
 
+import math
+
 from companion.link.calibration import Calibration
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandArgs, CommandService, Outcome
@@ -36,7 +38,7 @@ CANNOT = {
 def requested(p: tuple[float, ...]) -> str | None:
     """The calibration the (checked, whole-number) parameters ask for, as PX4 reads them;
     None for a combination that is none."""
-    p1, p2, p3, p4, p5, p6, p7 = (round(v) for v in p[:7])
+    p1, p2, p3, p4, p5, p6, p7 = (0 if math.isnan(v) else round(v) for v in p[:7])
     choices = (
         (p1 == 1, "gyro"),
         (3 in (p1, p5, p7), "temperature"),

@@ -85,6 +85,8 @@ def test_sessions_run_out_and_list_directory_names_the_files():
     assert (full.opcode, full.data[0]) == (NAK, ERR_NO_SESSIONS)
     (listing,) = ask(server, LIST_DIRECTORY, data=b"/m")
     assert listing.data[: listing.size].split(b"\0")[:2] == [b"Fg.json\t2", b"Fp.json\t2"]
+    (root,) = ask(server, LIST_DIRECTORY, data=b"/")  # the folder on the way to the files
+    assert root.data[: root.size].split(b"\0")[:1] == [b"Dm"]
 
 
 @settings(max_examples=400, deadline=None)
