@@ -59,7 +59,7 @@ class VehicleOptions:
             if value is not None:
                 args += [option, str(value)]
         for outage in self.gps_outage:
-            args += ["--gps-outage", outage if isinstance(outage, str) else _csv(outage, ":")]
+            args += ["--gps-outage", outage if isinstance(outage, str) else _joined(outage, ":")]
         if self.airborne:
             args.append("--airborne")
         return [*args, *self.sim_args]
@@ -68,4 +68,8 @@ class VehicleOptions:
 def _csv(value: Sequence[float] | str | None, sep: str = ",") -> str | None:
     if value is None or isinstance(value, str):
         return value
-    return sep.join(f"{v:g}" for v in value)
+    return _joined(value, sep)
+
+
+def _joined(values: Sequence[float], sep: str) -> str:
+    return sep.join(f"{v:g}" for v in values)

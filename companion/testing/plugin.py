@@ -102,10 +102,12 @@ def mavproxy_master(vehicle: LoopbackVehicle) -> str:
 
 try:
     import pytest_asyncio
-except ImportError:  # the fixture needs pytest-asyncio (companion[testing] has it)
-    pytest_asyncio = None
 
-if pytest_asyncio is not None:
+    HAS_PYTEST_ASYNCIO = True
+except ImportError:  # the fixture needs pytest-asyncio (companion[testing] has it)
+    HAS_PYTEST_ASYNCIO = False
+
+if HAS_PYTEST_ASYNCIO:
 
     @pytest_asyncio.fixture
     async def mavsdk_system(vehicle: LoopbackVehicle) -> AsyncIterator[Any]:
