@@ -44,9 +44,16 @@ def period_and_quota(percent: float) -> tuple[int, int]:
 
 
 class CpuQuota:
-    """``percent`` of one core (None: no limit, only counted) for the processes that join."""
+    """``percent`` of one core (None: no limit, only counted) for the processes that join.
 
-    def __init__(self, percent: float | None, tag: str = "companion_quota") -> None:
+    ``shares`` is the cgroup's weight against the other processes of the machine (1024:
+    one process at nice 0, however many processes join): a vehicle of 14 processes in a
+    cgroup at 1024 gets one process's share of a busy machine; a large weight lets it take
+    up to its quota first, as it would on a board of its own."""
+
+    def __init__(
+        self, percent: float | None, tag: str = "companion_quota", shares: int = 1024
+    ) -> None:
         self.percent = percent
         self.name = f"{tag}_{os.getpid()}_{next(_serial)}"
         roots = [CPU_ROOT]
@@ -61,6 +68,7 @@ class CpuQuota:
         self.period_us, self.quota_us = period_and_quota(percent) if percent else (PERIOD_US, -1)
         self._write("cpu.cfs_period_us", self.period_us)
         self._write("cpu.cfs_quota_us", self.quota_us)
+        self._write("cpu.shares", shares)
 
     def _write(self, name: str, value: int) -> None:
         (self.dirs[0] / name).write_text(f"{value}\n")
