@@ -26,8 +26,8 @@ RUNWAY_HALF_WIDTH_M = 15.0
 RUNWAY_LENGTH_M = 1500.0
 STOPPED_M_S = 0.5
 
-# The issue's criteria.
-MAX_ALONG_M, MAX_ACROSS_M, MAX_SINK_M_S, MAX_BOUNCE_M, MAX_BANK_DEG = 30.0, 3.0, 1.5, 1.0, 10.0
+# The criteria: issue 24's, the along and across tightened by issue 42 (item 8).
+MAX_ALONG_M, MAX_ACROSS_M, MAX_SINK_M_S, MAX_BOUNCE_M, MAX_BANK_DEG = 15.0, 2.0, 1.5, 1.0, 10.0
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from companion.control.flight.flare_aim import DecelEstimate, aimed_sink, time_to_point
 from companion.control.laws.limits import clamp
 from companion.geodesy import wrap_pi
 from companion.params import ParamDecl
@@ -53,8 +54,10 @@ NOT_FLYING = 0.6  # below this fraction of the approach speed the wings cannot l
 MIN_GLIDE = math.radians(1.5)  # a flatter path cannot be flown with the throttle at idle
 # The flare's sink demand may aim for the point within these fractions of the nominal
 # flare's: more, and a flare that started early floats then drops onto the runway.
-AIM_LOW, AIM_HIGH = 0.75, 1.25
-SINK_P = 0.04  # rad of pitch per m/s of sink-rate error in the flare
+# Never more than the nominal: a flare that dives for a point it would float past reaches
+# the ground before its pitch has caught up (short and hard); long is the lesser harm.
+AIM_LOW, AIM_HIGH = 0.6, 1.0
+SINK_P = 0.10  # rad of pitch per m/s of sink-rate error in the flare
 SINK_I = 0.05  # rad per (m/s·s)
 
 
@@ -151,6 +154,8 @@ class Landing:
         self._stopped_s = 0.0
         self._touchdown_pitch = 0.0
         self._tau = 1.0
+        self.flare_alt = math.nan  # where the flare is planned to begin (flare_distance)
+        self._decel = DecelEstimate()
 
     # -- geometry --------------------------------------------------------------------
 
@@ -180,14 +185,18 @@ class Landing:
         speed times the slope, which itself depends on where the flare begins, so the
         two are solved together by a few fixed-point steps.
         """
-        h_f, s_t = v["LAND_FLARE_ALT"], max(v["TECS_LAND_SINK"], 0.05)
+        s_t = max(v["TECS_LAND_SINK"], 0.05)
         gs = max(ground_speed, 5.0)
-        dist = 0.0
+        dist, h_f = 0.0, v["LAND_FLARE_ALT"]
         for _ in range(4):
             slope = self._slope(dist, h_f)
             s0 = max(gs * slope, s_t * 1.5)
+            # The flare begins where _flare_due will begin it: on a path steep enough that
+            # LAND_FLARE_SEC comes first, higher than LAND_FLARE_ALT (the Cub at 4-5 m).
+            h_f = max(v["LAND_FLARE_ALT"], v["LAND_FLARE_SEC"] * s0)
             tau = h_f / (s0 - s_t)
             dist = min(gs * tau * math.log(s0 / s_t), 0.5 * self.length)
+        self.flare_alt = h_f
         return dist
 
     def _slope(self, flare_dist: float, flare_alt: float) -> float:
@@ -196,7 +205,7 @@ class Landing:
 
     def glide_alt(self, pos: Point, flare_dist: float, v: Mapping[str, float]) -> float:
         """The glide path's height (MSL) abeam ``pos``."""
-        h_f = v["LAND_FLARE_ALT"]
+        h_f = self.flare_alt if math.isfinite(self.flare_alt) else v["LAND_FLARE_ALT"]
         to_flare = -self.along(pos) - flare_dist
         alt = self.land_alt + h_f + to_flare * self._slope(flare_dist, h_f)
         return min(alt, max(self.start_alt, self.land_alt + h_f))
@@ -217,6 +226,7 @@ class Landing:
             self._flare_pitch = s.pitch
             self._flare_sink = -s.climb_rate
             self._flare_integ = 0.0
+            self._decel = DecelEstimate()
             # The flare's time constant makes its first sink demand the sink rate now.
             s_t = max(v["TECS_LAND_SINK"], 0.05)
             self._tau = max(height, 0.5) / max(-s.climb_rate - s_t, 0.3)
@@ -239,7 +249,7 @@ class Landing:
         alt = self.glide_alt(s.pos, flare_dist, v)
         on_slope = alt < self.start_alt
         speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
-        slope = self._slope(flare_dist, v["LAND_FLARE_ALT"])
+        slope = self._slope(flare_dist, self.flare_alt)
         ff = -max(speed_along, 0.0) * slope if on_slope else 0.0
         return LandingDemand(
             self.phase, line, alt, v["TECS_LAND_ARSPD"], flaps=_flaps(v), climb_ff=ff
@@ -254,11 +264,13 @@ class Landing:
     ) -> LandingDemand:
         s_t = max(v["TECS_LAND_SINK"], 0.05)
         nominal = s_t + max(height, 0.0) / self._tau
-        # Steer the touchdown onto the point: the sink rate that reaches the ground there,
-        # kept near the nominal flare's so the touchdown stays gentle either way.
+        # Steer the touchdown onto the point: the flare that ends there (flare_aim.py),
+        # counting the speed it loses, kept near the nominal flare's so the touchdown
+        # stays gentle either way.
         speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
-        to_go = -self.along(s.pos) / max(speed_along, 1.0)
-        aim = max(height, 0.0) / to_go if to_go > 0.1 else math.inf
+        decel = self._decel.update(speed_along, dt)
+        t_go = time_to_point(-self.along(s.pos), speed_along, decel)
+        aim = aimed_sink(height, t_go, s_t)
         sink_dem = clamp(aim, AIM_LOW * nominal, AIM_HIGH * nominal)
         error = -s.climb_rate - sink_dem  # + when sinking faster than wanted: pitch up
         self._flare_integ = clamp(self._flare_integ + SINK_I * error * dt, -0.1, 0.25)

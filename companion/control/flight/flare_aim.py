@@ -1,0 +1,80 @@
+"""The flare's sink demand that puts the wheels on the landing point.
+
+The flare is an exponential approach to the ground: ḣ = -(s + h/τ), s the touchdown sink
+rate (``TECS_LAND_SINK``). From height h it reaches the ground after
+
+    T(τ) = τ · ln(1 + h / (s·τ)),
+
+which grows with τ from 0 (a dive) to h/s (sinking at s all the way). Given the time the
+aircraft needs to reach the landing point, the τ with T(τ) equal to it is the flare that
+ends there, and s + h/τ its sink demand now. Solved afresh every step, the demand steers
+the touchdown onto the point whatever put the aircraft where it is (a flare begun higher
+or lower than planned, a gust, a slower or faster approach).
+
+The time to the point counts the flare's loss of speed: with the throttle cut and the
+nose coming up the aircraft slows (a C172 with flaps by 2-3 m/s in a 5 s flare, which
+made it touch down 20-40 m short of where the constant-speed flare aimed), so the
+deceleration is measured while flaring and the distance d is flown in the T that solves
+d = v·T - a·T²/2. Pure: numbers in, numbers out.
+"""
+
+from __future__ import annotations
+
+import math
+
+MAX_DECEL = 3.0  # m/s²: more than any glider-like flare loses; a gust's spike is not speed lost
+DECEL_TAU_S = 1.0  # the measured deceleration's smoothing
+_ITERATIONS = 40
+
+
+def time_to_point(distance: float, speed: float, decel: float) -> float:
+    """Seconds to fly ``distance`` m starting at ``speed`` m/s, slowing by ``decel`` m/s²
+    (inf when the aircraft would stop first; 0 when the point is behind)."""
+    if distance <= 0.0:
+        return 0.0
+    speed = max(speed, 1.0)
+    a = min(max(decel, 0.0), MAX_DECEL)
+    if a < 1e-6:
+        return distance / speed
+    disc = speed * speed - 2.0 * a * distance
+    if disc <= 0.0:
+        return math.inf
+    return (speed - math.sqrt(disc)) / a
+
+
+def aimed_sink(height: float, t_go: float, touchdown_sink: float) -> float:
+    """The sink rate now of the exponential flare from ``height`` that touches down after
+    ``t_go`` s at ``touchdown_sink``: at least the touchdown sink (a point beyond reach is
+    floated towards at it), inf when the point is passed or the aircraft is on it."""
+    s = max(touchdown_sink, 1e-3)
+    h = max(height, 0.0)
+    if t_go <= 0.0:
+        return math.inf
+    ratio = t_go * s / max(h, 1e-6)  # T / (h/s): the fraction of the slowest flare's time
+    if ratio >= 1.0:
+        return s
+    # With x = h/(s·τ): T = (h/s)·ln(1+x)/x, and ln(1+x)/x falls from 1 to 0 as x grows.
+    lo, hi = 1e-6, 1e6
+    for _ in range(_ITERATIONS):
+        mid = math.sqrt(lo * hi)
+        if math.log1p(mid) / mid > ratio:
+            lo = mid
+        else:
+            hi = mid
+    return s * (1.0 + math.sqrt(lo * hi))
+
+
+class DecelEstimate:
+    """The aircraft's loss of speed along the runway, smoothed (m/s², + slowing)."""
+
+    def __init__(self) -> None:
+        self.decel = 0.0
+        self._last: float | None = None
+
+    def update(self, speed_along: float, dt: float) -> float:
+        if self._last is not None and dt > 0.0:
+            raw = (self._last - speed_along) / dt
+            k = min(dt / DECEL_TAU_S, 1.0)
+            self.decel += k * (min(max(raw, -MAX_DECEL), MAX_DECEL) - self.decel)
+        self._last = speed_along
+        return max(self.decel, 0.0)

@@ -1,0 +1,60 @@
+"""Circuits ending in NAV_LAND put the wheels on the landing point (issue 42.8).
+
+Each flight is a whole vehicle in exact lockstep JSBSim (``companion sim --exact``, the
+mission started by the simulator, as the campaigns and benchmarks/landing.py fly it): a
+take-off east, a circuit of waypoints, a final from its last waypoint straight to
+NAV_LAND, as a plan made in QGroundControl without its landing pattern would be. The
+plans differ in the landing's direction, the final's length and its height (west onto
+the runway, 1 km from 80 m; east beside it, 700 m from 50 m) so no one geometry is what
+is tuned for. Judged from the simulator's truth: touchdown within 15 m along and 2 m
+across the NAV_LAND point, at no more than 1.5 m/s down, stopped, disarmed.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from companion.control.mission.plan import checked_plan
+from companion.navigation.estimate_csv import read_estimate
+from ground.campaign.flight_run import FlightJob, fly_flight
+from ground.campaign.landing_score import landing_score_for_plan
+from ground.campaign.spec import SIM_CONFIG, Flight
+from tests.support.vehicle import REPO
+
+PLANS = REPO / "benchmarks" / "plans"
+CALM = ((0.0, 0.0, 0.0), "none")
+CROSSWIND = ((5.0, 0.0, 0.0), "light")  # from the south, across both runways (east-west)
+MAX_ALONG_M, MAX_ACROSS_M, MAX_SINK_M_S = 15.0, 2.0, 1.5
+# A hang guard only (wall seconds): alone a flight takes 2-3 min; beside other
+# simulations on two cores one took over 15.
+WALL_LIMIT_S = 2400.0
+
+
+@pytest.mark.timeout(2700)
+@pytest.mark.parametrize(
+    ("airframe", "plan", "weather"),
+    [
+        ("c172p", "circuit_east.plan", CALM),
+        ("c172p", "circuit_west.plan", CROSSWIND),
+        ("J3Cub", "circuit_west.plan", CALM),
+        ("J3Cub", "circuit_east.plan", CROSSWIND),
+    ],
+    ids=["c172p-calm", "c172p-crosswind", "J3Cub-calm", "J3Cub-crosswind"],
+)
+def test_the_circuit_touches_down_on_the_land_point(
+    tmp_path: Path, airframe: str, plan: str, weather: tuple[tuple[float, float, float], str]
+) -> None:
+    wind, turbulence = weather
+    flight = Flight(str(PLANS / plan), airframe, wind, turbulence, (), 1, str(SIM_CONFIG),
+                    False, 900.0, 10.0)  # fmt: skip
+    row = fly_flight(FlightJob(flight, str(tmp_path), timeout_s=WALL_LIMIT_S))
+    assert row["status"] == "ok", row
+    assert row["armed_at_end"] is False, row  # landed, stopped and disarmed itself
+    truth = read_estimate(tmp_path / flight.flight_id / "truth.csv")
+    score = landing_score_for_plan(truth, checked_plan(PLANS / plan)[0])
+    assert score.landed and score.stopped and score.on_runway, score
+    assert abs(score.along_m) <= MAX_ALONG_M, score
+    assert abs(score.across_m) <= MAX_ACROSS_M, score
+    assert score.sink_m_s <= MAX_SINK_M_S, score
