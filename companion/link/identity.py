@@ -7,6 +7,7 @@ from the bus; this service only turns it into messages at 1 Hz and on request.
 from __future__ import annotations
 
 import hashlib
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,6 +35,9 @@ class VehicleState:
     custom_mode: int = 0
     mode_flags: int = 0  # MAV_MODE_FLAG bits of the mode (auto, guided, stabilize, manual)
     system_status: int = mav_dialect.MAV_STATE_STANDBY
+    # False while the link has not read the vehicle's mode yet: no heartbeat then. A ground
+    # station bears a second without one; a false mode it shows, and acts on.
+    known: bool = True
 
 
 class IdentityService:
@@ -81,7 +85,7 @@ class IdentityService:
         return []
 
     def tick(self, now_s: float) -> list[Outgoing]:
-        if now_s < self._next_heartbeat:
+        if now_s < self._next_heartbeat or not self.state.known:
             return []
         # On time or a little late: keep the 1 Hz phase. A period or more late (the first
         # one, or after a stall): one heartbeat now and the phase starts again, never a
@@ -92,4 +96,4 @@ class IdentityService:
         return [Outgoing(self.heartbeat(), None)]
 
     def next_due(self) -> float:
-        return self._next_heartbeat
+        return self._next_heartbeat if self.state.known else math.inf

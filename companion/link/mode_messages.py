@@ -3,7 +3,9 @@
 CURRENT_MODE is streamed and sent on every change; AVAILABLE_MODES is sent on request, all
 of them (param2 = 0) or one by its 1-based index, as QGroundControl asks; the monitor's
 sequence number never changes because the set of modes never does. Until the commander
-has spoken, the mode reported is the one it starts in, so no tool ever reads "Unknown".
+has spoken, the mode reported is the ``assumed`` one: the commander's initial mode on a
+vehicle without a commander, none (no CURRENT_MODE, an unknown custom mode) where a
+commander runs, since a link restarted in flight would otherwise announce a false mode.
 """
 
 from __future__ import annotations
@@ -17,24 +19,28 @@ from mavlink_dialect import companion as d
 MODES_SEQ = 1
 
 
-def _info(status: VehicleStatus | None) -> ModeInfo | None:
-    if status is None:  # the commander has not spoken yet: it starts in INITIAL_MODE
-        return BY_MODE[INITIAL_MODE]
+def _info(status: VehicleStatus | None, assumed: FlightMode | None) -> ModeInfo | None:
+    if status is None:  # the commander has not spoken yet
+        return None if assumed is None else BY_MODE[assumed]
     try:
         return BY_MODE[FlightMode(status.mode)]
     except ValueError:
         return None
 
 
-def heartbeat_mode(status: VehicleStatus | None) -> tuple[int, int]:
-    """(custom_mode, extra base_mode flags) for the heartbeat."""
-    info = _info(status)
+def heartbeat_mode(
+    status: VehicleStatus | None, assumed: FlightMode | None = INITIAL_MODE
+) -> tuple[int, int]:
+    """(custom_mode, extra base_mode flags) for the heartbeat; (0, 0) for no known mode."""
+    info = _info(status, assumed)
     return (info.px4, info.base_flags) if info else (0, 0)
 
 
-def current_mode(mav: Any, status: VehicleStatus | None) -> Any:
-    """CURRENT_MODE (the initial mode before the commander has spoken)."""
-    info = _info(status)
+def current_mode(
+    mav: Any, status: VehicleStatus | None, assumed: FlightMode | None = INITIAL_MODE
+) -> Any:
+    """CURRENT_MODE (the ``assumed`` mode before the commander has spoken; None for none)."""
+    info = _info(status, assumed)
     return None if info is None else mav.current_mode_encode(info.standard, info.px4, info.px4)
 
 

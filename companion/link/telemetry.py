@@ -11,6 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+from companion.control.modes import INITIAL_MODE
 from companion.link import flight_messages
 from companion.link.codec import dialect as d
 from companion.link.flight_messages import landed_state, mission_current, nav_controller_output
@@ -27,6 +28,7 @@ from companion.messages import (
     Battery,
     Compass,
     ControlStatus,
+    FlightMode,
     GpsFix,
     Imu,
     Magnetometer,
@@ -78,6 +80,8 @@ class Snapshot:
     home: tuple[float, float, float] | None = None  # lat_deg, lon_deg, alt_msl_m
     health_cursor: int = 0  # PLUGIN_HEALTH sends one row at a time, round the table
     prearm_ok: bool | None = None  # the pre-arm checks pass (None: not judged yet)
+    # The mode shown before the commander has spoken (None: none, where a commander runs).
+    assumed_mode: FlightMode | None = INITIAL_MODE
 
 
 # Snapshot field -> the bus channel it holds: what the link reads for its streams.
@@ -340,7 +344,7 @@ STREAMS: dict[int, Stream] = {
             "CURRENT_MODE",
             d.MAVLINK_MSG_ID_CURRENT_MODE,
             0.5,
-            lambda m, s: current_mode(m, s.status),
+            lambda m, s: current_mode(m, s.status, s.assumed_mode),
         ),
         Stream(
             "AVAILABLE_MODES_MONITOR",

@@ -9,6 +9,11 @@ from __future__ import annotations
 
 import math
 
+# Consecutive readings this far apart are a new zero (the driver's process restarted and
+# counts its relative height from where it is now), not a climb: 0.1 s apart, an aircraft
+# moves a few metres up or down.
+STEP_M = 30.0
+
 
 class BaroDatum:
     """Holds the offset and how fresh the barometer is."""
@@ -19,6 +24,7 @@ class BaroDatum:
         self.tau_s = tau_s
         self.offset: float | None = None
         self.last_us: int | None = None
+        self.last_m: float | None = None
         self.next_us = 0
 
     def fresh(self, now_us: int) -> bool:
@@ -37,7 +43,9 @@ class BaroDatum:
         self.next_us = t_us + self.interval_us
         if self.offset is None or not self.fresh(t_us):
             self.offset = -ins_down - baro_m  # (re)join where the INS height is now
-        self.last_us = t_us
+        elif self.last_m is not None and abs(baro_m - self.last_m) > STEP_M:
+            self.offset += self.last_m - baro_m  # a new zero: the height went on as it was
+        self.last_us, self.last_m = t_us, baro_m
         return baro_m + self.offset
 
     def follow_gps(self, gps_down: float, ins_down: float, dt_s: float) -> None:

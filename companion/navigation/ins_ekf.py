@@ -36,6 +36,7 @@ from companion.navigation.ins_core import TH, InsCore
 from companion.navigation.ins_gps import GpsLag
 from companion.navigation.ins_mag import MagHeading, MagMonitor, mag_heading, yaw_jacobian
 from companion.navigation.ins_still import StillDetector
+from companion.navigation.ins_warm import WarmState, warm_start
 from companion.navigation.local_frame import LocalFrame, normal_gravity
 from companion.navigation.yaw_gsf import YawGsf
 
@@ -83,6 +84,7 @@ class InsEkf(InsCore):
         self.ground_speed = math.nan
         self.still_updates = 0
         self.yaw_resets = 0  # headings taken from the bank
+        self.warm: WarmState | None = None  # the last solution of a killed process
 
     # -- inputs ---------------------------------------------------------------------
     def on_imu(self, imu: Imu) -> None:
@@ -283,6 +285,10 @@ class InsEkf(InsCore):
         fix = self.pending_fix
         if fix is None or self.field is None:
             return
+        if self.warm is not None:  # the first fix decides: in the air, carry on (ins_warm)
+            warm, self.warm = self.warm, None
+            if warm_start(self, warm, fix, t_us):
+                return
         compass = self.last_compass
         fresh = compass is not None and self._fresh(compass.t_us, t_us)
         heading = compass.heading_rad + self._compass_declination() if compass and fresh else None

@@ -25,13 +25,14 @@ from companion.link.command_service import CommandService
 from companion.link.commands import register_commands
 from companion.link.endpoints import endpoint_problems, open_endpoints, serial_endpoints
 from companion.link.gcs_watch import GcsWatch
+from companion.link.heartbeat_state import HeartbeatFollower
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
 from companion.link.log_transfer import LogTransferService
 from companion.link.manual_control import ManualControlService
 from companion.link.metadata_service import MetadataService
 from companion.link.mission_service import MissionService
-from companion.link.mode_messages import current_mode, heartbeat_mode
+from companion.link.mode_messages import current_mode
 from companion.link.params_service import ParamsService
 from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
@@ -134,10 +135,11 @@ class MavlinkLink(Plugin):
         self.endpoints = open_endpoints(ctx.settings["endpoints"])
         autopilot = AUTOPILOTS[ctx.settings["autopilot"]]
         self.identity = IdentityService(self.mav, sysid, autopilot, CAPABILITIES)
-        # The first heartbeat already names a mode (the commander's initial one).
-        self.identity.state.custom_mode, self.identity.state.mode_flags = heartbeat_mode(None)
+        # Where a commander runs, the heartbeat waits for its status (heartbeat_state).
+        commander = COMMANDER in ctx.plugins
+        self.heartbeat = HeartbeatFollower(self.identity.state, commander, time.monotonic())
         self.commands = CommandService(self.mav, sysid, ctx.settings["compid"])
-        self.snapshot = Snapshot()
+        self.snapshot = Snapshot(assumed_mode=self.heartbeat.assumed)
         self.devices = DeviceWatch(ctx.plugins)  # silent or garbled devices refuse arming
         self.boot_us = ctx.clock.now_us()
         bus = ctx.bus
@@ -279,11 +281,11 @@ class MavlinkLink(Plugin):
         s.mission_completed, s.mission_paused = self.missions.completed, self.missions.paused
         s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
         s.unix_us = time.time_ns() // 1000
-        self._mode_changes(s)
-        if s.health is not None:
-            self.identity.state.armed = bool(s.health.flight_running)
-            active = d.MAV_STATE_ACTIVE if s.health.flight_running else d.MAV_STATE_STANDBY
-            self.identity.state.system_status = active
+        if self.heartbeat.update(s.status, s.health, time.monotonic()):
+            # A change of mode is announced at once, not at the stream's next turn.
+            msg = current_mode(self.mav, s.status)
+            if msg is not None:
+                self.router.send([Outgoing(msg, None)], time.monotonic())
 
     def _fresh_control(self, control: ControlStatus | None) -> ControlStatus | None:
         """The controller's status while it runs; MISSION_ITEM_REACHED when it grows."""
@@ -295,16 +297,6 @@ class MavlinkLink(Plugin):
         self.reached_count = control.reached_count
         self.missions.follow(control.mission_state, control.mission_seq)
         return control
-
-    def _mode_changes(self, s: Snapshot) -> None:
-        """The heartbeat shows the commander's mode; a change is announced at once."""
-        state = self.identity.state
-        custom, flags = heartbeat_mode(s.status)
-        if custom != state.custom_mode and s.status is not None:
-            msg = current_mode(self.mav, s.status)
-            if msg is not None:
-                self.router.send([Outgoing(msg, None)], time.monotonic())
-        state.custom_mode, state.mode_flags = custom, flags
 
     def _wait_input(self, now_s: float) -> None:
         nav_known = self.snapshot.nav is not None

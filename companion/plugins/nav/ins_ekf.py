@@ -10,8 +10,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 from companion.navigation.ins_ekf import InsEkfConfig
+from companion.navigation.ins_warm import WarmFile, warm_state
 from companion.navigation.offline import InsEkfRunner
 from companion.navigation.sample_order import FEED_ORDER, PublishGrid, SampleOrder
 from companion.plugin import Plugin, PluginContext, Setting
@@ -69,6 +71,9 @@ class InsEkfPlugin(Plugin):
         self.out = ctx.bus.writer("nav/state")
         self.grid = PublishGrid(s["publish_hz"])
         self.order = SampleOrder()
+        # The last solution, for a restart in the air (the state directory as configured).
+        self.warm_file = WarmFile(Path(ctx.vehicle.get("state_dir", ".")))
+        self.runner.nav.warm = self.warm_file.read()
 
     def step(self) -> None:
         # The waiter counts its own idle time and names the readers with data, in feed
@@ -82,7 +87,10 @@ class InsEkfPlugin(Plugin):
             self.runner.feed(sample)
             # A lockstep simulation sees the same states at the same times every run.
             if self.grid.due(nav.t_us, sample):
-                self.out.publish(nav.state())
+                state = nav.state()
+                self.out.publish(state)
+                if self.warm_file.due(state.t_us) and (warm := warm_state(state, nav.lag.lag_s)):
+                    self.warm_file.write(warm)
         self.ctx.health.ok(len(samples))
         self.ctx.health.frames_bad = nav.gps_rejected + nav.heading_rejected
 

@@ -30,3 +30,14 @@ def test_gps_pulls_the_datum_with_its_time_constant():
     assert datum.offset == pytest.approx(100.0 + 10.0, abs=0.01)
     datum.follow_gps(gps_down=float("nan"), ins_down=-100.0, dt_s=1.0)
     assert datum.offset == pytest.approx(110.0, abs=0.01)
+
+
+def test_a_barometer_that_starts_counting_from_zero_again_does_not_move_the_height():
+    """Its driver restarted in the air (the IMU's plug-in killed): 100 m above its old zero
+    it now reads 0. In lockstep the navigator's height fell 97 m with it, and the controller
+    climbed 24 m after the wrong height."""
+    datum = BaroDatum(interval_s=0.1, timeout_s=1.0, tau_s=300.0)
+    datum.height(100.0, 0, ins_down=-480.0)
+    assert datum.height(100.5, 100_000, ins_down=-480.5) == pytest.approx(480.5)
+    assert datum.height(0.2, 200_000, ins_down=-480.5) == pytest.approx(480.5)  # the same
+    assert datum.height(1.2, 300_000, ins_down=-481.0) == pytest.approx(481.5)  # then moves

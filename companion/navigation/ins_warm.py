@@ -1,0 +1,156 @@
+"""Warm start: a navigator restarted in the air carries on from its last solution.
+
+While the aircraft flies, the navigator writes its solution (position, velocity, attitude,
+the IMU's biases, the GPS lag) to a small file in the state directory, five times a
+second. A new process reads it back, and takes it up only when the sensors say the
+aircraft is in the air: its first GPS fix moves faster than an aircraft on the ground (the
+flight controller's landed speed), within a few seconds of the file by the vehicle's
+clock, and near where the file's solution, carried on by its velocity, says it should be.
+Then, instead of a cold alignment (half a second of IMU, then roll from the turn rate and
+a heading from the magnetometer, a few degrees and metres off), it starts at once from
+the last solution carried forward to now: position dead-reckoned over the gap (the fix's
+when the two differ by more than MAX_MISS_M), velocity from GPS, the attitude turned as
+the gyros say it turned, the biases as they were. On the ground, with
+a stale file or one from elsewhere, the alignment is cold.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from companion.messages import GpsFix, NavFlags, NavState
+from companion.navigation import rotations as rot
+
+if TYPE_CHECKING:
+    from companion.navigation.ins_ekf import InsEkf
+
+log = logging.getLogger(__name__)
+
+WARM_FILE = "nav_warm.json"
+WRITE_PERIOD_US = 200_000  # 5 Hz of vehicle time: the file is at most this much behind
+MAX_AGE_S = 10.0  # a supervisor restart under load takes a few seconds
+IN_AIR_SPEED_M_S = 8.0  # the flight controller's LANDED_SPEED: faster is flying
+# The fix this far across from the solution dead-reckoned over the gap: the position is
+# the fix's (a tight turn flown in the gap; under load, a simulator's fixes behind time);
+# this far, the file is not this flight's.
+MAX_MISS_M, OTHER_FLIGHT_M = 20.0, 1000.0
+# How much the attitude may have changed over the gap, per second of it (and at once).
+TILT_STD = (math.radians(2.0), math.radians(3.0))
+YAW_STD = (math.radians(2.0), math.radians(3.0))
+
+
+@dataclass(frozen=True)
+class WarmState:
+    """The solution as written (vehicle time, WGS-84, NED, body->NED quaternion)."""
+
+    t_us: int
+    lat_deg: float
+    lon_deg: float
+    alt_msl_m: float
+    vel: tuple[float, float, float]
+    q: tuple[float, float, float, float]
+    accel_bias: tuple[float, float, float]
+    gyro_bias: tuple[float, float, float]
+    gps_lag_s: float
+
+
+def warm_state(nav: NavState, gps_lag_s: float) -> WarmState | None:
+    """The solution to write, or None: none yet (aligning), or not flying (only a restart
+    in the air reads it, and a vehicle on the bench writes nothing to its state directory)."""
+    flying = math.hypot(nav.vn_m_s, nav.ve_m_s) >= IN_AIR_SPEED_M_S
+    if not flying or not nav.flags & NavFlags.ATTITUDE_VALID or not math.isfinite(nav.lat_deg):
+        return None
+    return WarmState(
+        int(nav.t_us), nav.lat_deg, nav.lon_deg, nav.alt_msl_m,
+        (nav.vn_m_s, nav.ve_m_s, nav.vd_m_s), tuple(nav.q), tuple(nav.accel_bias_m_s2),
+        tuple(nav.gyro_bias_rad_s), gps_lag_s,
+    )  # fmt: skip
+
+
+class WarmFile:
+    """The file in the state directory: written every WRITE_PERIOD_US, read once."""
+
+    def __init__(self, state_dir: Path) -> None:
+        self.path = state_dir / WARM_FILE
+        self.next_us = 0
+
+    def read(self) -> WarmState | None:
+        """The last solution written, or None (none, or damaged: a cold start)."""
+        try:
+            raw = json.loads(self.path.read_text())
+            state = WarmState(**raw)
+            values = [state.t_us, state.lat_deg, state.lon_deg, state.alt_msl_m, *state.vel]
+            values += [*state.q, *state.accel_bias, *state.gyro_bias, state.gps_lag_s]
+            return state if len(values) == 18 and all(map(math.isfinite, values)) else None
+        except (OSError, ValueError, TypeError):
+            return None
+
+    def due(self, t_us: int) -> bool:
+        return t_us >= self.next_us
+
+    def write(self, state: WarmState) -> None:
+        """Replace the file at once. No fsync: a killed process leaves what it wrote in
+        the page cache; after a power cut a missing or old file only means a cold start."""
+        self.next_us = state.t_us + WRITE_PERIOD_US
+        tmp = self.path.with_name(f".{WARM_FILE}.tmp")
+        try:
+            tmp.write_text(json.dumps(asdict(state)))
+            os.replace(tmp, self.path)
+        except OSError as exc:  # a full or read-only disk must not stop the navigator
+            log.warning("warm start file not written: %s", exc)
+
+
+def warm_start(nav: InsEkf, warm: WarmState, fix: GpsFix, t_us: int) -> bool:
+    """Start ``nav`` from ``warm`` carried to ``t_us`` if the fix says it is this flight,
+    in the air; False (and nothing changed) otherwise."""
+    age_s = (t_us - warm.t_us) / 1e6
+    gps_vel = np.array((fix.vn_m_s, fix.ve_m_s, fix.vd_m_s))
+    gps_vel = np.where(np.isfinite(gps_vel), gps_vel, warm.vel)
+    speed = math.hypot(gps_vel[0], gps_vel[1])
+    if nav.frame is None or not 0.0 <= age_s <= MAX_AGE_S or speed < IN_AIR_SPEED_M_S:
+        return False
+    moved = 0.5 * (np.array(warm.vel) + gps_vel) * age_s
+    p = nav.frame.ned(warm.lat_deg, warm.lon_deg, warm.alt_msl_m) + moved
+    fix_p = nav.frame.ned(fix.lat_deg, fix.lon_deg, warm.alt_msl_m)  # only across is judged
+    fix_p += gps_vel * (t_us - fix.t_us) / 1e6
+    miss = math.hypot(*(fix_p[:2] - p[:2]))
+    if miss > OTHER_FLIGHT_M:
+        log.info("warm start refused: the fix is %.0f m from the last solution", miss)
+        return False
+    if miss > MAX_MISS_M:  # the gap was flown otherwise than its ends' velocities say
+        p[:2] = fix_p[:2]
+    q = _turned_over_the_gap(nav, warm, age_s)
+    c = nav.cfg
+    tilt_std, yaw_std = (s0 + s1 * age_s for s0, s1 in (TILT_STD, YAW_STD))
+    pos_std = 2.0 + 0.5 * age_s
+    diag = [pos_std] * 3 + [max(c.gps_vel_std, 0.5)] * 3 + [tilt_std, tilt_std, yaw_std]
+    diag += [0.5 * c.accel_bias_std] * 3 + [0.5 * c.gyro_bias_std] * 3
+    nav.p, nav.v = p.tolist(), gps_vel.tolist()
+    nav.q = q
+    nav.ba, nav.bg = list(warm.accel_bias), list(warm.gyro_bias)
+    nav.lag.lag_s = warm.gps_lag_s
+    nav.P = np.diag(np.square(diag))
+    nav.aligned, nav.t_us = True, t_us
+    nav.aligned_us = nav.last_gps_us = fix.t_us
+    log.info("warm start: %.1f s after the last solution written", age_s)
+    return True
+
+
+def _turned_over_the_gap(nav: InsEkf, warm: WarmState, age_s: float) -> rot.Quat:
+    """The file's attitude turned by the gyros' rate since this process started, over the
+    whole gap: a rolling or turning aircraft has rolled and turned on meanwhile (in lockstep,
+    rolling at 17 deg/s, the roll as written was 5 deg off 0.3 s later)."""
+    rates = [s[2] for s in nav.aligner.samples]
+    if not rates:
+        return tuple(warm.q)  # type: ignore[return-value]
+    w = np.mean(rates, axis=0) - np.array(warm.gyro_bias)
+    turn = rot.rotation_vector_quaternion(*(float(x) * age_s for x in w))
+    return rot.normalized(rot.multiply(tuple(warm.q), turn))  # type: ignore[arg-type]
