@@ -31,8 +31,8 @@ from bridges.jsbsim.truth_log import ServoLog, TruthLog
 from bridges.jsbsim.vehicle_commands import VehicleCommands
 from bridges.sensor_models.sensor_errors import MagneticField, NoiseModel, SensorErrors
 from bridges.sensor_models.true_state import TrueState
-from companion.bus.channels import Reader
 from companion.bus.node import BusNode
+from companion.bus.patterns import Reader
 from companion.messages import SimClock, SimTruth, channel
 
 log = logging.getLogger(__name__)

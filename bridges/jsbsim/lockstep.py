@@ -9,8 +9,8 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
-    from companion.bus.channels import LatestReader, Reader
     from companion.bus.node import Waiter
+    from companion.bus.patterns import LatestReader, Reader
 
 log = logging.getLogger(__name__)
 

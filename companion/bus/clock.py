@@ -6,7 +6,7 @@ import time
 from typing import TYPE_CHECKING, Protocol
 
 if TYPE_CHECKING:
-    from companion.bus.channels import LatestReader
+    from companion.bus.patterns import LatestReader
     from companion.messages import SimClock
 
 

@@ -9,7 +9,8 @@ from typing import Any
 
 import iceoryx2 as iox2
 
-from companion.bus.channels import (
+from companion.bus.namespace import default_namespace, make_config
+from companion.bus.patterns import (
     IdleTally,
     LatestReader,
     QueueReader,
@@ -18,7 +19,6 @@ from companion.bus.channels import (
     Writer,
     duration,
 )
-from companion.bus.namespace import default_namespace, make_config
 from companion.messages import MAX_PLUGINS, Channel, channel
 
 log = logging.getLogger(__name__)

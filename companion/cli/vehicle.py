@@ -76,7 +76,7 @@ app.add_typer(mission_app, name="mission")
 
 
 def _mission_store(config: Path):
-    from companion.control.mission.store import MissionStore
+    from companion.control.mission.mission_files import MissionStore
 
     cfg = load_checked(config, None)
     return MissionStore(Path(cfg.vehicle["state_dir"]) / "missions")

@@ -18,7 +18,7 @@ from companion.control.mission.items import MAX_ALT_M
 from companion.messages import FlightMode, NavState, VehicleStatus
 
 if TYPE_CHECKING:
-    from companion.control.flight.pilot import Sticks
+    from companion.control.flight.attitude_modes import Sticks
 
 # Beyond these a value is a broken input, not a state the aircraft can be in: an IMU
 # saturates near 35 rad/s (2000 °/s), and no airframe here flies at 500 m/s.

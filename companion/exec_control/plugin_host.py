@@ -18,9 +18,9 @@ import time
 from collections import deque
 from typing import Any
 
-from companion.bus.channels import Writer
 from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
 from companion.bus.node import BusNode
+from companion.bus.patterns import Writer
 from companion.exec_control.profiling import run_profiled
 from companion.exec_control.registry import load
 from companion.messages import NAME_LEN, PluginState, PluginStats

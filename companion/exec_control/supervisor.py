@@ -13,10 +13,10 @@ import signal
 import time
 from dataclasses import asdict
 
-from companion.bus.channels import Reader, Writer
 from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
 from companion.bus.namespace import cleanup_namespace
 from companion.bus.node import BusNode
+from companion.bus.patterns import Reader, Writer
 from companion.exec_control.child import FIRST_BACKOFF_S, Child
 from companion.exec_control.composed_child import ComposedChild
 from companion.exec_control.composition import processes

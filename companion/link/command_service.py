@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from companion.link.codec import dialect as d
-from companion.link.service import Outgoing, Peer
+from companion.link.microservice import Outgoing, Peer
 
 log = logging.getLogger(__name__)
 

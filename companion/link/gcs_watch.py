@@ -11,7 +11,7 @@ import math
 from typing import Any
 
 from companion.link.codec import dialect as d
-from companion.link.service import Outgoing, Peer
+from companion.link.microservice import Outgoing, Peer
 
 STATUS_PERIOD_S = 0.2  # link/status (the silence) five times a second once one was heard
 UNHEARD_STATUS_PERIOD_S = 1.0  # before: the silence is "never heard", which changes nothing

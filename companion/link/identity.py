@@ -13,8 +13,8 @@ from typing import Any
 
 from companion import __version__
 from companion.link.codec import dialect as mav_dialect
+from companion.link.microservice import Outgoing, Peer
 from companion.link.px4_compat import PX4_COMPAT_VERSION
-from companion.link.service import Outgoing, Peer
 
 HEARTBEAT_PERIOD_S = 1.0
 

@@ -16,7 +16,7 @@ from typing import Any
 from companion.link.codec import StreamParser, new_encoder, new_parser
 from companion.link.endpoints import Endpoint, Remote, UdpOut, default_budget
 from companion.link.link_budget import LinkBudget
-from companion.link.service import Outgoing, Peer, Service
+from companion.link.microservice import Outgoing, Peer, Service
 from companion.link.signing import configure_parser, shared_state, signing_encoder
 from companion.link.stream_schedule import StreamSchedule
 from companion.link.telemetry import STREAMS, Snapshot

@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any, BinaryIO
 
 from companion.flight_log import LogDirectory
-from companion.link.service import Outgoing, Peer
+from companion.link.microservice import Outgoing, Peer
 
 log = logging.getLogger(__name__)
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from companion.link.service import Outgoing, Peer
+from companion.link.microservice import Outgoing, Peer
 from companion.messages import PilotInput, PilotSource
 
 AXIS_INVALID = 32767

@@ -14,7 +14,7 @@ from functools import cached_property
 from typing import Any
 
 from companion.link.ftp import FtpServer
-from companion.link.service import Outgoing, Peer
+from companion.link.microservice import Outgoing, Peer
 from companion.params.metadata import MetadataFiles, metadata_files
 from companion.params.store import ParamDecl
 

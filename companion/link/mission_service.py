@@ -16,9 +16,9 @@ from typing import Any
 
 from companion.control.mission.fence import honoured
 from companion.control.mission.items import MISSION_TYPES, MissionItem, check_mission
-from companion.control.mission.store import MissionStore
+from companion.control.mission.mission_files import MissionStore
 from companion.control.prearm import PlanVerdicts
-from companion.link.service import Outgoing, Peer
+from companion.link.microservice import Outgoing, Peer
 from companion.messages import MissionState
 from mavlink_dialect import companion as d
 

@@ -14,7 +14,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import Any
 
-from companion.link.service import Outgoing, Peer
+from companion.link.microservice import Outgoing, Peer
 from companion.params.live import RELOAD_ALL
 from companion.params.store import ParamError, ParamStore
 

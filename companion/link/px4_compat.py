@@ -74,7 +74,7 @@ AIRFRAME_FACTS = (
 # against the World Magnetic Model. What the user can measure on the ground, gyro offsets
 # and the IMU's mounting tilt, is the IMU driver's (``companion.sensors.imu_calibration``),
 # under PX4's names here; MAV_CMD_PREFLIGHT_CALIBRATION measures it
-# (``companion.link.calibration``).
+# (``companion.link.calibration_service``).
 SENSOR_IDS = tuple(
     ParamDecl(f"CAL_{kind}_ID", 0.0, doc=f"{what}: the device the vehicle uses (PX4's "
               "device id; 0: none)", values=((0.0, "None"), *DEVICES))

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from companion.link.service import Outgoing, Peer
+from companion.link.microservice import Outgoing, Peer
 
 
 class TimesyncService:

@@ -17,7 +17,7 @@ import numpy as np
 
 from companion.actuators.airframe import load_airframe
 from companion.control.flight.controller import TURN_BANK_FRACTION
-from companion.control.flight.params import control_params
+from companion.control.flight.flight_params import control_params
 from companion.control.laws.fillet import corner_arc
 from companion.control.mission.executor import RELATIVE_FRAMES
 from companion.control.mission.items import MissionItem

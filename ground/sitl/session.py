@@ -25,7 +25,7 @@ from pathlib import Path
 from bridges.jsbsim.options import BridgeOptions
 from companion.bus.namespace import cleanup_namespace
 from companion.bus.node import BusNode
-from companion.control.mission.store import MissionStore
+from companion.control.mission.mission_files import MissionStore
 from companion.control.modes import BY_MODE
 from companion.exec_control.config import VehicleConfig, load_config
 from companion.exec_control.plugin_host import die_with_parent

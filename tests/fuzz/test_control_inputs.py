@@ -15,9 +15,9 @@ from hypothesis import strategies as st
 
 from companion.actuators.airframe import load_airframe
 from companion.control.commander import Commander
+from companion.control.flight.attitude_modes import Sticks
 from companion.control.flight.controller import FlightController
-from companion.control.flight.params import control_params, flight_config
-from companion.control.flight.pilot import Sticks
+from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.mission.plan import load_plan
 from companion.messages import NavFlags, NavState, VehicleStatus
 from tests.support.vehicle import REPO

@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 
 from companion.control.commander import Commander
 from companion.control.mission.items import MissionItem, check_mission
-from companion.control.mission.store import MissionStore
+from companion.control.mission.mission_files import MissionStore
 from companion.link.codec import new_encoder
 from companion.link.command_rules import RULES
 from companion.link.command_service import CommandService
@@ -24,9 +24,9 @@ from companion.link.commands import register_commands
 from companion.link.endpoints import open_endpoint
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
+from companion.link.microservice import Peer
 from companion.link.mission_service import MissionService
 from companion.link.params_service import ParamsService
-from companion.link.service import Peer
 from companion.messages import CommandId, VehicleCommand
 from companion.params import ParamDecl, ParamStore
 from companion.sensors.imu_calibration import IMU_CAL_PARAMS

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
+from companion.control.mission.mission_files import MissionStore
 from companion.control.mission.plan import checked_plan
-from companion.control.mission.store import MissionStore
 from companion.control.modes import BY_MODE, MODES
 from companion.messages import FlightMode
 from mavlink_dialect import companion as m

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from companion.control.flight.params import CONTROL_PARAMS
+from companion.control.flight.flight_params import CONTROL_PARAMS
 from companion.params.live import LiveParams
 from mavlink_dialect import companion as m
 from tests.protocol.test_qgc_setup_pages import param_set, read_all, start

@@ -30,8 +30,8 @@ import math
 
 import pytest
 
+from companion.control.mission.mission_files import MissionStore
 from companion.control.mission.plan import checked_plan
-from companion.control.mission.store import MissionStore
 from companion.control.modes import BY_MODE
 from companion.messages import FlightMode
 from mavlink_dialect import companion as m

@@ -14,9 +14,9 @@ import numpy as np
 
 from bridges.jsbsim.fdm import Flight, Home
 from companion.actuators.airframe import load_airframe
+from companion.control.flight.attitude_modes import Sticks
 from companion.control.flight.controller import ControlOutput, FlightController
-from companion.control.flight.params import control_params, flight_config
-from companion.control.flight.pilot import Sticks
+from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.mission.items import MissionItem
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus

@@ -19,8 +19,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from companion.control.flight.params import FlightConfig
-from companion.control.flight.pilot import Sticks
+from companion.control.flight.attitude_modes import Sticks
+from companion.control.flight.flight_params import FlightConfig
 from companion.control.mission.executor import Kind, Setpoint
 from companion.messages import FlightMode, NavState
 

@@ -11,11 +11,11 @@ import math
 from dataclasses import replace
 
 from companion.control.flight.assisted import AssistedHold, track_ahead
+from companion.control.flight.attitude_modes import AcroHold, Sticks
+from companion.control.flight.flight_params import FlightConfig
 from companion.control.flight.landing import Landing
 from companion.control.flight.landing_flight import LandingFlight
 from companion.control.flight.output import ControlOutput
-from companion.control.flight.params import FlightConfig
-from companion.control.flight.pilot import AcroHold, Sticks
 from companion.control.flight.pilot_flight import PilotFlight
 from companion.control.flight.takeoff import Phase, RunwayTakeoff
 from companion.control.inputs import nav_usable, rates_or_zero, status_usable, sticks_usable

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from companion.control.flight.pilot import Sticks, fly_pilot
+from companion.control.flight.attitude_modes import Sticks, fly_pilot
 from companion.control.laws.limits import clamp
 from companion.messages import FlightMode, NavState
 

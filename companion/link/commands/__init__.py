@@ -8,13 +8,13 @@ command service.
 
 from __future__ import annotations
 
-from companion.link.calibration import Calibration
+from companion.link.calibration_service import Calibration
 from companion.link.command_rules import RULES, refusal
 from companion.link.command_service import CommandService
 from companion.link.commands.arming import ArmingCommands
 from companion.link.commands.calibration import CalibrationCommands
 from companion.link.commands.message_requests import MessageRequests
-from companion.link.commands.modes import ModeCommands
+from companion.link.commands.mode_commands import ModeCommands
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
 from companion.link.commands.storage import StorageCommands
 from companion.link.identity import IdentityService

@@ -5,7 +5,7 @@ in param1, param5 or param7 temperature; param2 1 compass; param3 1 barometer; p
 radio, 2 copy trims; param5 1 accelerometer, 2 level horizon, 4 quick accelerometer;
 param6 1 or 2 airspeed; param7 1 ESC; every parameter 0 cancels the one under way (and
 ends a radio calibration). Acknowledged at once, as PX4 does: ACCEPTED when it starts (the
-result follows in "[cal]" status texts, ``companion.link.calibration``), DENIED with
+result follows in "[cal]" status texts, ``companion.link.calibration_service``), DENIED with
 "[cal] calibration failed: <why>" when this vehicle cannot do it or is armed.
 
 QGroundControl sends the Sensors page's commands without waiting for the ack and follows
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from companion.link.calibration import Calibration
+from companion.link.calibration_service import Calibration
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandArgs, CommandService, Outcome
 from companion.link.commands.port import VehiclePort, armed

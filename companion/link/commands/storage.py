@@ -14,7 +14,7 @@ configuration defaults", writes PX4's SYS_AUTOCONFIG = 2, which does the same re
 
 from __future__ import annotations
 
-from companion.link.calibration import Calibration
+from companion.link.calibration_service import Calibration
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandArgs, CommandService, Outcome
 from companion.link.commands.port import VehiclePort, armed

@@ -19,10 +19,10 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from companion.actuators.airframe import AirframeError, load_airframe
+from companion.control.flight.attitude_modes import pilot_sticks
 from companion.control.flight.controller import ControlOutput, FlightController
-from companion.control.flight.params import control_params, flight_config
-from companion.control.flight.pilot import pilot_sticks
-from companion.control.mission.store import MissionStore, StoreFollower
+from companion.control.flight.flight_params import control_params, flight_config
+from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.messages import (
     ActuatorCommand,
     CommandId,

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from companion.control.device_watch import DeviceWatch
-from companion.control.mission.store import MissionStore
+from companion.control.mission.mission_files import MissionStore
 from companion.control.modes import INITIAL_MODE
 from companion.control.prearm import PREARM_PARAMS, Readiness, failures
 from companion.flight_log import LogDirectory
@@ -31,12 +31,12 @@ from companion.link.link_router import LinkRouter
 from companion.link.log_transfer import LogTransferService
 from companion.link.manual_control import ManualControlService
 from companion.link.metadata_service import MetadataService
+from companion.link.microservice import Outgoing, Service, refused_count
 from companion.link.mission_service import MissionService
 from companion.link.mode_messages import current_mode
 from companion.link.params_service import ParamsService
 from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
-from companion.link.service import Outgoing, Service, refused_count
 from companion.link.signing import configured_secret, key_file_problem, key_from
 from companion.link.statustext import StatusTexts
 from companion.link.telemetry import SNAPSHOT_CHANNELS, Snapshot

@@ -24,7 +24,7 @@ from companion.sensors.imu_calibration import IMU_CAL_PARAMS, ImuCalibration
 from companion.sensors.vectornav import VectorNavDecoder, VectorNavReading
 
 if TYPE_CHECKING:
-    from companion.bus.channels import Writer
+    from companion.bus.patterns import Writer
 
 PARAMS_EVERY_US = 100_000  # a calibration's new values are looked for this often
 

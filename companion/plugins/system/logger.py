@@ -37,7 +37,7 @@ from companion.params.store import ParamStore
 from companion.plugin import NO_VEHICLE, Plugin, PluginContext, Ports, Setting
 
 if TYPE_CHECKING:
-    from companion.bus.channels import Reader
+    from companion.bus.patterns import Reader
 
 # Every registered channel but those that opt out in the registry, with their reason.
 DEFAULT_CHANNELS = list(LOGGED)

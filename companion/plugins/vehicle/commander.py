@@ -22,7 +22,7 @@ from companion.control.flight.landing_flight import land_start
 from companion.control.flight_state import in_the_air, load_flight_state, save_flight_state
 from companion.control.ground_rules import ground_notice, standing
 from companion.control.mission.fence import Fence
-from companion.control.mission.store import MissionStore, StoreFollower
+from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch, ReceiverProcess
 from companion.messages import (
     NAME_LEN,

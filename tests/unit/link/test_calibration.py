@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 from pymavlink.dialects.v20 import common as m
 
-from companion.link.calibration import WINDOW_S, Calibration
+from companion.link.calibration_service import WINDOW_S, Calibration
 from companion.link.codec import new_encoder
 from companion.link.command_service import CommandArgs, CommandService
 from companion.link.commands.calibration import CalibrationCommands, requested
 from companion.link.commands.storage import StorageCommands
+from companion.link.microservice import Peer
 from companion.link.params_service import ParamsService
-from companion.link.service import Peer
 from companion.messages import Imu, SystemHealth
 from companion.params import ParamDecl, ParamError, ParamStore
 from companion.params.live import RELOAD_ALL

@@ -8,7 +8,7 @@ from pymavlink.dialects.v20 import common as m
 
 from companion.link.command_service import CommandArgs
 from companion.link.commands import ArmingCommands, ModeCommands
-from companion.link.service import Peer
+from companion.link.microservice import Peer
 from companion.messages import CommandId, ControlStatus, VehicleStatus
 from tests.support.vehicle_port import RecordingVehicle
 

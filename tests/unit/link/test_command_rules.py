@@ -11,8 +11,8 @@ from companion.link.commands import register_commands
 from companion.link.endpoints import open_endpoint
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
+from companion.link.microservice import Peer
 from companion.link.params_service import ParamsService
-from companion.link.service import Peer
 from companion.params import ParamStore
 from companion.sensors.imu_calibration import IMU_CAL_PARAMS
 from mavlink_dialect import companion as d

@@ -12,7 +12,7 @@ from companion.flight_log import LogDirectory, hold
 from companion.link.codec import new_encoder
 from companion.link.link_budget import LinkBudget
 from companion.link.log_transfer import SHARE, LogTransferService
-from companion.link.service import Peer
+from companion.link.microservice import Peer
 from mavlink_dialect import companion as d
 
 GCS = Peer(255, 190, 0)

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from companion.link.codec import new_encoder, new_parser
 from companion.link.manual_control import ManualControlService
-from companion.link.service import Peer
+from companion.link.microservice import Peer
 from companion.messages import PilotInput, PilotSource
 
 PEER = Peer(255, 190, 0)

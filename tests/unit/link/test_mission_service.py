@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import pytest
 
-from companion.control.mission.store import MissionStore
+from companion.control.mission.mission_files import MissionStore
 from companion.link.codec import new_encoder, new_parser
 from companion.link.flight_messages import mission_current
+from companion.link.microservice import Peer
 from companion.link.mission_service import MAX_RETRIES, MissionService
-from companion.link.service import Peer
 from companion.messages import ControlStatus, MissionState
 from mavlink_dialect import companion as d
 

@@ -4,8 +4,8 @@ index, and values queued for everyone (a reset's) still go out."""
 from __future__ import annotations
 
 from companion.link.codec import new_encoder
+from companion.link.microservice import Peer
 from companion.link.params_service import ParamsService
-from companion.link.service import Peer
 from companion.params import ParamDecl, ParamStore
 
 QGC = Peer(255, 190, 0)  # on the first endpoint

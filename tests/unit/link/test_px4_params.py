@@ -7,7 +7,7 @@ import pytest
 
 from companion.control.battery_failsafe import BATTERY_FS_PARAMS, BatteryFailsafe
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
-from companion.control.flight.params import control_params, flight_config
+from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch
 from companion.control.prearm import PREARM_PARAMS
 from companion.link.px4_aliases import PX4_SLOT

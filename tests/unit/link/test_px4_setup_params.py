@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from companion.control.flight.params import control_params, flight_config
+from companion.control.flight.flight_params import control_params, flight_config
 from companion.link.px4_compat import OS3000, PX4_PARAMS, VN100, sensor_ids, vehicle_facts
 from companion.messages import Imu
 from companion.params import ParamDecl, ParamError, ParamStore

@@ -7,16 +7,16 @@ from pathlib import Path
 
 import pytest
 
-from companion.control.mission.store import MissionStore
+from companion.control.mission.mission_files import MissionStore
 from companion.flight_log import LogDirectory
 from companion.link.codec import new_encoder
 from companion.link.command_service import CommandService
 from companion.link.link_router import _target_system
 from companion.link.log_transfer import LogTransferService
 from companion.link.metadata_service import MetadataService
+from companion.link.microservice import Peer, refused_count
 from companion.link.mission_service import MissionService
 from companion.link.params_service import ParamsService
-from companion.link.service import Peer, refused_count
 from companion.link.timesync import TimesyncService
 from companion.params import ParamDecl, ParamStore
 

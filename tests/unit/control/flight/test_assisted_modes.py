@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from companion.control.flight.pilot import Sticks
+from companion.control.flight.attitude_modes import Sticks
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode
 from tests.support.closed_loop import ClosedLoop

@@ -7,9 +7,9 @@ import math
 import pytest
 
 from companion.actuators.airframe import load_airframe
+from companion.control.flight.attitude_modes import Sticks
 from companion.control.flight.controller import FlightController
-from companion.control.flight.params import control_params, flight_config
-from companion.control.flight.pilot import Sticks
+from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.mission.plan import load_plan
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 from tests.support.vehicle import REPO

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from companion.control.flight.pilot import STICKS_STALE_US, Sticks, pilot_sticks
+from companion.control.flight.attitude_modes import STICKS_STALE_US, Sticks, pilot_sticks
 from companion.messages import FlightMode, PilotFlags, PilotInput, PilotSource
 from tests.support.closed_loop import ClosedLoop
 

@@ -7,8 +7,8 @@ import math
 
 import pytest
 
+from companion.control.flight.flight_params import CONTROL_PARAMS
 from companion.control.flight.landing import AircraftState, Landing, LandPhase
-from companion.control.flight.params import CONTROL_PARAMS
 from companion.control.flight.range_height import range_height
 from companion.messages import RangeReading
 

@@ -16,7 +16,7 @@ import pytest
 import companion.control.laws.fillet as corners
 from companion.actuators.airframe import load_airframe
 from companion.control.flight.controller import TURN_BANK_FRACTION
-from companion.control.flight.params import control_params
+from companion.control.flight.flight_params import control_params
 from companion.control.laws.fillet import Loop, arc_phase, fillet, loop_phase
 from companion.control.laws.l1_guidance import L1Guidance
 from companion.geodesy import STANDARD_GRAVITY as G

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.control.mission.plan import load_plan
-from companion.control.mission.store import MissionStore, StoreFollower
 from tests.support.vehicle import REPO
 
 

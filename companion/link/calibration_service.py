@@ -23,8 +23,8 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from companion.link.codec import dialect as d
+from companion.link.microservice import Outgoing, Peer
 from companion.link.params_service import ParamsService
-from companion.link.service import Outgoing, Peer
 from companion.messages import Imu
 from companion.navigation.ins_still import MAX_ACCEL_SPREAD, MAX_GRAVITY_ERROR, MAX_GYRO_SPREAD
 from companion.params import ParamError

@@ -25,7 +25,7 @@ from companion.messages import FlightMode, NavState, PilotInput
 from companion.params import ParamDecl
 
 if TYPE_CHECKING:
-    from companion.control.flight.params import FlightConfig
+    from companion.control.flight.flight_params import FlightConfig
 
 # Sticks older than this (by the navigation's sensor time) are not flown: the aircraft
 # holds its wings level until the pilot is back or the failsafe takes it home.

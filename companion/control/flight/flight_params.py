@@ -11,8 +11,8 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
+from companion.control.flight.attitude_modes import PILOT_PARAMS
 from companion.control.flight.landing import LANDING_PARAMS
-from companion.control.flight.pilot import PILOT_PARAMS
 from companion.control.laws.attitude import AttitudeGains
 from companion.control.laws.tecs import TecsGains
 from companion.control.mission.executor import ExecutorConfig
