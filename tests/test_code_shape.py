@@ -55,3 +55,16 @@ def test_program_files_stay_under_400_lines_and_functions_under_50():
         if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef) and _body_lines(node) > 50
     ]
     assert long_files == [] and long_functions == []
+
+
+def test_no_two_onboard_modules_share_a_basename():
+    """A reader who meets ``modes.py`` should not have to ask which one (issue 44.6). A
+    plug-in may share its library's name (plugins/sensors/os3000.py runs
+    sensors/os3000.py): the plug-in contract names a plug-in by its kind."""
+    plugins = REPO / "companion" / "plugins"
+    seen: dict[str, list[Path]] = {}
+    for path in sorted((REPO / "companion").rglob("*.py")):
+        if path.name != "__init__.py" and not path.is_relative_to(plugins):
+            seen.setdefault(path.name, []).append(path.relative_to(REPO))
+    shared = {name: paths for name, paths in seen.items() if len(paths) > 1}
+    assert shared == {}, shared

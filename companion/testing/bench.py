@@ -13,8 +13,8 @@ import json
 import math
 from pathlib import Path
 
+from companion.testing.loopback import LoopbackVehicle, companion_command
 from companion.testing.options import VehicleOptions
-from companion.testing.vehicle import LoopbackVehicle, companion_command
 
 HOME = (-37.9105, 145.1340)  # the sample circle's start (the simulator's default home)
 

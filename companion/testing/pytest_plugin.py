@@ -18,8 +18,8 @@ from typing import Any
 import pytest
 
 from companion.testing.bench import start_bench
+from companion.testing.loopback import LoopbackVehicle, start_sim
 from companion.testing.options import VehicleOptions
-from companion.testing.vehicle import LoopbackVehicle, start_sim
 
 MARKER = "vehicle"
 
