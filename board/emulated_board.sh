@@ -80,11 +80,11 @@ setup() {
     local t0=$SECONDS
     # As on a board: pip from the wheelhouse alone, with no network (a namespace of its own)
     # and no compiler in the root.
-    [[ -x $ROOT$VENV/bin/pip ]] || unshare --net chroot "$ROOT" /usr/bin/python3 -m venv $VENV
-    unshare --net chroot "$ROOT" $VENV/bin/pip install -q --no-index \
+    [[ -x $ROOT$VENV/bin/pip ]] || unshare --net chroot "$ROOT" /usr/bin/env -i PATH=/usr/bin:/bin HOME=/root /usr/bin/python3 -m venv $VENV
+    unshare --net chroot "$ROOT" /usr/bin/env -i PATH=/usr/bin:/bin HOME=/root $VENV/bin/pip install -q --no-index \
         --find-links /opt/wheelhouse companion
     # The project's own wheel again, whatever its version: a rebuilt one replaces the last.
-    unshare --net chroot "$ROOT" /bin/sh -c \
+    unshare --net chroot "$ROOT" /usr/bin/env -i PATH=/usr/bin:/bin HOME=/root /bin/sh -c \
         "$VENV/bin/pip install -q --no-index --no-deps --force-reinstall /opt/wheelhouse/companion-*.whl"
     say "pip install from the wheelhouse: $((SECONDS - t0)) s"
     say "installed: $(du -sm "$ROOT$VENV" | cut -f1) MB in $VENV"
