@@ -5,10 +5,8 @@ frames accepted and refused. A plug-in with a ``device`` setting that has read n
 the last few seconds has a silent device; one that has read bytes but decoded nothing, or
 mostly bad frames, has a garbled one (a wrong baud rate, a noisy line). Either refuses
 arming with the plug-in's name, as ``companion check`` would say on the bench. Until a
-plug-in has run for the whole window its device is judged only by whether it has sent one
-good frame yet: a device just opened may be slow to start, but the vehicle is not ready
-to arm on a device it has not heard at all (else an RC receiver or rangefinder left
-unplugged would pass in the first seconds after a start). Pure: tables in, reasons out.
+plug-in has run for the whole window there is no verdict: a device just opened has not
+had its chance (the navigator is still aligning then anyway). Pure: tables in, reasons out.
 """
 
 from __future__ import annotations
@@ -67,11 +65,7 @@ class DeviceWatch:
         found = []
         for name, history in self.history.items():
             first, last = history[0], history[-1]
-            if not last.pid:
-                continue
-            if last.t_us - first.t_us < WINDOW_US:
-                if last.ok == 0:  # counted since its process started
-                    found.append(f"{name}: waiting for data from its device")
+            if not last.pid or last.t_us - first.t_us < WINDOW_US:
                 continue
             ok, bad = last.ok - first.ok, last.bad - first.bad
             if last.bytes_in == first.bytes_in:
