@@ -37,11 +37,7 @@ from pathlib import Path
 
 import numpy as np
 import psutil
-from mavsdk.asyncio import Configuration, Mavsdk
-from mavsdk.asyncio.plugins.action import ActionAsync
-from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
 from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
-from mavsdk.component_type import ComponentType
 from mavsdk.plugins.telemetry import FlightMode
 
 REPO = Path(__file__).resolve().parents[1]
@@ -54,6 +50,7 @@ from companion.messages import NavFlags, channel  # noqa: E402
 from companion.navigation.estimate_csv import read_estimate  # noqa: E402
 from ground.campaign.legs import STRAIGHT_MARGIN_M, flight_legs  # noqa: E402
 from tests.support.hil import HilRun  # noqa: E402
+from tests.support.mavsdk_flight import plan_uploaded  # noqa: E402
 
 # Each plug-in of the HIL config and the channel its work shows on.
 OUTPUT = {
@@ -159,17 +156,9 @@ async def _killer(run: HilRun, watch: Watch, telemetry: TelemetryAsync, opts: di
 
 
 async def _fly_with_kills(run: HilRun, watch: Watch, plan: Path, opts: dict) -> dict:
-    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
-    async with Mavsdk(config) as mavsdk:
-        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{run.port}")
-        system = await mavsdk.first_autopilot(timeout_s=60.0)
-        telemetry, action = TelemetryAsync(system), ActionAsync(system)
-        mission = MissionRawAsync(system)
-        async for _home in telemetry.subscribe_home():  # a position before arming
-            break
-        data = await mission.import_qgroundcontrol_mission(str(plan))
-        await mission.upload_mission(data.mission_items)
-        await action.arm()
+    async with plan_uploaded(run.port, str(plan)) as flight:
+        telemetry, mission = flight.telemetry, flight.mission
+        await flight.action.arm()
         await mission.start_mission()
         task = asyncio.ensure_future(_killer(run, watch, telemetry, opts))
         modes: set = set()

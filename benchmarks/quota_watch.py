@@ -18,16 +18,12 @@ import threading
 import time
 
 import numpy as np
-from mavsdk.asyncio import Configuration, Mavsdk
-from mavsdk.asyncio.plugins.action import ActionAsync
-from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
-from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
-from mavsdk.component_type import ComponentType
 from mavsdk.plugins.action import ActionError
 
 from companion.bus.node import BusNode
 from companion.messages.channels import KEEP
 from mavlink_dialect import companion as m
+from tests.support.mavsdk_flight import mission_finished, plan_uploaded
 
 ARM_TRIES_S = 120.0  # pre-arm checks may take longer on a slow board: keep asking
 
@@ -149,21 +145,12 @@ class Watch:
 
 async def fly_watched(port: int, plan: str, deadline_s: float, watch: Watch) -> dict:
     """Upload ``plan``, arm (asking again while refused), start, wait for its end."""
-    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
     seen: dict = {}
-    async with Mavsdk(config) as mavsdk:
-        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
-        system = await mavsdk.first_autopilot(timeout_s=120.0)
-        telemetry, action = TelemetryAsync(system), ActionAsync(system)
-        mission = MissionRawAsync(system)
-        async for _home in telemetry.subscribe_home():  # a position before arming
-            break
-        data = await mission.import_qgroundcontrol_mission(plan)
-        await mission.upload_mission(data.mission_items)
+    async with plan_uploaded(port, plan, connect_s=120.0) as flight:
         give_up = time.monotonic() + ARM_TRIES_S
         while True:
             try:
-                await action.arm()
+                await flight.action.arm()
                 break
             except ActionError as exc:
                 if "arm_refused" not in seen:
@@ -174,12 +161,9 @@ async def fly_watched(port: int, plan: str, deadline_s: float, watch: Watch) -> 
                 await asyncio.sleep(2.0)
         watch.armed_at = time.monotonic()
         watch.imu_at_arming = watch.health.get("imu", {}).get("frames_ok", 0)
-        await mission.start_mission()
-        stop = time.monotonic() + deadline_s
-        while time.monotonic() < stop and not await mission.is_mission_finished():
-            await asyncio.sleep(0.5)
+        await flight.mission.start_mission()
+        seen["finished"] = await mission_finished(flight.mission, deadline_s)
         watch.ended_at = time.monotonic()
-        seen["finished"] = await mission.is_mission_finished()
         if not seen["finished"]:
             watch.event(f"mission not finished in {deadline_s:.0f} s")
     return seen

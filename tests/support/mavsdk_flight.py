@@ -5,6 +5,8 @@ from __future__ import annotations
 import asyncio
 import time
 from collections.abc import AsyncIterator, Callable
+from contextlib import asynccontextmanager
+from dataclasses import dataclass
 from typing import Any
 
 from mavsdk.asyncio import Configuration, Mavsdk
@@ -15,28 +17,53 @@ from mavsdk.component_type import ComponentType
 from mavsdk.plugins.action import ActionError
 
 
-async def fly_plan(port: int, plan: str, deadline_s: float) -> dict:
-    """Fly ``plan`` with the vehicle heard on udpin ``port``; what MAVSDK saw, as a dict."""
+@dataclass
+class PlanSession:
+    """A ground station's MAVSDK plug-ins, with a plan uploaded (``items`` of it)."""
+
+    telemetry: TelemetryAsync
+    action: ActionAsync
+    mission: MissionRawAsync
+    items: int = 0
+
+
+@asynccontextmanager
+async def plan_uploaded(
+    port: int, plan: str, connect_s: float = 60.0
+) -> AsyncIterator[PlanSession]:
+    """MAVSDK as a ground station hearing the vehicle on udpin ``port``, once the vehicle
+    has a home position (a position before arming) and ``plan`` is uploaded."""
     config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
-    seen: dict = {"reached": []}
     async with Mavsdk(config) as mavsdk:
         await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
-        system = await mavsdk.first_autopilot(timeout_s=60.0)
-        telemetry, action = TelemetryAsync(system), ActionAsync(system)
-        mission = MissionRawAsync(system)
-        async for _home in telemetry.subscribe_home():  # a position before arming
+        system = await mavsdk.first_autopilot(timeout_s=connect_s)
+        flight = PlanSession(TelemetryAsync(system), ActionAsync(system), MissionRawAsync(system))
+        async for _home in flight.telemetry.subscribe_home():
             break
-        data = await mission.import_qgroundcontrol_mission(plan)
-        await mission.upload_mission(data.mission_items)
-        seen["total"] = len(data.mission_items)
-        await action.arm()
-        await mission.start_mission()
-        stop = time.monotonic() + deadline_s
-        while time.monotonic() < stop and not await mission.is_mission_finished():
-            await asyncio.sleep(0.5)
-        seen["finished"] = await mission.is_mission_finished()
+        data = await flight.mission.import_qgroundcontrol_mission(plan)
+        await flight.mission.upload_mission(data.mission_items)
+        flight.items = len(data.mission_items)
+        yield flight
+
+
+async def mission_finished(mission: MissionRawAsync, deadline_s: float) -> bool:
+    """Whether the started mission finished within ``deadline_s`` (asked twice a second)."""
+    stop = time.monotonic() + deadline_s
+    while time.monotonic() < stop and not await mission.is_mission_finished():
+        await asyncio.sleep(0.5)
+    return await mission.is_mission_finished()
+
+
+async def fly_plan(port: int, plan: str, deadline_s: float) -> dict:
+    """Fly ``plan`` with the vehicle heard on udpin ``port``; what MAVSDK saw, as a dict."""
+    seen: dict = {"reached": []}
+    async with plan_uploaded(port, plan) as flight:
+        seen["total"] = flight.items
+        await flight.action.arm()
+        await flight.mission.start_mission()
+        seen["finished"] = await mission_finished(flight.mission, deadline_s)
         try:  # disarming in the air drops the aircraft: refused unless forced
-            await action.disarm()
+            await flight.action.disarm()
             seen["disarm"] = "accepted"
         except ActionError as exc:
             seen["disarm"] = exc.result.name
