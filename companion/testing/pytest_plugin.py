@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import AsyncIterator, Iterator
+from contextlib import closing
 from pathlib import Path
 from typing import Any
 
@@ -56,11 +57,9 @@ def sim(
     request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
 ) -> Iterator[LoopbackVehicle]:
     """``companion sim`` (lockstep unless ``speed`` says otherwise) on free loopback ports."""
-    vehicle = start_sim(_folder(request, tmp_path_factory, "sim"), vehicle_options(request))
-    try:
+    folder = _folder(request, tmp_path_factory, "sim")
+    with closing(start_sim(folder, vehicle_options(request))) as vehicle:
         yield vehicle
-    finally:
-        vehicle.close()
 
 
 @pytest.fixture
@@ -68,11 +67,9 @@ def bench(
     request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
 ) -> Iterator[LoopbackVehicle]:
     """``companion run`` with sensors replayed from a log, no simulator."""
-    vehicle = start_bench(_folder(request, tmp_path_factory, "bench"), vehicle_options(request))
-    try:
+    folder = _folder(request, tmp_path_factory, "bench")
+    with closing(start_bench(folder, vehicle_options(request))) as vehicle:
         yield vehicle
-    finally:
-        vehicle.close()
 
 
 @pytest.fixture
