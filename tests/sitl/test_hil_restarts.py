@@ -19,15 +19,12 @@ from typing import Any
 import numpy as np
 import psutil
 import pytest
-from mavsdk.asyncio import Configuration, Mavsdk
-from mavsdk.asyncio.plugins.action import ActionAsync
-from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
 from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
-from mavsdk.component_type import ComponentType
 from mavsdk.plugins.telemetry import FlightMode
 
 from companion.navigation.estimate_csv import read_estimate
 from tests.support.hil import HilRun
+from tests.support.mavsdk_flight import plan_uploaded
 from tests.support.vehicle import REPO
 
 PLAN = REPO / "qgc_plans" / "short_leg.plan"
@@ -43,18 +40,10 @@ def _plugin_pid(run: HilRun, name: str) -> int | None:
 
 
 async def _mission_with_crashes(run: HilRun) -> dict:
-    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
     seen: dict = {"killed": [], "modes": set()}
-    async with Mavsdk(config) as mavsdk:
-        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{run.port}")
-        system = await mavsdk.first_autopilot(timeout_s=60.0)
-        telemetry, action = TelemetryAsync(system), ActionAsync(system)
-        mission = MissionRawAsync(system)
-        async for _home in telemetry.subscribe_home():
-            break
-        data = await mission.import_qgroundcontrol_mission(str(PLAN))
-        await mission.upload_mission(data.mission_items)
-        await action.arm()
+    async with plan_uploaded(run.port, str(PLAN)) as flight:
+        telemetry, mission = flight.telemetry, flight.mission
+        await flight.action.arm()
         await mission.start_mission()
         started = time.monotonic()
         for k, name in enumerate(VICTIMS):
@@ -125,5 +114,7 @@ def test_a_mission_flies_on_through_plugin_kills_and_a_supervisor_crash(tmp_path
     height = alt - alt[0]
     climbed = t > t[np.argmax(height > 70.0)]
     assert np.min(height[climbed & (t < seen["finished_sim_s"])]) > 40.0, "came down with a kill"
-    assert height[-1] > 20.0, "not flying after the supervisor's restart"
+    after = height[t >= seen["finished_sim_s"]]
+    low = f"{seen}; after the kill from {after[0]:.1f} m, lowest {after.min():.1f} m"
+    assert height[-1] > 20.0, f"not flying after the supervisor's restart: {low}"
     assert statuses == (0, 0)

@@ -32,7 +32,8 @@ async def plan_uploaded(
     port: int, plan: str, connect_s: float = 60.0
 ) -> AsyncIterator[PlanSession]:
     """MAVSDK as a ground station hearing the vehicle on udpin ``port``, once the vehicle
-    has a home position (a position before arming) and ``plan`` is uploaded."""
+    has a home position, says it is armable (its pre-arm checks pass, as a MAVSDK script
+    waits for before arming) and ``plan`` is uploaded."""
     config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
     async with Mavsdk(config) as mavsdk:
         await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
@@ -40,6 +41,7 @@ async def plan_uploaded(
         flight = PlanSession(TelemetryAsync(system), ActionAsync(system), MissionRawAsync(system))
         async for _home in flight.telemetry.subscribe_home():
             break
+        await until(flight.telemetry.subscribe_health(), lambda h: h.is_armable, "armable", 120)
         data = await flight.mission.import_qgroundcontrol_mission(plan)
         await flight.mission.upload_mission(data.mission_items)
         flight.items = len(data.mission_items)
