@@ -26,7 +26,9 @@ _hogs: list[subprocess.Popen[bytes]] = []
 def pytest_sessionstart(session: pytest.Session) -> None:
     """Compile the project's modules once; start the CPU hogs when asked for a busy machine."""
     _compile_project()
-    if os.environ.get(STRESS_ENV, "") not in ("", "0"):
+    # Under pytest-xdist the controller starts the hogs once; its workers start none.
+    worker = "PYTEST_XDIST_WORKER" in os.environ
+    if os.environ.get(STRESS_ENV, "") not in ("", "0") and not worker:
         for _ in range(os.cpu_count() or 2):
             _hogs.append(subprocess.Popen([sys.executable, "-c", _HOG]))
 
