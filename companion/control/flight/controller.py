@@ -10,11 +10,11 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from companion.control.flight.assisted import AssistedHold, track_ahead
-from companion.control.flight.attitude_modes import AcroHold, Sticks
+from companion.control.flight.assisted import track_ahead
+from companion.control.flight.attitude_modes import Sticks
 from companion.control.flight.flight_params import FlightConfig
-from companion.control.flight.landing import Landing
-from companion.control.flight.landing_flight import LandingFlight
+from companion.control.flight.landing_flight import LandingFlight, MissionRef, Motion
+from companion.control.flight.mode_targets import mode_target
 from companion.control.flight.output import ControlOutput
 from companion.control.flight.pilot_flight import PilotFlight
 from companion.control.flight.takeoff import Phase, RunwayTakeoff
@@ -41,7 +41,7 @@ TURN_BANK_FRACTION = 0.7
 MAX_TURN_WIND = 15.0  # m/s: a wind estimate beyond this is not trusted to size turns
 
 
-class FlightController(LandingFlight, PilotFlight):
+class FlightController:
     """One aircraft's controller; ``step()`` once per navigation solution."""
 
     def __init__(self, config: FlightConfig, items: list[MissionItem] | None = None) -> None:
@@ -52,9 +52,7 @@ class FlightController(LandingFlight, PilotFlight):
         self.home_alt = 0.0
         self.executor: MissionExecutor | None = None
         self.takeoff: RunwayTakeoff | None = None
-        self.landing: Landing | None = None
         self.go_arounds: int | None = None  # the commander's count when last seen
-        self.return_lands = False  # this Return ends in the mission's landing
         self.landed: bool | None = None
         self.rejected = 0  # steps whose inputs were not usable (last good output kept)
         self._last_out = ControlOutput()
@@ -65,9 +63,9 @@ class FlightController(LandingFlight, PilotFlight):
         self._line: tuple[tuple[float, float], tuple[float, float]] | None = None
         self._corner_from: tuple[float, float] | None = None
         self.attitude = AttitudeController(config.attitude)
-        self.acro = AcroHold()
-        self.assisted = AssistedHold()
         self.tecs = Tecs(config.tecs)
+        self.pilot = PilotFlight(self.attitude, self.tecs)
+        self.lander = LandingFlight(self.attitude, self.tecs)
         self.l1 = L1Guidance(
             config["NAVL1_PERIOD"], config["NAVL1_DAMPING"], config["NAVL1_XTRACK_I"]
         )
@@ -132,7 +130,7 @@ class FlightController(LandingFlight, PilotFlight):
         out.brakes = self.config["LAND_BRAKE"] if self.landed else 0.0
         mode = FlightMode(status.mode) if status.mode else FlightMode.LOITER
         if mode in PILOT_MODES and sticks is not None:
-            return self._fly_sticks(mode, sticks, pos, vel, nav, airspeed, dt, out)
+            return self._fly_sticks(mode, sticks, (pos, vel, nav, airspeed, dt), out)
         if mode == FlightMode.MANUAL:
             out.throttle = self.config["TRIM_THROTTLE"] if not self.landed else 0.0
             return out
@@ -144,13 +142,23 @@ class FlightController(LandingFlight, PilotFlight):
         if setpoint.kind == Kind.TAKEOFF or self._taking_off(nav):
             return self._fly_takeoff(setpoint, pos, nav, airspeed, dt, out)
         self.takeoff = None
-        if setpoint.kind == Kind.LAND:
-            out = self._fly_landing(setpoint, pos, nav, status, airspeed, dt, out)
-            self.go_arounds = status.go_arounds
-            return out
-        self.landing = None
+        go_around = status.go_arounds != self.go_arounds
         self.go_arounds = status.go_arounds
+        if setpoint.kind == Kind.LAND:
+            motion, guidance = (pos, vel, nav, airspeed, dt), (self._fly, self._lateral)
+            ex = self.executor
+            return self.lander.fly(setpoint, motion, go_around, out, self.config, ex, guidance)
+        self.lander.landing = None
         return self._fly(setpoint, pos, vel, nav, airspeed, dt, out)
+
+    def _fly_sticks(
+        self, mode: FlightMode, sticks: Sticks, motion: Motion, out: ControlOutput
+    ) -> ControlOutput:
+        key = (int(mode), -1)  # a pilot's mode is entered once, whatever the commands
+        if key != self._mode_key:
+            self.pilot.reset()
+        self._mode_key = key
+        return self.pilot.fly(mode, sticks, motion, out, self.config, bool(self.landed), self._fly)
 
     def _dead_reckoning(
         self, setpoint: Setpoint | None, pos: tuple[float, float], nav: NavState
@@ -200,19 +208,42 @@ class FlightController(LandingFlight, PilotFlight):
         key = (int(mode), int(status.changes))
         entered = key != self._mode_key
         self._mode_key = key
-        self._leave_home_landing(mode)
+        if self.lander.leave_home_landing(mode):
+            self.executor = None
         if mode == FlightMode.MISSION:
             return self._mission(status, pos, nav, t_s, entered, out)
-        if mode in (FlightMode.RTL, FlightMode.LAND) and (not self.landed or self.landing):
-            landing = self._mode_landing(mode, status, pos, nav, t_s, entered, out)
+        if mode in (FlightMode.RTL, FlightMode.LAND) and (not self.landed or self.lander.landing):
+            landing = self._mode_landing(mode, status, (pos, nav, t_s), entered, out)
             if landing is not None:
                 return landing
         if self.landed and mode != FlightMode.TAKEOFF:
             return None
         if entered or self._mode_setpoint is None:
-            self._mode_setpoint = self._mode_target(mode, status, pos, nav)
+            home = (self.frame, self.home_alt)
+            self._mode_setpoint = mode_target(mode, status, pos, nav, home, self.config)
         self._mode_setpoint = self._arrive(self._mode_setpoint, mode, pos, nav.alt_msl_m)
         return self._mode_setpoint
+
+    def _mode_landing(
+        self,
+        mode: FlightMode,
+        status: VehicleStatus,
+        where: tuple[tuple[float, float], NavState, float],
+        entered: bool,
+        out: ControlOutput,
+    ) -> Setpoint | None:
+        """Return or Land flown as a landing (``LandingFlight.mode_landing``), else None."""
+        pos, nav, t_s = where
+
+        def fly_mission(ex: MissionExecutor) -> Setpoint | None:
+            self.executor = ex
+            return self._mission(status, pos, nav, t_s, False, out)
+
+        plan = MissionRef(self.items, self.frame, self.home_alt, self.executor)
+        radius = self._turn_radius()
+        sp = self.lander.mode_landing(mode, where, entered, plan, self.config, radius, fly_mission)
+        self.executor = plan.executor
+        return sp
 
     def _arrive(
         self, sp: Setpoint, mode: FlightMode, pos: tuple[float, float], alt: float
@@ -257,34 +288,6 @@ class FlightController(LandingFlight, PilotFlight):
         out.reached = ex.drain_reached()
         return setpoint
 
-    def _mode_target(
-        self, mode: FlightMode, status: VehicleStatus, pos: tuple[float, float], nav: NavState
-    ) -> Setpoint:
-        assert self.frame is not None
-        radius = self.config["WP_LOITER_RAD"]
-        alt = nav.alt_msl_m
-        if mode == FlightMode.TAKEOFF:  # to the height asked for, else the return height
-            climb_to = status.target_alt_msl_m
-            if not math.isfinite(climb_to):
-                climb_to = self.home_alt + self.config["RTL_ALT_M"]
-            return Setpoint(Kind.TAKEOFF, pos, pos, climb_to)
-        if mode == FlightMode.RTL:
-            rtl_alt = self.home_alt + self.config["RTL_ALT_M"]
-            return Setpoint(Kind.LINE, pos, (0.0, 0.0), rtl_alt, radius)
-        target = (status.target_lat_deg, status.target_lon_deg, status.target_alt_msl_m)
-        has_target = math.isfinite(target[0]) and math.isfinite(target[1])
-        if math.isfinite(status.target_radius_m) and status.target_radius_m > 0:
-            radius = status.target_radius_m  # an orbit's own radius
-        if mode in (FlightMode.GUIDED, FlightMode.LOITER) and has_target:
-            point = self.frame.ne(target[0], target[1])
-            alt = target[2] if math.isfinite(target[2]) else alt  # NaN: hold the height
-            if mode == FlightMode.GUIDED:
-                return Setpoint(Kind.LINE, pos, point, alt, radius)
-            return Setpoint(Kind.CIRCLE, point, point, alt, radius)
-        if mode in PILOT_MODES:  # no fresh sticks: straight on, height held
-            return Setpoint(Kind.LINE, pos, track_ahead(pos, nav), alt)
-        return Setpoint(Kind.CIRCLE, pos, pos, alt, radius)
-
     def _fly_takeoff(
         self,
         setpoint: Setpoint,
@@ -295,10 +298,11 @@ class FlightController(LandingFlight, PilotFlight):
         out: ControlOutput,
     ) -> ControlOutput:
         if self.takeoff is None:
-            self.takeoff = self.runway = RunwayTakeoff(pos, nav.yaw_rad, self.home_alt)
+            self.takeoff = self.lander.runway = RunwayTakeoff(pos, nav.yaw_rad, self.home_alt)
             self.attitude.reset()
         to = self.takeoff
-        demand = to.step(pos, nav.alt_msl_m, nav.yaw_rad, nav.yaw_rate_rad_s, airspeed, self.config)
+        cfg = self.config.values
+        demand = to.step(pos, nav.alt_msl_m, nav.yaw_rad, nav.yaw_rate_rad_s, airspeed, cfg)
         out.takeoff_phase = int(demand.phase)
         if demand.phase == Phase.CLIMB_OUT:
             # Climb straight out along the runway with normal energy control.

@@ -2,14 +2,16 @@
 and rollout by attitude, a go-around and its second approach, Return ending in a landing
 (ArduPlane's ``RTL_AUTOLAND``), and Land without a landing in the mission (``home_landing``).
 
-A mix-in of ``FlightController`` (companion/control/flight/controller.py), kept apart so
-each file stays one subject; the landing itself is ``Landing`` (landing.py).
+A collaborator of ``FlightController``, given the attitude and energy controllers it
+shares and, per step, the parameters, the mission and the controller's guidance; the
+landing itself is ``Landing`` (landing.py).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from companion.control.flight.landing import AircraftState, Landing, LandingDemand, LandPhase
@@ -17,13 +19,16 @@ from companion.control.flight.range_height import range_height
 from companion.control.laws.l1_guidance import bank_for
 from companion.control.mission.executor import Kind, MissionExecutor, Setpoint
 from companion.control.mission.items import MissionItem
-from companion.messages import FlightMode, NavState, RangeReading, VehicleStatus
+from companion.messages import FlightMode, NavState, RangeReading
 from mavlink_dialect import companion as d
 
 if TYPE_CHECKING:
-    from companion.control.flight.controller import FlightController
+    from companion.control.flight.flight_params import FlightConfig
     from companion.control.flight.output import ControlOutput
     from companion.control.flight.takeoff import RunwayTakeoff
+    from companion.control.laws.attitude import AttitudeController
+    from companion.control.laws.l1_guidance import LateralDemand
+    from companion.control.laws.tecs import Tecs
     from companion.geodesy import LocalFrame
 
 FLARE_PITCH_GAIN = 2.5
@@ -59,9 +64,12 @@ def home_landing(frame: LocalFrame, base: tuple[float, float], heading: float) -
     back, side = HOME_APPROACH_M, HOME_LOITER_RADIUS_M
     centre = (touchdown[0] - back * un - side * ue, touchdown[1] - back * ue + side * un)
 
-    def item(seq: int, command: int, point: tuple[float, float], agl: float, *p: float):
+    def item(
+        seq: int, command: int, point: tuple[float, float], agl: float,
+        p1: float, p2: float, p3: float, p4: float,
+    ) -> MissionItem:  # fmt: skip
         lat, lon = frame.latlon(*point)
-        return MissionItem(seq, d.MAV_FRAME_GLOBAL_RELATIVE_ALT, command, 0, 1, *p,
+        return MissionItem(seq, d.MAV_FRAME_GLOBAL_RELATIVE_ALT, command, 0, 1, p1, p2, p3, p4,
                            round(lat * 1e7), round(lon * 1e7), agl)  # fmt: skip
 
     return [
@@ -70,77 +78,100 @@ def home_landing(frame: LocalFrame, base: tuple[float, float], heading: float) -
     ]
 
 
+@dataclass
+class MissionRef:
+    """The controller's stored mission and its executor, lent for one step: a landing may
+    replace ``executor`` (the controller takes it back after)."""
+
+    items: list[MissionItem]
+    frame: LocalFrame | None
+    home_alt: float
+    executor: MissionExecutor | None
+
+
+Motion = tuple[tuple[float, float], tuple[float, float], NavState, float, float]
+"""Position and velocity (local N, E), the navigation solution, the airspeed, the step."""
+FlyLine = Callable[..., "ControlOutput"]  # FlightController._fly
+Lateral = Callable[[Setpoint, tuple[float, float], tuple[float, float], float], "LateralDemand"]
+
+
 class LandingFlight:
     """The landing half of the flight controller (see the module's docstring)."""
 
-    # The rangefinder's newest reading, set by whoever steps the controller (None: none).
-    range_reading: RangeReading | None = None
-    range_steps = 0  # landing steps that flew on the rangefinder's height
-    runway: RunwayTakeoff | None = None  # this flight's take-off roll, kept after the climb
-    landing_home = False  # the executor flies ``home_landing``, not the stored mission
+    def __init__(self, attitude: AttitudeController, tecs: Tecs) -> None:
+        self.attitude = attitude
+        self.tecs = tecs
+        self.landing: Landing | None = None
+        # The rangefinder's newest reading, set by whoever steps the controller (None: none).
+        self.range_reading: RangeReading | None = None
+        self.range_steps = 0  # landing steps that flew on the rangefinder's height
+        self.runway: RunwayTakeoff | None = None  # this flight's take-off roll, kept after
+        self.landing_home = False  # the executor flies ``home_landing``, not the mission
+        self.return_lands = False  # this Return ends in the mission's landing
 
-    def _fly_landing(
-        self: FlightController,
+    def fly(
+        self,
         sp: Setpoint,
-        pos: tuple[float, float],
-        nav: NavState,
-        status: VehicleStatus,
-        airspeed: float,
-        dt: float,
+        motion: Motion,
+        go_around: bool,
         out: ControlOutput,
+        config: FlightConfig,
+        executor: MissionExecutor | None,
+        guidance: tuple[FlyLine, Lateral],
     ) -> ControlOutput:
+        """Fly the landing ``sp``; ``go_around``: the commander counted a new go-around."""
+        pos, _, nav, airspeed, dt = motion
+        fly_line, lateral = guidance
         land = self.landing
         if land is None or (land.start, land.touchdown, land.land_alt) != (sp.a, sp.b, sp.alt_msl):
             from_alt = sp.from_alt if math.isfinite(sp.from_alt) else nav.alt_msl_m
             land = self.landing = Landing(sp.a, from_alt, sp.b, sp.alt_msl)
-        if status.go_arounds != self.go_arounds:
+        if go_around:
             land.abort()
         vel = (nav.vn_m_s, nav.ve_m_s)
         agl = range_height(self.range_reading, nav.t_us, nav.roll_rad, nav.pitch_rad,
-                           self.config["RNGFND_LANDING"])  # fmt: skip
+                           config["RNGFND_LANDING"])  # fmt: skip
         self.range_steps += math.isfinite(agl)
         state = AircraftState(pos, vel, nav.alt_msl_m, -nav.vd_m_s, nav.pitch_rad, nav.yaw_rad,
                               nav.yaw_rate_rad_s, agl)  # fmt: skip
-        dem = land.step(state, self.config, dt)
+        dem = land.step(state, config.values, dt)
         out.land_phase = int(dem.phase)
         out.flaps, out.brakes = dem.flaps, dem.brakes
         if dem.phase == LandPhase.GO_AROUND and nav.alt_msl_m >= dem.alt_msl - GO_AROUND_MARGIN_M:
-            self._come_round(pos, nav.alt_msl_m)
+            self._come_round(executor, pos, nav.alt_msl_m)
         if dem.phase in (LandPhase.APPROACH, LandPhase.GO_AROUND):
             line = Setpoint(Kind.LINE, dem.line[0], dem.line[1], dem.alt_msl, speed=dem.speed)
             if dem.phase == LandPhase.APPROACH:  # the glide path before the speed
-                weight = self.config["TECS_LAND_SPDWGT"]
-                self.tecs.gains = replace(self.config.tecs, speed_weight=weight)
-            return self._fly(line, pos, vel, nav, airspeed, dt, out, dem.speed, dem.climb_ff)
-        if dem.disarm and self.executor is not None and not self.landing_home:
-            self.executor.land_complete()
+                weight = config["TECS_LAND_SPDWGT"]
+                self.tecs.gains = replace(config.tecs, speed_weight=weight)
+            return fly_line(line, pos, vel, nav, airspeed, dt, out, dem.speed, dem.climb_ff)
+        if dem.disarm and executor is not None and not self.landing_home:
+            executor.land_complete()
             out.mission_finished = True
-            out.reached += self.executor.drain_reached()
+            out.reached += executor.drain_reached()
         out.disarm = dem.disarm
-        return self._fly_attitude(dem, pos, vel, nav, airspeed, dt, out)
+        return self._fly_attitude(dem, (pos, vel, nav, airspeed, dt), out, config, lateral)
 
-    def _come_round(self: FlightController, pos: tuple[float, float], alt: float) -> None:
+    def _come_round(self, ex: MissionExecutor | None, pos: tuple[float, float], alt: float) -> None:
         """Climbed out after a go-around: fly the landing's approach again."""
-        ex = self.executor
         if ex is not None:
             ex.start(approach_start(ex.items, ex.current), pos, alt)
         self.landing = None
 
     def _fly_attitude(
-        self: FlightController,
+        self,
         dem: LandingDemand,
-        pos: tuple[float, float],
-        vel: tuple[float, float],
-        nav: NavState,
-        airspeed: float,
-        dt: float,
+        motion: Motion,
         out: ControlOutput,
+        config: FlightConfig,
+        lateral_of: Lateral,
     ) -> ControlOutput:
         """The flare and the rollout: pitch and throttle given, bank limited, L1 on the
         centreline for what bank is allowed."""
+        pos, vel, nav, airspeed, dt = motion
         line = Setpoint(Kind.LINE, dem.line[0], dem.line[1], dem.alt_msl)
-        lateral = self._lateral(line, pos, vel, dt)
-        roll_dem = bank_for(lateral.lat_acc, min(dem.roll_limit, self.config.roll_limit))
+        lateral = lateral_of(line, pos, vel, dt)
+        roll_dem = bank_for(lateral.lat_acc, min(dem.roll_limit, config.roll_limit))
         flying = dem.phase == LandPhase.FLARE
         # The flare's pitch changes in a second or two, faster than cruise ever asks for:
         # the pitch loop works harder while flaring (the gains return after).
@@ -152,7 +183,7 @@ class LandingFlight:
             dem.pitch,
             (nav.roll_rad, nav.pitch_rad),
             (nav.roll_rate_rad_s, nav.pitch_rate_rad_s, nav.yaw_rate_rad_s),
-            max(airspeed, self.config["TKOFF_ROTATE_SPD"] * 0.5),
+            max(airspeed, config["TKOFF_ROTATE_SPD"] * 0.5),
             dt,
             integrate=flying,
         )
@@ -169,64 +200,75 @@ class LandingFlight:
         out.alt_error = dem.alt_msl - nav.alt_msl_m
         return out
 
-    def _mode_landing(
-        self: FlightController,
+    def mode_landing(
+        self,
         mode: FlightMode,
-        status: VehicleStatus,
-        pos: tuple[float, float],
-        nav: NavState,
-        t_s: float,
+        where: tuple[tuple[float, float], NavState, float],
         entered: bool,
-        out: ControlOutput,
+        plan: MissionRef,
+        config: FlightConfig,
+        turn_radius: float,
+        fly_mission: Callable[[MissionExecutor], Setpoint | None],
     ) -> Setpoint | None:
         """The mission's landing from its first DO_LAND_START, None when not landing now.
         Land (PX4's Land, as a fixed wing flies it): at once. Return with RTL_AUTOLAND: 2
-        at once, 1 once home is reached (as ArduPlane)."""
-        first = land_start(self.items)
+        at once, 1 once home is reached (as ArduPlane). ``where``: position, navigation
+        solution, time; ``fly_mission`` steps the controller's mission on this executor."""
+        pos, nav, t_s = where
+        first = land_start(plan.items)
         if first is None and mode == FlightMode.LAND:
-            return self._land_at_home(pos, nav, t_s)
-        autoland = 2 if mode == FlightMode.LAND else round(self.config["RTL_AUTOLAND"])
+            return self._land_at_home(pos, nav, t_s, plan, config, turn_radius)
+        autoland = 2 if mode == FlightMode.LAND else round(config["RTL_AUTOLAND"])
         if first is None or autoland not in (1, 2):
             return None
         if entered:
             self.return_lands = autoland == 2
         if not self.return_lands:
             home = (0.0, 0.0)
-            reach = max(self.config["WP_LOITER_RAD"], self._turn_radius()) * 1.5
+            reach = max(config["WP_LOITER_RAD"], turn_radius) * 1.5
             if math.hypot(pos[0] - home[0], pos[1] - home[1]) > reach:
                 return None
             self.return_lands = True
-        if entered or self.executor is None or self.executor.current < first:
-            assert self.frame is not None
-            ex = MissionExecutor(self.items, self.frame, self.home_alt, self.config.executor)
+        if entered or plan.executor is None or plan.executor.current < first:
+            assert plan.frame is not None
+            ex = MissionExecutor(plan.items, plan.frame, plan.home_alt, config.executor)
             ex.start(first, pos, nav.alt_msl_m)
-            self.executor = ex
-        return self._mission(status, pos, nav, t_s, False, out)
+            plan.executor = ex
+        return fly_mission(plan.executor)
 
     def _land_at_home(
-        self: FlightController, pos: tuple[float, float], nav: NavState, t_s: float
+        self,
+        pos: tuple[float, float],
+        nav: NavState,
+        t_s: float,
+        plan: MissionRef,
+        config: FlightConfig,
+        turn_radius: float,
     ) -> Setpoint:
         """Land (MAVSDK's land(), MAV_CMD_NAV_LAND without a position) with no landing in
         the mission: back onto the runway of this flight's take-off, along its roll; without
         one (started in the air), straight in from here to home. PX4 loiters down where the
         aircraft is; a fixed wing with wheels needs a runway, and this one is known."""
-        if not self.landing_home or self.executor is None:
-            assert self.frame is not None
+        if not self.landing_home or plan.executor is None:
+            assert plan.frame is not None
             if self.runway is not None:
                 base, heading = self.runway.start, self.runway.heading
             elif math.hypot(*pos) > HOME_TOUCHDOWN_M:
                 base, heading = (0.0, 0.0), math.atan2(-pos[1], -pos[0])
             else:
                 base, heading = (0.0, 0.0), nav.yaw_rad
-            items = home_landing(self.frame, base, heading)
-            ex = MissionExecutor(items, self.frame, self.home_alt, self.config.executor)
+            items = home_landing(plan.frame, base, heading)
+            ex = MissionExecutor(items, plan.frame, plan.home_alt, config.executor)
             ex.start(0, pos, nav.alt_msl_m)
-            self.executor, self.landing_home, self.landing = ex, True, None
-        sp = self.executor.step(pos, nav.alt_msl_m, t_s, self._turn_radius())
-        self.executor.drain_reached()  # not the stored mission's items: nothing to report
+            plan.executor, self.landing_home, self.landing = ex, True, None
+        sp = plan.executor.step(pos, nav.alt_msl_m, t_s, turn_radius)
+        plan.executor.drain_reached()  # not the stored mission's items: nothing to report
         return sp
 
-    def _leave_home_landing(self: FlightController, mode: FlightMode) -> None:
-        """Another mode: the stored mission's executor is made afresh when it is flown."""
+    def leave_home_landing(self, mode: FlightMode) -> bool:
+        """Another mode: True when the controller is to drop the executor (the stored
+        mission's is made afresh when it is flown)."""
         if self.landing_home and mode != FlightMode.LAND:
-            self.executor, self.landing_home = None, False
+            self.landing_home = False
+            return True
+        return False

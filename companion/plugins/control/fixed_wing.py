@@ -134,9 +134,9 @@ class FixedWingPlugin(Plugin):
         # The receiver first: a safety pilot's sticks win over the ground station's joystick.
         sticks = pilot_sticks(nav.t_us, self.rc.get(), self.joystick.get())
         rejected = self.controller.rejected
-        self.controller.range_reading = self.range.get()
+        self.controller.lander.range_reading = self.range.get()
         out = self.controller.step(nav, status, nav.t_us / 1e6, sticks)
-        if self.controller.range_steps and not self.range_said:
+        if self.controller.lander.range_steps and not self.range_said:
             self.ctx.log.info("landing: flaring on the rangefinder's height")
             self.range_said = True
         self._count(self.controller.rejected > rejected, nav.t_us)
@@ -172,7 +172,7 @@ class FixedWingPlugin(Plugin):
         self.status_out.publish(self._status(now_us, out, status))
         self.ctx.log.info(
             "landed and stopped: disarming (%d landing steps on the rangefinder's height)",
-            self.controller.range_steps,
+            self.controller.lander.range_steps,
         )
         self.commands.publish(VehicleCommand(t_us=now_us, command=int(CommandId.STOP)))
         self.disarm_sent = True

@@ -84,7 +84,7 @@ def test_land_without_a_landing_in_the_mission_flies_the_pattern_onto_the_runway
     for i in range(50):
         out = controller.step(_in_the_air(i * 0.02), _status(FlightMode.LAND), i * 0.02)
     ex = controller.executor
-    assert ex is not None and controller.landing_home
+    assert ex is not None and controller.lander.landing_home
     loiter, land = ex.items
     assert loiter.command == d.MAV_CMD_NAV_LOITER_TO_ALT and land.command == d.MAV_CMD_NAV_LAND
     assert loiter.z == HOME_APPROACH_AGL_M
@@ -96,6 +96,6 @@ def test_land_without_a_landing_in_the_mission_flies_the_pattern_onto_the_runway
     assert out.land_phase == 0  # still circling down to the approach height
     # Another mode: the stored mission is flown afresh, never the pattern's items.
     controller.step(_in_the_air(1.0), _status(FlightMode.MISSION), 1.0)
-    assert not controller.landing_home
+    assert not controller.lander.landing_home
     assert controller.executor is not None and controller.executor.items[0].seq == 0
     assert len(controller.executor.items) > 2

@@ -1,0 +1,51 @@
+"""The setpoint a mode other than Mission flies when it is entered: take-off to a height,
+Return home, go to or circle a point, straight on for a pilot's mode without fresh sticks,
+else circle where the aircraft is."""
+
+from __future__ import annotations
+
+import math
+
+from companion.control.flight.assisted import track_ahead
+from companion.control.flight.flight_params import FlightConfig
+from companion.control.mission.executor import Kind, Setpoint
+from companion.control.modes import PILOT_MODES
+from companion.geodesy import LocalFrame
+from companion.messages import FlightMode, NavState, VehicleStatus
+
+
+def mode_target(
+    mode: FlightMode,
+    status: VehicleStatus,
+    pos: tuple[float, float],
+    nav: NavState,
+    where: tuple[LocalFrame | None, float],
+    config: FlightConfig,
+) -> Setpoint:
+    """What a mode other than Mission flies when entered at ``pos``; ``where``: the local
+    frame about home and home's height (m MSL)."""
+    frame, home_alt = where
+    assert frame is not None
+    radius = config["WP_LOITER_RAD"]
+    alt = nav.alt_msl_m
+    if mode == FlightMode.TAKEOFF:  # to the height asked for, else the return height
+        climb_to = status.target_alt_msl_m
+        if not math.isfinite(climb_to):
+            climb_to = home_alt + config["RTL_ALT_M"]
+        return Setpoint(Kind.TAKEOFF, pos, pos, climb_to)
+    if mode == FlightMode.RTL:
+        rtl_alt = home_alt + config["RTL_ALT_M"]
+        return Setpoint(Kind.LINE, pos, (0.0, 0.0), rtl_alt, radius)
+    target = (status.target_lat_deg, status.target_lon_deg, status.target_alt_msl_m)
+    has_target = math.isfinite(target[0]) and math.isfinite(target[1])
+    if math.isfinite(status.target_radius_m) and status.target_radius_m > 0:
+        radius = status.target_radius_m  # an orbit's own radius
+    if mode in (FlightMode.GUIDED, FlightMode.LOITER) and has_target:
+        point = frame.ne(target[0], target[1])
+        alt = target[2] if math.isfinite(target[2]) else alt  # NaN: hold the height
+        if mode == FlightMode.GUIDED:
+            return Setpoint(Kind.LINE, pos, point, alt, radius)
+        return Setpoint(Kind.CIRCLE, point, point, alt, radius)
+    if mode in PILOT_MODES:  # no fresh sticks: straight on, height held
+        return Setpoint(Kind.LINE, pos, track_ahead(pos, nav), alt)
+    return Setpoint(Kind.CIRCLE, pos, pos, alt, radius)
