@@ -134,27 +134,12 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return sorted(groups)
 
 
-# Cycles older than this test, each to be broken apart (issue 44.4); none may be added, and
-# one that is broken comes off the list.
-KNOWN_CYCLES = [
-    ["companion.control.flight.attitude_modes", "companion.control.flight.flight_params"],
-    ["companion.exec_control.child", "companion.exec_control.composed_host",
-     "companion.exec_control.plugin_host", "companion.exec_control.zygote"],
-    ["companion.exec_control.composition", "companion.exec_control.config"],
-    ["companion.link.system_messages", "companion.link.telemetry"],
-    ["companion.navigation.ins_ekf", "companion.navigation.ins_warm"],
-]  # fmt: skip
-
-
-def test_companion_has_no_new_import_cycle():
+def test_companion_has_no_import_cycle():
     """No module of companion/ imports, even for type checking only, a module that imports
     it back (issue 44.4: collaborators with explicit inputs, not mix-ins on ``self``)."""
     graph = _import_graph("companion")
-    cycles = _cycles(graph)
     shown = [
         ", ".join(f"{m} -> {n}" for m in c for n in sorted(graph[m] & set(c)))
-        for c in cycles
-        if c not in KNOWN_CYCLES
+        for c in _cycles(graph)
     ]
     assert shown == [], "\n".join(shown)
-    assert cycles == KNOWN_CYCLES, "a known cycle is gone: take it off KNOWN_CYCLES"

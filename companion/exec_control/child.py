@@ -13,18 +13,17 @@ from typing import Any
 
 import psutil
 
-from companion.exec_control.config import PluginSpec
+from companion.exec_control.backoff import (
+    FIRST_BACKOFF_S,
+    MAX_BACKOFF_S,
+    SECOND_BACKOFF_S,
+    STABLE_AFTER_S,
+)
+from companion.exec_control.plugin_spec import PluginSpec
 from companion.exec_control.zygote import CHILD_ENV, ForkedProcess, ForkServer
 from companion.messages import NAME_LEN, PluginHealth, PluginState, PluginStats
 
 log = logging.getLogger(__name__)
-
-# A plug-in that dies after running a while is restarted at once; one that keeps dying
-# waits 0.1, 0.2, 0.4 ... up to 5 s between attempts.
-FIRST_BACKOFF_S = 0.0
-SECOND_BACKOFF_S = 0.1
-MAX_BACKOFF_S = 5.0
-STABLE_AFTER_S = 10.0  # a plug-in that ran this long starts its back-off afresh
 
 
 class Child:
@@ -55,7 +54,7 @@ class Child:
         self.stats = PluginStats()  # the dead process's counters are not the new one's
         forked = self.forker.spawn(self._argv_spec) if self.forker is not None else None
         self.proc = forked or subprocess.Popen(
-            [sys.executable, "-m", "companion.exec_control.plugin_host", self._argv_spec],
+            [sys.executable, "-m", "companion.exec_control.host_main", self._argv_spec],
             start_new_session=True,  # a terminal's Ctrl-C reaches the supervisor only
             env={**os.environ, **CHILD_ENV},
         )

@@ -12,7 +12,7 @@ import json
 from typing import Any
 
 from companion.exec_control.child import Child, _spec_dict
-from companion.exec_control.config import PluginSpec
+from companion.exec_control.plugin_spec import PluginSpec
 from companion.messages import NAME_LEN, PluginHealth, PluginState, PluginStats
 from companion.plugin import Ports
 

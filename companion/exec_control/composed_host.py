@@ -28,7 +28,7 @@ from typing import Any
 
 from companion.bus.node import BusNode
 from companion.bus.patterns import Writer
-from companion.exec_control.child import MAX_BACKOFF_S, SECOND_BACKOFF_S, STABLE_AFTER_S
+from companion.exec_control.backoff import MAX_BACKOFF_S, SECOND_BACKOFF_S, STABLE_AFTER_S
 from companion.exec_control.plugin_host import EXIT_INIT_FAILED, PluginHost, _signal_pipe
 from companion.exec_control.registry import load
 from companion.messages import PluginStats

@@ -10,24 +10,27 @@ from __future__ import annotations
 
 import re
 from collections import defaultdict
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import Any
 
-if TYPE_CHECKING:
-    from companion.exec_control.config import PluginSpec, _Checker
-    from companion.exec_control.config_locator import KeyPath
+from companion.exec_control.config_locator import KeyPath
+from companion.exec_control.plugin_spec import PluginSpec
+
+# The config check's error for a key path: an exception carrying the file and line.
+ConfigFault = Callable[[KeyPath, str], Exception]
 
 # Linux shows 15 characters of a process name (ps, top); the name is also in bus node names.
 PROCESS_NAME = re.compile(r"[a-z][a-z0-9_-]{0,14}")
 RESERVED = ("exec_control", "fork_server")
 
 
-def process_name(check: _Checker, entry: dict[str, Any], where: KeyPath) -> str:
+def process_name(error: ConfigFault, entry: dict[str, Any], where: KeyPath) -> str:
     """The entry's ``process`` ("" when it has none), refused when it is no fit name."""
     if "process" not in entry:
         return ""
     name = entry["process"]
     if not isinstance(name, str) or not PROCESS_NAME.fullmatch(name) or name in RESERVED:
-        raise check.error(
+        raise error(
             (*where, "process"),
             f"process {name!r} must be 1-15 characters of a-z, 0-9, '_' or '-', starting"
             f" with a letter, and none of {list(RESERVED)}",
@@ -35,7 +38,7 @@ def process_name(check: _Checker, entry: dict[str, Any], where: KeyPath) -> str:
     return name
 
 
-def check_processes(check: _Checker, specs: list[PluginSpec]) -> None:
+def check_processes(error: ConfigFault, specs: list[PluginSpec]) -> None:
     """Refuse groupings the supervisor could not run as the config means them."""
     members: dict[str, list[int]] = defaultdict(list)
     for index, spec in enumerate(specs):
@@ -48,7 +51,7 @@ def check_processes(check: _Checker, specs: list[PluginSpec]) -> None:
             spec = specs[index]
             if spec.group != first.group:
                 # START and STOP start and stop whole processes: half a process cannot be.
-                raise check.error(
+                raise error(
                     ("plugins", index, "process"),
                     f"process {process!r} would hold the {first.group} plug-in {first.name!r}"
                     f" and the {spec.group} plug-in {spec.name!r}: a process holds plug-ins of"
@@ -56,7 +59,7 @@ def check_processes(check: _Checker, specs: list[PluginSpec]) -> None:
                 )
         hosted = {specs[i].name for i in indexes}
         if process in names and process not in hosted:
-            raise check.error(
+            raise error(
                 ("plugins", indexes[0], "process"),
                 f"process {process!r} has the name of a plug-in it does not hold;"
                 " `companion status` would be ambiguous",

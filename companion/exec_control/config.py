@@ -19,8 +19,9 @@ from companion.actuators.airframe import DEFAULT_AIRFRAME, AirframeError, load_a
 from companion.bus.namespace import default_namespace, validate_namespace
 from companion.exec_control.composition import check_processes, process_name
 from companion.exec_control.config_locator import KeyPath, line_of, locate
+from companion.exec_control.plugin_spec import PluginSpec
 from companion.exec_control.registry import PluginLoadError, load
-from companion.plugin import Plugin, Ports, Setting
+from companion.plugin import Plugin, Setting
 
 GROUPS = ("core", "flight")
 CLOCKS = ("monotonic", "sim")
@@ -35,20 +36,6 @@ class ConfigError(Exception):
         self.file, self.line, self.key, self.message = file, line, key, message
         where = f"{file}:{line}" if line else f"{file}"
         super().__init__(f"{where}: {key}: {message}" if key else f"{where}: {message}")
-
-
-@dataclass(frozen=True)
-class PluginSpec:
-    """One plug-in instance as the config declares it, settings validated."""
-
-    name: str
-    kind: str  # the plug-in name as written: short name or module:Class
-    group: str
-    settings: dict[str, Any]
-    ports: Ports
-    line: int | None = None
-    params: tuple[Any, ...] = ()  # the plug-in class's ParamDecl declarations
-    process: str = ""  # the OS process it shares with others ("": a process of its own)
 
 
 @dataclass(frozen=True)
@@ -266,7 +253,7 @@ def _plugin_specs(check: _Checker, entries: Any, vehicle: Mapping[str, Any]) -> 
             raise check.error((*where, "name"), f"plug-in name {spec.name!r} is used twice")
         seen.add(spec.name)
         specs.append(spec)
-    check_processes(check, specs)
+    check_processes(check.error, specs)
     return specs
 
 
@@ -309,7 +296,7 @@ def _plugin_spec(
         ports=cls.ports(settings),
         line=line_of(check.lines, where),
         params=cls.param_decls(settings, vehicle),
-        process=process_name(check, entry, where),
+        process=process_name(check.error, entry, where),
     )
 
 

@@ -9,7 +9,6 @@ non-zero status; the supervisor restarts it.
 from __future__ import annotations
 
 import ctypes
-import json
 import logging
 import os
 import signal
@@ -184,14 +183,9 @@ class PluginHost:
         return code
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of a plug-in process; argv[0] is the JSON spec from the supervisor."""
-    args = sys.argv[1:] if argv is None else argv
-    spec = json.loads(args[0])
-    if "members" in spec:  # several plug-ins in this process (``process`` in the config)
-        from companion.exec_control.composed_host import main as composed_main
-
-        return composed_main(spec)
+def main(spec: dict[str, Any]) -> int:
+    """Run the one plug-in of ``spec`` until SIGTERM/SIGINT; the process's exit status
+    (started by ``host_main``)."""
     logging.basicConfig(
         level=spec.get("log_level", "INFO"),
         format=f"%(asctime)s {spec['name']}[%(process)d] %(levelname)s %(message)s",
@@ -205,7 +199,3 @@ def main(argv: list[str] | None = None) -> int:
         return run_profiled(spec["name"], lambda: host.run(plugin))
     finally:
         host.bus.close()
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -44,7 +44,7 @@ PRELOAD = (
     "companion.bus.node",
     "companion.bus.clock",
     "companion.messages",
-    "companion.exec_control.plugin_host",
+    "companion.exec_control.host_main",
 )
 READY_TIMEOUT_S = 20.0  # a first start on a busy machine (imports from a cold disk)
 REPLY_TIMEOUT_S = 2.0
@@ -262,7 +262,7 @@ def _run_child(spec_json: str, middle: int, supervisor: int, fds: tuple[int, ...
             time.sleep(0.0002)
         logging.root.handlers.clear()
         _set_name(json.loads(spec_json).get("name", "plugin"))
-        from companion.exec_control.plugin_host import main
+        from companion.exec_control.host_main import main
 
         if os.getppid() == supervisor:  # not adopted: the supervisor is gone, so stop
             code = main([spec_json])

@@ -18,8 +18,9 @@ from companion.link.endpoints import Endpoint, Remote, UdpOut, default_budget
 from companion.link.link_budget import LinkBudget
 from companion.link.microservice import Outgoing, Peer, Service
 from companion.link.signing import configure_parser, shared_state, signing_encoder
+from companion.link.snapshot import Snapshot
 from companion.link.stream_schedule import StreamSchedule
-from companion.link.telemetry import STREAMS, Snapshot
+from companion.link.telemetry import STREAMS
 from companion.link.tlog import TlogWriter
 
 log = logging.getLogger(__name__)

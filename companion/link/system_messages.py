@@ -16,7 +16,7 @@ from companion.link.codec import dialect as d
 from companion.messages import BatteryLevel, NavFlags
 
 if TYPE_CHECKING:
-    from companion.link.telemetry import Snapshot
+    from companion.link.snapshot import Snapshot
 
 # Sample age beyond which a sensor is reported unhealthy (vehicle-clock microseconds).
 STALE_US = {"imu": 500_000, "mag": 1_000_000, "baro": 1_000_000, "gps": 2_000_000}

@@ -59,3 +59,14 @@ def wmm_field(
         allow_date_outside_lifespan=True,
     )  # fmt: skip
     return EarthField(math.radians(result.d), math.radians(result.i), result.f / NT_PER_GAUSS)
+
+
+def configured_field(
+    lat_deg: float, lon_deg: float, alt_m: float, year: float, declination_deg: float | None
+) -> EarthField:
+    """The World Magnetic Model's field, with the configured declination when one is set
+    (None: the model's)."""
+    field = wmm_field(lat_deg, lon_deg, alt_m, year)
+    if declination_deg is None:
+        return field
+    return EarthField(math.radians(declination_deg), field.inclination, field.intensity_gauss)

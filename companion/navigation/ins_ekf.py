@@ -29,7 +29,7 @@ import numpy as np
 from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
 from companion.navigation import rotations as rot
 from companion.navigation.baro_datum import BaroDatum
-from companion.navigation.earth_field import EarthField, wmm_field
+from companion.navigation.earth_field import EarthField, configured_field
 from companion.navigation.ins_align import Aligner, Alignment
 from companion.navigation.ins_config import InsEkfConfig
 from companion.navigation.ins_core import TH, InsCore
@@ -43,15 +43,13 @@ from companion.navigation.yaw_gsf import YawGsf
 MAX_IMU_GAP_S = 0.5
 COMPASS_TILT_TO_HEADING = 3.0
 LAG_MAX_WANDER = 0.5
-LOST_TILT_STD = math.radians(5.0)
-LOST_YAW_STD = math.radians(30.0)
+LOST_TILT_STD, LOST_YAW_STD = math.radians(5.0), math.radians(30.0)
 GSF_MIN_VEL_STD = 0.5  # m/s: the bank ignores the GPS lag, which this allows for
 GSF_STEP_S = 0.04  # the yaw estimator bank integrates the IMU in steps of this
 # The bank's heading is believed over the INS's only when the bank is this sure, and the two
 # disagree by more than a heading error anyone would accept, for longer than a manoeuvre.
 GSF_TRUST_STD = math.radians(10.0)
-GSF_DISAGREE_RAD = math.radians(30.0)
-GSF_DISAGREE_S = 2.0
+GSF_DISAGREE_RAD, GSF_DISAGREE_S = math.radians(30.0), 2.0
 _I15 = np.eye(15)
 _YAW_ONLY = np.array([True] * 6 + [False, False, True] + [False] * 3 + [True] * 3)
 __all__ = ["InsEkf", "InsEkfConfig"]
@@ -157,7 +155,9 @@ class InsEkf(InsCore):
             alt = fix.alt_msl_m if math.isfinite(fix.alt_msl_m) else 0.0
             self.frame = LocalFrame(fix.lat_deg, fix.lon_deg, alt)
             self.g[2] = self.aligner.g = normal_gravity(fix.lat_deg, alt)
-            self.field = self._earth_field(fix.lat_deg, fix.lon_deg, alt)
+            self.field = configured_field(
+                fix.lat_deg, fix.lon_deg, alt, self.cfg.field_year, self.cfg.declination_deg
+            )
         if not self.aligned:
             self.pending_fix = fix
             return
@@ -191,13 +191,6 @@ class InsEkf(InsCore):
         self._set_yaw(found[0], max(found[1], self.cfg.mag_heading_std))
         self.gsf_disagree_us = None
         self.yaw_resets += 1
-
-    def _earth_field(self, lat: float, lon: float, alt: float) -> EarthField:
-        field = wmm_field(lat, lon, alt, self.cfg.field_year)
-        if self.cfg.declination_deg is None:
-            return field
-        return EarthField(math.radians(self.cfg.declination_deg), field.inclination,
-                          field.intensity_gauss)  # fmt: skip
 
     def on_baro(self, reading: Baro) -> None:
         """Barometric height: the vertical channel follows it; GPS only moves its datum."""
@@ -285,10 +278,8 @@ class InsEkf(InsCore):
         fix = self.pending_fix
         if fix is None or self.field is None:
             return
-        if self.warm is not None:  # the first fix decides: in the air, carry on (ins_warm)
-            warm, self.warm = self.warm, None
-            if warm_start(self, warm, fix, t_us):
-                return
+        if (warm := self.warm) is not None and self._started_warm(warm, fix, t_us):
+            return
         compass = self.last_compass
         fresh = compass is not None and self._fresh(compass.t_us, t_us)
         heading = compass.heading_rad + self._compass_declination() if compass and fresh else None
@@ -297,6 +288,16 @@ class InsEkf(InsCore):
         found = self.aligner.align(vel, heading, mag, self.field, self.mag_monitor)
         if found is not None:
             self._start(found, fix, vel)
+
+    def _started_warm(self, warm: WarmState, fix: GpsFix, t_us: int) -> bool:
+        """In the air, carry on from the last process's solution (ins_warm), aligned."""
+        self.warm = None
+        if (s := warm_start(self.frame, self.cfg, self.aligner.samples, warm, fix, t_us)) is None:
+            return False
+        self.p, self.v, self.q, self.P, self.ba, self.bg = s.p, s.v, s.q, s.P, s.ba, s.bg
+        self.lag.lag_s, self.aligned, self.t_us = s.gps_lag_s, True, t_us
+        self.aligned_us = self.last_gps_us = fix.t_us
+        return True
 
     def _start(self, a: Alignment, fix: GpsFix, vel: np.ndarray) -> None:
         self.p = self._fix_position(fix).tolist()

@@ -20,6 +20,7 @@ import json
 import logging
 import math
 import os
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -30,7 +31,8 @@ from companion.messages import GpsFix, NavFlags, NavState
 from companion.navigation import rotations as rot
 
 if TYPE_CHECKING:
-    from companion.navigation.ins_ekf import InsEkf
+    from companion.navigation.ins_config import InsEkfConfig
+    from companion.navigation.local_frame import LocalFrame
 
 log = logging.getLogger(__name__)
 
@@ -108,49 +110,63 @@ class WarmFile:
             log.warning("warm start file not written: %s", exc)
 
 
-def warm_start(nav: InsEkf, warm: WarmState, fix: GpsFix, t_us: int) -> bool:
-    """Start ``nav`` from ``warm`` carried to ``t_us`` if the fix says it is this flight,
-    in the air; False (and nothing changed) otherwise."""
+@dataclass(frozen=True)
+class WarmSolution:
+    """The navigator's state to start from: the last solution carried over the gap."""
+
+    p: list[float]  # NED metres in the navigator's frame
+    v: list[float]
+    q: rot.Quat
+    ba: list[float]  # the accelerometers' bias, m/s2
+    bg: list[float]  # the gyros' bias, rad/s
+    gps_lag_s: float
+    P: np.ndarray  # the covariance, widened by the gap
+
+
+def warm_start(
+    frame: LocalFrame | None,
+    cfg: InsEkfConfig,
+    imu_window: Iterable[tuple[int, np.ndarray, np.ndarray]],
+    warm: WarmState,
+    fix: GpsFix,
+    t_us: int,
+) -> WarmSolution | None:
+    """``warm`` carried to ``t_us`` if the fix says it is this flight, in the air (None
+    otherwise); ``imu_window`` holds the (t_us, accel, gyro) samples read since the start."""
     age_s = (t_us - warm.t_us) / 1e6
     gps_vel = np.array((fix.vn_m_s, fix.ve_m_s, fix.vd_m_s))
     gps_vel = np.where(np.isfinite(gps_vel), gps_vel, warm.vel)
     speed = math.hypot(gps_vel[0], gps_vel[1])
-    if nav.frame is None or not 0.0 <= age_s <= MAX_AGE_S or speed < IN_AIR_SPEED_M_S:
-        return False
+    if frame is None or not 0.0 <= age_s <= MAX_AGE_S or speed < IN_AIR_SPEED_M_S:
+        return None
     moved = 0.5 * (np.array(warm.vel) + gps_vel) * age_s
-    p = nav.frame.ned(warm.lat_deg, warm.lon_deg, warm.alt_msl_m) + moved
-    fix_p = nav.frame.ned(fix.lat_deg, fix.lon_deg, warm.alt_msl_m)  # only across is judged
+    p = frame.ned(warm.lat_deg, warm.lon_deg, warm.alt_msl_m) + moved
+    fix_p = frame.ned(fix.lat_deg, fix.lon_deg, warm.alt_msl_m)  # only across is judged
     fix_p += gps_vel * (t_us - fix.t_us) / 1e6
     miss = math.hypot(*(fix_p[:2] - p[:2]))
     if miss > OTHER_FLIGHT_M:
         log.info("warm start refused: the fix is %.0f m from the last solution", miss)
-        return False
+        return None
     if miss > MAX_MISS_M:  # the gap was flown otherwise than its ends' velocities say
         p[:2] = fix_p[:2]
-    q = _turned_over_the_gap(nav, warm, age_s)
-    c = nav.cfg
     tilt_std, yaw_std = (s0 + s1 * age_s for s0, s1 in (TILT_STD, YAW_STD))
     pos_std = 2.0 + 0.5 * age_s
-    diag = [pos_std] * 3 + [max(c.gps_vel_std, 0.5)] * 3 + [tilt_std, tilt_std, yaw_std]
-    diag += [0.5 * c.accel_bias_std] * 3 + [0.5 * c.gyro_bias_std] * 3
-    nav.p, nav.v = p.tolist(), gps_vel.tolist()
-    nav.q = q
-    nav.ba, nav.bg = list(warm.accel_bias), list(warm.gyro_bias)
-    nav.lag.lag_s = warm.gps_lag_s
-    nav.P = np.diag(np.square(diag))
-    nav.aligned, nav.t_us = True, t_us
-    nav.aligned_us = nav.last_gps_us = fix.t_us
+    diag = [pos_std] * 3 + [max(cfg.gps_vel_std, 0.5)] * 3 + [tilt_std, tilt_std, yaw_std]
+    diag += [0.5 * cfg.accel_bias_std] * 3 + [0.5 * cfg.gyro_bias_std] * 3
     log.info("warm start: %.1f s after the last solution written", age_s)
-    return True
+    q = _turned_over_the_gap([gyro for _t, _a, gyro in imu_window], warm, age_s)
+    return WarmSolution(
+        p.tolist(), gps_vel.tolist(), q,
+        list(warm.accel_bias), list(warm.gyro_bias), warm.gps_lag_s, np.diag(np.square(diag)),
+    )  # fmt: skip
 
 
-def _turned_over_the_gap(nav: InsEkf, warm: WarmState, age_s: float) -> rot.Quat:
+def _turned_over_the_gap(gyro_rates: list[np.ndarray], warm: WarmState, age_s: float) -> rot.Quat:
     """The file's attitude turned by the gyros' rate since this process started, over the
     whole gap: a rolling or turning aircraft has rolled and turned on meanwhile (in lockstep,
     rolling at 17 deg/s, the roll as written was 5 deg off 0.3 s later)."""
-    rates = [s[2] for s in nav.aligner.samples]
-    if not rates:
+    if not gyro_rates:
         return tuple(warm.q)  # type: ignore[return-value]
-    w = np.mean(rates, axis=0) - np.array(warm.gyro_bias)
+    w = np.mean(gyro_rates, axis=0) - np.array(warm.gyro_bias)
     turn = rot.rotation_vector_quaternion(*(float(x) * age_s for x in w))
     return rot.normalized(rot.multiply(tuple(warm.q), turn))  # type: ignore[arg-type]

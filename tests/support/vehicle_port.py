@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from companion.link.telemetry import Snapshot
+from companion.link.snapshot import Snapshot
 
 
 @dataclass

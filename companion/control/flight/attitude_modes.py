@@ -22,7 +22,6 @@ from companion.control.laws.attitude import AttitudeController
 from companion.control.laws.limits import clamp
 from companion.geodesy import wrap_pi
 from companion.messages import FlightMode, NavState, PilotInput
-from companion.params import ParamDecl
 
 if TYPE_CHECKING:
     from companion.control.flight.flight_params import FlightConfig
@@ -33,14 +32,6 @@ STICKS_STALE_US = 500_000
 # Acro's held attitude never leads the aircraft's by more than this: a target the aircraft
 # cannot follow (full stick on a slow roll) would otherwise wind on and overshoot.
 ACRO_LEAD_RAD = math.radians(30.0)
-
-PILOT_PARAMS = (
-    ParamDecl("ACRO_ROLL_RATE", 90.0, 10.0, 500.0, "deg/s", "Acro: roll rate at full stick"),
-    ParamDecl("ACRO_PITCH_RATE", 45.0, 10.0, 500.0, "deg/s", "Acro: pitch rate at full stick"),
-    ParamDecl("ACRO_PITCH_LIM", 60.0, 10.0, 85.0, "deg", "Acro: largest pitch either way"),
-    ParamDecl("RATT_TH", 0.8, 0.0, 1.0, "norm",
-              "Rattitude: stick deflection beyond which the sticks command rates"),
-)  # fmt: skip
 
 
 @dataclass(frozen=True)

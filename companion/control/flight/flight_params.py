@@ -11,7 +11,6 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
-from companion.control.flight.attitude_modes import PILOT_PARAMS
 from companion.control.flight.landing import LANDING_PARAMS
 from companion.control.laws.attitude import AttitudeGains
 from companion.control.laws.tecs import TecsGains
@@ -21,6 +20,16 @@ from companion.params import ParamDecl
 
 def _p(name: str, default: float, lo: float, hi: float, unit: str, doc: str) -> ParamDecl:
     return ParamDecl(name, default, lo, hi, unit, doc)
+
+
+# Acro and Rattitude (control/flight/attitude_modes.py).
+ACRO_PARAMS = (
+    ParamDecl("ACRO_ROLL_RATE", 90.0, 10.0, 500.0, "deg/s", "Acro: roll rate at full stick"),
+    ParamDecl("ACRO_PITCH_RATE", 45.0, 10.0, 500.0, "deg/s", "Acro: pitch rate at full stick"),
+    ParamDecl("ACRO_PITCH_LIM", 60.0, 10.0, 85.0, "deg", "Acro: largest pitch either way"),
+    ParamDecl("RATT_TH", 0.8, 0.0, 1.0, "norm",
+              "Rattitude: stick deflection beyond which the sticks command rates"),
+)  # fmt: skip
 
 
 CONTROL_PARAMS = (
@@ -64,7 +73,7 @@ CONTROL_PARAMS = (
     _p("WP_LOITER_RAD", 80.0, 10.0, 2000.0, "m", "loiter radius when an item gives none"),
     _p("RTL_ALT_M", 100.0, 10.0, 1000.0, "m", "return altitude above home"),
     *LANDING_PARAMS,
-    *PILOT_PARAMS,
+    *ACRO_PARAMS,
 )
 BY_NAME = {p.name: p for p in CONTROL_PARAMS}
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Protocol
 
 from companion.link.codec import dialect as d
-from companion.link.telemetry import Snapshot
+from companion.link.snapshot import Snapshot
 
 # How long a command handed to another plug-in waits for its answer: a busy machine may
 # take seconds to start the flight group.

@@ -38,8 +38,8 @@ from companion.link.params_service import ParamsService
 from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
 from companion.link.signing import configured_secret, key_file_problem, key_from
+from companion.link.snapshot import SNAPSHOT_CHANNELS, Snapshot
 from companion.link.statustext import StatusTexts
-from companion.link.telemetry import SNAPSHOT_CHANNELS, Snapshot
 from companion.link.timesync import TimesyncService
 from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChange, VehicleCommand
 from companion.messages.channels import CHANNELS

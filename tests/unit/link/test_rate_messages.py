@@ -8,7 +8,7 @@ import pytest
 
 from companion.link.codec import dialect as d
 from companion.link.rate_messages import attitude_target, highres_imu
-from companion.link.telemetry import Snapshot
+from companion.link.snapshot import Snapshot
 from companion.messages import ControlStatus, Imu, NavState
 
 

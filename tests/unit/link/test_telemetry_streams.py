@@ -6,7 +6,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from companion.link.codec import new_encoder, new_parser
-from companion.link.telemetry import STREAMS, Snapshot
+from companion.link.snapshot import Snapshot
+from companion.link.telemetry import STREAMS
 from companion.messages import (
     Battery,
     ControlStatus,

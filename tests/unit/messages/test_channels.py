@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import get_type_hints
 
-from companion.link.telemetry import SNAPSHOT_CHANNELS, Snapshot
+from companion.link.snapshot import SNAPSHOT_CHANNELS, Snapshot
 from companion.messages.channels import CHANNELS, LOGGED
 from companion.plugins.link.mavlink_link import MavlinkLink
 from companion.plugins.system.logger import LoggerPlugin
