@@ -21,9 +21,9 @@ from mavlink_dialect import companion as d
 # On the leg or the corner's arc into it: within this many turn radii of the segment (an
 # arc up to a 120° corner stays within 1.7 radii of the leg it turns onto).
 ON_LEG_RADII = 2.0
-# A leg whose start is not known (after a take-off, whose climb ended somewhere unknown)
-# is drawn back from here at least this many turn radii: the lead of the corner at its end
-# is at most half the leg, and no more than 1.7 radii.
+# A leg whose start is not known (after a take-off whose climb ended off its line, after a
+# loiter, a jump) is drawn back from here at least this many turn radii: the lead of the
+# corner at its end is at most half the leg, and no more than 1.7 radii.
 UNKNOWN_START_RADII = 4.0
 Point = tuple[float, float]
 
@@ -68,11 +68,16 @@ def resumed_leg(ex: MissionExecutor, first: int, pos: Point, turn_radius: float)
         return ResumedLeg(pos, None, speed)
     b = ex.point_of(items[first], pos)
     prev = _previous_place(ex, first)
-    tolerance = max(items[first].acceptance_m(ex.config.wp_radius), ON_LEG_RADII * turn_radius)
+    waypoint = prev is not None and items[prev].command == d.MAV_CMD_NAV_WAYPOINT
+    # After a waypoint the aircraft may be on the corner's arc into the leg; after a
+    # take-off the leg began where the climb ended, on the line from its place only if
+    # the aircraft is on that line now.
+    tolerance = items[first].acceptance_m(ex.config.wp_radius)
+    if waypoint:
+        tolerance = max(tolerance, ON_LEG_RADII * turn_radius)
     if prev is not None and _segment_distance(ex.point_of(items[prev], pos), b, pos) <= tolerance:
-        before = _previous_place(ex, prev)
-        waypoint = items[prev].command == d.MAV_CMD_NAV_WAYPOINT
-        corner_from = ex.point_of(items[before], pos) if before is not None and waypoint else None
+        before = _previous_place(ex, prev) if waypoint else None
+        corner_from = ex.point_of(items[before], pos) if before is not None else None
         return ResumedLeg(ex.point_of(items[prev], pos), corner_from, speed)
     # Not known, or not on it: the line from here, drawn back far enough for the corner.
     dist = math.hypot(b[0] - pos[0], b[1] - pos[1])

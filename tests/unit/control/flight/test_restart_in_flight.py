@@ -22,11 +22,13 @@ from companion.control.flight.controller import FlightController
 from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.mission.executor import MissionExecutor
 from companion.control.mission.plan import load_plan
-from companion.control.mission.resume import resumed_leg
+from companion.control.mission.resume import resumed_leg, start_mission
 from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 from tests.support.vehicle import REPO
+from tests.unit.control.mission.executor_flying import HOME as HOME_FRAME
+from tests.unit.control.mission.executor_flying import HOME_ALT, speed, wp
 
 # The airborne start of companion sim: west of the plan's take-off point, flying east.
 HOME = (-37.9105, 145.134, 81.3)
@@ -126,3 +128,25 @@ def test_the_leg_is_taken_up_from_the_previous_waypoint_and_its_corner():
     leg = resumed_leg(ex, 2, far, 200.0)
     assert leg.corner_from is None
     assert math.dist(leg.start, _place(2)) >= 800.0
+
+
+def test_after_a_take_off_the_leg_is_its_line_only_when_the_aircraft_is_on_it():
+    """The leg after a take-off began where the climb ended: off the line from the take-off's
+    place, the line the aircraft flies is taken (through it towards the item)."""
+    ex = MissionExecutor(ITEMS, FRAME, HOME[2])
+    off = (_place(1)[0] + 100.0, _place(1)[1] - 800.0)  # 100 m north of that line
+    leg = resumed_leg(ex, 1, off, 200.0)
+    assert leg.corner_from is None
+    course = math.atan2(_place(1)[1] - off[1], _place(1)[0] - off[0])
+    back = math.atan2(_place(1)[1] - leg.start[1], _place(1)[0] - leg.start[0])
+    assert back == pytest.approx(course)
+    assert math.dist(leg.start, _place(1)) == pytest.approx(math.hypot(100.0, 800.0))
+
+
+def test_the_speed_a_do_change_speed_set_is_taken_up():
+    items = [wp(0, (0.0, 0.0)), speed(1, 22.0), wp(2, (0.0, 1000.0)), wp(3, (1000.0, 1000.0))]
+    ex = MissionExecutor(items, HOME_FRAME, HOME_ALT)
+    leg = start_mission(ex, 3, (500.0, 1000.0), HOME_ALT + 100.0, 200.0)
+    assert leg is not None and ex.speed == 22.0
+    assert leg.start == pytest.approx((0.0, 1000.0), abs=0.1)
+    assert leg.corner_from == pytest.approx((0.0, 0.0), abs=0.1)
