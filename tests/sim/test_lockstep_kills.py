@@ -6,7 +6,7 @@ flight scores the same on a loaded machine. Each plug-in is killed with SIGKILL 
 leg's straight part (the controller's distance to its waypoint says where), one every few
 simulated seconds; the execution control starts it again. The flight is then scored on
 the simulator's truth: the mission completed, in Mission throughout, no failsafe, the track
-on every leg's straight part within a few metres across and in height.
+on every leg's straight part within 2 m across and 10 m in height.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ WINDOW_S = 8.0  # the excursion a kill caused is looked for this long after it
 KILL_FROM_S, KILL_EVERY_S = 20.0, 7.0  # simulated seconds
 START_AT_S = 2.0  # the simulator arms and starts the mission then
 FROM_WAYPOINT_M = 400.0  # past the corner's turn, and the window before the next one
-MAX_ACROSS_M, MAX_HEIGHT_M = 10.0, 10.0
+MAX_ACROSS_M, MAX_HEIGHT_M = 2.0, 10.0  # across: 0.63-0.69 m measured (121.7 m before)
 log = logging.getLogger(__name__)
 
 
@@ -138,11 +138,6 @@ def excursions(truth: dict, killed: list[tuple[str, float]]) -> dict[str, tuple[
 
 
 @pytest.mark.timeout(1500)
-@pytest.mark.xfail(
-    reason="open: a controller restarted inside a corner's turn lead (235 m before the first"
-    " waypoint) takes the next leg without the corner's arc and overshoots it by 126 m",
-    strict=False,
-)
 def test_a_plan_flies_on_in_lockstep_while_each_plugin_is_killed(tmp_path):
     args = ("--exact", "--plan", str(PLAN), "--airborne", "--start-at", str(START_AT_S),
             "--duration", "240")  # fmt: skip

@@ -25,6 +25,7 @@ from companion.control.laws.tecs import Tecs
 from companion.control.laws.wind import WindEstimator
 from companion.control.mission.executor import Kind, MissionExecutor, Setpoint, past_point
 from companion.control.mission.items import MissionItem
+from companion.control.mission.resume import start_mission
 from companion.control.modes import PILOT_MODES
 from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import LocalFrame
@@ -269,13 +270,17 @@ class FlightController:
         entered: bool,
         out: ControlOutput,
     ) -> Setpoint | None:
-        ex = self.executor
+        ex, resumed = self.executor, None
         if ex is None or (entered and ex.finished):
             assert self.frame is not None
             ex = MissionExecutor(self.items, self.frame, self.home_alt, self.config.executor)
-            ex.start(status.mission_first, pos, nav.alt_msl_m)
+            # In the air (a restarted controller, say) the leg is taken up as it was flown.
+            radius = None if self.landed else self._turn_radius()
+            resumed = start_mission(ex, status.mission_first, pos, nav.alt_msl_m, radius)
             self.executor = ex
         setpoint = ex.step(pos, nav.alt_msl_m, t_s, self._turn_radius())
+        if resumed is not None:  # and the corner it may be turning through
+            self._line = resumed.line_before(setpoint)
         if self.landed and setpoint.kind not in (Kind.TAKEOFF, Kind.LAND):
             if ex.finished:
                 return None  # flown to its end: nothing more to take off for

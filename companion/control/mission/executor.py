@@ -31,6 +31,7 @@ MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO it
 SKIPPED = CAMERA_STOPS | {d.MAV_CMD_DO_LAND_START}
 LOITER_ALT_MARGIN_M = 5.0  # LOITER_TO_ALT: this close to its height counts as there
 TANGENT_WINDOW = math.radians(30.0)  # leave a LOITER_TO_ALT this soon past the tangent point
+Point = tuple[float, float]
 
 
 class Kind(enum.IntEnum):
@@ -47,8 +48,8 @@ class Setpoint:
     """One guidance target in the home-centred north/east frame (metres, MSL altitude)."""
 
     kind: Kind
-    a: tuple[float, float]
-    b: tuple[float, float]
+    a: Point
+    b: Point
     alt_msl: float
     radius: float = 0.0
     clockwise: bool = True
@@ -88,17 +89,18 @@ class MissionExecutor:
     def __post_init__(self) -> None:
         self._jumps_done: dict[int, int] = {}
         self._loiter = _Loiter()
-        self._prev: tuple[float, float] = (0.0, 0.0)
+        self._prev: Point = (0.0, 0.0)
         self._prev_alt = self.home_alt_msl
         self._hold: Setpoint | None = None
         self._turn_radius = 0.0
         # An implicit take-off's height (take_off_first); the waypoint the climb flew past.
         self.climb_to, self._flown_back = math.nan, False
 
-    def start(self, first: int, pos: tuple[float, float], alt_msl: float) -> None:
-        """Begin at item ``first`` from where the aircraft is."""
+    def start(self, first: int, pos: Point, alt_msl: float, leg_from: Point | None = None) -> None:
+        """Begin at item ``first`` from where the aircraft is (or on the leg from ``leg_from``:
+        a mission taken up in the air, ``resume.resumed_leg``)."""
         self.current = max(0, min(first, len(self.items)))
-        self._prev, self._prev_alt = pos, alt_msl
+        self._prev, self._prev_alt = leg_from or pos, alt_msl
         self._jumps_done.clear()
         self.finished = False
         self._hold = None
@@ -119,15 +121,13 @@ class MissionExecutor:
         """An item's altitude above MSL."""
         return item.z + (self.home_alt_msl if item.frame in RELATIVE_FRAMES else 0.0)
 
-    def point_of(self, item: MissionItem, pos: tuple[float, float]) -> tuple[float, float]:
+    def point_of(self, item: MissionItem, pos: Point) -> Point:
         """An item's point in the local frame (lat = lon = 0 means here)."""
         if item.x == 0 and item.y == 0:
             return pos
         return self.frame.ne(item.x / 1e7, item.y / 1e7)
 
-    def step(
-        self, pos: tuple[float, float], alt_msl: float, t_s: float, turn_radius: float = 0.0
-    ) -> Setpoint:
+    def step(self, pos: Point, alt_msl: float, t_s: float, turn_radius: float = 0.0) -> Setpoint:
         """The setpoint for now; advances through items that are done. ``turn_radius`` (m)
         lets a waypoint count as reached early enough for the turn to end on the next leg."""
         self._turn_radius = turn_radius
@@ -152,7 +152,7 @@ class MissionExecutor:
                 return setpoint
         return self._end(pos)  # a DO_JUMP loop without a NAV item: stop, don't spin
 
-    def _advance(self, reached: bool, pos: tuple[float, float], alt: float) -> None:
+    def _advance(self, reached: bool, pos: Point, alt: float) -> None:
         if reached:
             self.reached.append(self.items[self.current].seq)
         self.current += 1
@@ -160,7 +160,7 @@ class MissionExecutor:
         self._flown_back = False
         self._loiter = _Loiter()
 
-    def _end(self, pos: tuple[float, float]) -> Setpoint:
+    def _end(self, pos: Point) -> Setpoint:
         if self._hold is None:
             self.finished = True
             self._hold = Setpoint(
@@ -173,9 +173,7 @@ class MissionExecutor:
             )
         return self._hold
 
-    def _item(
-        self, item: MissionItem, pos: tuple[float, float], alt: float, t_s: float
-    ) -> Setpoint | None:
+    def _item(self, item: MissionItem, pos: Point, alt: float, t_s: float) -> Setpoint | None:
         """The setpoint of ``item``, or None when it is done (and the next is current)."""
         cmd = item.command
         if cmd == d.MAV_CMD_DO_CHANGE_SPEED:
@@ -210,7 +208,7 @@ class MissionExecutor:
         else:
             self.current += 1
 
-    def _takeoff(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
+    def _takeoff(self, item: MissionItem, pos: Point, alt: float) -> Setpoint | None:
         target = self.alt_of(item)
         if alt >= target - TAKEOFF_MARGIN_M:
             self._advance(True, self._prev, target)
@@ -218,7 +216,7 @@ class MissionExecutor:
             return None
         return Setpoint(Kind.TAKEOFF, pos, pos, target, speed=self.speed)
 
-    def _climbed(self, nxt: int, pos: tuple[float, float], alt: float) -> None:
+    def _climbed(self, nxt: int, pos: Point, alt: float) -> None:
         """The climb has ended at ``pos``: the next leg starts here (ArduPlane), so a first
         waypoint the climb flew past is flown back to (it counted as passed: the next leg
         joined 800 m from it), reached inside its acceptance radius, not a turn's lead (370 m
@@ -236,7 +234,7 @@ class MissionExecutor:
         else:
             self._flown_back = past_point(began, point, pos)
 
-    def _waypoint(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint | None:
+    def _waypoint(self, item: MissionItem, pos: Point, alt: float) -> Setpoint | None:
         b = self.point_of(item, pos)
         radius = item.acceptance_m(self.config.wp_radius)
         if not self._flown_back:
@@ -246,7 +244,7 @@ class MissionExecutor:
             return None
         return Setpoint(Kind.LINE, self._prev, b, self.alt_of(item), speed=self.speed)
 
-    def _turn_lead(self, a: tuple[float, float], b: tuple[float, float]) -> float:
+    def _turn_lead(self, a: Point, b: Point) -> float:
         """How far before ``b`` to start turning onto the next leg: R·tan(turn / 2)."""
         nxt = self._next_point(b)
         if nxt is None or self._turn_radius <= 0.0:
@@ -258,7 +256,7 @@ class MissionExecutor:
             return 0.0
         return corner_arc(turn, self._turn_radius, _distance(a, b), _distance(b, nxt))[0]
 
-    def _next_point(self, here: tuple[float, float]) -> tuple[float, float] | None:
+    def _next_point(self, here: Point) -> Point | None:
         """Where the leg after the current waypoint goes (None when it is not a leg)."""
         seq, jumps = self.current + 1, dict(self._jumps_done)
         for _ in range(MAX_JUMPS_PER_STEP):
@@ -281,7 +279,7 @@ class MissionExecutor:
                 return None
         return None
 
-    def _return(self, item: MissionItem, pos: tuple[float, float], alt: float) -> Setpoint:
+    def _return(self, item: MissionItem, pos: Point, alt: float) -> Setpoint:
         home = (0.0, 0.0)
         rtl_alt = self.home_alt_msl + self.config.rtl_alt_rel
         radius = self.config.loiter_radius
@@ -294,7 +292,7 @@ class MissionExecutor:
             return Setpoint(Kind.CIRCLE, home, home, rtl_alt, radius, speed=self.speed)
         return Setpoint(Kind.LINE, self._prev, home, rtl_alt, speed=self.speed)
 
-    def _land(self, item: MissionItem, pos: tuple[float, float]) -> Setpoint:
+    def _land(self, item: MissionItem, pos: Point) -> Setpoint:
         """NAV_LAND: the approach runs from the previous point; the controller lands."""
         point = self.point_of(item, pos)
         return Setpoint(Kind.LAND, self._prev, point, self.alt_of(item), from_alt=self._prev_alt)
@@ -305,9 +303,7 @@ class MissionExecutor:
             self.reached.append(self.items[self.current].seq)
             self.finished = True
 
-    def _loiter_to_alt(
-        self, item: MissionItem, pos: tuple[float, float], alt: float
-    ) -> Setpoint | None:
+    def _loiter_to_alt(self, item: MissionItem, pos: Point, alt: float) -> Setpoint | None:
         """Circle until at the item's height, then (param1 = 1) leave on the tangent that
         points at the next waypoint, so the next leg starts on the circle's edge."""
         centre = self.point_of(item, self._prev)
@@ -345,7 +341,7 @@ class MissionExecutor:
         return None
 
     def _loiter_item(
-        self, item: MissionItem, pos: tuple[float, float], alt: float, t_s: float
+        self, item: MissionItem, pos: Point, alt: float, t_s: float
     ) -> Setpoint | None:
         centre = self.point_of(item, self._prev)
         given = math.isfinite(item.param3) and item.param3 != 0
@@ -375,9 +371,7 @@ class MissionExecutor:
         return circle
 
 
-def tangent_angle(
-    centre: tuple[float, float], radius: float, clockwise: bool, target: tuple[float, float]
-) -> float | None:
+def tangent_angle(centre: Point, radius: float, clockwise: bool, target: Point) -> float | None:
     """The angle (from north, about ``centre``) of the point where a circle flown that way
     is left straight towards ``target``; None when the target is inside the circle."""
     dist = _distance(centre, target)
@@ -388,11 +382,11 @@ def tangent_angle(
     return wrap_pi(bearing - beta if clockwise else bearing + beta)
 
 
-def _distance(a: tuple[float, float], b: tuple[float, float]) -> float:
+def _distance(a: Point, b: Point) -> float:
     return math.hypot(b[0] - a[0], b[1] - a[1])
 
 
-def past_point(a: tuple[float, float], b: tuple[float, float], pos: tuple[float, float]) -> bool:
+def past_point(a: Point, b: Point, pos: Point) -> bool:
     """True once ``pos`` is beyond the line through ``b`` square to the leg a→b."""
     leg = (b[0] - a[0], b[1] - a[1])
     if math.hypot(*leg) < 1.0:
