@@ -1,7 +1,8 @@
 """The bench vehicle: ``companion run`` with its sensors replayed from a recorded log
 (``sensors.replay``), the GPS-compass navigator, the commander and the MAVLink link; no
 simulator, nothing that moves. It answers every ground tool (parameters, missions,
-fences, logs, commands) with the position and attitude the log says.
+fences, logs, commands) with the position and attitude the log says, and records a flight
+log (``system.logger``) from each arming to its disarming, as the aircraft does.
 
 Its pre-arm checks are off (``ARMING_CHECK`` 0), as on a bench: the replayed samples keep
 the log's time stamps, which are not the vehicle clock's, so none would ever look fresh.
@@ -70,6 +71,10 @@ plugin = "nav.gps_compass"
 [[plugins]]
 name = "commander"
 plugin = "vehicle.commander"
+
+[[plugins]]
+name = "logger"
+plugin = "system.logger"
 """
 
 

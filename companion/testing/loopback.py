@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from companion.flight_log import being_written
 from companion.navigation.estimate_csv import read_estimate
 from companion.testing.options import VehicleOptions
 from companion.testing.processes import (
@@ -26,6 +27,8 @@ from companion.testing.watcher import PREARM, VehicleError, Watcher
 from mavlink_dialect import companion as d
 
 START_S = 120.0  # wall seconds for a vehicle to answer: a busy machine imports slowly
+READY_HOLD_S = 4.0  # vehicle seconds: longer than the pre-arm's device window (3 s)
+FORCE_DISARM = 21196  # MAV_CMD_COMPONENT_ARM_DISARM's param 2: disarm even in the air
 
 
 class TeardownWarning(UserWarning):
@@ -133,23 +136,46 @@ class LoopbackVehicle:
         return self._watcher
 
     def wait_ready(self, timeout_s: float = 180.0) -> None:
-        """Until SYS_STATUS says the pre-arm checks pass (QGroundControl's Ready To Fly)."""
+        """Until SYS_STATUS says the pre-arm checks pass (QGroundControl's Ready To Fly),
+        and has said so for READY_HOLD_S of the vehicle clock: just after a start the bit
+        may be set before the vehicle has judged its devices (it waits three seconds for
+        each to speak), and an arm at that moment was refused ("PreArm: range: no data
+        from its device") 20 ms after the bit said ready."""
+        w = self.watcher
+        since: list[float] = []  # the vehicle time the bit was first seen set, unbroken
 
         def ready(m: object) -> bool:
-            if m.get_type() != "SYS_STATUS":  # type: ignore[attr-defined]
-                return False
-            return bool(m.onboard_control_sensors_health & PREARM)  # type: ignore[attr-defined]
+            if m.get_type() == "SYS_STATUS":  # type: ignore[attr-defined]
+                if not m.onboard_control_sensors_health & PREARM:  # type: ignore[attr-defined]
+                    since.clear()
+                elif not since:
+                    since.append(w.time_boot_s)
+            return bool(since) and w.time_boot_s - since[0] >= READY_HOLD_S
 
-        self.watcher.until(ready, timeout_s, "pre-arm checks passed (SYS_STATUS)")
+        w.until(ready, timeout_s, "pre-arm checks passed (SYS_STATUS)")
 
     def upload_plan(self, plan: str | Path) -> dict[int, int]:
         """Upload a QGroundControl .plan (mission, fence, rally); item count per type."""
         return self.watcher.upload_plan(plan)
 
+    def arm(self, timeout_s: float = 30.0) -> None:
+        """Arm (the flight log starts); VehicleError with the vehicle's reason if refused."""
+        self.watcher.command(d.MAV_CMD_COMPONENT_ARM_DISARM, 1, timeout_s=timeout_s)
+
     def arm_and_start(self, timeout_s: float = 30.0) -> None:
         """Arm, then start the mission (MAV_CMD_MISSION_START); VehicleError if refused."""
-        self.watcher.command(d.MAV_CMD_COMPONENT_ARM_DISARM, 1, timeout_s=timeout_s)
+        self.arm(timeout_s)
         self.watcher.command(d.MAV_CMD_MISSION_START, 0, 0, timeout_s=timeout_s)
+
+    def disarm(self, force: bool = False, timeout_s: float = 30.0) -> list[Path]:
+        """Disarm (``force``: in the air too) and wait until the flight's log is closed;
+        the flight logs then. VehicleError if refused."""
+        cmd = d.MAV_CMD_COMPONENT_ARM_DISARM
+        self.watcher.command(cmd, 0, FORCE_DISARM if force else 0, timeout_s=timeout_s)
+        w = self.watcher
+        w.until(lambda _m: not any(map(being_written, self.flight_logs())), timeout_s,
+                "the flight log closed")  # fmt: skip
+        return self.flight_logs()
 
     def run_until_item(self, seq: int, timeout_s: float = 600.0) -> None:
         """Until the mission item ``seq`` is reached (or the mission is past it)."""

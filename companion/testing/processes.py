@@ -73,8 +73,9 @@ def stop_tree(
     proc: LoggedProcess, namespace: str, sig: int = signal.SIGINT, timeout_s: float = 30.0
 ) -> list[str]:
     """Stop ``proc`` as at a terminal (``sig``), kill whatever of its tree is left after
-    ``timeout_s``, remove the namespace's shared memory. Returns what was left behind
-    (empty after a clean stop): the caller decides whether that fails the test."""
+    ``timeout_s``, remove the namespace's shared memory. Returns what was left behind or
+    went wrong (empty after a clean stop: exit status 0, nothing running, nothing in
+    /dev/shm): the caller decides whether that fails the test."""
     pids = proc.tree()  # read first: the children are orphaned once the parent is gone
     left: list[str] = []
     if proc.poll() is None:
@@ -91,6 +92,8 @@ def stop_tree(
                 os.kill(pid, signal.SIGKILL)
     with contextlib.suppress(subprocess.TimeoutExpired):
         proc.wait(timeout=5.0)
+    if not left and proc.returncode not in (0, None):  # a clean stop exits 0, also on sig
+        left.append(f"exit status {proc.returncode} (its output: {proc.log_path})")
     shm = leftover_files(namespace)
     if shm:
         left.append(f"shared memory left behind: {[p.name for p in shm]}")

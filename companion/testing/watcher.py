@@ -1,9 +1,14 @@
 """The fixture's own MAVLink connection to the vehicle, with pymavlink: what the helpers
 (wait until ready, upload a plan, arm and start, run until ...) use.
 
-It says it is an onboard controller, not a ground station: the vehicle's ground-station
-failsafe watches ground-station heartbeats only, so a test that stops polling here for a
-while (its script talks to the vehicle meanwhile) does not send the aircraft home.
+It is invisible to the test's scripts: it sends no HEARTBEAT and nothing broadcast, only
+messages addressed to the vehicle, which the vehicle does not forward to its other
+endpoints. A heartbeat (even an onboard controller's) would be forwarded, as
+mavlink-router does: a script's MAVSDK counted a second system (253), and pymavlink's
+``wait_heartbeat`` could return the helper's. Its keep-alive is a TIMESYNC request to the
+vehicle (the vehicle's udpin endpoint learns where to answer from it), and the vehicle's
+ground-station failsafe, fed by ground-station heartbeats only, hears nothing from it: a
+script's own link loss is the vehicle's, whatever the helpers do meanwhile.
 """
 
 from __future__ import annotations
@@ -45,13 +50,15 @@ class Watcher:
         self.sysid = sysid
         self.texts: list[str] = []  # every STATUSTEXT seen, for the failure messages
         self.time_boot_s = 0.0  # the vehicle clock (the simulation's, in a simulation)
-        self._beat = 0.0
+        self._hello_at = 0.0
 
-    def _heartbeat(self) -> None:
+    def _hello(self) -> None:
+        """Once a second, a TIMESYNC request addressed to the vehicle's autopilot: the
+        vehicle answers it to us alone and forwards it nowhere (see the module's text)."""
         now = time.monotonic()
-        if now - self._beat >= 1.0:
-            self._beat = now
-            self.mav.heartbeat_send(d.MAV_TYPE_ONBOARD_CONTROLLER, d.MAV_AUTOPILOT_INVALID, 0, 0, 0)
+        if now - self._hello_at >= 1.0:
+            self._hello_at = now
+            self.mav.timesync_send(0, time.monotonic_ns(), self.sysid, 1)
 
     def _note(self, msg: Any) -> None:
         if msg.get_type() == "STATUSTEXT":
@@ -66,7 +73,7 @@ class Watcher:
 
     def recv(self, timeout_s: float = 0.2) -> Any:
         """The next message from the vehicle, or None; keeps the vehicle hearing us."""
-        self._heartbeat()
+        self._hello()
         msg = self.conn.recv_match(blocking=True, timeout=timeout_s)
         if msg is None or msg.get_type() == "BAD_DATA":
             return None
@@ -93,7 +100,7 @@ class Watcher:
         )
 
     def connect(self, timeout_s: float) -> Any:
-        """Wait for the vehicle's heartbeat (it answers once it has heard us)."""
+        """Wait for the vehicle's heartbeat (it sends once it has heard us)."""
         return self.until(lambda m: m.get_type() == "HEARTBEAT" and m, timeout_s, "HEARTBEAT")
 
     def command(self, command: int, *params: float, timeout_s: float = 30.0) -> Any:

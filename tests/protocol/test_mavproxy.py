@@ -28,11 +28,15 @@ WAYPOINTS = """QGC WPL 110
 class MavProxy:
     """MAVProxy run as a user runs it, its console typed into and read back."""
 
-    def __init__(self, port: int, cwd: Path) -> None:
+    def __init__(self, master: int | str, cwd: Path) -> None:
+        """``master``: a connection string (the plug-in's ``mavproxy_master``), or the
+        port of the vehicle's udpin endpoint on loopback."""
         mavproxy = Path(sys.executable).parent / "mavproxy.py"
         assert mavproxy.exists() or shutil.which("mavproxy.py"), "MAVProxy is a dev dependency"
+        if isinstance(master, int):
+            master = f"udpout:127.0.0.1:{master}"
         self.proc = subprocess.Popen(
-            [sys.executable, str(mavproxy), f"--master=udpout:127.0.0.1:{port}"],
+            [sys.executable, str(mavproxy), f"--master={master}"],
             cwd=cwd,
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,

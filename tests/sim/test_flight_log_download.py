@@ -9,7 +9,6 @@ import itertools
 import logging
 import math
 import re
-import signal
 import time
 from pathlib import Path
 from typing import Any
@@ -22,9 +21,8 @@ from companion.bus.node import BusNode
 from companion.flight_log import being_written
 from mavlink_dialect import companion as m
 from tests.protocol.log_client import QgcDownload, list_logs, mavproxy_download
-from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.protocol.mav_client import GroundStation
 from tests.protocol.test_mavproxy import MavProxy
-from tests.sim.sim_run import finish, start_sim
 from tests.support.vehicle import REPO, wait_for
 
 log = logging.getLogger(__name__)
@@ -90,8 +88,8 @@ def disarm(flight: Flight, timeout_s: float = 60.0) -> None:
     raise AssertionError("no acknowledgement of the disarm")
 
 
-def download_with_mavproxy(port: int, folder: Path, size: int) -> bytes:
-    mavproxy = MavProxy(port, folder)
+def download_with_mavproxy(master: str, folder: Path, size: int) -> bytes:
+    mavproxy = MavProxy(master, folder)
 
     def online() -> None:
         # Typed once MAVProxy has heard the vehicle (the link's counters include QGC's
@@ -102,46 +100,37 @@ def download_with_mavproxy(port: int, folder: Path, size: int) -> bytes:
     return mavproxy_download(mavproxy, folder, online, size, 300)
 
 
-def download_both(flight: Flight, port: int, folder: Path, size: int) -> tuple[bytes, bytes]:
+def download_both(flight: Flight, master: str, folder: Path, size: int) -> tuple[bytes, bytes]:
     """The log as QGroundControl downloads it, then as MAVProxy does."""
     started = time.monotonic()
     by_qgc = QgcDownload(flight.gcs, 0, size).run()
     qgc_s, started = time.monotonic() - started, time.monotonic()
-    by_mavproxy = download_with_mavproxy(port, folder, size)
+    by_mavproxy = download_with_mavproxy(master, folder, size)
     took = (qgc_s, time.monotonic() - started)
     log.info("%d bytes: pymavlink as QGC in %.1f s, MAVProxy in %.1f s", size, *took)
     return by_qgc, by_mavproxy
 
 
 @pytest.mark.timeout(600)
-def test_a_flown_log_downloads_whole_and_holds_what_the_drivers_published(tmp_path):
-    qgc_port, mavproxy_port = free_udp_port(), free_udp_port()
-    proc, namespace, _ = start_sim(
-        tmp_path, f"udpin://127.0.0.1:{qgc_port}", "--link", f"udpin://127.0.0.1:{mavproxy_port}",
-        "--plan", PLAN, "--start-at", f"{START_AT_S:g}",
-    )  # fmt: skip
-    logs = tmp_path / "state" / "logs"
+@pytest.mark.vehicle(plan=PLAN, sim_args=["--start-at", f"{START_AT_S:g}"])
+def test_a_flown_log_downloads_whole_and_holds_what_the_drivers_published(sim, tmp_path):
+    logs = sim.state_dir / "logs"
+    flight = Flight(sim.namespace, sim.ports.pymavlink)
     try:
-        flight = Flight(namespace, qgc_port)
-        try:
-            flight.gcs.connect(120)
-            disarmed_ms = fly_the_leg(flight, 240)
-            disarm(flight)
-            wait_for(lambda: list(logs.glob("*.ulg")), 30, "the flight's log")
-            (on_board,) = logs.glob("*.ulg")
-            wait_for(lambda: not being_written(on_board), 30, "the log closed at the disarm")
-            entries = list_logs(flight.gcs)
-            assert list(entries) == [0] and entries[0].size == on_board.stat().st_size
-            by_qgc, by_mavproxy = download_both(flight, mavproxy_port, tmp_path, entries[0].size)
-            for _ in range(10):  # the driver's counters of the last seconds
-                flight.poll("HEARTBEAT")
-            imu_counts = flight.imu_counts
-        finally:
-            flight.close()
+        flight.gcs.connect(120)
+        disarmed_ms = fly_the_leg(flight, 240)
+        disarm(flight)
+        wait_for(lambda: list(logs.glob("*.ulg")), 30, "the flight's log")
+        (on_board,) = logs.glob("*.ulg")
+        wait_for(lambda: not being_written(on_board), 30, "the log closed at the disarm")
+        entries = list_logs(flight.gcs)
+        assert list(entries) == [0] and entries[0].size == on_board.stat().st_size
+        by_qgc, by_mavproxy = download_both(flight, sim.mavproxy_master, tmp_path, entries[0].size)
+        for _ in range(10):  # the driver's counters of the last seconds
+            flight.poll("HEARTBEAT")
+        imu_counts = flight.imu_counts
     finally:
-        if proc.poll() is None:
-            proc.send_signal(signal.SIGINT)
-        finish(proc, namespace, 60)
+        flight.close()
     assert by_qgc == on_board.read_bytes()
     assert by_mavproxy == on_board.read_bytes()
 

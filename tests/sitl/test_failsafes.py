@@ -7,7 +7,6 @@ STATUSTEXT the operator reads.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import time
 from collections.abc import Iterator
@@ -20,19 +19,18 @@ from pymavlink import mavutil
 from companion.control.modes import BY_MODE
 from companion.messages import FlightMode
 from mavlink_dialect import companion as d
-from tests.protocol.mav_client import free_udp_port
-from tests.sim.sim_run import finish, start_sim
 from tests.support.vehicle import REPO
 
 PLAN = str(REPO / "qgc_plans" / "square.plan")
+pytestmark = pytest.mark.vehicle(plan=PLAN, duration=1500)
 WATCHED = ["HEARTBEAT", "STATUSTEXT", "MISSION_CURRENT", "COMMAND_ACK"]
 
 
 class Station:
     """A ground station that beats only while asked to."""
 
-    def __init__(self, port: int) -> None:
-        self.conn = mavutil.mavlink_connection(f"udpin:127.0.0.1:{port}", source_system=255)
+    def __init__(self, url: str) -> None:
+        self.conn = mavutil.mavlink_connection(url, source_system=255)
         self.beating = True
         self.texts: list[str] = []
         self.mode = -1
@@ -98,73 +96,62 @@ class Station:
         self.until(lambda: self.in_mode(FlightMode.MISSION), 20, "in Mission")
 
 
-@contextlib.contextmanager
-def flying(tmp_path, *args: str) -> Iterator[Station]:
-    """``companion sim`` with the square plan (and ``args``), a station on its link; the
-    simulation is stopped and checked clean afterwards, whatever the test did."""
-    port = free_udp_port()
-    station = Station(port)
-    proc, namespace, _truth = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--plan", PLAN, "--duration", "1500", *args
-    )
-    try:
-        yield station
-    finally:
-        proc.terminate()
-        finish(proc, namespace, 60)
-        station.conn.close()
+@pytest.fixture
+def station(sim) -> Iterator[Station]:
+    """A station on the plug-in's ``sim`` vehicle (the square plan preloaded); the
+    vehicle is stopped and checked clean afterwards, whatever the test did."""
+    station = Station(sim.pymavlink_url)
+    yield station
+    station.conn.close()
 
 
 @pytest.mark.timeout(240)
-def test_ground_station_lost_returns_home_then_resumes_the_mission(tmp_path):
-    with flying(tmp_path) as station:
-        station.fly_mission()
-        # Airborne, judged by the vehicle (past the take-off item), not by wall time: a
-        # busy machine runs the simulation slower.
-        station.until(lambda: station.mission_seq >= 1, 120, "past the take-off")
-        station.beating = False
-        station.until(lambda: station.in_mode(FlightMode.RTL), 30, "returning")
-        station.until(lambda: station.said("ground station lost"), 5, "told why")
-        station.beating = True
-        station.until(lambda: station.in_mode(FlightMode.MISSION), 30, "back in the mission")
-        station.until(lambda: station.said("resuming the mission"), 5, "told so")
+def test_ground_station_lost_returns_home_then_resumes_the_mission(station):
+    station.fly_mission()
+    # Airborne, judged by the vehicle (past the take-off item), not by wall time: a
+    # busy machine runs the simulation slower.
+    station.until(lambda: station.mission_seq >= 1, 120, "past the take-off")
+    station.beating = False
+    station.until(lambda: station.in_mode(FlightMode.RTL), 30, "returning")
+    station.until(lambda: station.said("ground station lost"), 5, "told why")
+    station.beating = True
+    station.until(lambda: station.in_mode(FlightMode.MISSION), 30, "back in the mission")
+    station.until(lambda: station.said("resuming the mission"), 5, "told so")
 
 
 @pytest.mark.timeout(240)
-def test_gps_lost_holds_heading_and_loiters_when_it_returns(tmp_path):
+def test_gps_lost_holds_heading_and_loiters_when_it_returns(station):
     # The GPS is switched off as a PX4 user would, with MAV_CMD_INJECT_FAILURE (what
     # MAVSDK's Failure.inject sends), once the aircraft is on its first leg.
     gps, off, ok = d.FAILURE_UNIT_SENSOR_GPS, d.FAILURE_TYPE_OFF, d.FAILURE_TYPE_OK
-    with flying(tmp_path) as station:
-        station.fly_mission()
-        assert station.acked(d.MAV_CMD_INJECT_FAILURE, gps, off) == d.MAV_RESULT_DENIED
-        assert station.said("SYS_FAILURE_EN")  # refused until enabled, as PX4
-        station.conn.mav.param_set_send(1, 1, b"SYS_FAILURE_EN", 1, d.MAV_PARAM_TYPE_REAL32)
-        station.until(lambda: station.mission_seq >= 1, 60, "on the first leg")
-        assert station.acked(d.MAV_CMD_INJECT_FAILURE, gps, off) == d.MAV_RESULT_ACCEPTED
-        station.until(lambda: station.said("GPS lost"), 60, "told of the GPS loss")
-        assert station.in_mode(FlightMode.MISSION)  # the course is held, the mode kept
-        assert sum("GPS lost" in t for t in station.texts) == 1  # said once, no flapping
-        assert station.acked(d.MAV_CMD_INJECT_FAILURE, gps, ok) == d.MAV_RESULT_ACCEPTED
-        loiter = BY_MODE[FlightMode.LOITER].px4
-        station.until(lambda: loiter in station.modes, 60, "loitering")
-        station.until(lambda: station.said("GPS back"), 30, "told GPS is back")
-        station.pump(1.0)
-        assert sum("GPS lost" in t for t in station.texts) == 1
-        assert sum("GPS back" in t for t in station.texts) == 1
+    station.fly_mission()
+    assert station.acked(d.MAV_CMD_INJECT_FAILURE, gps, off) == d.MAV_RESULT_DENIED
+    assert station.said("SYS_FAILURE_EN")  # refused until enabled, as PX4
+    station.conn.mav.param_set_send(1, 1, b"SYS_FAILURE_EN", 1, d.MAV_PARAM_TYPE_REAL32)
+    station.until(lambda: station.mission_seq >= 1, 60, "on the first leg")
+    assert station.acked(d.MAV_CMD_INJECT_FAILURE, gps, off) == d.MAV_RESULT_ACCEPTED
+    station.until(lambda: station.said("GPS lost"), 60, "told of the GPS loss")
+    assert station.in_mode(FlightMode.MISSION)  # the course is held, the mode kept
+    assert sum("GPS lost" in t for t in station.texts) == 1  # said once, no flapping
+    assert station.acked(d.MAV_CMD_INJECT_FAILURE, gps, ok) == d.MAV_RESULT_ACCEPTED
+    loiter = BY_MODE[FlightMode.LOITER].px4
+    station.until(lambda: loiter in station.modes, 60, "loitering")
+    station.until(lambda: station.said("GPS back"), 30, "told GPS is back")
+    station.pump(1.0)
+    assert sum("GPS lost" in t for t in station.texts) == 1
+    assert sum("GPS back" in t for t in station.texts) == 1
 
 
 @pytest.mark.timeout(240)
-def test_fence_breach_returns_home(tmp_path):
-    with flying(tmp_path) as station:
-        # A 1 km circle round home: the first leg (to 1.8 km east) leaves it.
-        lat, lon = -37.9105, 145.1340
-        station.fly_mission()
-        station.command(d.MAV_CMD_DO_SET_MODE, 1, 4, 3)  # loiter while the fence goes up
-        _upload_circle_fence(station, lat, lon, 1000.0)
-        station.command(d.MAV_CMD_MISSION_START, 0, 0)
-        station.until(lambda: station.said("Fence breached"), 90, "told of the breach")
-        station.until(lambda: station.in_mode(FlightMode.RTL), 10, "returning")
+def test_fence_breach_returns_home(station):
+    # A 1 km circle round home: the first leg (to 1.8 km east) leaves it.
+    lat, lon = -37.9105, 145.1340
+    station.fly_mission()
+    station.command(d.MAV_CMD_DO_SET_MODE, 1, 4, 3)  # loiter while the fence goes up
+    _upload_circle_fence(station, lat, lon, 1000.0)
+    station.command(d.MAV_CMD_MISSION_START, 0, 0)
+    station.until(lambda: station.said("Fence breached"), 90, "told of the breach")
+    station.until(lambda: station.in_mode(FlightMode.RTL), 10, "returning")
 
 
 def _upload_circle_fence(station: Station, lat: float, lon: float, radius: float) -> None:
@@ -183,27 +170,26 @@ def _upload_circle_fence(station: Station, lat: float, lon: float, radius: float
 
 
 @pytest.mark.timeout(300)
-def test_a_fence_breach_that_holds_takes_back_the_operators_mission_but_not_stabilized(tmp_path):
+def test_a_fence_breach_that_holds_takes_back_the_operators_mission_but_not_stabilized(station):
     """QGroundControl's one-click Start Mission outside the fence must not end its Return."""
-    with flying(tmp_path) as station:
-        lat, lon = -37.9105, 145.1340
-        station.fly_mission()
-        station.until(lambda: station.mission_seq >= 1, 120, "past the take-off")
-        # A fence 5 km north that home is not in: the breach holds however the aircraft flies.
-        _upload_circle_fence(station, lat + 0.045, lon, 500.0)
-        station.until(lambda: station.in_mode(FlightMode.RTL), 60, "returning")
-        mission = BY_MODE[FlightMode.MISSION].px4
-        for round_ in range(1, 3):  # Start Mission as QGroundControl's PX4 plug-in sends it
-            assert station.acked(d.MAV_CMD_DO_SET_MODE, 1, mission) == d.MAV_RESULT_ACCEPTED
-            station.until(lambda n=round_: _count(station, "Fence still breached") == n, 60,
-                          "the Return taken back")  # fmt: skip
-            station.until(lambda: station.in_mode(FlightMode.RTL), 20, "returning again")
-        # Stabilized is taking control: left alone for seconds of vehicle time.
-        stabilized = BY_MODE[FlightMode.STABILIZED].px4
-        assert station.acked(d.MAV_CMD_DO_SET_MODE, 1, stabilized) == d.MAV_RESULT_ACCEPTED
-        station.until(lambda: station.in_mode(FlightMode.STABILIZED), 20, "in Stabilized")
-        modes = _modes_for(station, 3.0)
-        assert set(modes) == {stabilized}, modes
+    lat, lon = -37.9105, 145.1340
+    station.fly_mission()
+    station.until(lambda: station.mission_seq >= 1, 120, "past the take-off")
+    # A fence 5 km north that home is not in: the breach holds however the aircraft flies.
+    _upload_circle_fence(station, lat + 0.045, lon, 500.0)
+    station.until(lambda: station.in_mode(FlightMode.RTL), 60, "returning")
+    mission = BY_MODE[FlightMode.MISSION].px4
+    for round_ in range(1, 3):  # Start Mission as QGroundControl's PX4 plug-in sends it
+        assert station.acked(d.MAV_CMD_DO_SET_MODE, 1, mission) == d.MAV_RESULT_ACCEPTED
+        station.until(lambda n=round_: _count(station, "Fence still breached") == n, 60,
+                      "the Return taken back")  # fmt: skip
+        station.until(lambda: station.in_mode(FlightMode.RTL), 20, "returning again")
+    # Stabilized is taking control: left alone for seconds of vehicle time.
+    stabilized = BY_MODE[FlightMode.STABILIZED].px4
+    assert station.acked(d.MAV_CMD_DO_SET_MODE, 1, stabilized) == d.MAV_RESULT_ACCEPTED
+    station.until(lambda: station.in_mode(FlightMode.STABILIZED), 20, "in Stabilized")
+    modes = _modes_for(station, 3.0)
+    assert set(modes) == {stabilized}, modes
 
 
 def _count(station: Station, words: str) -> int:

@@ -6,14 +6,12 @@ the plug-in's helper, and MAVProxy reads each part back and saves it, item for i
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
-import threading
 import time
 from pathlib import Path
 
 import pytest
 
+from tests.protocol.test_mavproxy import MavProxy
 from tests.support.vehicle import REPO, wait_for
 
 HOME = (-37.9105, 145.1340)
@@ -34,31 +32,18 @@ def fenced_plan(path: Path) -> Path:
 def test_mavproxy_lists_the_mission_fence_and_rally_points(bench, tmp_path):
     bench.wait_ready()
     assert bench.upload_plan(fenced_plan(tmp_path / "fenced.plan")) == {0: 3, 1: 4, 2: 1}
-    mavproxy = Path(sys.executable).parent / "mavproxy.py"
-    proc = subprocess.Popen(
-        [sys.executable, str(mavproxy), f"--master={bench.mavproxy_master}"], cwd=tmp_path,
-        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-    )  # fmt: skip
-    lines: list[str] = []
-    reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)
-    reader.start()
+    mavproxy = MavProxy(bench.mavproxy_master, tmp_path)
+    lines = mavproxy.lines
     try:
         # Typed once MAVProxy has its parameters: a list asked before is not answered.
         wait_for(lambda: any("parameters to" in line for line in lines), 120, "MAVProxy's params")
         for command, saved in (("wp list", "way.txt"), ("fence list", "fence-items.txt"),
                                ("rally list", "rally-items.txt")):  # fmt: skip
-            proc.stdin.write(command + "\n")
-            proc.stdin.flush()
+            mavproxy.type(command)
             wait_for(lambda s=saved: any(f"to {s}" in line for line in lines), 60, command)
             time.sleep(0.5)
     finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            proc.kill()  # MAVProxy's threads can ignore SIGTERM while stdin is open
-            proc.wait()
-    out = "".join(lines)
+        out = mavproxy.close()
     assert "Saved 3 waypoints" in out and "Saved 4 fence items" in out, out[-3000:]
     assert "Saved 1 rally items" in out, out[-3000:]
     fence = (tmp_path / "fence-items.txt").read_text()
