@@ -19,7 +19,7 @@ from companion.link.link_budget import LinkBudget
 from companion.link.microservice import Outgoing, Peer, Service
 from companion.link.signing import configure_parser, shared_state, signing_encoder
 from companion.link.snapshot import Snapshot
-from companion.link.stream_schedule import StreamSchedule
+from companion.link.stream_schedule import BATCH_S, StreamSchedule
 from companion.link.telemetry import STREAMS
 from companion.link.tlog import TlogWriter
 
@@ -168,7 +168,7 @@ class LinkRouter:
         for index, endpoint in enumerate(self.endpoints):
             if not endpoint.has_remote():
                 continue
-            for msg_id in self.schedules[index].due(now_s, nav_at_s):
+            for msg_id in self.schedules[index].due(now_s, nav_at_s, BATCH_S):
                 try:
                     msg = STREAMS[msg_id].build(self.mav, snapshot)
                     # Framed once, for this endpoint; values out of a field's range raise here.

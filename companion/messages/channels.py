@@ -42,8 +42,10 @@ class Channel:
 
 
 # Latest channels that change at up to 100 Hz keep this many values for a reader that
-# asks: the flight log, reading every ~0.1 s, records each one.
-KEEP = 16
+# asks: the flight log, woken every 0.1 s, records each one. 32 is 0.32 s at 100 Hz, three
+# of its periods: room for a late wake-up on a busy machine (16 held 0.16 s, and the
+# logger, keeping a queue under a quarter full, read 24 times a second).
+KEEP = 32
 
 
 def _channels(*chans: Channel) -> dict[str, Channel]:
@@ -86,7 +88,8 @@ CHANNELS: dict[str, Channel] = _channels(
         unlogged="every sample's t_us is on the simulation's clock already",
     ),
     Channel("vehicle/status", VehicleStatus, "latest", KEEP, doc="mode, home, guided target"),
-    Channel("control/actuators", ActuatorCommand, "queue", 8, "normalised surfaces"),
+    # 32 at 50 Hz: 0.64 s, for the flight log's 0.1 s reads (the servos take the newest).
+    Channel("control/actuators", ActuatorCommand, "queue", 32, "normalised surfaces"),
     Channel("control/status", ControlStatus, "latest", KEEP, doc="guidance and mission progress"),
     Channel("actuators/servos", ServoOutput, "latest", KEEP, doc="servo outputs written"),
     Channel("link/commands", VehicleCommand, "queue", 16, "commands for the vehicle", True),

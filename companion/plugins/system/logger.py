@@ -42,10 +42,16 @@ if TYPE_CHECKING:
 # Every registered channel but those that opt out in the registry, with their reason.
 DEFAULT_CHANNELS = list(LOGGED)
 MIN_PERIOD_S = 0.001
-# While data flows and no queue comes back a quarter full, the reads spread out to this:
-# the IMU's 64-deep queue holds 0.64 s at 100 Hz, a Latest channel 16 values (0.32 s at
-# 50 Hz). Each read costs a wake-up and a pass over every channel.
+# The logger's wake-up period while data flows at the vehicle's own rates: it then drains
+# every sample that queued on its channels since the last read, each with its own t_us.
+# Every channel it reads holds three periods or more (channels.py): the IMU's 64-deep
+# queue 0.64 s at 100 Hz, control/actuators' 32 0.64 s at 50 Hz, a Latest channel's 32
+# kept values 0.32 s at 100 Hz (the rangefinder). Each read costs a wake-up and a pass
+# over every channel; 10 a second, not one per sample (about 450 a second flying).
 CALM_PERIOD_S = 0.1
+# The reads spread out towards CALM_PERIOD_S while no channel comes back this full (at
+# 0.1 s the fullest, the rangefinder's, is 10 of 32); over half full they come faster.
+CALM_FILL = 0.4
 # With nothing arriving (a vehicle on the bench), it reads this seldom at most: a sensor
 # starting at 200 Hz fills a 64-deep queue in 0.32 s, and arming wakes it at once.
 IDLE_PERIOD_S = 0.25
@@ -260,7 +266,7 @@ class LoggerPlugin(Plugin):
             self.period_s = max(base, min(self.period_s * 2, IDLE_PERIOD_S))
         elif fill > 0.5:  # after a quiet spell, a stream has started: from the base period
             self.period_s = base if was_quiet else max(self.period_s / 2, MIN_PERIOD_S)
-        elif fill < 0.25 and self.period_s < CALM_PERIOD_S:
+        elif fill < CALM_FILL and self.period_s < CALM_PERIOD_S:
             # A trickle (a vehicle on the bench) leaves a quiet spell's period as it is.
             self.period_s = min(self.period_s * 1.25, max(base, CALM_PERIOD_S))
 

@@ -9,6 +9,7 @@ from companion.link.codec import dialect as d
 from companion.link.codec import new_encoder
 from companion.link.endpoints import open_endpoint
 from companion.link.link_router import LinkRouter
+from companion.link.stream_schedule import BATCH_S
 
 ATTITUDE = d.MAVLINK_MSG_ID_ATTITUDE
 MAX_WAIT_S = 0.05  # the link plug-in's
@@ -84,3 +85,32 @@ def test_before_the_first_state_the_streams_that_carry_one_wake_nobody(endpoint)
             now, wakes = now + max(timeout, 1e-3), wakes + 1
         counts[nav_known] = wakes / 10.0
     assert counts[False] <= 3.0 < 10.0 <= counts[True]
+
+
+def test_slower_streams_ride_the_wakeups_of_the_fastest_at_their_own_rates(endpoint):
+    """At the default rates (ATTITUDE 10 Hz, the others 5 Hz to 0.2 Hz) a link that sends
+    what falls due within BATCH_S with what it woke for is no longer woken apart for the
+    slower streams, and every stream keeps its rate."""
+    wakes_by_batch, counts_by_batch = {}, {}
+    for early_s in (0.0, BATCH_S):
+        router = LinkRouter(new_encoder(1, 1), [endpoint], [], None)
+        schedule, counts = router.schedules[0], {}
+        nav_at, nav_wanted, wake_at, wakes = float("-inf"), True, 0.0, 0
+        for ms in range(20_000):
+            now = ms / 1000
+            state = ms % 20 == 7  # the navigator at 50 Hz, out of phase with the grid
+            if not ((state and nav_wanted) or now >= wake_at - 1e-9):
+                continue
+            wakes, nav_at = wakes + 1, now if state else nav_at
+            # Served late, as a busy link is: the streams drift apart without the batch.
+            for msg_id in schedule.due(now + 0.003 * (ms % 3), nav_at, early_s):
+                counts[msg_id] = counts.get(msg_id, 0) + 1
+            timeout, nav_wanted = router.next_wake(now, 1.0)
+            wake_at = now + max(timeout, 1e-3)
+        wakes_by_batch[early_s], counts_by_batch[early_s] = wakes / 20.0, counts
+    for msg_id, period in router.schedules[0].period_s.items():
+        if period > 0:
+            assert abs(counts_by_batch[BATCH_S][msg_id] - 20.0 / period) <= 1.5, msg_id
+    # Two wake-ups per ATTITUDE (its time opens the gate, the next state sends it), the
+    # others riding them: 25.1 a second without the batch, 21.95 with it.
+    assert wakes_by_batch[BATCH_S] <= min(22.5, wakes_by_batch[0.0] - 2.0)
