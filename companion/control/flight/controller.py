@@ -262,14 +262,9 @@ class FlightController:
         return sp
 
     def _mission(
-        self,
-        status: VehicleStatus,
-        pos: tuple[float, float],
-        nav: NavState,
-        t_s: float,
-        entered: bool,
-        out: ControlOutput,
-    ) -> Setpoint | None:
+        self, status: VehicleStatus, pos: tuple[float, float], nav: NavState, t_s: float,
+        entered: bool, out: ControlOutput,
+    ) -> Setpoint | None:  # fmt: skip
         ex, resumed = self.executor, None
         if ex is None or (entered and ex.finished):
             assert self.frame is not None
