@@ -5,14 +5,18 @@ frames accepted and refused. A plug-in with a ``device`` setting that has read n
 the last few seconds has a silent device; one that has read bytes but decoded nothing, or
 mostly bad frames, has a garbled one (a wrong baud rate, a noisy line). Either refuses
 arming with the plug-in's name, as ``companion check`` would say on the bench. Until a
-plug-in has run for the whole window there is no verdict: a device just opened has not
-had its chance (the navigator is still aligning then anyway). Pure: tables in, reasons out.
+plug-in has run for the whole window its device is judged only by whether it has sent one
+good frame yet: a device just opened may be slow to start, but the vehicle is not ready to
+arm on a device it has not heard at all (else the pre-arm bit a ground station reads in
+SYS_STATUS would say ready in the first seconds after a start and then take it back).
+The RC receiver may be excused by the caller while a ground station's joystick flies the
+aircraft (PX4's "RC and Joystick with fallback"). Pure: tables in, reasons out.
 """
 
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -21,6 +25,7 @@ from companion.messages import PluginState, SystemHealth
 WINDOW_US = 3_000_000  # a 1 Hz GPS sends three fixes in it
 BAD_SHARE = 0.2  # more bad frames than this share of the window's frames: garbled
 MIN_BAD = 3  # and at least this many (one cut sentence at start-up is no fault)
+RC_RECEIVER = "sensors.rc_input"  # the plug-in kind a joystick may stand in for
 
 
 @dataclass(frozen=True)
@@ -39,6 +44,7 @@ class DeviceWatch:
         # plugins: every plug-in's settings by kind (PluginContext.plugins)
         self.kinds = {kind for kind, settings in plugins.items() if "device" in settings}
         self.history: dict[str, deque[_Counts]] = {}
+        self.kind_of: dict[str, str] = {}  # plug-in name -> kind
         self._last_t_us: int | None = None
 
     def update(self, health: SystemHealth | None) -> None:
@@ -52,7 +58,9 @@ class DeviceWatch:
             running = row.state == PluginState.RUNNING
             now = _Counts(health.t_us, row.pid if running else 0, row.bytes_in,
                           row.frames_ok, row.frames_bad)  # fmt: skip
-            history = self.history.setdefault(row.name.decode(), deque())
+            name = row.name.decode()
+            self.kind_of[name] = row.kind.decode()
+            history = self.history.setdefault(name, deque())
             if history and history[-1].pid != now.pid:
                 history.clear()  # a new process counts from zero: judge it afresh
             history.append(now)
@@ -60,12 +68,17 @@ class DeviceWatch:
             while len(history) > 1 and now.t_us - history[1].t_us >= WINDOW_US:
                 history.popleft()
 
-    def failures(self) -> list[str]:
-        """Each silent or garbled device's plug-in, worded for ``PreArm: ``."""
+    def failures(self, excused: Collection[str] = ()) -> list[str]:
+        """Each silent or garbled device's plug-in, worded for ``PreArm: ``; plug-ins of
+        the ``excused`` kinds are not judged."""
         found = []
         for name, history in self.history.items():
             first, last = history[0], history[-1]
-            if not last.pid or last.t_us - first.t_us < WINDOW_US:
+            if not last.pid or self.kind_of.get(name) in excused:
+                continue
+            if last.t_us - first.t_us < WINDOW_US:
+                if last.ok == 0:  # counted since its process started
+                    found.append(f"{name}: waiting for data from its device")
                 continue
             ok, bad = last.ok - first.ok, last.bad - first.bad
             if last.bytes_in == first.bytes_in:

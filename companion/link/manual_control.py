@@ -18,6 +18,7 @@ from companion.link.microservice import Outgoing, Peer
 from companion.messages import PilotInput, PilotSource
 
 AXIS_INVALID = 32767
+JOYSTICK_FRESH_US = 1_000_000
 FULL = 1000.0
 
 
@@ -39,6 +40,7 @@ class ManualControlService:
         self.on_refusal = on_refusal
         self.accepted = 0
         self.refused = 0
+        self.last_us: int | None = None  # when the newest accepted sticks arrived
 
     def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
         if msg.target != self.sysid:
@@ -50,6 +52,7 @@ class ManualControlService:
                 self.on_refusal(f"MANUAL_CONTROL refused: {problem}")
             return []
         sticks = PilotInput(t_us=self.now_us(), source=PilotSource.MANUAL_CONTROL, rssi=255)
+        self.last_us = sticks.t_us
         sticks.pitch = -_axis(msg.x)  # stick forward is nose down
         sticks.roll = _axis(msg.y)
         sticks.yaw = _axis(msg.r)
@@ -61,6 +64,11 @@ class ManualControlService:
 
     def tick(self, now_s: float) -> list[Outgoing]:
         return []
+
+    def flying(self, now_us: int) -> bool:
+        """Whether a joystick is sending sticks now (a ground station sends them at 10 Hz
+        or more while its joystick is on, armed or not)."""
+        return self.last_us is not None and now_us - self.last_us < JOYSTICK_FRESH_US
 
     @staticmethod
     def _problem(msg: Any) -> str | None:

@@ -9,13 +9,17 @@ off and on with MAV_CMD_INJECT_FAILURE, and brings the pack's charge under BATT_
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import pytest
 from pyulog import ULog
 
 from companion.messages import FlightMode
 from mavlink_dialect import companion as d
-from tests.sitl.test_failsafes import Station, flying
+from tests.protocol.mav_client import free_udp_port
+from tests.sim.sim_run import finish, start_sim
+from tests.sitl.test_failsafes import PLAN, Station
 
 WATCHED = ["HEARTBEAT", "STATUSTEXT", "MISSION_CURRENT", "COMMAND_ACK", "SYS_STATUS",
            "BATTERY_STATUS"]  # fmt: skip
@@ -27,6 +31,23 @@ SENSORS = {
     "GPS": d.MAV_SYS_STATUS_SENSOR_GPS,
     "battery": d.MAV_SYS_STATUS_SENSOR_BATTERY,
 }
+
+
+@contextmanager
+def flying(tmp_path) -> Iterator[Station]:
+    """``companion sim`` with the square plan, a station on its link; the simulation is
+    stopped and checked clean afterwards (its flight log closed), whatever the test did."""
+    port = free_udp_port()
+    station = Station(f"udpin:127.0.0.1:{port}")
+    proc, namespace, _truth = start_sim(
+        tmp_path, f"udpout://127.0.0.1:{port}", "--plan", PLAN, "--duration", "1500"
+    )
+    try:
+        yield station
+    finally:
+        proc.terminate()
+        finish(proc, namespace, 60)
+        station.conn.close()
 
 
 class BatteryStation(Station):

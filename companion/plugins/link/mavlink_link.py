@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from companion.control.device_watch import DeviceWatch
+from companion.control.device_watch import RC_RECEIVER, DeviceWatch
 from companion.control.mission.mission_files import MissionStore
 from companion.control.modes import INITIAL_MODE
 from companion.control.prearm import PREARM_PARAMS, Readiness, failures
@@ -356,10 +356,13 @@ class MavlinkLink(Plugin):
         mode = INITIAL_MODE
         if snap.status is not None and snap.status.mode in FlightMode._value2member_map_:
             mode = FlightMode(snap.status.mode)
-        items = self.missions.store.items
+        items, now = self.missions.store.items, self.ctx.clock.now_us()
+        # A joystick flying the aircraft stands in for a silent RC receiver (PX4's "RC and
+        # Joystick with fallback"); without one the receiver must speak.
+        devices = self.devices.failures(excused=(RC_RECEIVER,) if self.manual.flying(now) else ())
         r = Readiness(
-            now_us=self.ctx.clock.now_us(), nav=snap.nav, gps=snap.gps, imu=snap.imu, mode=mode,
-            mag=snap.mag, compass=snap.compass, baro=snap.baro, devices=self.devices.failures(),
+            now_us=now, nav=snap.nav, gps=snap.gps, imu=snap.imu, mode=mode,
+            mag=snap.mag, compass=snap.compass, baro=snap.baro, devices=devices,
             mission=items[d.MAV_MISSION_TYPE_MISSION], fence=items[d.MAV_MISSION_TYPE_FENCE],
         )  # fmt: skip
         return failures(r, self.store.values, self.missions.verdicts)

@@ -41,7 +41,8 @@ def test_healthy_devices_pass_and_only_device_plugins_running_now_are_judged():
 
 
 def test_a_silent_device_is_named_once_the_window_is_covered():
-    assert watch_over(2, {"gps": (400, 5, 0)}).failures() == []  # not 3 s yet: no verdict
+    young = watch_over(2, {"gps": (400, 5, 0)}).failures()  # not 3 s yet: heard or not
+    assert young == ["compass: waiting for data from its device"]
     assert watch_over(3, {"gps": (400, 5, 0)}).failures() == ["compass: no data from its device"]
 
 
@@ -60,7 +61,17 @@ def test_a_device_that_fell_silent_is_named_and_a_restarted_plugin_is_judged_afr
         watch.update(table(t, {"gps": (400 * t, 5 * t, 0), "compass": (3000, 100, 0)}))
     assert watch.failures() == ["compass: no data from its device"]
     watch.update(table(10, {"gps": (4000, 50, 0)}, pid=200))  # every plug-in restarted
-    assert watch.failures() == []
+    assert watch.failures() == ["compass: waiting for data from its device"]
+    watch.update(table(11, {"gps": (4400, 55, 0), "compass": (60, 1, 0)}, pid=200))
+    assert watch.failures() == []  # one good frame from the new process: no verdict yet
+
+
+def test_an_excused_kind_is_not_judged_silent_or_waiting():
+    # The link excuses the RC receiver while a ground station's joystick flies.
+    assert watch_over(2, {"gps": (400, 5, 0)}).failures(excused=("sensors.os3000",)) == []
+    silent = watch_over(4, {"gps": (400, 5, 0)})
+    assert silent.failures(excused=("sensors.os3000",)) == []
+    assert silent.failures() == ["compass: no data from its device"]
 
 
 def test_the_same_table_twice_counts_once_and_the_reason_reaches_prearm():
