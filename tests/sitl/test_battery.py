@@ -9,16 +9,12 @@ off and on with MAV_CMD_INJECT_FAILURE, and brings the pack's charge under BATT_
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 
 import pytest
 from pyulog import ULog
 
 from companion.messages import FlightMode
 from mavlink_dialect import companion as d
-from tests.protocol.mav_client import free_udp_port
-from tests.sim.sim_run import finish, start_sim
 from tests.sitl.test_failsafes import PLAN, Station
 
 WATCHED = ["HEARTBEAT", "STATUSTEXT", "MISSION_CURRENT", "COMMAND_ACK", "SYS_STATUS",
@@ -33,21 +29,7 @@ SENSORS = {
 }
 
 
-@contextmanager
-def flying(tmp_path) -> Iterator[Station]:
-    """``companion sim`` with the square plan, a station on its link; the simulation is
-    stopped and checked clean afterwards (its flight log closed), whatever the test did."""
-    port = free_udp_port()
-    station = Station(f"udpin:127.0.0.1:{port}")
-    proc, namespace, _truth = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--plan", PLAN, "--duration", "1500"
-    )
-    try:
-        yield station
-    finally:
-        proc.terminate()
-        finish(proc, namespace, 60)
-        station.conn.close()
+pytestmark = pytest.mark.vehicle(plan=PLAN, duration=1500)
 
 
 class BatteryStation(Station):
@@ -94,10 +76,10 @@ class BatteryStation(Station):
 
 
 @pytest.mark.timeout(300)
-def test_battery_and_sensors_are_shown_true_and_low_battery_returns_home(tmp_path):
+def test_battery_and_sensors_are_shown_true_and_low_battery_returns_home(sim):
     unit, off, ok = d.FAILURE_UNIT_SYSTEM_BATTERY, d.FAILURE_TYPE_OFF, d.FAILURE_TYPE_OK
-    with flying(tmp_path) as plain:
-        station = BatteryStation(plain)
+    station = BatteryStation(Station(sim.pymavlink_url))
+    try:
         every = sum(SENSORS.values())
         station.until(lambda: station.healthy(every), 60, "every sensor healthy")
         status = station.sys_status
@@ -135,8 +117,11 @@ def test_battery_and_sensors_are_shown_true_and_low_battery_returns_home(tmp_pat
         station.until(
             lambda: station.battery.charge_state == d.MAV_BATTERY_CHARGE_STATE_LOW, 10, "LOW"
         )
+    finally:
+        station.conn.close()
+    sim.close()  # stopped as at a terminal: the flight log is closed (and checked clean)
     # The flight log (one ULog per arming) records the gauge beside the other sensors.
-    (log,) = (tmp_path / "state" / "logs").glob("*_armed.ulg")
+    (log,) = (sim.state_dir / "logs").glob("*_armed.ulg")
     battery = ULog(str(log), ["sensors_battery"]).data_list[0].data
     assert battery["voltage_v"].max() > 11.5 and battery["current_a"].max() > 5.0
     assert battery["consumed_mah"][-1] > 10.0 and battery["level"][-1] == 1  # LOW
