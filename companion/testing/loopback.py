@@ -27,7 +27,6 @@ from companion.testing.watcher import PREARM, VehicleError, Watcher
 from mavlink_dialect import companion as d
 
 START_S = 120.0  # wall seconds for a vehicle to answer: a busy machine imports slowly
-READY_HOLD_S = 4.0  # vehicle seconds: longer than the pre-arm's device window (3 s)
 FORCE_DISARM = 21196  # MAV_CMD_COMPONENT_ARM_DISARM's param 2: disarm even in the air
 
 
@@ -136,23 +135,17 @@ class LoopbackVehicle:
         return self._watcher
 
     def wait_ready(self, timeout_s: float = 180.0) -> None:
-        """Until SYS_STATUS says the pre-arm checks pass (QGroundControl's Ready To Fly),
-        and has said so for READY_HOLD_S of the vehicle clock: just after a start the bit
-        may be set before the vehicle has judged its devices (it waits three seconds for
-        each to speak), and an arm at that moment was refused ("PreArm: range: no data
-        from its device") 20 ms after the bit said ready."""
-        w = self.watcher
-        since: list[float] = []  # the vehicle time the bit was first seen set, unbroken
-
-        def ready(m: object) -> bool:
-            if m.get_type() == "SYS_STATUS":  # type: ignore[attr-defined]
-                if not m.onboard_control_sensors_health & PREARM:  # type: ignore[attr-defined]
-                    since.clear()
-                elif not since:
-                    since.append(w.time_boot_s)
-            return bool(since) and w.time_boot_s - since[0] >= READY_HOLD_S
-
-        w.until(ready, timeout_s, "pre-arm checks passed (SYS_STATUS)")
+        """Until SYS_STATUS says the pre-arm checks pass (QGroundControl's Ready To Fly).
+        The vehicle sets that bit only once every device has spoken, so an arm right
+        after it is not refused for a device that has not been judged yet."""
+        self.watcher.until(
+            lambda m: (
+                m.get_type() == "SYS_STATUS"  # type: ignore[attr-defined]
+                and bool(m.onboard_control_sensors_health & PREARM)
+            ),  # type: ignore[attr-defined]
+            timeout_s,
+            "pre-arm checks passed (SYS_STATUS)",
+        )
 
     def upload_plan(self, plan: str | Path) -> dict[int, int]:
         """Upload a QGroundControl .plan (mission, fence, rally); item count per type."""
