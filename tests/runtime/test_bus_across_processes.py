@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from companion.bus.namespace import cleanup_namespace
+from companion.bus.namespace import cleanup_namespace, prefix_of
 from companion.bus.node import BusNode
 from companion.messages import Imu, Magnetometer, NavState
 from tests.support.configs import PUBLISH_ONCE, plugin, vehicle_config
@@ -225,7 +225,9 @@ def test_a_killed_processs_node_leaves_no_directory_behind(namespace):
         [sys.executable, "-c", code, namespace], cwd=REPO, stdout=subprocess.PIPE, text=True
     )
     assert proc.stdout is not None and proc.stdout.readline() == "up\n"
-    created = set(nodes.iterdir()) - before
+    # Only this namespace's: other vehicles on the machine make and remove nodes meanwhile.
+    ours = prefix_of(namespace)
+    created = {d for d in set(nodes.iterdir()) - before if any(_named(d, ours))}
     assert created, "the node made its directory"
     proc.kill()
     proc.wait()
@@ -233,3 +235,11 @@ def test_a_killed_processs_node_leaves_no_directory_behind(namespace):
     assert_clean(namespace)
     left = [d for d in created if d.exists() and (not d.is_dir() or not any(d.iterdir()))]
     assert left == [], left
+
+
+def _named(directory: Path, prefix: str) -> list[Path]:
+    """The files in a node's directory whose names start with ``prefix``."""
+    try:
+        return [f for f in directory.iterdir() if f.name.startswith(prefix)]
+    except OSError:  # not a directory, or another vehicle's node gone since the listing
+        return []
