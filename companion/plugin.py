@@ -136,6 +136,11 @@ class PluginContext:
         return self.supervisor_pid is not None and os.getppid() != self.supervisor_pid
 
 
+# Raising a priority needs CAP_SYS_NICE (root, or the service unit's capability); without
+# it a plug-in runs at the supervisor's (companion.exec_control.priority).
+FLIGHT_NICE = -5
+
+
 class Plugin(ABC):
     """Base class of every plug-in.
 
@@ -153,6 +158,11 @@ class Plugin(ABC):
     # (the link serves them, the flight logger records them). Other plug-ins get them
     # empty: parsing them cost each plug-in process ~1 MB of its own memory.
     wants_vehicle_tables: ClassVar[bool] = False
+    # The Linux nice value its process asks for (the config's ``nice`` overrides it). The
+    # IMU -> navigator -> controller -> servos chain and the pilot's receiver ask for
+    # FLIGHT_NICE: on a board short of CPU the link, the flight log and the slower sensors
+    # give way to them, not the other way round. Other work on the board keeps nice 0.
+    nice: ClassVar[int] = 0
 
     @classmethod
     def ports(cls, settings: Mapping[str, Any]) -> Ports:

@@ -147,7 +147,13 @@ class Child:
 
 
 def _spec_dict(spec: PluginSpec) -> dict[str, Any]:
-    return {"name": spec.name, "kind": spec.kind, "group": spec.group, "settings": spec.settings}
+    return {
+        "name": spec.name,
+        "kind": spec.kind,
+        "group": spec.group,
+        "settings": spec.settings,
+        "nice": spec.nice,
+    }
 
 
 def _describe(code: int) -> str:

@@ -30,6 +30,7 @@ from companion.bus.node import BusNode
 from companion.bus.patterns import Writer
 from companion.exec_control.backoff import MAX_BACKOFF_S, SECOND_BACKOFF_S, STABLE_AFTER_S
 from companion.exec_control.plugin_host import EXIT_INIT_FAILED, PluginHost, _signal_pipe
+from companion.exec_control.priority import apply_nice
 from companion.exec_control.registry import load
 from companion.messages import PluginStats
 
@@ -60,6 +61,7 @@ class Member:
 
     def run(self) -> None:
         """The thread: run the plug-in, and again after each failure, until stopped."""
+        apply_nice(self.name, self.spec.get("nice", 0))  # this thread's own
         with BusNode(self.spec["namespace"], f"{self.name}_stats") as node:
             self.loop(node.writer("system/plugin_stats"))
 

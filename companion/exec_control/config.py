@@ -20,6 +20,7 @@ from companion.bus.namespace import default_namespace, validate_namespace
 from companion.exec_control.composition import check_processes, process_name
 from companion.exec_control.config_locator import KeyPath, line_of, locate
 from companion.exec_control.plugin_spec import PluginSpec
+from companion.exec_control.priority import NICE_MAX, NICE_MIN
 from companion.exec_control.registry import PluginLoadError, load
 from companion.plugin import Plugin, Setting
 
@@ -80,7 +81,7 @@ _FLEET_KEYS: dict[str, Setting] = {
     ),
 }
 _TABLES = ["vehicle", "plugins", "fleet"]
-_PLUGIN_KEYS = ("name", "plugin", "group", "settings", "process")
+_PLUGIN_KEYS = ("name", "plugin", "group", "settings", "process", "nice")
 # Settings that belong to the whole vehicle: once a plug-in setting each, now named once in
 # [vehicle], so two plug-ins can never disagree (the J3Cub's gains on the Cessna's servos).
 _VEHICLE_WIDE = ("airframe",)
@@ -297,7 +298,19 @@ def _plugin_spec(
         line=line_of(check.lines, where),
         params=cls.param_decls(settings, vehicle),
         process=process_name(check.error, entry, where),
+        nice=_nice(check, entry.get("nice", cls.nice), where),
     )
+
+
+def _nice(check: _Checker, value: Any, where: KeyPath) -> int:
+    """The entry's nice value (its class's unless the entry gives one), checked."""
+    if isinstance(value, bool) or not isinstance(value, int) or not NICE_MIN <= value <= NICE_MAX:
+        raise check.error(
+            (*where, "nice"),
+            f"nice {value!r} must be a whole number from {NICE_MIN} (first when the CPU is"
+            f" short) to {NICE_MAX} (last)",
+        )
+    return value
 
 
 def _refuse_vehicle_wide(check: _Checker, settings: dict[str, Any], where: KeyPath) -> None:

@@ -20,3 +20,4 @@ class PluginSpec:
     line: int | None = None
     params: tuple[Any, ...] = ()  # the plug-in class's ParamDecl declarations
     process: str = ""  # the OS process it shares with others ("": a process of its own)
+    nice: int = 0  # the Linux nice value it asks for (companion.exec_control.priority)

@@ -58,6 +58,8 @@ Wants=network-online.target
 Type=exec
 User={spec.user}
 SupplementaryGroups=dialout
+# The flight chain's plug-ins raise their priority (companion.exec_control.priority).
+AmbientCapabilities=CAP_SYS_NICE
 ExecStart={shlex.join(run)}
 KillMode=mixed
 KillSignal=SIGTERM

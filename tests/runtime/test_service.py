@@ -59,6 +59,7 @@ def test_install_writes_a_unit_that_systemd_verifies_and_uninstall_removes_it(tm
     unit = root / "etc/systemd/system/companion.service"
     v = unit_values(unit.read_text())
     assert v["User"] == [USER] and v["SupplementaryGroups"] == ["dialout"]
+    assert v["AmbientCapabilities"] == ["CAP_SYS_NICE"]  # the flight chain's priority
     assert v["Restart"] == ["on-failure"] and v["RestartPreventExitStatus"] == ["2"]
     assert v["KillMode"] == ["mixed"] and v["KillSignal"] == ["SIGTERM"]  # the supervisor's
     assert v["StateDirectory"] == ["companion"]  # /var/lib/companion

@@ -35,6 +35,7 @@ class PluginEntry:
     group: str | None = None
     settings: dict[str, Any] = field(default_factory=dict)
     process: str | None = None  # the OS process it shares with others
+    nice: int | None = None  # the scheduling priority it asks for
 
     def toml(self) -> str:
         """The table as TOML lines."""
@@ -43,6 +44,8 @@ class PluginEntry:
             lines.append(f"group = {_value(self.group)}")
         if self.process is not None:
             lines.append(f"process = {_value(self.process)}")
+        if self.nice is not None:
+            lines.append(f"nice = {_value(self.nice)}")
         if self.settings:
             lines.append(f"settings = {_value(self.settings)}")
         return "\n".join(lines) + "\n"

@@ -17,7 +17,7 @@ from typing import Any
 from companion.actuators import minissc
 from companion.actuators.airframe import Airframe, load_airframe
 from companion.messages import ActuatorCommand, ServoOutput
-from companion.plugin import NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
+from companion.plugin import FLIGHT_NICE, NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
 from companion.sensors.serial_port import ReopeningSerial, open_problem
 
 WAIT_S = 0.1  # also the refresh cadence when no command arrives
@@ -39,6 +39,8 @@ def surface_value(cmd: ActuatorCommand, surface: str) -> float:
 
 class MiniSscOutput(Plugin):
     """Writes changed channels first, never more than one cycle of frames ahead of the wire."""
+
+    nice = FLIGHT_NICE
 
     settings = {
         "device": Setting(str, doc="serial:///dev/ttyS1:9600, a pty path or a pyserial URL"),

@@ -34,7 +34,7 @@ from companion.messages import (
 )
 from companion.params import ParamDecl
 from companion.params.live import LiveParams
-from companion.plugin import NO_VEHICLE, Plugin, PluginContext, Setting
+from companion.plugin import FLIGHT_NICE, NO_VEHICLE, Plugin, PluginContext, Setting
 from mavlink_dialect import companion as d
 
 WAIT_S = 0.5
@@ -45,6 +45,8 @@ STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item 
 
 class FixedWingPlugin(Plugin):
     """Guidance, energy and attitude control for one airframe."""
+
+    nice = FLIGHT_NICE
 
     # The airframe (gains, limits, speeds as parameter defaults) is the vehicle's:
     # [vehicle] airframe, the same file the servo output and the flight log read.

@@ -9,13 +9,15 @@ from __future__ import annotations
 
 from companion.messages import Compass, GpsFix
 from companion.navigation.gps_compass import GpsCompassNavigator
-from companion.plugin import Plugin, PluginContext
+from companion.plugin import FLIGHT_NICE, Plugin, PluginContext
 
 WAIT_S = 0.5
 
 
 class GpsCompassPlugin(Plugin):
     """GPS for position and velocity, the compass for attitude."""
+
+    nice = FLIGHT_NICE
 
     inputs = ("sensors/gps", "sensors/compass")
     outputs = ("nav/state",)

@@ -16,7 +16,7 @@ from companion.navigation.ins_ekf import InsEkfConfig
 from companion.navigation.ins_warm import WarmFile, warm_state
 from companion.navigation.offline import InsEkfRunner
 from companion.navigation.sample_order import FEED_ORDER, PublishGrid, SampleOrder
-from companion.plugin import Plugin, PluginContext, Setting
+from companion.plugin import FLIGHT_NICE, Plugin, PluginContext, Setting
 
 WAIT_S = 1.0  # without an IMU: its status, and any aiding samples, once a second
 _DEFAULTS = InsEkfConfig()
@@ -24,6 +24,8 @@ _DEFAULTS = InsEkfConfig()
 
 class InsEkfPlugin(Plugin):
     """IMU-driven navigation aided by GPS and a heading."""
+
+    nice = FLIGHT_NICE
 
     settings = {
         "publish_hz": Setting(float, 50.0, "nav/state rate, in vehicle time", min=1.0, max=400),

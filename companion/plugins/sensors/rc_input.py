@@ -24,7 +24,7 @@ import serial
 
 from companion.messages import RC_MAX_CHANNELS, PilotFlags, PilotInput, PilotSource
 from companion.params.live import LiveParams
-from companion.plugin import NO_VEHICLE, DeviceProbe, Plugin, PluginContext
+from companion.plugin import FLIGHT_NICE, NO_VEHICLE, DeviceProbe, Plugin, PluginContext
 from companion.plugins.sensors.serial_sensor import serial_settings
 from companion.sensors.rc_channels import RC_PARAMS, StickMap
 from companion.sensors.sbus import SbusDecoder, SbusFrame, SbusStream
@@ -38,6 +38,8 @@ _THROTTLE_LOW = int(PilotFlags.THROTTLE_LOW)
 
 class RcInput(Plugin):
     """Publishes the pilot's sticks and mode switch from every SBUS frame."""
+
+    nice = FLIGHT_NICE
 
     settings = serial_settings("serial:///dev/ttyAMA0:100000", 100000, 70.0)
     params = RC_PARAMS

@@ -15,12 +15,14 @@ from typing import Any
 
 from companion.messages import Message
 from companion.navigation.offline import true_headings
-from companion.plugin import NO_VEHICLE, Plugin, PluginContext, Setting
+from companion.plugin import FLIGHT_NICE, NO_VEHICLE, Plugin, PluginContext, Setting
 from companion.sensors.sensorlog import CHANNEL_OF, LogStats, read_sensor_log
 
 
 class ReplaySensors(Plugin):
     """Publishes a sensor log's samples on sensors/imu, gps, mag, baro and compass."""
+
+    nice = FLIGHT_NICE
 
     settings = {
         "file": Setting(str, doc="sensor log CSV (the design's format)"),

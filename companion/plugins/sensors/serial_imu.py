@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 from companion.messages import Baro
 from companion.params.live import LiveParams
-from companion.plugin import PluginContext, Ports, Setting
+from companion.plugin import FLIGHT_NICE, PluginContext, Ports, Setting
 from companion.plugins.sensors.serial_sensor import SerialSensor, serial_settings
 from companion.sensors.barometer import pressure_altitude_m
 from companion.sensors.imu_calibration import IMU_CAL_PARAMS, ImuCalibration
@@ -32,6 +32,8 @@ PARAMS_EVERY_US = 100_000  # a calibration's new values are looked for this ofte
 class SerialImu(SerialSensor[VectorNavReading]):
     """Publishes every IMU sample on sensors/imu, its magnetometer on sensors/mag and its
     pressure (as height above the first reading) on sensors/baro."""
+
+    nice = FLIGHT_NICE
 
     settings = {
         **serial_settings("serial:///dev/ttyUSB1:115200", 115200, 40.0),

@@ -1,0 +1,101 @@
+"""When the CPU is short the flight chain goes first: each plug-in's process (or, composed,
+its thread) runs at the nice value its class or its config entry asks for."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import psutil
+import pytest
+
+from companion.exec_control.config import ConfigError, load_config
+from companion.plugin import FLIGHT_NICE
+from tests.support.configs import RELAY, TICKER, WAITING, plugin, vehicle_config
+from tests.support.vehicle import REPO, wait_for
+
+# A raise needs CAP_SYS_NICE; without it the plug-in stays at the supervisor's priority.
+CAN_RAISE = os.geteuid() == 0
+
+
+def expected(nice: int) -> int:
+    return nice if nice >= 0 or CAN_RAISE else 0
+
+
+def entries() -> list:
+    return [
+        replace(plugin("imu", TICKER, rate_hz=50.0), nice=FLIGHT_NICE),
+        plugin("relay", RELAY),  # the test plug-in's class asks for nothing
+        replace(plugin("idle", WAITING), nice=10),
+    ]
+
+
+def thread_nices(pid: int) -> list[int]:
+    """The nice value of every thread of a process (field 19 of /proc/PID/task/TID/stat)."""
+    out = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        stat = (task / "stat").read_text()
+        out.append(int(stat[stat.rindex(")") + 2 :].split()[16]))
+    return out
+
+
+def test_each_plugin_process_runs_at_its_nice_value(vehicle_factory):
+    vehicle = vehicle_factory(vehicle_config("prio", *entries()))
+    pids = {name: vehicle.wait_running(name) for name in ("imu", "relay", "idle")}
+    nices = {name: psutil.Process(pid).nice() for name, pid in pids.items()}
+    assert nices == {"imu": expected(FLIGHT_NICE), "relay": 0, "idle": 10}
+    assert psutil.Process(vehicle.proc.pid).nice() == 0  # the supervisor keeps its own
+
+
+def test_composed_plugins_keep_their_own_nice_values_on_their_threads(vehicle_factory):
+    composed = [replace(e, process="core") for e in entries()]
+    vehicle = vehicle_factory(vehicle_config("prio", *composed))
+    pid = vehicle.wait_running("imu")
+    # The main thread (which only waits for signals) and the relay's stay at 0.
+    wanted = sorted([expected(FLIGHT_NICE), 0, 10])
+    wait_for(lambda: set(wanted) <= set(thread_nices(pid)), 10, "the threads' priorities")
+    assert expected(FLIGHT_NICE) in thread_nices(pid) and 10 in thread_nices(pid)
+
+
+def test_a_raise_refused_by_the_system_leaves_the_plugin_running_at_its_parents():
+    """As an unprivileged user without CAP_SYS_NICE (a service unit that grants none)."""
+    code = (
+        "import logging, os\n"
+        "from companion.exec_control.priority import apply_nice\n"
+        "logging.basicConfig(level=logging.INFO)\n"
+        # Imported first: the nobody user cannot read the interpreter's files here.
+        + ("os.setgid(65534); os.setuid(65534)\n" if CAN_RAISE else "")
+        + "print(apply_nice('imu', -5), apply_nice('logger', 3))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["0", "3"]
+    assert "needs CAP_SYS_NICE" in done.stderr
+
+
+def test_flight_chain_classes_ask_for_the_flight_priority_and_a_config_can_override(tmp_path):
+    path = tmp_path / "v.toml"
+    path.write_text(
+        vehicle_config(
+            "v",
+            plugin("imu", "sensors.serial_imu", device="/dev/null"),
+            replace(plugin("link", "link.mavlink"), nice=0),
+            replace(plugin("log", "system.logger"), nice=12),
+        )
+    )
+    nice = {spec.name: spec.nice for spec in load_config(path).plugins}
+    assert nice == {"imu": FLIGHT_NICE, "link": 0, "log": 12}
+
+
+@pytest.mark.parametrize("bad", [25, -21, "high", 1.5, True])
+def test_a_nice_value_out_of_range_is_refused_with_its_line(tmp_path, bad):
+    path = tmp_path / "bad.toml"
+    path.write_text(vehicle_config("v", replace(plugin("imu", TICKER, rate_hz=5.0), nice=bad)))
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    assert "nice" in str(info.value) and "-20" in str(info.value)
