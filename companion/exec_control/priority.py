@@ -11,25 +11,57 @@ from __future__ import annotations
 
 import logging
 import os
+import resource
+from collections.abc import Iterable
+from typing import Protocol
 
 NICE_MIN, NICE_MAX = -20, 19
+_CAP_SYS_NICE = 23  # the capability's bit in /proc/PID/status CapEff
 
 log = logging.getLogger("companion.priority")
+
+
+class HasNice(Protocol):
+    name: str
+    nice: int
+
+
+def can_raise(by: int) -> bool:
+    """Whether this process may lower its nice value by ``by`` steps: root, CAP_SYS_NICE,
+    or an RLIMIT_NICE that reaches that far."""
+    if os.geteuid() == 0:
+        return True
+    try:
+        with open("/proc/self/status") as status:
+            caps = next(ln.split()[1] for ln in status if ln.startswith("CapEff:"))
+        if int(caps, 16) >> _CAP_SYS_NICE & 1:
+            return True
+    except (OSError, StopIteration, ValueError):
+        pass
+    soft, _hard = resource.getrlimit(resource.RLIMIT_NICE)
+    lowest = 20 - soft if soft != resource.RLIM_INFINITY else NICE_MIN
+    return lowest <= os.nice(0) - by
+
+
+def note_refused_raises(specs: Iterable[HasNice]) -> None:
+    """Say once, for the whole vehicle, when the flight chain cannot be put first."""
+    raised = [s for s in specs if s.nice < 0]
+    if raised and not can_raise(max(-s.nice for s in raised)):
+        log.info(
+            "%s run at the same priority as the rest: raising it needs CAP_SYS_NICE"
+            " (root, or the service unit's AmbientCapabilities)",
+            ", ".join(s.name for s in raised),
+        )
 
 
 def apply_nice(name: str, nice: int) -> int:
     """Move the calling thread ``nice`` steps from the supervisor's priority (threads it
     starts afterwards inherit it); the nice value it runs at. A raise the system refuses
-    (it needs CAP_SYS_NICE: root, or the service unit's capability) leaves it where it is."""
+    leaves it where it is (the supervisor has said so: ``note_refused_raises``)."""
     if nice == 0:
         return os.nice(0)
     try:
         return os.nice(nice)
     except PermissionError:
-        log.info(
-            "%s runs at the supervisor's priority: nice %+d needs CAP_SYS_NICE"
-            " (root, or the service unit's AmbientCapabilities)",
-            name,
-            nice,
-        )
+        log.debug("%s: nice %+d refused", name, nice)
         return os.nice(0)

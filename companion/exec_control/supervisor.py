@@ -21,6 +21,7 @@ from companion.exec_control.child import FIRST_BACKOFF_S, Child
 from companion.exec_control.composed_child import ComposedChild
 from companion.exec_control.composition import processes
 from companion.exec_control.config import VehicleConfig
+from companion.exec_control.priority import note_refused_raises
 from companion.exec_control.registry import load
 from companion.exec_control.zygote import READY_TIMEOUT_S, ForkServer, become_subreaper
 from companion.messages import (
@@ -193,6 +194,7 @@ class Supervisor:
             if self.forker.proc is None:
                 self.forker.start()
         cleanup_namespace(self.cfg.namespace)  # leftovers of a crashed earlier run
+        note_refused_raises(self.cfg.plugins)
         bus = BusNode(self.cfg.namespace, "exec_control")
         try:
             self._loop(bus)
