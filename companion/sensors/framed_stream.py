@@ -11,7 +11,7 @@ from typing import Generic, TypeVar
 
 from companion.sensors.codec_types import Framer, SentenceDecoder
 
-__all__ = ["FramedStream", "Framer", "SentenceDecoder"]
+__all__ = ["FramedStream", "Framer", "SentenceDecoder", "spread_stamps"]
 
 ReadingT = TypeVar("ReadingT")
 
@@ -32,6 +32,21 @@ class FramedStream(Generic[ReadingT]):
                 readings.append(reading)
         return readings
 
+    def feed_spaced(
+        self, data: bytes, t_us: int, since_us: int | None, period_us: float
+    ) -> list[tuple[ReadingT, int]]:
+        """As ``feed`` for a device that sends one frame per sample, every ``period_us``:
+        the readings with each frame's own time (``spread_stamps``), not the read's."""
+        sentences = self.framer.feed(data)
+        out = []
+        for sentence, t in zip(
+            sentences, spread_stamps(len(sentences), t_us, since_us, period_us), strict=True
+        ):
+            reading = self.decoder.decode(sentence, t)
+            if reading is not None:
+                out.append((reading, t))
+        return out
+
     @property
     def frames_ok(self) -> int:
         """Sentences or frames the decoder accepted."""
@@ -42,3 +57,22 @@ class FramedStream(Generic[ReadingT]):
         """Bad checksums, undecodable sentences and stretches of garbage."""
         c = self.decoder.counters
         return c.bad_checksum + c.garbage + self.framer.rejected
+
+
+def spread_stamps(n: int, t_us: int, since_us: int | None, period_us: float) -> list[int]:
+    """When the ``n`` frames one read completed were sent: the last at the read's ``t_us``,
+    each earlier one a device period before the next, and all after the previous read
+    (``since_us``), which had found none of them.
+
+    A reader that fell behind (a busy board) finds several samples of a periodic device
+    waiting; stamped alike, a navigator would take all but one as no time passing.
+    """
+    if n <= 1:
+        return [t_us] * n
+    step = period_us if period_us > 0 else float("inf")
+    if since_us is not None:
+        step = min(step, (t_us - since_us) / n)
+    if step == float("inf"):
+        step = 0.0
+    step = max(step, 0.0)
+    return [t_us - round((n - 1 - i) * step) for i in range(n)]

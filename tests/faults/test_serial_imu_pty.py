@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import pytest
 
 from tests.support.configs import plugin, vehicle_config
@@ -69,3 +71,26 @@ def test_the_imu_is_reopened_after_it_vanishes(vehicle_factory, tmp_path):
     wait_for(lambda: pty.write(GOOD) or imu.take(0.2), 20, "samples after the reopen")
     assert vehicle.row("imu").restarts == 0
     pty.vanish()
+
+
+@pytest.mark.timeout(60)
+def test_samples_found_together_keep_their_own_times(vehicle_factory, tmp_path):
+    """A driver that reads late (a busy board) finds several samples waiting: each gets
+    its own time, so the navigator integrates every one of them."""
+    pty = Pty(tmp_path / "ttyImu")
+    vehicle = imu_vehicle(vehicle_factory, pty)
+    imu = vehicle.bus.queue_reader("sensors/imu")
+    vehicle.wait_running("imu")
+    got: list = []
+
+    def burst() -> bool:  # four samples in one write: the driver finds them together
+        pty.write(GOOD * 4)
+        got.extend(imu.take(0.3))
+        return len(got) >= 8
+
+    wait_for(burst, 15, "IMU samples")
+    stamps = [s.t_us for s in got]
+    assert stamps == sorted(stamps) and len(set(stamps)) == len(stamps), stamps
+    # No more than the configured period (40 Hz: 25 ms) apart within a burst.
+    gaps = [b - a for a, b in itertools.pairwise(stamps)]
+    assert min(gaps) <= 25_000, gaps

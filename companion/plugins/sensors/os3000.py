@@ -14,6 +14,8 @@ from companion.sensors.os3000 import Os3000Decoder, Os3000Reading
 class Os3000Compass(SerialSensor[Os3000Reading]):
     """Publishes compass attitude, and magnetometer readings when the sentence has them."""
 
+    periodic_frames = True
+
     settings = {
         **serial_settings("serial:///dev/ttyS0:19200", 19200, 20.0),
         "mag_unit_gauss": Setting(float, 1e-3, "gauss per unit of the Mx/My/Mz fields", min=0.0),

@@ -33,6 +33,8 @@ RANGEFINDER_PARAMS = (
 class Rangefinder(SerialSensor[RangeSample]):
     """Publishes each lidar frame on sensors/range."""
 
+    periodic_frames = True
+
     settings = serial_settings("serial:///dev/ttyAMA2:115200", 115200, 100.0)
     params = RANGEFINDER_PARAMS
     optional_inputs = ("params/changes",)

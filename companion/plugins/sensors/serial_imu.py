@@ -33,6 +33,8 @@ class SerialImu(SerialSensor[VectorNavReading]):
     """Publishes every IMU sample on sensors/imu, its magnetometer on sensors/mag and its
     pressure (as height above the first reading) on sensors/baro."""
 
+    periodic_frames = True
+
     nice = FLIGHT_NICE
 
     settings = {

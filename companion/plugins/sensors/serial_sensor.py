@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from abc import abstractmethod
 from collections.abc import Mapping
-from typing import Any, Generic, TypeVar
+from typing import Any, ClassVar, Generic, TypeVar
 
 from companion.plugin import NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
 from companion.sensors.codec_types import Framer, SentenceDecoder
@@ -39,6 +39,10 @@ class SerialSensor(Plugin, Generic[ReadingT]):
     """A sensor that sends text lines on a serial port (or pty, socket, loop)."""
 
     decoder: SentenceDecoder[ReadingT]
+    # One frame per sample, sent every 1/rate_hz (an IMU, not a GPS's several sentences a
+    # fix): frames a late read finds together are stamped a period apart, not alike.
+    periodic_frames: ClassVar[bool] = False
+    _last_read_us: int | None = None
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
@@ -75,8 +79,16 @@ class SerialSensor(Plugin, Generic[ReadingT]):
     def step(self) -> None:
         with self.ctx.bus.idle:  # waiting for the device is not busy time
             data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
-        for reading in self.stream.feed(data, t_us):
-            self.publish(reading, t_us)
+        if self.periodic_frames:
+            period_us = 1e6 / rate if (rate := self.ctx.settings["rate_hz"]) > 0 else 0.0
+            stamped = self.stream.feed_spaced(data, t_us, self._last_read_us, period_us)
+            if data:
+                self._last_read_us = t_us
+            for reading, t in stamped:
+                self.publish(reading, t)
+        else:
+            for reading in self.stream.feed(data, t_us):
+                self.publish(reading, t_us)
         health = self.ctx.health
         health.frames_ok, health.frames_bad = self.stream.frames_ok, self.stream.frames_bad
         health.bytes_in = self.port.bytes_in
