@@ -36,7 +36,7 @@ KILL_FROM_S, KILL_EVERY_S = 35.0, 3.0
 BACK_AFTER_S = 30.0  # armed in Mission again after the supervisor's kill, at most
 SAFE_HEIGHT_M = 20.0  # lowest height after it (the mission flies at 80 m)
 # Left alone on trimmed surfaces for longer than this, the aircraft may spiral down before
-# the vehicle is back (HIL runs: 5.6-9.2 s back at load 14-15, never lower than 77.7 m).
+# the vehicle is back (HIL runs: back in 5.6-9.2 s at load 14-15, never lower than 77.7 m).
 UNATTENDED_S = 12.0
 
 
