@@ -1,5 +1,5 @@
-"""``python -m companion`` runs the command line."""
+"""``python -m companion`` runs the command line (``launch``: a plain ``run`` at once)."""
 
-from companion.cli import main
+from companion.launch import main
 
 main()

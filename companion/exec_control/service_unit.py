@@ -11,6 +11,11 @@ What each line is for:
 - ``Restart=on-failure``: a supervisor that dies or exits non-zero is started again; a
   clean stop (``systemctl stop``, exit status 0) is not. A refused config (exit status 2)
   would only fail again, so it is not restarted (``RestartPreventExitStatus``).
+- ``RestartSec=100ms``: at once. A supervisor that dies in the air must be back flying
+  within 3 s (its plug-ins die with it; the card holds the servos meanwhile), and the
+  restart itself takes most of that on a slow board: the 2 s this unit used to wait were
+  most of the budget. ``StartLimitIntervalSec=0``: never give up (systemd's default stops
+  restarting after 5 starts in 10 s, which an aircraft in the air cannot afford).
 - ``StateDirectory=companion``: systemd makes ``/var/lib/companion``, owned by the user;
   ``COMPANION_STATE_DIR`` points the config's default state directory there (parameters,
   missions, flight logs: ``/var/lib/companion/NAME/NAMESPACE``).
@@ -53,6 +58,7 @@ def unit_text(spec: UnitSpec) -> str:
 Description=UAV companion computer ({spec.config.name})
 After=network-online.target
 Wants=network-online.target
+StartLimitIntervalSec=0
 
 [Service]
 Type=exec
@@ -65,7 +71,7 @@ KillMode=mixed
 KillSignal=SIGTERM
 TimeoutStopSec={STOP_TIMEOUT_S}
 Restart=on-failure
-RestartSec=2
+RestartSec=100ms
 RestartPreventExitStatus={EXIT_CONFIG}
 StateDirectory=companion
 StateDirectoryMode=0750

@@ -2,7 +2,9 @@
 
 ``python -m companion.exec_control.vehicle_process`` is started only by the ``companion``
 command (``handover.exec_module``), which parses the options and nothing more: the config
-is loaded and checked here, so the vehicle's libraries are imported once. This process
+is loaded and checked here, so the vehicle's libraries are imported once. A plain
+``companion run`` calls ``run_vehicle`` in its own process without loading the command
+line at all (``companion.launch``). This process
 never imports the command line's libraries (typer, rich, pydantic), and neither do the
 fork server and the plug-ins it forks.
 """
@@ -31,11 +33,16 @@ def config_refused(exc: Exception) -> int:
 def main(argv: list[str] | None = None) -> int:
     """Check the handed-over config (path, namespace, log level), then run it until a stop
     signal. A refused config: its error on stderr and ``EXIT_CONFIG``, nothing started."""
+    config, namespace, log_level = received(sys.argv[1:] if argv is None else argv)
+    return run_vehicle(config, namespace, log_level)
+
+
+def run_vehicle(config: str, namespace: str | None, log_level: str) -> int:
+    """Load and check the config, then run it until a stop signal; the exit status."""
     from companion.exec_control.config import ConfigError, load_config
     from companion.exec_control.supervisor import Supervisor
     from companion.exec_control.topology import check_topology
 
-    config, namespace, log_level = received(sys.argv[1:] if argv is None else argv)
     setup_logging(log_level)
     try:
         cfg = load_config(config, namespace)

@@ -23,6 +23,7 @@ Feed samples in time order (``on_imu``, ``on_gps``, ``on_compass``, ``on_mag``);
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -36,7 +37,7 @@ from companion.navigation.ins_core import TH, InsCore
 from companion.navigation.ins_gps import GpsLag
 from companion.navigation.ins_mag import MagHeading, MagMonitor, mag_heading, yaw_jacobian
 from companion.navigation.ins_still import StillDetector
-from companion.navigation.ins_warm import WarmState, warm_start
+from companion.navigation.ins_warm import WarmState, waits_for_alignment, warm_start
 from companion.navigation.local_frame import LocalFrame, normal_gravity
 from companion.navigation.yaw_gsf import YawGsf
 
@@ -67,20 +68,16 @@ class InsEkf(InsCore):
         self.last_mag: np.ndarray | None = None
         self.last_mag_us: int | None = None
         self.pending_fix: GpsFix | None = None
-        self.gps_reject_run = self.baro_reject_run = 0
-        self.resets = 0
-        self.aligned_us = 0
-        self.next_heading_us = 0
+        self.gps_reject_run = self.baro_reject_run = self.resets = 0
+        self.aligned_us = self.next_heading_us = 0
         self.baro = BaroDatum(c.baro_interval_s, c.baro_timeout_s, c.baro_offset_tau_s)
         self.lag = GpsLag(c.gps_lag_window_s, c.gps_delay_s or 0.0)
         self.mag_monitor = MagMonitor(c.mag_window_s, c.mag_max_nis)
-        self.gsf = YawGsf()
-        self.gsf_dt = 0.0
+        self.gsf, self.gsf_dt = YawGsf(), 0.0
         self.gsf_sums = [0.0] * 6  # specific force and rate, times dt
         self.gsf_disagree_us: int | None = None
         self.still = StillDetector(c.still_window_s)
-        self.ground_speed = math.nan
-        self.still_updates = 0
+        self.ground_speed, self.still_updates = math.nan, 0
         self.yaw_resets = 0  # headings taken from the bank
         self.warm: WarmState | None = None  # the last solution of a killed process
 
@@ -275,24 +272,27 @@ class InsEkf(InsCore):
     def _collect(self, t_us: int, accel: np.ndarray, gyro: np.ndarray) -> None:
         self.t_us = t_us
         self.aligner.add_imu(t_us, accel, gyro)
-        fix = self.pending_fix
+        fix, compass = self.pending_fix, self.last_compass
         if fix is None or self.field is None:
             return
-        if (warm := self.warm) is not None and self._started_warm(warm, fix, t_us):
-            return
-        compass = self.last_compass
         fresh = compass is not None and self._fresh(compass.t_us, t_us)
         heading = compass.heading_rad + self._compass_declination() if compass and fresh else None
         mag = self.last_mag if self._fresh(self.last_mag_us, t_us) else None
         vel = np.array((fix.vn_m_s, fix.ve_m_s, fix.vd_m_s))
         found = self.aligner.align(vel, heading, mag, self.field, self.mag_monitor)
+        if (warm := self.warm) is not None:
+            if found is None and waits_for_alignment(warm, t_us):
+                return  # a long gap: the warm start's attitude is the in-air alignment's
+            if self._started_warm(warm, fix, t_us, found):
+                return
         if found is not None:
             self._start(found, fix, vel)
 
-    def _started_warm(self, warm: WarmState, fix: GpsFix, t_us: int) -> bool:
+    def _started_warm(self, warm: WarmState, fix: GpsFix, t_us: int, found: Any) -> bool:
         """In the air, carry on from the last process's solution (ins_warm), aligned."""
         self.warm = None
-        if (s := warm_start(self.frame, self.cfg, self.aligner.samples, warm, fix, t_us)) is None:
+        s = warm_start(self.frame, self.cfg, self.aligner.samples, warm, fix, t_us, found)
+        if s is None:
             return False
         self.p, self.v, self.q, self.P, self.ba, self.bg = s.p, s.v, s.q, s.P, s.ba, s.bg
         self.lag.lag_s, self.aligned, self.t_us = s.gps_lag_s, True, t_us

@@ -9,9 +9,17 @@ clock, and near where the file's solution, carried on by its velocity, says it s
 Then, instead of a cold alignment (half a second of IMU, then roll from the turn rate and
 a heading from the magnetometer, a few degrees and metres off), it starts at once from
 the last solution carried forward to now: position dead-reckoned over the gap (the fix's
-when the two differ by more than MAX_MISS_M), velocity from GPS, the attitude turned as
-the gyros say it turned, the biases as they were. On the ground, with
-a stale file or one from elsewhere, the alignment is cold.
+when the two differ by more than MAX_MISS_M), velocity from GPS, the biases as they were.
+The attitude is the file's turned by the gyros' rate now only over a short gap (a
+navigator restarted alone, in about a second). Over a longer one (the whole vehicle
+restarted) nobody knows how the aircraft turned: with the servos held as the dead
+controller left them it may have rolled from one bank into the other, and the new
+process's rate times the whole gap had been seen 40-100 degrees off, rolling the aircraft
+over when the controller came back. Then the attitude is aligned in the air from what the
+sensors say now (``ins_align``: roll from the turn rate, pitch from the specific force,
+heading from the magnetometer, compass or course), with its own uncertainty, half a second
+of IMU after the start. On the ground, with a stale file or one from elsewhere, the
+alignment is cold.
 """
 
 from __future__ import annotations
@@ -31,6 +39,7 @@ from companion.messages import GpsFix, NavFlags, NavState
 from companion.navigation import rotations as rot
 
 if TYPE_CHECKING:
+    from companion.navigation.ins_align import Alignment
     from companion.navigation.ins_config import InsEkfConfig
     from companion.navigation.local_frame import LocalFrame
 
@@ -39,6 +48,9 @@ log = logging.getLogger(__name__)
 WARM_FILE = "nav_warm.json"
 WRITE_PERIOD_US = 200_000  # 5 Hz of vehicle time: the file is at most this much behind
 MAX_AGE_S = 10.0  # a supervisor restart under load takes a few seconds
+# Over a gap this short the attitude is turned on by the gyros' rate now (a navigator
+# restarted alone: about a second); over a longer one it is aligned in the air.
+GYRO_GAP_S = 2.0
 IN_AIR_SPEED_M_S = 8.0  # the flight controller's LANDED_SPEED: faster is flying
 # The fix this far across from the solution dead-reckoned over the gap: the position is
 # the fix's (a tight turn flown in the gap; under load, a simulator's fixes behind time);
@@ -130,14 +142,19 @@ def warm_start(
     warm: WarmState,
     fix: GpsFix,
     t_us: int,
+    aligned: Alignment | None = None,
 ) -> WarmSolution | None:
     """``warm`` carried to ``t_us`` if the fix says it is this flight, in the air (None
-    otherwise); ``imu_window`` holds the (t_us, accel, gyro) samples read since the start."""
+    otherwise, and after a long gap while ``aligned``, the in-air alignment of now, is
+    None: ``waits_for_alignment``); ``imu_window`` holds the (t_us, accel, gyro) samples
+    read since the start."""
     age_s = (t_us - warm.t_us) / 1e6
     gps_vel = np.array((fix.vn_m_s, fix.ve_m_s, fix.vd_m_s))
     gps_vel = np.where(np.isfinite(gps_vel), gps_vel, warm.vel)
     speed = math.hypot(gps_vel[0], gps_vel[1])
     if frame is None or not 0.0 <= age_s <= MAX_AGE_S or speed < IN_AIR_SPEED_M_S:
+        return None
+    if age_s > GYRO_GAP_S and aligned is None:
         return None
     moved = 0.5 * (np.array(warm.vel) + gps_vel) * age_s
     p = frame.ned(warm.lat_deg, warm.lon_deg, warm.alt_msl_m) + moved
@@ -149,22 +166,34 @@ def warm_start(
         return None
     if miss > MAX_MISS_M:  # the gap was flown otherwise than its ends' velocities say
         p[:2] = fix_p[:2]
-    tilt_std, yaw_std = (s0 + s1 * age_s for s0, s1 in (TILT_STD, YAW_STD))
+    if age_s <= GYRO_GAP_S:
+        q = _turned_over_the_gap([gyro for _t, _a, gyro in imu_window], warm, age_s)
+        tilt_std, yaw_std = (s0 + s1 * age_s for s0, s1 in (TILT_STD, YAW_STD))
+    else:
+        assert aligned is not None
+        q = rot.euler_to_quaternion(aligned.roll, aligned.pitch, aligned.yaw)
+        tilt_std, yaw_std = aligned.tilt_std, aligned.yaw_std
     pos_std = 2.0 + 0.5 * age_s
     diag = [pos_std] * 3 + [max(cfg.gps_vel_std, 0.5)] * 3 + [tilt_std, tilt_std, yaw_std]
     diag += [0.5 * cfg.accel_bias_std] * 3 + [0.5 * cfg.gyro_bias_std] * 3
-    log.info("warm start: %.1f s after the last solution written", age_s)
-    q = _turned_over_the_gap([gyro for _t, _a, gyro in imu_window], warm, age_s)
+    how = "turned by the gyros" if age_s <= GYRO_GAP_S else "aligned in the air"
+    log.info("warm start: %.1f s after the last solution written, attitude %s", age_s, how)
     return WarmSolution(
         p.tolist(), gps_vel.tolist(), q,
         list(warm.accel_bias), list(warm.gyro_bias), warm.gps_lag_s, np.diag(np.square(diag)),
     )  # fmt: skip
 
 
+def waits_for_alignment(warm: WarmState, t_us: int) -> bool:
+    """Whether a warm start at ``t_us`` needs the in-air alignment, which is not there yet
+    (a long gap, but not too long for the file)."""
+    return GYRO_GAP_S < (t_us - warm.t_us) / 1e6 <= MAX_AGE_S
+
+
 def _turned_over_the_gap(gyro_rates: list[np.ndarray], warm: WarmState, age_s: float) -> rot.Quat:
     """The file's attitude turned by the gyros' rate since this process started, over the
-    whole gap: a rolling or turning aircraft has rolled and turned on meanwhile (in lockstep,
-    rolling at 17 deg/s, the roll as written was 5 deg off 0.3 s later)."""
+    whole (short) gap: a rolling or turning aircraft has rolled and turned on meanwhile (in
+    lockstep, rolling at 17 deg/s, the roll as written was 5 deg off 0.3 s later)."""
     if not gyro_rates:
         return tuple(warm.q)  # type: ignore[return-value]
     w = np.mean(gyro_rates, axis=0) - np.array(warm.gyro_bias)

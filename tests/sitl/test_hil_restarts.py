@@ -11,6 +11,7 @@ again and carry on in its mode.
 from __future__ import annotations
 
 import asyncio
+import logging
 import os
 import signal
 import time
@@ -32,6 +33,11 @@ PLAN = REPO / "qgc_plans" / "short_leg.plan"
 # over by then); then the supervisor. The restarted link must not show a mode change.
 VICTIMS = ("commander", "control", "servos", "nav", "imu", "gps", "compass", "link", "rc")
 KILL_FROM_S, KILL_EVERY_S = 35.0, 3.0
+BACK_AFTER_S = 30.0  # armed in Mission again after the supervisor's kill, at most
+SAFE_HEIGHT_M = 20.0  # lowest height after it (the mission flies at 80 m)
+# Left alone on trimmed surfaces for longer than this, the aircraft may spiral down before
+# the vehicle is back (HIL runs: back in 5.6-9.2 s at load 14-15, never lower than 77.7 m).
+UNATTENDED_S = 12.0
 
 
 def _plugin_pid(run: HilRun, name: str) -> int | None:
@@ -72,8 +78,11 @@ async def _kill_the_supervisor(run: HilRun, telemetry: TelemetryAsync) -> float:
     killed = time.monotonic()
     run.restart_vehicle()
     while time.monotonic() - killed < 30.0:
-        armed = await _first(telemetry.subscribe_armed())
-        mode = await _first(telemetry.subscribe_flight_mode())
+        # Both from the same (1 Hz) heartbeat: asked one after the other, each waited for
+        # the next, and the figure grew by up to two seconds.
+        armed, mode = await asyncio.gather(
+            _first(telemetry.subscribe_armed()), _first(telemetry.subscribe_flight_mode())
+        )
         if armed and mode == FlightMode.MISSION and _plugin_pid(run, "servos") is not None:
             return time.monotonic() - killed
         await asyncio.sleep(0.1)
@@ -106,8 +115,9 @@ def test_a_mission_flies_on_through_plugin_kills_and_a_supervisor_crash(tmp_path
     assert seen["finished"], (seen, vehicle_log[-3000:])
     assert seen["modes"] == {FlightMode.MISSION}, seen
     # The restarted vehicle armed itself again and took the flight up. How soon depends on
-    # how fast Python starts on the machine (1-3 s idle here; much longer under load).
-    assert seen["back_after_s"] < 60.0, vehicle_log[-3000:]
+    # how fast Python starts on the machine (5.6-9.2 s as MAVSDK hears it, its 1 Hz
+    # heartbeat included, beside CPU hogs at load 14-15; 21 s at load 20).
+    assert seen["back_after_s"] < BACK_AFTER_S, (seen, vehicle_log[-3000:])
     assert "Restarted in flight: Mission resumed" in run.log("vehicle_restarted")
     truth = read_estimate(run.truth)
     t, alt = np.asarray(truth["t"]), np.asarray(truth["alt"])
@@ -115,13 +125,16 @@ def test_a_mission_flies_on_through_plugin_kills_and_a_supervisor_crash(tmp_path
     climbed = t > t[np.argmax(height > 70.0)]
     assert np.min(height[climbed & (t < seen["finished_sim_s"])]) > 40.0, "came down with a kill"
     assert statuses == (0, 0)
+    # While the vehicle restarts the card holds the surfaces trimmed (not the dead
+    # controller's last roll: held, it had rolled the aircraft over into the ground) and
+    # the restarted navigator aligns in the air (not the old attitude turned by the new
+    # gyro rate over the whole gap); the aircraft stays well clear of the ground throughout.
     after = height[t >= seen["finished_sim_s"]]
-    if height[-1] <= 20.0:
-        # Open (issue 41.3): while the supervisor restarts (6-10 s on a busy machine, against
-        # 3 s asked), the servo card holds the circle's bank and the aircraft spirals; the
-        # restarted vehicle has at times been seen to roll it past 90 degrees into the ground
-        # a second after it came back. Everything before this point is asserted above.
-        pytest.xfail(
-            f"not flying after the supervisor's restart: {seen}; from {after[0]:.1f} m at the"
-            f" kill, lowest {after.min():.1f} m, last {height[-1]:.1f} m"
-        )
+    report = f"{seen}; from {after[0]:.1f} m at the kill, lowest {after.min():.1f} m"
+    logging.getLogger(__name__).info("supervisor restart: %s", report)
+    if seen["back_after_s"] > UNATTENDED_S and after.min() <= SAFE_HEIGHT_M:
+        # A machine so loaded that the restart took this long (21 s at load 20): on trimmed
+        # surfaces and the last throttle the C172 winds into a spiral dive after 15-20 s,
+        # before the vehicle is back. Not the restarted vehicle's doing; said, not hidden.
+        pytest.xfail(f"restart slower than {UNATTENDED_S} s (a loaded machine): {report}")
+    assert after.min() > SAFE_HEIGHT_M, report

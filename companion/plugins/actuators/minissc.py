@@ -5,7 +5,12 @@ stopped), when its command input goes stale, or when a command says disarmed, ev
 channel goes to its safe position: throttle off, surfaces at trim. Armed, the last
 positions are held a while longer (``flight_hold_s``) before the input counts as stale, so
 that a controller restarting in flight finds the aircraft as it left it. When the supervisor
-itself dies, the card keeps its last positions for the restarted vehicle to take over.
+itself dies, the whole vehicle restarts (seconds on a busy board): the flight surfaces go
+to trim, as ArduPilot sets its I/O co-processor's failsafe outputs when the flight
+computer stops, and the card holds them and the throttle until the restarted controller
+commands it. Holding the last surfaces instead held whatever the controller was doing:
+killed while rolling into a turn with full aileron, the aircraft rolled on at 40°/s and was
+inverted and in the ground 6 s later, before the vehicle was back.
 """
 
 from __future__ import annotations
@@ -23,6 +28,8 @@ from companion.sensors.serial_port import ReopeningSerial, open_problem
 WAIT_S = 0.1  # also the refresh cadence when no command arrives
 CYCLE_MIN_S, CYCLE_MAX_S = 0.01, 0.1
 FRAME_BYTES = 3
+# Trimmed when the supervisor dies; the rest (throttle, flaps, brakes) is held.
+FLIGHT_SURFACES = ("aileron", "elevator", "rudder")
 
 
 def surface_value(cmd: ActuatorCommand, surface: str) -> float:
@@ -122,9 +129,15 @@ class MiniSscOutput(Plugin):
     def close(self) -> None:
         if self.ctx.supervisor_gone():
             # The execution control crashed, maybe in the air: throttle off would drop the
-            # aircraft while the vehicle restarts. The card holds the last positions until
-            # the restarted vehicle's controller commands it again.
-            self.ctx.log.warning("the supervisor is gone: the servos keep their positions")
+            # aircraft while the vehicle restarts, and a held roll would roll it over. The
+            # card holds trimmed surfaces and the last throttle until the restarted
+            # vehicle's controller commands it again.
+            self.ctx.log.warning("the supervisor is gone: surfaces trimmed, throttle held")
+            trimmed = [c.servo for c in self.airframe.channels if c.surface in FLIGHT_SURFACES]
+            self.wanted.update({servo: self.safe[servo] for servo in trimmed})
+            for servo in trimmed:
+                self.sent.pop(servo, None)  # sent again, whatever the card had
+            self._send(len(trimmed))
         else:
             self.wanted = dict(self.safe)
             self.sent = {}  # everything counts as changed: all channels go out

@@ -123,7 +123,9 @@ class CommanderPlugin(Plugin):
 
     def step(self) -> None:
         c = self.commander
-        self.waiter.wait(WAIT_S if c.armed else DISARMED_WAIT_S)
+        # A flight to resume is judged as often as an armed one: a restart in the air waits
+        # for the navigator's first solution, not for the next second.
+        self.waiter.wait(WAIT_S if c.armed or self.saved is not None else DISARMED_WAIT_S)
         now = self.ctx.clock.now_us()
         nav = self._nav()
         health = self.health.get()

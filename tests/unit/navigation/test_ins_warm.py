@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from companion.messages import Compass, GpsFix, Message, NavState
 from companion.navigation.ins_warm import WarmFile, WarmState, warm_state
@@ -94,6 +95,41 @@ def test_nothing_is_written_on_the_ground():
     assert warm_state(state, 0.2) is None
     state.vn_m_s = 25.0
     assert warm_state(state, 0.2) is not None
+
+
+def _level_imu(t_us: int) -> Message:
+    from companion.messages import Imu
+
+    return Imu(t_us=t_us, az_m_s2=-9.81, temp_c=np.nan)
+
+
+@pytest.mark.parametrize(("kill_s", "back_s"), [(48.0, 54.0), (66.0, 74.0)])
+def test_after_a_long_gap_the_attitude_is_the_one_of_now_not_the_files_turned_on(
+    tmp_path, kill_s, back_s
+):
+    # The whole vehicle restarted (6-8 s): killed banked in the 8°/s turn and started again
+    # wings level in the climb after it; or killed in the climb and started in the -6°/s
+    # turn. Nobody saw the aircraft roll meanwhile: the file's attitude turned by the
+    # gyros' rate of now over the whole gap was 12° off in roll and 24-29° in heading.
+    before = InsEkfRunner(DECLINATION)
+    samples = _samples()
+    _run_until(before, samples, 0.0, kill_s)
+    file = WarmFile(tmp_path)
+    file.write(warm_state(before.nav.state(), before.nav.lag.lag_s))  # type: ignore[arg-type]
+    warm = InsEkfRunner(DECLINATION)
+    warm.nav.warm = file.read()
+    first = None
+    for s in samples:
+        if s.t_us >= back_s * 1e6:
+            warm.feed(s)
+            if warm.nav.aligned:
+                first = warm.nav.state()
+                break
+    assert first is not None
+    roll, pitch, yaw, pos = _errors(first)
+    assert max(roll, pitch) < 5.0 and yaw < 10.0 and pos < 25.0, _errors(first)
+    # A warm start: the biases carried over, not learnt again from the defaults.
+    assert np.allclose(warm.nav.bg, before.nav.bg, atol=1e-6)
 
 
 def _level_imu(t_us: int) -> Message:
