@@ -18,12 +18,18 @@ does), and the rate, character size and parity are then set together by ``TCSETS
 glibc never sees. Everything else (raw mode, stop bits, flow control, timeouts, the lock)
 is pyserial's own. Drop this module once a pyserial release has PR #808 and a test shows
 the second open of a pty at 100000 8E2 passing with plain ``serial.Serial``.
+
+Where ``TCSETS2`` is not implemented (ENOSYS: qemu-user, the emulated arm64 board), the
+rate and framing go through ``tcsetattr`` instead; a custom rate then stays at the
+placeholder, with a warning (on a pty, as in hardware in the loop, the rate means nothing).
 """
 
 from __future__ import annotations
 
 import array
+import errno
 import fcntl
+import logging
 import sys
 import termios
 
@@ -52,6 +58,8 @@ PLACEHOLDER_BAUD = 38400  # what tcsetattr is given for a rate without a Bnnn co
 # TCSETS2: Python's ``termios.Bnnn`` are glibc's, which from 2.42 may be the rate itself.
 _KERNEL_SPEED: dict[int, int] = dict(PlatformSpecific.BAUDRATE_CONSTANTS)
 
+log = logging.getLogger(__name__)
+
 
 def speed_constant(baud: int) -> int | None:
     """The ``Bnnn`` constant (glibc's, for tcsetattr) of a standard rate, None for a custom
@@ -74,8 +82,31 @@ def apply_rate_and_framing(fd: int, baud: int, bytesize: int, parity: str) -> in
         buf[_ISPEED] = buf[_OSPEED] = baud
         fcntl.ioctl(fd, TCSETS2, buf)
     except OSError as exc:
+        if exc.errno == errno.ENOSYS:  # an emulator without termios2
+            return _apply_with_tcsetattr(fd, baud, bytesize, parity)
         raise ValueError(f"cannot set {baud} baud {bytesize}{parity}: {exc}") from exc
     return cflag
+
+
+def _apply_with_tcsetattr(fd: int, baud: int, bytesize: int, parity: str) -> int:
+    """The rate (a standard one; else the placeholder's stays), character size and parity
+    through ``tcsetattr``; the c_cflag the tty then has."""
+    attrs = termios.tcgetattr(fd)
+    cflag = attrs[2] & ~(termios.CSIZE | termios.PARENB | termios.PARODD | CMSPAR)
+    attrs[2] = cflag | _CHAR_SIZE[bytesize] | _PARITY[parity]
+    speed = speed_constant(baud)
+    if speed is None:
+        log.warning("no termios2 here (an emulator?): %d baud left at %d", baud, PLACEHOLDER_BAUD)
+    else:
+        attrs[4] = attrs[5] = speed
+    try:
+        termios.tcsetattr(fd, termios.TCSANOW, attrs)
+    except termios.error as exc:
+        # glibc's check that parity stuck fails on a pty, which drops it: the port stays
+        # as pyserial left it (8 bits, no parity), which is all a pty carries anyway.
+        log.warning("no termios2 here: %d%s not set (%s); the port stays 8N", bytesize, parity, exc)
+        return int(termios.tcgetattr(fd)[2])
+    return int(attrs[2])
 
 
 class Termios2Serial(serial.Serial):

@@ -9,6 +9,7 @@ passes every call on to the real ioctl."""
 from __future__ import annotations
 
 import array
+import errno
 import fcntl
 import os
 import signal
@@ -213,5 +214,43 @@ def test_a_framing_no_tty_takes_is_refused_without_touching_the_port(tmp_path):
         with pytest.raises(ValueError):
             termios2_serial.apply_rate_and_framing(pty.slave, 9600, 9, serial.PARITY_NONE)
         assert kernel_termios2(pty.slave)[0] & termios.CBAUD == termios.B38400
+    finally:
+        pty.vanish()
+
+
+def no_termios2(real):
+    """Stand-in for ``fcntl.ioctl`` under qemu-user, which implements no termios2."""
+
+    def ioctl(fd, request, *args):
+        if request in (TCGETS2, TCSETS2):
+            raise OSError(errno.ENOSYS, "Function not implemented")
+        return real(fd, request, *args)
+
+    return ioctl
+
+
+@pytest.mark.parametrize(("baud", "framing"), DRIVERS)
+def test_without_termios2_every_drivers_port_opens_and_carries_its_bytes(
+    tmp_path, monkeypatch, baud, framing
+):
+    """The emulated arm64 board (qemu-user) answers ENOSYS to TCSETS2: the vehicle's
+    ports there must still open, again and again, and carry the device's bytes."""
+    monkeypatch.setattr(termios2_serial.fcntl, "ioctl", no_termios2(fcntl.ioctl))
+    pty = Pty(tmp_path / "ttyDEV")
+    try:
+        for attempt in range(3):
+            port = ReopeningSerial(str(pty.link), baud, 0.5, framing=framing)
+            port.read(0)
+            os.write(pty.master, sbus_bytes())
+            data = b""
+            while len(data) < 25:
+                chunk = port.read()
+                assert chunk, f"open {attempt + 1}: nothing read (failures {port.open_failures})"
+                data += chunk
+            assert data == sbus_bytes() and port.opens == 1 and port.open_failures == 0
+            rate = termios.tcgetattr(pty.slave)[5]  # the output rate, glibc's constant
+            standard = termios2_serial.speed_constant(baud)
+            assert rate == (standard or termios2_serial.speed_constant(38400))
+            port.close()
     finally:
         pty.vanish()
