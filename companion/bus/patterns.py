@@ -148,9 +148,11 @@ class Reader(Generic[M]):
         subscriber: iox2.Subscriber,
         listener: iox2.Listener,
         idle: IdleTally | None = None,
+        service: iox2.PortFactoryPublishSubscribe | None = None,
     ) -> None:
         self.name = name
         self._idle = idle or IdleTally()
+        self._service = service
         self.msg_type = msg_type
         self._size = ctypes.sizeof(msg_type)
         self._subscriber = subscriber
@@ -209,10 +211,17 @@ class Reader(Generic[M]):
         """True when a sample is waiting."""
         return bool(self._subscriber.has_samples())
 
+    def writers(self) -> int:
+        """How many writers the channel has now (0 when unknown)."""
+        if self._service is None:
+            return 0
+        return int(self._service.dynamic_config.number_of_publishers)
+
     def close(self) -> None:
-        """Release the iceoryx2 ports."""
+        """Release the iceoryx2 ports and the service (which holds the node alive)."""
         self.listener.delete()
         self._subscriber.delete()
+        self._service = None
 
 
 class QueueReader(Reader[M]):
@@ -241,16 +250,9 @@ class LatestReader(Reader[M]):
         idle: IdleTally | None = None,
         service: iox2.PortFactoryPublishSubscribe | None = None,
     ) -> None:
-        super().__init__(name, msg_type, subscriber, listener, idle)
+        super().__init__(name, msg_type, subscriber, listener, idle, service)
         self._latest: M | None = None
-        self._service = service
         self._waited = False
-
-    def writers(self) -> int:
-        """How many writers the channel has now (0 when unknown)."""
-        if self._service is None:
-            return 0
-        return int(self._service.dynamic_config.number_of_publishers)
 
     def first(self, timeout_s: float) -> M | None:
         """The newest value; the first call waits up to ``timeout_s`` for one if a writer exists.
@@ -265,11 +267,6 @@ class LatestReader(Reader[M]):
             value = self.wait(timeout_s)
         self._waited = True  # once: a writer that never speaks costs one wait, not one a call
         return value
-
-    def close(self) -> None:
-        """Release the iceoryx2 ports and the service."""
-        super().close()
-        self._service = None
 
     def _count_gap(self, writer_id: int, seq: int) -> None:
         """Skipping superseded values is what Latest is for: nothing counts as lost."""
