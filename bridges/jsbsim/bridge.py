@@ -50,7 +50,9 @@ DEVICE_CHANNELS = {
 }
 STANDARD_PRESSURE_KPA = 101.325
 FAST_LAG_PERIODS = 1  # fast lockstep: how many nav/state periods the vehicle may trail
-SERVO_BYTES_WAIT_S = 1.0  # exact: longest wait for servo bytes an answer says were written
+# Exact: the longest wait for servo bytes an answer says were written (the kernel hands
+# them over on a worker thread, which a loaded machine may run late)
+SERVO_BYTES_WAIT_S = EXACT_STALL_S
 POLL_S = 50e-6
 
 
@@ -124,6 +126,7 @@ class SimBridge:
         self.order = 0
         self.servo_card = MiniSscReader()
         self.servo_bytes_in = 0
+        self.servo_late = 0  # exact: answers whose bytes did not all come in time
         self.pacer = RealTime(opts.speed) if opts.speed else None
         lockstep = self.pacer is None and opts.sync_hz > 0
         exact = lockstep and opts.exact
@@ -218,6 +221,7 @@ class SimBridge:
             text += f"; nav stalls {nav.stalls} (waited {nav.wait_s:.1f} s)"
         if samples is not None:
             text += f"; late samples {samples.late} (waited {samples.wait_s:.1f} s)"
+            text += f"; late servo bytes {self.servo_late}"
         return text
 
     def stop(self) -> None:
@@ -314,6 +318,12 @@ class SimBridge:
             time.sleep(POLL_S)
             chunks.append(chunk := self.ports["servos"].read())
             self.servo_bytes_in += len(chunk)
+        if answer.bytes_out > self.servo_bytes_in:
+            # The rest moves the surfaces a frame late: not the same flight as another run.
+            log.warning(
+                "lockstep: servo bytes of the command at %.2f s missing", answer.command_t_us / 1e6
+            )
+            self.servo_late += 1
         return b"".join(chunks)
 
     def _apply_servos(self) -> None:

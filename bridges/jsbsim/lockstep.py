@@ -19,8 +19,10 @@ log = logging.getLogger(__name__)
 STALL_S = 5.0
 EXACT_STALL_S = 10.0  # the same, when every frame must be the same run after run
 EVENT_WAIT_S = 0.05  # exact: longest sleep on a bus event before looking again
-SAMPLE_GRACE_S = 2.0  # exact: a driver's sample is waited for this long after its bytes
-FIRST_SAMPLE_GRACE_S = 0.3  # ... and this long on a channel that has carried nothing yet
+# Exact: a driver's sample is waited for this long after its bytes (a loaded machine can
+# starve a healthy driver for seconds, most of all one of ten plug-ins sharing a process)
+SAMPLE_GRACE_S = EXACT_STALL_S
+FIRST_SAMPLE_GRACE_S = 0.3  # ... and this long on a further channel that has carried nothing
 SPIN_POLLS = 50  # polls that only yield the CPU before sleeping between polls
 POLL_SLEEP_S = 50e-6
 START_FLIGHT_S = 20.0  # the flight plug-ins' start-up after START, at most
@@ -205,9 +207,15 @@ class SampleSync(_BusWait):
     them in the pty's buffer while reporting nothing unread, and the driver may not have
     published yet. Waiting for every sample a write produces on the bus (each channel the
     device's driver publishes, stamped with this frame's time) closes these gaps, so no
-    driver reads two frames as one or publishes one late. A channel that has never carried
-    anything (the GPS decoder learns its epoch before its first fix) is waited for only
-    ``first_grace_s``; the others at most ``grace_s`` a frame.
+    driver reads two frames as one or publishes one late.
+
+    Every write of a device gives a sample on its first channel (``DEVICE_CHANNELS``), so
+    that one is waited for from the first write on, as long as a driver has a writer on it
+    (``grace_s``, counted in ``late`` when it passes: the frame is then no longer the same
+    run after run). A further channel of the device that has never carried anything (an
+    IMU whose sentence has no pressure never publishes a barometer) is waited for only
+    ``first_grace_s`` after the first channel's sample came, the driver publishing both
+    from the same reading.
     """
 
     def __init__(
@@ -218,22 +226,27 @@ class SampleSync(_BusWait):
         first_grace_s: float = FIRST_SAMPLE_GRACE_S,
     ) -> None:
         super().__init__(waiter)
-        self.channels = channels  # device → {channel: reader}
+        self.channels = channels  # device → {channel: reader}, its first channel first
         self.newest_us = {c: -1 for readers in channels.values() for c in readers}
         self.grace_s, self.first_grace_s = grace_s, first_grace_s
         self.late = 0  # frames in which a sample did not come within grace_s
 
     def wait(self, written: set[str], t_us: int) -> None:
         """Return when every device written this frame has published its samples."""
-        expected = [c for dev in written for c in self.channels.get(dev, {})]
-        seen = all(self.newest_us[c] >= 0 for c in expected)
+        firm: list[str] = []  # waited for up to grace_s
+        loose: list[str] = []  # never heard: waited for briefly once the firm ones came
+        for device in sorted(written):
+            for i, (name, reader) in enumerate(self.channels.get(device, {}).items()):
+                heard = self.newest_us[name] >= 0
+                (firm if heard or (i == 0 and reader.writers() > 0) else loose).append(name)
+        if not self._until(lambda: self._arrived(firm, t_us), self.grace_s):
+            self.late += 1
+        if loose:
+            self._until(lambda: self._arrived(loose, t_us), self.first_grace_s)
 
-        def arrived() -> bool:
-            self._take()
-            return all(self.newest_us[c] >= t_us for c in expected)
-
-        if not self._until(arrived, self.grace_s if seen else self.first_grace_s):
-            self.late += seen
+    def _arrived(self, names: list[str], t_us: int) -> bool:
+        self._take()
+        return all(self.newest_us[c] >= t_us for c in names)
 
     def _take(self) -> None:
         for readers in self.channels.values():

@@ -105,9 +105,10 @@ class BusNode:
         chan = channel(name)
         if chan.pattern != "queue":
             raise ValueError(f"channel {name!r} is a Latest channel; use latest_reader()")
-        sub = self._pubsub(chan).subscriber_builder().buffer_size(chan.depth).create()
+        service = self._pubsub(chan)
+        sub = service.subscriber_builder().buffer_size(chan.depth).create()
         listener = self._event(chan).listener_builder().create()
-        port: QueueReader[Any] = QueueReader(name, chan.type, sub, listener, self.idle)
+        port: QueueReader[Any] = QueueReader(name, chan.type, sub, listener, self.idle, service)
         self._ports.append(port)
         return port
 

@@ -20,6 +20,7 @@ import ctypes
 import logging
 import random
 import time
+from collections import deque
 from collections.abc import Iterator
 from typing import Any, Generic, TypeVar
 
@@ -33,6 +34,7 @@ M = TypeVar("M", bound=Message)
 
 _MAX_WAIT_S = 3600.0
 _MIN_LISTENER_WAIT_S = 1e-6
+_MAX_AHEAD = 64  # LatestReader.before(): values kept that are not older yet
 
 
 class SampleHeader(ctypes.Structure):
@@ -148,9 +150,11 @@ class Reader(Generic[M]):
         subscriber: iox2.Subscriber,
         listener: iox2.Listener,
         idle: IdleTally | None = None,
+        service: iox2.PortFactoryPublishSubscribe | None = None,
     ) -> None:
         self.name = name
         self._idle = idle or IdleTally()
+        self._service = service
         self.msg_type = msg_type
         self._size = ctypes.sizeof(msg_type)
         self._subscriber = subscriber
@@ -209,10 +213,17 @@ class Reader(Generic[M]):
         """True when a sample is waiting."""
         return bool(self._subscriber.has_samples())
 
+    def writers(self) -> int:
+        """How many writers the channel has now (0 when unknown)."""
+        if self._service is None:
+            return 0
+        return int(self._service.dynamic_config.number_of_publishers)
+
     def close(self) -> None:
-        """Release the iceoryx2 ports."""
+        """Release the iceoryx2 ports and the service (which holds the node alive)."""
         self.listener.delete()
         self._subscriber.delete()
+        self._service = None
 
 
 class QueueReader(Reader[M]):
@@ -241,16 +252,11 @@ class LatestReader(Reader[M]):
         idle: IdleTally | None = None,
         service: iox2.PortFactoryPublishSubscribe | None = None,
     ) -> None:
-        super().__init__(name, msg_type, subscriber, listener, idle)
+        super().__init__(name, msg_type, subscriber, listener, idle, service)
         self._latest: M | None = None
-        self._service = service
         self._waited = False
-
-    def writers(self) -> int:
-        """How many writers the channel has now (0 when unknown)."""
-        if self._service is None:
-            return 0
-        return int(self._service.dynamic_config.number_of_publishers)
+        self._ahead: deque[M] = deque(maxlen=_MAX_AHEAD)  # for before(): not yet older
+        self._before: M | None = None
 
     def first(self, timeout_s: float) -> M | None:
         """The newest value; the first call waits up to ``timeout_s`` for one if a writer exists.
@@ -266,13 +272,25 @@ class LatestReader(Reader[M]):
         self._waited = True  # once: a writer that never speaks costs one wait, not one a call
         return value
 
-    def close(self) -> None:
-        """Release the iceoryx2 ports and the service."""
-        super().close()
-        self._service = None
-
     def _count_gap(self, writer_id: int, seq: int) -> None:
         """Skipping superseded values is what Latest is for: nothing counts as lost."""
+
+    def before(self, t_us: int) -> M | None:
+        """The newest value stamped before ``t_us`` of those received (None: none yet).
+
+        For a reader that acts on another channel's sample of time ``t_us`` (the flight
+        controller on a navigation solution): a value stamped with that very instant may or
+        may not have come when it runs, as the processes happened to be scheduled, while in
+        exact lockstep every earlier one has (the simulator waited for it). So what it reads
+        depends on the data alone. Its reader keeps (``latest_reader(keep=...)``) the values
+        that come between two calls; use either this or ``get()`` on one reader.
+        """
+        for msg in self.drain():
+            self._latest = msg
+            self._ahead.append(msg)
+        while self._ahead and self._ahead[0].t_us < t_us:
+            self._before = self._ahead.popleft()
+        return self._before
 
     def get(self) -> M | None:
         """The newest value published so far, or None if nothing has been seen yet."""

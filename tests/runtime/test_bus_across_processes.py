@@ -237,6 +237,29 @@ def test_a_killed_processs_node_leaves_no_directory_behind(namespace):
     assert left == [], left
 
 
+def test_before_gives_the_newest_value_older_than_a_time_whatever_came_since(namespace):
+    """The flight controller reads the rangefinder measured before its navigation solution:
+    the reading of the solution's own instant, there or not yet, changes nothing."""
+    from companion.messages import RangeReading
+
+    with BusNode(namespace, "w") as bus_w, BusNode(namespace, "r") as bus_r:
+        reader = bus_r.latest_reader("sensors/range", keep=4)
+        writer = bus_w.writer("sensors/range")
+        assert reader.writers() == 1 and bus_r.queue_reader("sensors/imu").writers() == 0
+        assert reader.before(10) is None
+        for t_us in (10, 20):
+            writer.publish(RangeReading(t_us=t_us, distance_m=t_us / 10))
+        wait_for(lambda: reader.has_samples(), 5, "the readings")
+        without = reader.before(30)
+        writer.publish(RangeReading(t_us=30, distance_m=3.0))  # the solution's own instant
+        wait_for(lambda: reader.has_samples(), 5, "the reading at 30")
+        with_it = reader.before(30)
+        later = reader.before(40)
+    assert without is not None and with_it is not None and later is not None
+    assert (without.t_us, with_it.t_us, with_it.distance_m) == (20, 20, 2.0)
+    assert later.t_us == 30
+
+
 def _named(directory: Path, prefix: str) -> list[Path]:
     """The files in a node's directory whose names start with ``prefix``."""
     try:

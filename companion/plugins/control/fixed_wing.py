@@ -41,6 +41,7 @@ WAIT_S = 0.5
 STATUS_WAIT_S = 5.0  # the commander's last status, once, when this process starts
 OUTPUT_WAIT_S = 5.0  # ... and the servo output's process, started with this one, listening
 STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item is reached)
+RECENT = 4  # receiver and rangefinder values kept between steps (100 Hz against 50 Hz)
 
 
 class FixedWingPlugin(Plugin):
@@ -96,9 +97,9 @@ class FixedWingPlugin(Plugin):
         self.nav = bus.latest_reader("nav/state")
         self.status_in = bus.latest_reader("vehicle/status")
         self.mission_changes = bus.latest_reader("mission/changed")
-        self.rc = bus.latest_reader("sensors/rc")
+        self.rc = bus.latest_reader("sensors/rc", keep=RECENT)
         self.joystick = bus.latest_reader("link/manual_control")
-        self.range = bus.latest_reader("sensors/range")
+        self.range = bus.latest_reader("sensors/range", keep=RECENT)
         self.range_said = False  # the log says once when a landing flies on the range
         self.surfaces = bus.writer("control/actuators")
         self.servo_answers = bus.latest_reader("actuators/servos")
@@ -134,9 +135,12 @@ class FixedWingPlugin(Plugin):
         status = self.status_in.first(STATUS_WAIT_S) or self.default_status
         self._await_output()
         # The receiver first: a safety pilot's sticks win over the ground station's joystick.
-        sticks = pilot_sticks(nav.t_us, self.rc.get(), self.joystick.get())
+        # Its frame and the rangefinder's reading are the newest measured before this
+        # solution: one of the same instant may or may not have come yet (exact lockstep
+        # waits for the earlier ones), and the flight must not depend on which.
+        sticks = pilot_sticks(nav.t_us, self.rc.before(nav.t_us), self.joystick.get())
         rejected = self.controller.rejected
-        self.controller.lander.range_reading = self.range.get()
+        self.controller.lander.range_reading = self.range.before(nav.t_us)
         out = self.controller.step(nav, status, nav.t_us / 1e6, sticks)
         if self.controller.lander.range_steps and not self.range_said:
             self.ctx.log.info("landing: flaring on the rangefinder's height")
