@@ -64,6 +64,8 @@ SINK_I = 0.05  # rad per (m/s·s)
 LANDING_PARAMS = (
     ParamDecl("LAND_FLARE_ALT", 3.0, 0.5, 20.0, "m", "landing: flare below this height"),
     ParamDecl("LAND_FLARE_SEC", 2.0, 0.5, 10.0, "s", "landing: flare this long before ground"),
+    ParamDecl("LAND_FLARE_AIM", 90.0, 50.0, 150.0, "%", "landing: the glide ends this share of "
+              "the modelled flare's distance before the point (less: the airframe lands short)"),
     ParamDecl("LAND_PITCH_CD", 0.0, -500.0, 1500.0, "cdeg", "landing: least pitch in the flare"),
     ParamDecl("LAND_DISARMDELAY", 3.0, 0.0, 127.0, "s", "landing: disarm this long after stop"),
     ParamDecl("TECS_LAND_ARSPD", 28.0, 5.0, 100.0, "m/s", "landing: approach airspeed"),
@@ -195,7 +197,11 @@ class Landing:
             # LAND_FLARE_SEC comes first, higher than LAND_FLARE_ALT (the Cub at 4-5 m).
             h_f = max(v["LAND_FLARE_ALT"], v["LAND_FLARE_SEC"] * s0)
             tau = h_f / (s0 - s_t)
-            dist = min(gs * tau * math.log(s0 / s_t), 0.5 * self.length)
+            # The model's flare holds its speed and follows its demand at once; a real one
+            # slows with the throttle cut and lags the demand, so it flies a share of this
+            # distance, the airframe's LAND_FLARE_AIM (as ArduPlane's flare aim point).
+            share = v["LAND_FLARE_AIM"] / 100.0
+            dist = min(share * gs * tau * math.log(s0 / s_t), 0.5 * self.length)
         self.flare_alt = h_f
         return dist
 

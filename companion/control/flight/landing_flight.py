@@ -174,10 +174,16 @@ class LandingFlight:
         roll_dem = bank_for(lateral.lat_acc, min(dem.roll_limit, config.roll_limit))
         flying = dem.phase == LandPhase.FLARE
         # The flare's pitch changes in a second or two, faster than cruise ever asks for:
-        # the pitch loop works harder while flaring (the gains return after).
+        # the pitch loop works harder while flaring (the gains return after). Its integrator
+        # too: as the aircraft slows the elevator the pitch needs grows, and at the cruise
+        # rate the pitch stayed 2-3 degrees under the demand, sinking faster than the flare.
         gains = self.attitude.gains
         if flying:
-            self.attitude.gains = replace(gains, pitch_p=gains.pitch_p * FLARE_PITCH_GAIN)
+            self.attitude.gains = replace(
+                gains,
+                pitch_p=gains.pitch_p * FLARE_PITCH_GAIN,
+                pitch_i=gains.pitch_i * FLARE_PITCH_GAIN,
+            )
         surfaces = self.attitude.step(
             roll_dem,
             dem.pitch,

@@ -76,3 +76,16 @@ def test_a_go_around_climbs_away_along_the_runway_and_cannot_start_on_the_ground
     rolled.step(_state(285.0, 0.1, sink=0.0), V, 0.4)
     rolled.abort()
     assert rolled.phase == LandPhase.ROLLOUT
+
+
+def test_the_glide_ends_the_airframes_flare_aim_share_of_the_modelled_flare_before_the_point():
+    # An airframe whose flares fly short of the model (LAND_FLARE_AIM under 100) has its
+    # glide path end, and so its flare begin, nearer the point by that share.
+    modelled = Landing(START, 150.0, TOUCHDOWN, 100.0).flare_distance(
+        28.0, V | {"LAND_FLARE_AIM": 100.0}
+    )
+    land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+    aimed = land.flare_distance(28.0, V | {"LAND_FLARE_AIM": 80.0})
+    assert aimed == pytest.approx(0.8 * modelled, rel=0.05)
+    dem = land.step(_state(TOUCHDOWN[1] - aimed - 1.0, 40.0), V | {"LAND_FLARE_AIM": 80.0}, 0.02)
+    assert dem.alt_msl - 100.0 == pytest.approx(land.flare_alt, abs=0.3)

@@ -2,7 +2,7 @@
 
 The benchmark's plan (take off east, a loop, then QGroundControl's landing pattern back
 onto the runway) scored as the issue asks, from the simulator's state: touchdown within
-30 m along and 3 m across the landing point, at most 1.5 m/s down, no bounce over 1 m,
+15 m along and 2 m across the landing point, at most 1.5 m/s down, no bounce over 1 m,
 wings within 10° of level, stopped on the runway, and the controller asking to disarm.
 A go-around ordered on the approach climbs away and the aircraft lands on its second
 approach.
