@@ -126,7 +126,9 @@ def per_process(watch: Watch, log: str) -> dict[str, tuple[float, int]]:
         cpu_start = first[1].get(pid)
         pct = 100 * (cpu_end - cpu_start) / (last[0] - first[0]) if cpu_start else float("nan")
         pss = max(s[2].get(pid, 0) for s in watch.samples)
-        out[label.get(pid, str(pid))] = (pct, pss)
+        # The fork server is the one child not started as a plug-in (forked, it has the
+        # supervisor's command line).
+        out[label.get(pid, "fork server")] = (pct, pss)
     return out
 
 

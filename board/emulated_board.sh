@@ -101,7 +101,9 @@ run_vehicle() {
     mount_root
     mkdir -p "$ROOT/opt/board" "$ROOT/var/log"
     cp "$config" "$ROOT/opt/board/vehicle.toml"
-    in_root companion run --config /opt/board/vehicle.toml "$@" \
+    # chroot and env exec what follows: $! is the supervisor itself, not a subshell.
+    chroot "$ROOT" /usr/bin/env -i PATH=$VENV/bin:/usr/bin:/bin HOME=/root \
+        companion run --config /opt/board/vehicle.toml "$@" \
         >"$ROOT/var/log/companion.log" 2>&1 &
     echo $! >"$STATE/pid"
     say "vehicle started: pid $(cat "$STATE/pid"), log $ROOT/var/log/companion.log"
