@@ -96,6 +96,9 @@ class HealthCounters:
     dropped: int = 0
     refused: int = 0  # well-formed input refused by its rules (NaN, out of range)
     bytes_in: int = 0  # read from the plug-in's device (pre-arm tells silence from garbage)
+    # When the runner last published them: a reading counted in a report must not be
+    # stamped after it, nor one counted later before it (serial_sensor's spread stamps).
+    reported_us: int | None = None
 
     def ok(self, n: int = 1) -> None:
         """Count good frames (or samples) accepted."""

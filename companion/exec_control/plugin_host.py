@@ -143,6 +143,7 @@ class PluginHost:
             msg.restarts = self.restarts + int(self.failed)
             msg.state = PluginState.BACKOFF if self.failed else PluginState.RUNNING
         self.stats.publish(msg)
+        health.reported_us = msg.t_us
 
     def run(self, plugin: Plugin) -> int:
         try:

@@ -81,7 +81,8 @@ class SerialSensor(Plugin, Generic[ReadingT]):
             data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
         if self.periodic_frames:
             period_us = 1e6 / rate if (rate := self.ctx.settings["rate_hz"]) > 0 else 0.0
-            stamped = self.stream.feed_spaced(data, t_us, self._last_read_us, period_us)
+            since = max(self._last_read_us or 0, self.ctx.health.reported_us or 0) or None
+            stamped = self.stream.feed_spaced(data, t_us, since, period_us)
             if data:
                 self._last_read_us = t_us
             for reading, t in stamped:
