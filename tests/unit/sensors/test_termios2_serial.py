@@ -54,20 +54,26 @@ def sbus_bytes() -> bytes:
     return frame([us_to_raw(1500)] * 16)
 
 
+def opened_and_heard(pty: Pty, baud: int, framing: dict, attempt: int) -> ReopeningSerial:
+    """The pty opened at ``baud`` and ``framing``, once, and an SBUS frame read through it."""
+    port = ReopeningSerial(str(pty.link), baud, 0.5, framing=framing)
+    port.read(0)  # open it: pyserial flushes what came before
+    os.write(pty.master, sbus_bytes())
+    data = b""
+    while len(data) < 25:
+        chunk = port.read()
+        assert chunk, f"open {attempt + 1}: nothing read (failures {port.open_failures})"
+        data += chunk
+    assert data == sbus_bytes() and port.opens == 1 and port.open_failures == 0
+    return port
+
+
 @pytest.mark.parametrize(("baud", "framing"), DRIVERS)
 def test_a_port_opens_again_and_again_at_each_drivers_rate(tmp_path, baud, framing):
     pty = Pty(tmp_path / "ttyDEV")
     try:
         for attempt in range(REOPENS):
-            port = ReopeningSerial(str(pty.link), baud, 0.5, framing=framing)
-            port.read(0)  # open it: pyserial flushes what came before
-            os.write(pty.master, sbus_bytes())
-            data = b""
-            while len(data) < 25:
-                chunk = port.read()
-                assert chunk, f"open {attempt + 1}: nothing read (opens {port.opens})"
-                data += chunk
-            assert data == sbus_bytes() and port.opens == 1 and port.open_failures == 0
+            port = opened_and_heard(pty, baud, framing, attempt)
             cflag, ispeed, ospeed = kernel_termios2(pty.slave)
             assert (ispeed, ospeed) == (baud, baud), f"open {attempt + 1}"
             assert bool(cflag & termios.CSTOPB) == (framing.get("stopbits") == 2)
@@ -239,15 +245,7 @@ def test_without_termios2_every_drivers_port_opens_and_carries_its_bytes(
     pty = Pty(tmp_path / "ttyDEV")
     try:
         for attempt in range(3):
-            port = ReopeningSerial(str(pty.link), baud, 0.5, framing=framing)
-            port.read(0)
-            os.write(pty.master, sbus_bytes())
-            data = b""
-            while len(data) < 25:
-                chunk = port.read()
-                assert chunk, f"open {attempt + 1}: nothing read (failures {port.open_failures})"
-                data += chunk
-            assert data == sbus_bytes() and port.opens == 1 and port.open_failures == 0
+            port = opened_and_heard(pty, baud, framing, attempt)
             rate = termios.tcgetattr(pty.slave)[5]  # the output rate, glibc's constant
             standard = termios2_serial.speed_constant(baud)
             assert rate == (standard or termios2_serial.speed_constant(38400))
