@@ -30,7 +30,7 @@ from companion.bus.node import BusNode
 from companion.bus.patterns import Writer
 from companion.exec_control.backoff import MAX_BACKOFF_S, SECOND_BACKOFF_S, STABLE_AFTER_S
 from companion.exec_control.plugin_host import EXIT_INIT_FAILED, PluginHost, _signal_pipe
-from companion.exec_control.priority import apply_nice, set_session_nice
+from companion.exec_control.priority import apply_nice
 from companion.exec_control.registry import load
 from companion.messages import PluginStats
 
@@ -119,9 +119,6 @@ def main(spec: dict[str, Any]) -> int:
     from companion.exec_control.plugin_host import die_with_parent
 
     die_with_parent()
-    # Its threads keep their own nice values; its session weighs as its most urgent one.
-    if (first := min(m.get("nice", 0) for m in spec["members"])) != 0:
-        set_session_nice(os.nice(0) + first)
     stopping = threading.Event()
     wake = _signal_pipe()  # readable once a signal has come
     for sig in (signal.SIGTERM, signal.SIGINT):

@@ -193,7 +193,7 @@ def main(spec: dict[str, Any]) -> int:
         format=f"%(asctime)s {spec['name']}[%(process)d] %(levelname)s %(message)s",
     )
     die_with_parent()
-    apply_nice(spec["name"], spec.get("nice", 0), session=True)
+    apply_nice(spec["name"], spec.get("nice", 0))
     host = PluginHost(spec)
     signal.signal(signal.SIGTERM, host.request_stop)
     signal.signal(signal.SIGINT, host.request_stop)

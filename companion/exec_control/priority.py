@@ -54,32 +54,14 @@ def note_refused_raises(specs: Iterable[HasNice]) -> None:
         )
 
 
-def apply_nice(name: str, nice: int, session: bool = False) -> int:
+def apply_nice(name: str, nice: int) -> int:
     """Move the calling thread ``nice`` steps from the supervisor's priority (threads it
     starts afterwards inherit it); the nice value it runs at. A raise the system refuses
-    leaves it where it is (the supervisor has said so: ``note_refused_raises``).
-
-    ``session``: the thread leads a session of its own (a plug-in's process), whose
-    autogroup gets the same value (``set_session_nice``)."""
+    leaves it where it is (the supervisor has said so: ``note_refused_raises``)."""
     if nice == 0:
         return os.nice(0)
     try:
-        value = os.nice(nice)
+        return os.nice(nice)
     except PermissionError:
         log.debug("%s: nice %+d refused", name, nice)
         return os.nice(0)
-    if session:
-        set_session_nice(value)
-    return value
-
-
-def set_session_nice(value: int) -> None:
-    """Give this process's session the nice value ``value``, where the kernel groups
-    sessions (autogroup, in the root cgroup: a shell on a machine without systemd). There
-    each session gets an equal share whatever its threads' nice values, and each plug-in
-    starts a session of its own; in a service's or a quota's cgroup this does nothing."""
-    try:
-        with open("/proc/self/autogroup", "w") as group:
-            group.write(str(value))
-    except OSError:  # no autogroup in this kernel, or a raise refused
-        pass

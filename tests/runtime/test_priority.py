@@ -48,16 +48,6 @@ def test_each_plugin_process_runs_at_its_nice_value(vehicle_factory):
     nices = {name: psutil.Process(pid).nice() for name, pid in pids.items()}
     assert nices == {"imu": expected(FLIGHT_NICE), "relay": 0, "idle": 10}
     assert psutil.Process(vehicle.proc.pid).nice() == 0  # the supervisor keeps its own
-    # Each plug-in leads a session; where the kernel groups sessions (autogroup), its group
-    # weighs as the plug-in asked, or nice would not count between plug-ins at all.
-    if Path("/proc/self/autogroup").exists():
-        groups = {name: autogroup_nice(pid) for name, pid in pids.items()}
-        assert groups == {"imu": expected(FLIGHT_NICE), "relay": 0, "idle": 10}
-
-
-def autogroup_nice(pid: int) -> int:
-    """The nice value of the process's session group: "/autogroup-N nice V"."""
-    return int(Path(f"/proc/{pid}/autogroup").read_text().split()[-1])
 
 
 def test_composed_plugins_keep_their_own_nice_values_on_their_threads(vehicle_factory):
@@ -68,8 +58,6 @@ def test_composed_plugins_keep_their_own_nice_values_on_their_threads(vehicle_fa
     wanted = sorted([expected(FLIGHT_NICE), 0, 10])
     wait_for(lambda: set(wanted) <= set(thread_nices(pid)), 10, "the threads' priorities")
     assert expected(FLIGHT_NICE) in thread_nices(pid) and 10 in thread_nices(pid)
-    if Path("/proc/self/autogroup").exists():  # the process weighs as its most urgent
-        assert autogroup_nice(pid) == expected(FLIGHT_NICE)
 
 
 def test_a_raise_refused_by_the_system_leaves_the_plugin_running_at_its_parents():
