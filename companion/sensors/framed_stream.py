@@ -25,12 +25,8 @@ class FramedStream(Generic[ReadingT]):
 
     def feed(self, data: bytes, t_us: int) -> list[ReadingT]:
         """The readings completed by ``data`` (received at ``t_us``)."""
-        readings = []
-        for sentence in self.framer.feed(data):
-            reading = self.decoder.decode(sentence, t_us)
-            if reading is not None:
-                readings.append(reading)
-        return readings
+        sentences = self.framer.feed(data)
+        return [reading for reading, _t in self._decode(sentences, [t_us] * len(sentences))]
 
     def feed_spaced(
         self, data: bytes, t_us: int, since_us: int | None, period_us: float
@@ -38,10 +34,12 @@ class FramedStream(Generic[ReadingT]):
         """As ``feed`` for a device that sends one frame per sample, every ``period_us``:
         the readings with each frame's own time (``spread_stamps``), not the read's."""
         sentences = self.framer.feed(data)
+        return self._decode(sentences, spread_stamps(len(sentences), t_us, since_us, period_us))
+
+    def _decode(self, sentences: list[bytes], stamps: list[int]) -> list[tuple[ReadingT, int]]:
+        """Each sentence decoded at its stamp; the readings with their stamps."""
         out = []
-        for sentence, t in zip(
-            sentences, spread_stamps(len(sentences), t_us, since_us, period_us), strict=True
-        ):
+        for sentence, t in zip(sentences, stamps, strict=True):
             reading = self.decoder.decode(sentence, t)
             if reading is not None:
                 out.append((reading, t))

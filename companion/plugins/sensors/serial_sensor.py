@@ -52,6 +52,8 @@ class SerialSensor(Plugin, Generic[ReadingT]):
         self.framer = self.make_framer()
         self.decoder = self.make_decoder(ctx.settings)
         self.stream = FramedStream(self.framer, self.decoder)
+        rate_hz = ctx.settings["rate_hz"]
+        self.period_us = 1e6 / rate_hz if rate_hz > 0 else 0.0
 
     @classmethod
     def probe(
@@ -80,9 +82,8 @@ class SerialSensor(Plugin, Generic[ReadingT]):
         with self.ctx.bus.idle:  # waiting for the device is not busy time
             data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
         if self.periodic_frames:
-            period_us = 1e6 / rate if (rate := self.ctx.settings["rate_hz"]) > 0 else 0.0
             since = max(self._last_read_us or 0, self.ctx.health.reported_us or 0) or None
-            stamped = self.stream.feed_spaced(data, t_us, since, period_us)
+            stamped = self.stream.feed_spaced(data, t_us, since, self.period_us)
             if data:
                 self._last_read_us = t_us
             for reading, t in stamped:
