@@ -22,8 +22,10 @@ log = logging.getLogger("companion.priority")
 
 
 class HasNice(Protocol):
-    name: str
-    nice: int
+    @property
+    def name(self) -> str: ...
+    @property
+    def nice(self) -> int: ...
 
 
 def can_raise(by: int) -> bool:
