@@ -140,8 +140,7 @@ class LoopbackVehicle:
         after it is not refused for a device that has not been judged yet."""
         self.watcher.until(
             lambda m: (
-                m.get_type() == "SYS_STATUS"
-                and bool(m.onboard_control_sensors_health & PREARM)
+                m.get_type() == "SYS_STATUS" and bool(m.onboard_control_sensors_health & PREARM)
             ),
             timeout_s,
             "pre-arm checks passed (SYS_STATUS)",
