@@ -11,7 +11,7 @@ from typing import Generic, TypeVar
 
 from companion.sensors.codec_types import Framer, SentenceDecoder
 
-__all__ = ["FramedStream", "Framer", "SentenceDecoder", "spread_stamps"]
+__all__ = ["FramedStream", "Framer", "SentenceDecoder", "spread_since", "spread_stamps"]
 
 ReadingT = TypeVar("ReadingT")
 
@@ -74,3 +74,10 @@ def spread_stamps(n: int, t_us: int, since_us: int | None, period_us: float) -> 
         step = 0.0
     step = max(step, 0.0)
     return [t_us - round((n - 1 - i) * step) for i in range(n)]
+
+
+def spread_since(last_read_us: int | None, reported_us: int | None) -> int | None:
+    """The time no frame of a read can be stamped before: the previous read's (it found
+    none of them), and the driver's last counter report (which counted every sample
+    stamped up to then, so a frame stamped before it would be counted twice or never)."""
+    return max(last_read_us or 0, reported_us or 0) or None

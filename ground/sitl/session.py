@@ -111,6 +111,8 @@ def vehicle_config(req: SimRequest, opts: BridgeOptions, devices: dict[str, str]
         if spec.kind == "system.logger" and opts.exact:
             # One file from boot: a replay then sees every sample the navigator saw.
             spec.settings.update(from_boot=True, split=False, in_step=True)
+        if "batch_s" in spec.settings and opts.exact:
+            spec.settings["batch_s"] = 0.0  # the simulator waits for each frame's sample
     if req.state_dir:
         cfg.vehicle["state_dir"] = req.state_dir
     if req.sysid is not None:

@@ -14,10 +14,11 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from companion.messages import RangeReading
+from companion.messages import RangeReading, VehicleStatus
 from companion.params import ParamDecl
 from companion.params.live import LiveParams
 from companion.plugin import PluginContext
+from companion.plugins.sensors.read_batching import batch_setting
 from companion.plugins.sensors.serial_sensor import SerialSensor, serial_settings
 from companion.sensors.codec_types import Framer
 from companion.sensors.tfmini import RangeSample, TfminiDecoder, TfminiFramer, signal_quality
@@ -35,9 +36,13 @@ class Rangefinder(SerialSensor[RangeSample]):
 
     periodic_frames = True
 
-    settings = serial_settings("serial:///dev/ttyAMA2:115200", 115200, 100.0)
+    settings = {
+        **serial_settings("serial:///dev/ttyAMA2:115200", 115200, 100.0),
+        "batch_s": batch_setting("Disarmed, or armed with the ground out of its range"),
+    }
     params = RANGEFINDER_PARAMS
-    optional_inputs = ("params/changes",)
+    optional_inputs = ("params/changes", "vehicle/status")
+    ground_in_view = False  # the last reading was valid: the landing may be using it
     outputs = ("sensors/range",)
 
     def init(self, ctx: PluginContext) -> None:
@@ -55,7 +60,13 @@ class Rangefinder(SerialSensor[RangeSample]):
         self.tfmini = TfminiDecoder(v["RNGFND1_MIN"], v["RNGFND1_MAX"])
         return self.tfmini
 
+    def per_frame(self, status: VehicleStatus) -> bool:
+        """Each frame as it comes once the aircraft is armed and the ground in view (take-off
+        roll, approach, flare): the landing flares on these readings."""
+        return bool(status.armed) and self.ground_in_view
+
     def publish(self, reading: RangeSample, t_us: int) -> None:
+        self.ground_in_view = reading.valid
         v = self.live.values
         if self.live.poll():
             self.tfmini.min_m, self.tfmini.max_m = v["RNGFND1_MIN"], v["RNGFND1_MAX"]

@@ -22,10 +22,19 @@ from typing import Any
 
 import serial
 
-from companion.messages import RC_MAX_CHANNELS, PilotFlags, PilotInput, PilotSource
+from companion.control.modes import PILOT_MODES
+from companion.messages import (
+    RC_MAX_CHANNELS,
+    PilotFlags,
+    PilotInput,
+    PilotSource,
+    VehicleStatus,
+)
 from companion.params.live import LiveParams
 from companion.plugin import FLIGHT_NICE, NO_VEHICLE, DeviceProbe, Plugin, PluginContext
+from companion.plugins.sensors.read_batching import BatchedReads, batch_setting
 from companion.plugins.sensors.serial_sensor import serial_settings
+from companion.sensors.framed_stream import spread_since, spread_stamps
 from companion.sensors.rc_channels import RC_PARAMS, StickMap
 from companion.sensors.sbus import SbusDecoder, SbusFrame, SbusStream
 from companion.sensors.serial_port import ReopeningSerial
@@ -41,9 +50,13 @@ class RcInput(Plugin):
 
     nice = FLIGHT_NICE
 
-    settings = serial_settings("serial:///dev/ttyAMA0:100000", 100000, 70.0)
+    settings = {
+        **serial_settings("serial:///dev/ttyAMA0:100000", 100000, 70.0),
+        "batch_s": batch_setting("Unless the pilot flies the aircraft (armed, in a pilot's mode)"),
+    }
     params = RC_PARAMS
-    optional_inputs = ("params/changes",)
+    optional_inputs = ("params/changes", "vehicle/status")
+    _last_read_us: int | None = None
     outputs = ("sensors/rc", "sensors/rc_switch")
 
     @classmethod
@@ -70,15 +83,25 @@ class RcInput(Plugin):
         # mode wherever the switch happens to be.
         self.announced: int | None = None
         self.candidate = -1  # a new position seen once, waiting for a second frame
+        rate_hz = ctx.settings["rate_hz"]
+        self.period_us = 1e6 / rate_hz if rate_hz > 0 else 0.0
+        # The autopilot's modes look at the receiver for its switch and its failsafe only.
+        self.batching = BatchedReads(ctx, _pilot_flies)
 
     def step(self) -> None:
         with self.ctx.bus.idle:  # waiting for the receiver is not busy time
+            self.batching.wait()
             data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
         frames = self.decoder.feed(data)
         if frames and self.live.poll():
             self.stick_map = StickMap.from_params(self.live.values)
-        for frame in frames:
-            self._publish(frame, t_us)
+        since = spread_since(self._last_read_us, self.ctx.health.reported_us)
+        stamps = spread_stamps(len(frames), t_us, since, self.period_us)
+        for frame, t in zip(frames, stamps, strict=True):
+            self._publish(frame, t)
+        if data:
+            self._last_read_us = t_us
+            self.batching.read_done(t_us)
         c = self.decoder.counters
         self.ctx.health.frames_ok = c.ok
         self.ctx.health.frames_bad = c.bad_frames
@@ -117,3 +140,8 @@ class RcInput(Plugin):
 
     def close(self) -> None:
         self.port.close()
+
+
+def _pilot_flies(status: VehicleStatus) -> bool:
+    """Whether the sticks fly the aircraft now, so every frame counts at once."""
+    return bool(status.armed) and status.mode in PILOT_MODES

@@ -14,9 +14,11 @@ from abc import abstractmethod
 from collections.abc import Mapping
 from typing import Any, ClassVar, Generic, TypeVar
 
+from companion.messages import VehicleStatus
 from companion.plugin import NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
+from companion.plugins.sensors.read_batching import BatchedReads
 from companion.sensors.codec_types import Framer, SentenceDecoder
-from companion.sensors.framed_stream import FramedStream
+from companion.sensors.framed_stream import FramedStream, spread_since
 from companion.sensors.line_framer import LineFramer
 from companion.sensors.serial_port import ReopeningSerial
 
@@ -54,6 +56,13 @@ class SerialSensor(Plugin, Generic[ReadingT]):
         self.stream = FramedStream(self.framer, self.decoder)
         rate_hz = ctx.settings["rate_hz"]
         self.period_us = 1e6 / rate_hz if rate_hz > 0 else 0.0
+        # A device whose plug-in has a ``batch_s`` setting is read in batches when it may be.
+        self.batching = BatchedReads(ctx, self.per_frame) if "batch_s" in ctx.settings else None
+
+    def per_frame(self, status: VehicleStatus) -> bool:
+        """Whether the vehicle, in this ``status``, needs each frame as it comes (a plug-in
+        with a ``batch_s`` setting says when it does not)."""
+        return True
 
     @classmethod
     def probe(
@@ -80,9 +89,13 @@ class SerialSensor(Plugin, Generic[ReadingT]):
 
     def step(self) -> None:
         with self.ctx.bus.idle:  # waiting for the device is not busy time
+            if self.batching is not None:
+                self.batching.wait()
             data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
+        if data and self.batching is not None:
+            self.batching.read_done(t_us)
         if self.periodic_frames:
-            since = max(self._last_read_us or 0, self.ctx.health.reported_us or 0) or None
+            since = spread_since(self._last_read_us, self.ctx.health.reported_us)
             stamped = self.stream.feed_spaced(data, t_us, since, self.period_us)
             if data:
                 self._last_read_us = t_us

@@ -1,0 +1,56 @@
+"""A driver's reads batched while the vehicle does not need each frame at once.
+
+The plug-in says when it needs every frame (``per_frame``, from the commander's
+``vehicle/status`` and what it knows of its own readings); otherwise it reads once every
+``batch_s`` of vehicle time (``companion.sensors.read_pacing``). Without a commander on the
+bus nothing is known of the flight, and every frame is read as it comes.
+"""
+
+from __future__ import annotations
+
+import select
+import time
+from collections.abc import Callable
+
+from companion.messages import VehicleStatus
+from companion.plugin import PluginContext, Setting
+from companion.sensors.read_pacing import ReadPacer
+
+
+def batch_setting(what: str) -> Setting:
+    """The ``batch_s`` setting of a driver that batches ``what``."""
+    return Setting(
+        float,
+        0.1,
+        f"{what}, read the frames that piled up every batch_s of vehicle time"
+        " (0: each frame as it comes)",
+        min=0.0,
+        max=1.0,
+    )
+
+
+class BatchedReads:
+    """Waits before a read while ``per_frame(status)`` says batching is allowed."""
+
+    def __init__(self, ctx: PluginContext, per_frame: Callable[[VehicleStatus], bool]) -> None:
+        self.clock, self.stop_fd = ctx.clock, ctx.stop_fd
+        self.pacer = ReadPacer(ctx.settings["batch_s"])
+        self.per_frame = per_frame
+        self.status = ctx.bus.latest_reader("vehicle/status") if self.pacer.batch_us else None
+
+    def wait(self) -> None:
+        """Before a read: let the frames pile up for the rest of the batch, unless the
+        vehicle wants them one by one now. A stop request ends the wait."""
+        if self.status is None:
+            return
+        status = self.status.get()
+        if status is None or self.per_frame(status):
+            return
+        pause = self.pacer.pause_s(self.clock.now_us())
+        if pause > 0:
+            select.select([] if self.stop_fd is None else [self.stop_fd], [], [], pause)
+
+    def read_done(self, t_us: int) -> None:
+        """A read happened at vehicle time ``t_us``."""
+        if self.status is not None:
+            self.pacer.read_at(t_us, time.monotonic())
