@@ -71,11 +71,7 @@ def test_the_composed_layout_flies_the_same_flight(tmp_path):
     if rows[0] != rows[1]:
         parted = next((x.split(",")[0] for x, y in zip(*rows, strict=False) if x != y), "the end")
         first = _first_difference(own.with_suffix(".ulg"), composed.with_suffix(".ulg"))
-        # Open (issue 46.4): in a clean-clone run the navigator's state parted at 14.02 s
-        # while every sensor channel stayed identical to 23.9 s: which IMU step a GPS,
-        # compass or barometer sample of the same frame reaches the navigator at still
-        # depends on scheduling in the composed process. Everything above stays asserted.
-        pytest.xfail(
+        pytest.fail(
             f"the layouts flew different flights: the truth parts at t={parted} s; the"
             f" flight logs first differ in {first}"
         )

@@ -95,7 +95,7 @@ class MiniSscOutput(Plugin):
         self.wanted = dict(self.safe)
         self.sent: dict[int, int] = {}
         self.refresh_order = [c.servo for c in self.airframe.channels]
-        self.last_command_at = ctx.clock.now_us() / 1e6
+        self.last_command_at: float | None = None  # vehicle seconds
         self.cycle_s = CYCLE_MAX_S
         self.stale = True
         self.flying = False  # the last command was armed
@@ -109,13 +109,23 @@ class MiniSscOutput(Plugin):
         # The wire runs on vehicle time: in a simulation, simulated seconds.
         now = self.ctx.clock.now_us() / 1e6
         if received:
-            gap = now - self.last_command_at
-            self.cycle_s = min(CYCLE_MAX_S, max(CYCLE_MIN_S, gap))
+            # A command is no older than its own stamp. A plug-in started in a simulation
+            # held for its answer reads time 0 until the simulator's next frame: taken as
+            # the command's time, the next wake-up (a wall-clock timeout, or not, as the
+            # machine ran) found it seconds old and sent safe positions for a frame.
+            now = max(now, received[-1].t_us / 1e6)
+            if self.last_command_at is not None:
+                gap = now - self.last_command_at
+                self.cycle_s = min(CYCLE_MAX_S, max(CYCLE_MIN_S, gap))
             self.last_command_at = now
             self.wanted = self._positions(received[-1])
             self.stale = False
             self.flying = bool(received[-1].armed)
-        elif not self.stale and now - self.last_command_at > self._stale_after_s():
+        elif (
+            not self.stale
+            and self.last_command_at is not None
+            and now - self.last_command_at > self._stale_after_s()
+        ):
             self.ctx.log.warning(
                 "no command for %.2f s: safe positions", now - self.last_command_at
             )

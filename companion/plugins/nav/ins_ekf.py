@@ -10,8 +10,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import Protocol
 
+from companion.messages import Message
 from companion.navigation.ins_ekf import InsEkfConfig
 from companion.navigation.ins_warm import WarmFile, warm_state
 from companion.navigation.offline import InsEkfRunner
@@ -69,7 +72,7 @@ class InsEkfPlugin(Plugin):
         # Woken by the IMU only: an aiding sample waits for the IMU sample after it anyway
         # (SampleOrder), and without an IMU there is nothing to publish (``WAIT_S`` still
         # feeds it the aiding samples then).
-        self.waiter = ctx.bus.waiter(self.readers, triggers=self.readers[:1])
+        self.waiter = ctx.bus.waiter(self.readers[:1])
         self.out = ctx.bus.writer("nav/state")
         self.grid = PublishGrid(s["publish_hz"])
         self.order = SampleOrder()
@@ -78,10 +81,8 @@ class InsEkfPlugin(Plugin):
         self.runner.nav.warm = self.warm_file.read()
 
     def step(self) -> None:
-        # The waiter counts its own idle time and names the readers with data, in feed
-        # order: the empty ones are not asked again.
-        ready = self.waiter.wait(WAIT_S)
-        samples = self.order.push(m for r in ready for m in r.drain())
+        self.waiter.wait(WAIT_S)  # the waiter counts its own idle time
+        samples = self.order.push(received(self.readers))
         if not samples:
             return
         nav = self.runner.nav
@@ -98,6 +99,30 @@ class InsEkfPlugin(Plugin):
 
     def close(self) -> None:
         self.waiter.close()
+
+
+class _Drains(Protocol):
+    def drain(self) -> Iterable[Message]: ...
+
+
+def received(readers: Sequence[_Drains]) -> list[Message]:
+    """Every sample the readers hold: the IMU's (the first reader) taken before the others.
+
+    In exact lockstep every aiding sample of a frame is on the bus before the simulator
+    writes the next frame's IMU sample. Aiding readers drained after the IMU's therefore
+    give every aiding sample older than the newest IMU sample taken, and ``SampleOrder``
+    feeds each one before the IMU sample that follows it. Asked before (which readers had
+    data when the wait ended), a fix or a heading published between that look and the
+    IMU's drain stayed behind while the next frame's IMU sample was taken: it was fused one
+    IMU step late or on time, as the threads happened to be scheduled. A thread of a composed
+    process, sharing one interpreter, is held there for milliseconds, and its flight
+    parted from the same flight in separate processes (issue 46.4).
+    """
+    imu, *aiding = readers
+    taken = list(imu.drain())
+    for reader in aiding:
+        taken.extend(reader.drain())
+    return taken
 
 
 def _given(value: float) -> float | None:

@@ -88,3 +88,37 @@ def test_fixes_that_arrive_late_are_still_used_and_never_look_like_an_outage():
                 dead_reckoning_outside_outage += bool(state.flags & NavFlags.DEAD_RECKONING)
     assert fixes > 500 and accepted >= 0.98 * fixes
     assert dead_reckoning_outside_outage == 0
+
+
+class _Channel:
+    """A reader of one channel; ``then`` runs once its first sample has been read (what the
+    simulator and the other drivers do meanwhile)."""
+
+    def __init__(self, *samples) -> None:
+        self.samples = list(samples)
+        self.then = None
+
+    def drain(self):
+        while self.samples:
+            yield self.samples.pop(0)
+            if self.then is not None:
+                self.then, then = None, self.then
+                then()
+
+
+def test_a_fix_published_while_the_imu_is_read_is_fed_before_the_next_imu_sample():
+    # nav.ins_ekf woken by the IMU sample of 0 ms: while it reads it, the GPS driver
+    # publishes its fix of 0 ms and the simulator, having waited for that fix, writes the
+    # next frame, whose IMU sample of 10 ms the same read takes. The fix must go in before it.
+    from companion.plugins.nav.ins_ekf import received
+
+    imu, gps = _Channel(Imu(t_us=0)), _Channel()
+    heading_and_baro = [_Channel(), _Channel(), _Channel()]
+
+    def next_frame() -> None:
+        gps.samples.append(GpsFix(t_us=0))
+        imu.samples.append(Imu(t_us=10_000))
+
+    imu.then = next_frame
+    fed = _kinds(SampleOrder().push(received([imu, gps, *heading_and_baro])))
+    assert fed == [("Imu", 0), ("GpsFix", 0), ("Imu", 10_000)]
