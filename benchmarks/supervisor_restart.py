@@ -141,7 +141,7 @@ async def _fly(run: HilRun, watch: Watch, opts: argparse.Namespace) -> list[dict
             killed = time.monotonic()
             name = f"vehicle_restart{k}"
             started = time.monotonic()
-            run.vehicle = run._start(name, run.env, "run", "--config", str(run.config))
+            run.restart_vehicle(name)
             await asyncio.sleep(opts.every)
             results.append(_phases(run, watch, name, killed, started, before, load))
             if opts.show_log and k == opts.restarts - 1:
