@@ -80,3 +80,20 @@ def processes(specs: list[PluginSpec]) -> list[tuple[str, list[PluginSpec]]]:
             shared[spec.process] = [spec]
             out.append((spec.process, shared[spec.process]))
     return out
+
+
+def start_rank(specs: list[PluginSpec]) -> dict[str, int]:
+    """0 for the plug-ins a flight in the air waits for, 1 for the rest: the supervisor
+    starts them in that order (each in config order), as one at a time they take a tenth of
+    a second each on a busy board, and a supervisor restarted in the air has 3 s in all.
+
+    A flight waits for the flight chain (a raised priority: the IMU, the navigator, the
+    receiver; the flight group), the commander (it writes ``vehicle/status``: it judges
+    whether the restart is in the air and arms again), and whatever writes a required
+    input of theirs (the GPS the navigator aligns on in the air, the link's commands).
+    """
+    first = {s.name for s in specs if s.nice < 0 or s.group == "flight"}
+    first |= {s.name for s in specs if "vehicle/status" in s.ports.outputs}
+    wanted = {ch for s in specs if s.name in first for ch in s.ports.inputs}
+    first |= {s.name for s in specs if wanted.intersection(s.ports.outputs)}
+    return {s.name: 0 if s.name in first else 1 for s in specs}

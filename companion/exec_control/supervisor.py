@@ -19,7 +19,7 @@ from companion.bus.node import BusNode
 from companion.bus.patterns import Reader, Writer
 from companion.exec_control.child import FIRST_BACKOFF_S, Child
 from companion.exec_control.composed_child import ComposedChild
-from companion.exec_control.composition import processes
+from companion.exec_control.composition import processes, start_rank
 from companion.exec_control.config import VehicleConfig
 from companion.exec_control.priority import note_refused_raises
 from companion.exec_control.registry import load
@@ -58,6 +58,7 @@ class Supervisor:
             "plugins": {spec.kind: spec.settings for spec in cfg.plugins},
         }
         self.children: list[Child] = []
+        self.rank = start_rank(cfg.plugins)
         for process, specs in processes(cfg.plugins):
             wants = any(load(spec.kind).wants_vehicle_tables for spec in specs)
             args = {**base, **tables} if wants else base
@@ -83,12 +84,17 @@ class Supervisor:
         return [c for c in self.children if c.spec.group == name]
 
     def start_group(self, name: str) -> None:
-        for child in self.group(name):
+        # The flight chain and what it needs first: a restart in the air is back sooner.
+        for child in sorted(self.group(name), key=self._rank):
             if not child.wanted:
                 child.wanted = True
                 child.backoff_s = FIRST_BACKOFF_S
                 if child.proc is None:
                     child.start()
+
+    def _rank(self, child: Child) -> int:
+        members = getattr(child, "members", [child.spec])
+        return min(self.rank.get(m.name, 1) for m in members)
 
     def stop_children(self, children: list[Child]) -> None:
         """SIGTERM, wait for a clean exit, SIGKILL what is left."""
@@ -220,8 +226,11 @@ class Supervisor:
         # Commands wake it; the plug-ins' counters (each plug-in's once a second) wait for
         # the health table they go into.
         waiter = bus.waiter([commands, stats], triggers=[commands])
-        if self.forker.proc is not None and not self.forker.wait_ready(READY_TIMEOUT_S):
-            log.warning("fork server not ready: spawning plug-ins until it is")
+        if self.forker.proc is not None:
+            if self.forker.wait_ready(READY_TIMEOUT_S):
+                log.info("fork server ready")
+            else:
+                log.warning("fork server not ready: spawning plug-ins until it is")
         self.start_group("core")
         next_health = time.monotonic()
         while not self.stopping:

@@ -44,11 +44,15 @@ def run_vehicle(config: str, namespace: str | None, log_level: str) -> int:
     from companion.exec_control.topology import check_topology
 
     setup_logging(log_level)
+    log = logging.getLogger(__name__)
+    # Each step of a start is a line with its time: a restart in the air is timed by them.
+    log.info("starting %s", config)
     try:
         cfg = load_config(config, namespace)
         check_topology(cfg)
     except ConfigError as exc:
         return config_refused(exc)
+    log.info("config read")
     return Supervisor(cfg, log_level).run()
 
 

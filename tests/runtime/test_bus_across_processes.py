@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from companion.bus.namespace import cleanup_namespace, prefix_of
+from companion.bus.namespace import IOX_DIR, cleanup_namespace, prefix_of
 from companion.bus.node import BusNode
 from companion.messages import Imu, Magnetometer, NavState
 from tests.support.configs import PUBLISH_ONCE, plugin, vehicle_config
@@ -210,11 +210,11 @@ def test_a_waiter_on_one_trigger_sleeps_for_it_alone_and_never_for_ever(namespac
 
 
 def test_a_killed_processs_node_leaves_no_directory_behind(namespace):
-    """A vehicle killed outright (power lost: /tmp survives on a board whose /tmp is on
-    disk) leaves its nodes' directories; the next start's cleanup removes them whole.
+    """A vehicle killed outright (kill -9 of the supervisor, which its service restarts)
+    leaves its nodes' directories; the next start's cleanup removes them whole.
     Empty ones used to stay, and every node created later (each plug-in's start) walks
     all of them."""
-    nodes = Path("/tmp/iceoryx2/nodes")
+    nodes = IOX_DIR / "nodes"
     before = set(nodes.iterdir()) if nodes.exists() else set()
     code = (
         "import sys, time\nfrom companion.bus.node import BusNode\n"

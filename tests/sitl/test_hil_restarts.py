@@ -11,9 +11,11 @@ again and carry on in its mode.
 from __future__ import annotations
 
 import asyncio
+import itertools
 import logging
 import os
 import signal
+import threading
 import time
 from typing import Any
 
@@ -23,6 +25,7 @@ import pytest
 from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
 from mavsdk.plugins.telemetry import FlightMode
 
+from companion.bus.node import BusNode
 from companion.navigation.estimate_csv import read_estimate
 from tests.support.hil import HilRun
 from tests.support.mavsdk_flight import plan_uploaded
@@ -33,11 +36,40 @@ PLAN = REPO / "qgc_plans" / "short_leg.plan"
 # over by then); then the supervisor. The restarted link must not show a mode change.
 VICTIMS = ("commander", "control", "servos", "nav", "imu", "gps", "compass", "link", "rc")
 KILL_FROM_S, KILL_EVERY_S = 35.0, 3.0
-BACK_AFTER_S = 30.0  # armed in Mission again after the supervisor's kill, at most
+BACK_AFTER_S = 12.0  # armed in Mission again after the supervisor's kill, at most
+# From the dead controller's last command to the restarted one's first, by the vehicle's
+# own stamps (its clock: CLOCK_MONOTONIC on HIL). Issue 41 asks for 3 s; measured 3.0-3.8 s
+# from the kill beside two CPU hogs at load 11-13 (benchmarks/supervisor_restart.py).
+OUTAGE_S = 8.0
 SAFE_HEIGHT_M = 20.0  # lowest height after it (the mission flies at 80 m)
 # Left alone on trimmed surfaces for longer than this, the aircraft may spiral down before
-# the vehicle is back (HIL runs: back in 5.6-9.2 s at load 14-15, never lower than 77.7 m).
-UNATTENDED_S = 12.0
+# the vehicle is back (a HIL run: 5.6 s unattended from a straight leg, 44 m lost).
+UNATTENDED_S = 5.0
+
+
+class Commands(threading.Thread):
+    """The time stamps of every controller command on the bus, whichever process sent it."""
+
+    def __init__(self, namespace: str) -> None:
+        super().__init__(daemon=True)
+        self.bus = BusNode(namespace, "restart_test")
+        self.reader = self.bus.queue_reader("control/actuators")
+        self.t_us: list[int] = []
+        self.stop = False
+        self.ended_us = 0
+
+    def run(self) -> None:
+        while not self.stop:
+            self.t_us += [int(s.t_us) for s in self.reader.drain()]
+            self.bus.update_connections()
+            time.sleep(0.005)
+        self.ended_us = time.monotonic_ns() // 1000
+
+    def outage_s(self, killed_us: int) -> float:
+        """The longest gap between two commands from a second before the kill on (to the
+        end of the watch: no command after the kill is one gap to the end)."""
+        window = [t for t in self.t_us if t >= killed_us - 1_000_000] + [self.ended_us]
+        return max((b - a) / 1e6 for a, b in itertools.pairwise(window))
 
 
 def _plugin_pid(run: HilRun, name: str) -> int | None:
@@ -66,6 +98,7 @@ async def _mission_with_crashes(run: HilRun) -> dict:
         seen["finished"] = await mission.is_mission_finished()
         seen["finished_sim_s"] = _simulated_so_far(run)
         # Done, circling at the mission's height: now the supervisor dies.
+        seen["killed_us"] = time.monotonic_ns() // 1000  # the vehicle's clock (HIL)
         seen["back_after_s"] = await _kill_the_supervisor(run, telemetry)
         await asyncio.sleep(10.0)  # flying on, restarted
     return seen
@@ -106,18 +139,27 @@ async def _first(stream: Any) -> Any:
 @pytest.mark.timeout(400)
 def test_a_mission_flies_on_through_plugin_kills_and_a_supervisor_crash(tmp_path):
     run = HilRun(tmp_path, "--duration", "300")
+    commands = Commands(run.namespace)
+    commands.start()
     try:
         seen = asyncio.run(_mission_with_crashes(run))
     finally:
+        commands.stop = True
+        commands.join()
+        commands.bus.close()
         statuses = run.stop()
     vehicle_log = run.log("vehicle") + run.log("vehicle_restarted")
     assert seen["killed"] == list(VICTIMS), vehicle_log[-3000:]
     assert seen["finished"], (seen, vehicle_log[-3000:])
     assert seen["modes"] == {FlightMode.MISSION}, seen
-    # The restarted vehicle armed itself again and took the flight up. How soon depends on
-    # how fast Python starts on the machine (5.6-9.2 s as MAVSDK hears it, its 1 Hz
-    # heartbeat included, beside CPU hogs at load 14-15; 21 s at load 20).
+    # The restarted vehicle armed itself again and took the flight up: the controller's
+    # commands stopped for less than OUTAGE_S by the vehicle's clock (the gap's start is
+    # the dead controller's last command, its end the restarted one's first). MAVSDK hears
+    # it later, its 1 Hz heartbeat included.
+    outage = commands.outage_s(seen["killed_us"])
+    seen["outage_s"] = round(outage, 2)
     assert seen["back_after_s"] < BACK_AFTER_S, (seen, vehicle_log[-3000:])
+    assert outage < OUTAGE_S, (seen, vehicle_log[-3000:])
     assert "Restarted in flight: Mission resumed" in run.log("vehicle_restarted")
     truth = read_estimate(run.truth)
     t, alt = np.asarray(truth["t"]), np.asarray(truth["alt"])
@@ -132,9 +174,9 @@ def test_a_mission_flies_on_through_plugin_kills_and_a_supervisor_crash(tmp_path
     after = height[t >= seen["finished_sim_s"]]
     report = f"{seen}; from {after[0]:.1f} m at the kill, lowest {after.min():.1f} m"
     logging.getLogger(__name__).info("supervisor restart: %s", report)
-    if seen["back_after_s"] > UNATTENDED_S and after.min() <= SAFE_HEIGHT_M:
-        # A machine so loaded that the restart took this long (21 s at load 20): on trimmed
-        # surfaces and the last throttle the C172 winds into a spiral dive after 15-20 s,
-        # before the vehicle is back. Not the restarted vehicle's doing; said, not hidden.
+    if outage > UNATTENDED_S and after.min() <= SAFE_HEIGHT_M:
+        # A machine so loaded that the restart took this long: on trimmed surfaces and the
+        # last throttle the C172 rolls away into a spiral dive (44 m lost in 5.6 s), before
+        # the vehicle is back. Not the restarted vehicle's doing; said, not hidden.
         pytest.xfail(f"restart slower than {UNATTENDED_S} s (a loaded machine): {report}")
     assert after.min() > SAFE_HEIGHT_M, report
