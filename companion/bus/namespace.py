@@ -11,7 +11,6 @@ the ``COMPANION_BUS`` environment variable (default ``companion``).
 
 from __future__ import annotations
 
-import contextlib
 import logging
 import os
 import re
@@ -32,8 +31,9 @@ SHM_DIR = Path("/dev/shm")
 # on tmpfs, not in /tmp. iceoryx2 fsyncs every one it writes (14 per channel a process
 # opens), and /tmp is often on the board's disk or SD card: each plug-in's start spent
 # 0.2-0.3 s there (8 channels: 0.23 s under /tmp on this machine's disk, 0.02 s here), on
-# the path of a vehicle restarted in the air. A reboot clears them, as nothing survives it.
-IOX_DIR = SHM_DIR / "iceoryx2"
+# the path of a vehicle restarted in the air. Each namespace has its own folder for them
+# (``iox_dir``), removed whole with its shared memory, so nothing of a vehicle stays in
+# /dev/shm once it has stopped (a reboot clears them anyway).
 # Per reader, room for publishers gone (a plug-in restarted) while their samples were still
 # unread. iceoryx2's default of 128 costs every reader ~0.5 MB of its process's own memory,
 # a quarter of the vehicle's; a reader reads at least once a second, and 16 restarts
@@ -72,6 +72,11 @@ def prefix_of(namespace: str) -> str:
     return f"cmp_{validate_namespace(namespace)}_"
 
 
+def iox_dir(namespace: str) -> Path:
+    """The folder of iceoryx2's own files for this namespace (a name with its prefix)."""
+    return SHM_DIR / f"{prefix_of(namespace)}iox"
+
+
 def make_config(namespace: str) -> iox2.config.Config:
     """An iceoryx2 config whose every resource carries the namespace's prefix."""
     import iceoryx2 as iox2
@@ -79,7 +84,7 @@ def make_config(namespace: str) -> iox2.config.Config:
     quiet_iceoryx()
     cfg = iox2.config.global_config()
     cfg.global_cfg.prefix = iox2.FileName.new(prefix_of(namespace))
-    cfg.global_cfg.root_path = iox2.Path.new(f"{IOX_DIR}/")
+    cfg.global_cfg.root_path = iox2.Path.new(f"{iox_dir(namespace)}/")
     cfg.defaults.publish_subscribe.subscriber_expired_connection_buffer = EXPIRED_CONNECTIONS
     return cfg
 
@@ -119,37 +124,29 @@ def _matching(base: Path, prefix: str) -> list[Path]:
     trips over one is started again."""
     for _ in range(5):
         try:
-            return list(base.rglob(f"{prefix}*"))
+            return list(base.glob(f"{prefix}*"))
         except FileNotFoundError:
             continue
     return []
 
 
 def _remove_prefixed_files(prefix: str) -> int:
+    """Remove this namespace's shared memory and its iceoryx2 folder (``iox_dir``), which
+    holds its nodes' and services' descriptions."""
     removed = 0
-    emptied: set[Path] = set()
-    for base in (SHM_DIR,):  # IOX_DIR is under it
-        if not base.exists():
-            continue
-        for path in _matching(base, prefix):
-            try:
-                if path.is_dir():
-                    shutil.rmtree(path)
-                else:
-                    path.unlink()
-                removed += 1
-            except FileNotFoundError:
-                pass
-            except OSError as exc:
-                log.warning("cannot remove %s: %s", path, exc)
-            if path.parent.parent == IOX_DIR / "nodes":  # in a dead node's own directory
-                emptied.add(path.parent)
-    # A node's directory is named by its id alone, not the namespace: once this
-    # namespace's files are out of it, it goes too. Left empty, every node created later
-    # on the machine (each plug-in's start) would still walk it.
-    for folder in emptied:
-        with contextlib.suppress(OSError):  # not empty: not only this namespace's
-            folder.rmdir()
+    if not SHM_DIR.exists():
+        return 0
+    for path in _matching(SHM_DIR, prefix):
+        try:
+            if path.is_dir():
+                shutil.rmtree(path)
+            else:
+                path.unlink()
+            removed += 1
+        except FileNotFoundError:
+            pass  # inside a folder removed a moment ago
+        except OSError as exc:
+            log.warning("cannot remove %s: %s", path, exc)
     return removed
 
 
