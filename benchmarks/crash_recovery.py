@@ -46,7 +46,7 @@ sys.path.insert(0, str(REPO))
 from companion.bus.node import BusNode  # noqa: E402
 from companion.control.mission.plan import checked_plan  # noqa: E402
 from companion.geodesy import LocalFrame  # noqa: E402
-from companion.messages import NavFlags, channel  # noqa: E402
+from companion.messages import NavFlags  # noqa: E402
 from companion.navigation.estimate_csv import read_estimate  # noqa: E402
 from ground.campaign.legs import STRAIGHT_MARGIN_M, flight_legs  # noqa: E402
 from tests.support.hil import HilRun  # noqa: E402
@@ -75,17 +75,12 @@ class Watch(threading.Thread):
     def __init__(self, namespace: str) -> None:
         super().__init__(daemon=True)
         self.bus = BusNode(namespace, "crash_bench")
-        self.readers = {ch: self._reader(ch) for ch in OUTPUT.values()}
+        self.readers = {ch: self.bus.reader(ch) for ch in OUTPUT.values()}
         self.control = self.bus.latest_reader("control/status")
         self.seen: dict[str, list[float]] = {ch: [] for ch in OUTPUT.values()}
         self.nav: list[tuple[float, object]] = []
         self.last: dict[str, int] = {}
         self.stop = False
-
-    def _reader(self, name: str):  # type: ignore[no-untyped-def]
-        if channel(name).pattern == "latest":
-            return self.bus.latest_reader(name)
-        return self.bus.queue_reader(name)
 
     def run(self) -> None:
         while not self.stop:

@@ -52,7 +52,6 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from companion.bus.node import BusNode  # noqa: E402
-from companion.messages import channel  # noqa: E402
 from tests.support.hil import HilRun  # noqa: E402
 from tests.support.mavsdk_flight import plan_uploaded  # noqa: E402
 
@@ -75,15 +74,10 @@ class Watch(threading.Thread):
     def __init__(self, namespace: str) -> None:
         super().__init__(daemon=True)
         self.bus = BusNode(namespace, "restart_bench")
-        self.readers = {ch: self._reader(ch) for ch in CHANNELS}
+        self.readers = {ch: self.bus.reader(ch) for ch in CHANNELS}
         self.samples: dict[str, list[tuple[float, object]]] = {ch: [] for ch in CHANNELS}
         self.last: dict[str, object] = {}
         self.stop = False
-
-    def _reader(self, name: str):  # type: ignore[no-untyped-def]
-        if channel(name).pattern == "latest":
-            return self.bus.latest_reader(name)
-        return self.bus.queue_reader(name)
 
     def run(self) -> None:
         while not self.stop:

@@ -7,7 +7,6 @@ import heapq
 import logging
 import time
 from collections.abc import Callable
-from typing import Any
 
 from bridges.jsbsim.airframe_file import SimAirframe, read_airframe
 from bridges.jsbsim.device_streams import EmulatedDevices
@@ -32,8 +31,7 @@ from bridges.jsbsim.vehicle_commands import VehicleCommands
 from bridges.sensor_models.sensor_errors import MagneticField, NoiseModel, SensorErrors
 from bridges.sensor_models.true_state import TrueState
 from companion.bus.node import BusNode
-from companion.bus.patterns import Reader
-from companion.messages import SimClock, SimTruth, channel
+from companion.messages import SimClock, SimTruth
 
 log = logging.getLogger(__name__)
 
@@ -175,7 +173,7 @@ class SimBridge:
         self.nav_sync = FlightSync(period_us, nav, waiter, lag, "t_us", True, from_start=exact)
         if exact:
             readers = {
-                device: {c: self._sample_reader(c) for c in channels}
+                device: {c: self.bus.reader(c) for c in channels}
                 for device, channels in DEVICE_CHANNELS.items()
             }
             every = [r for by_channel in readers.values() for r in by_channel.values()]
@@ -183,12 +181,6 @@ class SimBridge:
             # The flight log's reader, a period behind at most, so its queues never overflow.
             logged = self.bus.latest_reader("system/logged")
             self.logged = FlightSync(period_us, logged, self.bus.waiter([logged]), 1, "t_us", True)
-
-    def _sample_reader(self, name: str) -> Reader[Any]:
-        assert self.bus is not None
-        if channel(name).pattern == "latest":
-            return self.bus.latest_reader(name)
-        return self.bus.queue_reader(name)
 
     def device_paths(self) -> dict[str, str]:
         """Device name → the pty path the vehicle's driver opens."""
