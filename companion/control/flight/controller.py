@@ -14,7 +14,7 @@ from companion.control.flight.assisted import track_ahead
 from companion.control.flight.attitude_modes import Sticks
 from companion.control.flight.flight_params import FlightConfig
 from companion.control.flight.landing_flight import LandingFlight, MissionRef, Motion
-from companion.control.flight.mode_targets import mode_target
+from companion.control.flight.mode_targets import arrive, mode_target
 from companion.control.flight.output import ControlOutput
 from companion.control.flight.pilot_flight import PilotFlight
 from companion.control.flight.takeoff import Phase, RunwayTakeoff
@@ -23,8 +23,9 @@ from companion.control.laws.attitude import AttitudeController
 from companion.control.laws.l1_guidance import L1Guidance, LateralDemand, bank_for
 from companion.control.laws.tecs import Tecs
 from companion.control.laws.wind import WindEstimator
-from companion.control.mission.executor import Kind, MissionExecutor, Setpoint, past_point
+from companion.control.mission.executor import Kind, MissionExecutor, Setpoint
 from companion.control.mission.items import MissionItem
+from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.resume import start_mission
 from companion.control.modes import PILOT_MODES
 from companion.geodesy import STANDARD_GRAVITY as G
@@ -52,6 +53,7 @@ class FlightController:
         self.frame: LocalFrame | None = None
         self.home_alt = 0.0
         self.executor: MissionExecutor | None = None
+        self.jumps = JumpCounts()  # DO_JUMP counts on disk: the plug-in gives it a folder
         self.takeoff: RunwayTakeoff | None = None
         self.go_arounds: int | None = None  # the commander's count when last seen
         self.landed: bool | None = None
@@ -127,6 +129,7 @@ class FlightController:
             self.wind.update(vel, nav.yaw_rad, dt)
         airspeed = self.wind.airspeed
         self._update_landed(nav, airspeed)
+        self.jumps.first_solution(bool(self.landed))  # before a mission takes them up
         out = ControlOutput(airspeed=airspeed, landed=bool(self.landed))
         out.brakes = self.config["LAND_BRAKE"] if self.landed else 0.0
         mode = FlightMode(status.mode) if status.mode else FlightMode.LOITER
@@ -222,7 +225,9 @@ class FlightController:
         if entered or self._mode_setpoint is None:
             home = (self.frame, self.home_alt)
             self._mode_setpoint = mode_target(mode, status, pos, nav, home, self.config)
-        self._mode_setpoint = self._arrive(self._mode_setpoint, mode, pos, nav.alt_msl_m)
+        self._mode_setpoint = arrive(
+            self._mode_setpoint, mode, pos, nav.alt_msl_m, self.config, self._turn_radius()
+        )
         return self._mode_setpoint
 
     def _mode_landing(
@@ -246,21 +251,6 @@ class FlightController:
         self.executor = plan.executor
         return sp
 
-    def _arrive(
-        self, sp: Setpoint, mode: FlightMode, pos: tuple[float, float], alt: float
-    ) -> Setpoint:
-        """Return and go-to circle their point on arrival; a take-off circles when high."""
-        radius = self.config["WP_LOITER_RAD"]
-        reach = max(radius, self._turn_radius()) * 1.5
-        near = math.hypot(sp.b[0] - pos[0], sp.b[1] - pos[1]) < reach
-        # Passing the point counts too: the line goes on past it for ever.
-        arrived = near or past_point(sp.a, sp.b, pos)
-        if sp.kind == Kind.LINE and mode in (FlightMode.RTL, FlightMode.GUIDED) and arrived:
-            return Setpoint(Kind.CIRCLE, sp.b, sp.b, sp.alt_msl, radius)
-        if sp.kind == Kind.TAKEOFF and alt >= sp.alt_msl - 5.0:
-            return Setpoint(Kind.CIRCLE, pos, pos, sp.alt_msl, radius)
-        return sp
-
     def _mission(
         self, status: VehicleStatus, pos: tuple[float, float], nav: NavState, t_s: float,
         entered: bool, out: ControlOutput,
@@ -272,6 +262,7 @@ class FlightController:
             # In the air (a restarted controller, say) the leg is taken up as it was flown.
             radius = None if self.landed else self._turn_radius()
             resumed = start_mission(ex, status.mission_first, pos, nav.alt_msl_m, radius)
+            ex.jumps_done.update(self.jumps.take_up(self.items))  # restarted in the air
             self.executor = ex
         setpoint = ex.step(pos, nav.alt_msl_m, t_s, self._turn_radius())
         if resumed is not None:  # and the corner it may be turning through
@@ -283,6 +274,7 @@ class FlightController:
             # take off towards the item rather than sit armed and silent on the runway.
             ex.take_off_first(max(setpoint.alt_msl, self.home_alt + IMPLICIT_TAKEOFF_AGL_M))
             setpoint = ex.step(pos, nav.alt_msl_m, t_s, self._turn_radius())
+        self.jumps.keep(self.items, ex.jumps_done)
         out.mission_seq = ex.current
         out.mission_finished = ex.finished
         out.reached = ex.drain_reached()

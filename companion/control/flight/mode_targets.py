@@ -1,6 +1,7 @@
 """The setpoint a mode other than Mission flies when it is entered: take-off to a height,
 Return home, go to or circle a point, straight on for a pilot's mode without fresh sticks,
-else circle where the aircraft is."""
+else circle where the aircraft is; and the circle a return, a go-to or a take-off turns
+into on arrival (``arrive``)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import math
 
 from companion.control.flight.assisted import track_ahead
 from companion.control.flight.flight_params import FlightConfig
-from companion.control.mission.executor import Kind, Setpoint
+from companion.control.mission.executor import Kind, Setpoint, past_point
 from companion.control.modes import PILOT_MODES
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavState, VehicleStatus
@@ -49,3 +50,24 @@ def mode_target(
     if mode in PILOT_MODES:  # no fresh sticks: straight on, height held
         return Setpoint(Kind.LINE, pos, track_ahead(pos, nav), alt)
     return Setpoint(Kind.CIRCLE, pos, pos, alt, radius)
+
+
+def arrive(
+    sp: Setpoint,
+    mode: FlightMode,
+    pos: tuple[float, float],
+    alt: float,
+    config: FlightConfig,
+    turn_radius: float,
+) -> Setpoint:
+    """Return and go-to circle their point on arrival; a take-off circles when high."""
+    radius = config["WP_LOITER_RAD"]
+    reach = max(radius, turn_radius) * 1.5
+    near = math.hypot(sp.b[0] - pos[0], sp.b[1] - pos[1]) < reach
+    # Passing the point counts too: the line goes on past it for ever.
+    arrived = near or past_point(sp.a, sp.b, pos)
+    if sp.kind == Kind.LINE and mode in (FlightMode.RTL, FlightMode.GUIDED) and arrived:
+        return Setpoint(Kind.CIRCLE, sp.b, sp.b, sp.alt_msl, radius)
+    if sp.kind == Kind.TAKEOFF and alt >= sp.alt_msl - 5.0:
+        return Setpoint(Kind.CIRCLE, pos, pos, sp.alt_msl, radius)
+    return sp

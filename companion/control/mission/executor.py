@@ -87,7 +87,7 @@ class MissionExecutor:
     reached: list[int] = field(default_factory=list)  # items reached since the last drain
 
     def __post_init__(self) -> None:
-        self._jumps_done: dict[int, int] = {}
+        self.jumps_done: dict[int, int] = {}  # how often each DO_JUMP (by seq) jumped
         self._loiter = _Loiter()
         self._prev: Point = (0.0, 0.0)
         self._prev_alt = self.home_alt_msl
@@ -101,7 +101,7 @@ class MissionExecutor:
         a mission taken up in the air, ``resume.resumed_leg``)."""
         self.current = max(0, min(first, len(self.items)))
         self._prev, self._prev_alt = leg_from or pos, alt_msl
-        self._jumps_done.clear()
+        self.jumps_done.clear()
         self.finished = False
         self._hold = None
         self._loiter = _Loiter()
@@ -142,7 +142,7 @@ class MissionExecutor:
                 return self._end(pos)
             # Back at an item with every finite jump counter unchanged: an endless loop of
             # DO items that never flies anywhere. End the mission rather than spin.
-            state = (self.current, tuple(sorted(self._jumps_done.items())))
+            state = (self.current, tuple(sorted(self.jumps_done.items())))
             if state in seen:
                 return self._end(pos)
             seen.add(state)
@@ -200,10 +200,10 @@ class MissionExecutor:
 
     def _jump(self, item: MissionItem) -> None:
         repeats = round(item.param2)
-        done = self._jumps_done.get(item.seq, 0)
+        done = self.jumps_done.get(item.seq, 0)
         if repeats < 0 or done < repeats:
             if repeats >= 0:  # an endless jump keeps no count (see the loop check in step)
-                self._jumps_done[item.seq] = done + 1
+                self.jumps_done[item.seq] = done + 1
             self.current = max(0, min(round(item.param1), len(self.items)))
         else:
             self.current += 1
@@ -258,7 +258,7 @@ class MissionExecutor:
 
     def _next_point(self, here: Point) -> Point | None:
         """Where the leg after the current waypoint goes (None when it is not a leg)."""
-        seq, jumps = self.current + 1, dict(self._jumps_done)
+        seq, jumps = self.current + 1, dict(self.jumps_done)
         for _ in range(MAX_JUMPS_PER_STEP):
             if seq >= len(self.items):
                 return None

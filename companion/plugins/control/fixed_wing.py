@@ -22,6 +22,7 @@ from companion.actuators.airframe import AirframeError, load_airframe
 from companion.control.flight.attitude_modes import pilot_sticks
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.flight_params import control_params, flight_config
+from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.messages import (
     ActuatorCommand,
@@ -93,6 +94,7 @@ class FixedWingPlugin(Plugin):
         self.controller = FlightController(
             flight_config(self.live_params.values), self.missions.items[0]
         )
+        self.controller.jumps = JumpCounts(state_dir)
         bus = ctx.bus
         self.nav = bus.latest_reader("nav/state")
         self.status_in = bus.latest_reader("vehicle/status")
