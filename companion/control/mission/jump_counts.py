@@ -35,13 +35,17 @@ def mission_key(items: Sequence[MissionItem]) -> int:
 
 
 class JumpCounts:
-    """Jump counts on disk: kept as they change, taken up once after a restart in the air."""
+    """Jump counts on disk: kept as they change, taken up once after a restart in the air.
+
+    A write (fsync'd, a few milliseconds on a card) happens only when a jump is counted,
+    never on a step that changed nothing.
+    """
 
     def __init__(self, state_dir: Path | None = None) -> None:
         self.path = None if state_dir is None else state_dir / FILE_NAME  # None: kept nowhere
-        self._written: tuple[int, dict[int, int]] | None = None  # unknown until written
         self._may_take_up: bool | None = None  # None until the first solution is judged
-        self._key: tuple[int, int] | None = None  # (id of the items, their mission_key)
+        # What the file holds: (id of the items list, counts); None when not known.
+        self._on_disk: tuple[int, dict[int, int]] | None = None
 
     def first_solution(self, landed: bool) -> None:
         """Where this controller's first navigation solution was: on the ground a new
@@ -64,45 +68,34 @@ class JumpCounts:
                 return {}
             counts = {int(seq): int(done) for seq, done in saved["jumps"].items()}
         except FileNotFoundError:
+            self._on_disk = (0, {})
             return {}
         except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
             log.warning("jump counts unreadable, starting from none: %s", exc)
             return {}
         log.info("jump counts taken up after a restart: %s", counts)
+        self._on_disk = (id(items), dict(counts))
         return counts
 
     def keep(self, items: Sequence[MissionItem], counts: dict[int, int]) -> None:
-        """Write ``counts`` if they changed since the last write (called every step)."""
-        if self.path is None:
+        """Write ``counts`` of ``items`` if they differ from what the file holds (called at
+        every step of a mission)."""
+        if self.path is None or self._on_disk == (id(items), counts):
             return
-        if (
-            self._written is not None
-            and self._written[1] == counts
-            and self._key
-            == (
-                id(items),
-                self._written[0],
-            )
-        ):
-            return
-        key = self._mission_key(items)
-        if self._written == (key, counts):
-            return
-        text = json.dumps({"mission": key, "jumps": {str(s): n for s, n in counts.items()}})
+        if not counts and self._on_disk is not None and not self._on_disk[1]:
+            return  # none counted, none on disk: for any mission alike
+        text = json.dumps(
+            {"mission": mission_key(items), "jumps": {str(s): n for s, n in counts.items()}}
+        )
         try:
             atomic_write_text(self.path, text)
         except OSError as exc:  # a full or read-only card must not stop the flight
             log.warning("cannot keep the jump counts: %s", exc)
             return
-        self._written = (key, dict(counts))
-
-    def _mission_key(self, items: Sequence[MissionItem]) -> int:
-        if self._key is None or self._key[0] != id(items):
-            self._key = (id(items), mission_key(items))
-        return self._key[1]
+        self._on_disk = (id(items), dict(counts))
 
     def forget(self) -> None:
         """The flight is over (or a new one begins): no counts to take up."""
         if self.path is not None:
             self.path.unlink(missing_ok=True)
-        self._written = None
+        self._on_disk = (0, {})
