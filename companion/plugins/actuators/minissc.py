@@ -6,11 +6,13 @@ channel goes to its safe position: throttle off, surfaces at trim. Armed, the la
 positions are held a while longer (``flight_hold_s``) before the input counts as stale, so
 that a controller restarting in flight finds the aircraft as it left it. When the supervisor
 itself dies, the whole vehicle restarts (seconds on a busy board): the flight surfaces go
-to trim, as ArduPilot sets its I/O co-processor's failsafe outputs when the flight
-computer stops, and the card holds them and the throttle until the restarted controller
-commands it. Holding the last surfaces instead held whatever the controller was doing:
-killed while rolling into a turn with full aileron, the aircraft rolled on at 40°/s and was
-inverted and in the ground 6 s later, before the vehicle was back.
+to the trim the aircraft was flying on (each surface's command averaged over the last
+seconds, ``companion.actuators.flying_trim``), as ArduPilot sets its I/O co-processor's
+failsafe outputs when the flight computer stops, and the card holds them and the throttle
+until the restarted controller commands it. Holding the last surfaces instead held
+whatever the controller was doing: killed while rolling into a turn with full aileron, the
+aircraft rolled on at 40°/s and was inverted and in the ground 6 s later, before the
+vehicle was back; the card's centre positions rolled it 35° in a second.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from typing import Any
 
 from companion.actuators import minissc
 from companion.actuators.airframe import Airframe, load_airframe
+from companion.actuators.flying_trim import FlyingTrim
 from companion.messages import ActuatorCommand, ServoOutput
 from companion.plugin import FLIGHT_NICE, NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
 from companion.sensors.serial_port import ReopeningSerial, open_problem
@@ -99,6 +102,7 @@ class MiniSscOutput(Plugin):
         self.cycle_s = CYCLE_MAX_S
         self.stale = True
         self.flying = False  # the last command was armed
+        self.trim = FlyingTrim()  # what the surfaces flew on lately
         # Every channel safe at once, so the first command finds the same card every time.
         if self._send(len(self.safe)):
             self._publish(-1)
@@ -121,6 +125,8 @@ class MiniSscOutput(Plugin):
             self.wanted = self._positions(received[-1])
             self.stale = False
             self.flying = bool(received[-1].armed)
+            if self.flying:
+                self.trim.update(self.wanted, now)
         elif (
             not self.stale
             and self.last_command_at is not None
@@ -140,11 +146,11 @@ class MiniSscOutput(Plugin):
         if self.ctx.supervisor_gone():
             # The execution control crashed, maybe in the air: throttle off would drop the
             # aircraft while the vehicle restarts, and a held roll would roll it over. The
-            # card holds trimmed surfaces and the last throttle until the restarted
-            # vehicle's controller commands it again.
+            # card holds the surfaces at the trim they flew on lately and the last throttle
+            # until the restarted vehicle's controller commands it again.
             self.ctx.log.warning("the supervisor is gone: surfaces trimmed, throttle held")
             trimmed = [c.servo for c in self.airframe.channels if c.surface in FLIGHT_SURFACES]
-            self.wanted.update({servo: self.safe[servo] for servo in trimmed})
+            self.wanted.update({s: self.trim.position(s, self.safe[s]) for s in trimmed})
             for servo in trimmed:
                 self.sent.pop(servo, None)  # sent again, whatever the card had
             self._send(len(trimmed))
