@@ -111,8 +111,10 @@ def vehicle_config(req: SimRequest, opts: BridgeOptions, devices: dict[str, str]
         if spec.kind == "system.logger" and opts.exact:
             # One file from boot: a replay then sees every sample the navigator saw.
             spec.settings.update(from_boot=True, split=False, in_step=True)
-        if "batch_s" in spec.settings and opts.exact:
-            spec.settings["batch_s"] = 0.0  # the simulator waits for each frame's sample
+        if "batch_s" in spec.settings and opts.speed is None:
+            # Lockstep: the simulator waits for each driver to read its frame (exact: to
+            # publish its sample) before the next step, so a batching driver would hold it.
+            spec.settings["batch_s"] = 0.0
     if req.state_dir:
         cfg.vehicle["state_dir"] = req.state_dir
     if req.sysid is not None:
