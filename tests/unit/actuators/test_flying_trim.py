@@ -3,9 +3,7 @@ flying on lately (not the dead controller's last frame, not the card's centre)."
 
 from __future__ import annotations
 
-import logging
 import math
-import os
 
 import pytest
 
@@ -13,10 +11,7 @@ from companion.actuators.airframe import load_airframe
 from companion.actuators.flying_trim import FlyingTrim
 from companion.actuators.minissc import FrameDecoder
 from companion.messages import ActuatorCommand
-from companion.plugin import PluginContext
-from companion.plugins.actuators.minissc import MiniSscOutput
-from tests.support.pty import Pty
-from tests.unit.actuators.test_minissc_start import _Bus, _Clock, _written
+from tests.unit.actuators.test_minissc_start import _written, started_servos
 
 
 def test_the_average_follows_a_steady_command_and_forgets_an_old_one():
@@ -36,16 +31,8 @@ def test_a_gap_in_the_commands_weighs_as_the_time_it_lasted():
 
 
 def test_with_the_supervisor_gone_the_card_holds_the_surfaces_flown_lately(tmp_path):
-    pty = Pty(tmp_path / "ttyServo")
-    os.set_blocking(pty.master, False)
-    bus, clock = _Bus(), _Clock()
-    settings = {"device": str(pty.link), "baud": 9600, "stale_s": 0.5, "flight_hold_s": 2.0}
-    servos = MiniSscOutput()
-    ctx = PluginContext(
-        "servos", settings, logging.getLogger("servos"), bus, clock, {"airframe": "c172p"}
-    )  # type: ignore[arg-type]
-    ctx.supervisor_pid = -1  # not this process's parent: the supervisor is gone
-    servos.init(ctx)
+    # A supervisor pid not this process's parent: the supervisor is gone.
+    servos, bus, clock, pty = started_servos(tmp_path, supervisor_pid=-1)
     channels = {c.surface: c for c in load_airframe("c172p").channels}
     # 4 s of a straight leg (a little right aileron, some up elevator, cruise power),
     # then the last command before the death: rolling hard left into a turn.

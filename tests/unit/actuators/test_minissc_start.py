@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import os
 import select
+from pathlib import Path
 from types import SimpleNamespace
 
 from companion.actuators.airframe import load_airframe
@@ -49,7 +50,10 @@ class _Clock:
         return self.us
 
 
-def test_a_wake_up_just_after_the_first_command_keeps_the_commanded_throttle(tmp_path):
+def started_servos(
+    tmp_path: Path, supervisor_pid: int | None = None
+) -> tuple[MiniSscOutput, _Bus, _Clock, Pty]:
+    """The plug-in on a pty, with stand-ins for its bus ports and its clock (a C172)."""
     pty = Pty(tmp_path / "ttyServo")
     os.set_blocking(pty.master, False)
     bus, clock = _Bus(), _Clock()
@@ -58,7 +62,13 @@ def test_a_wake_up_just_after_the_first_command_keeps_the_commanded_throttle(tmp
     ctx = PluginContext(
         "servos", settings, logging.getLogger("servos"), bus, clock, {"airframe": "c172p"}
     )  # type: ignore[arg-type]
+    ctx.supervisor_pid = supervisor_pid
     servos.init(ctx)
+    return servos, bus, clock, pty
+
+
+def test_a_wake_up_just_after_the_first_command_keeps_the_commanded_throttle(tmp_path):
+    servos, bus, clock, pty = started_servos(tmp_path)
     throttle = next(c for c in load_airframe("c172p").channels if c.surface == "throttle")
     # Started at START at 5 s of simulation: the first command (answering the navigator's
     # state of 5.00 s) comes while this process's clock still reads 0; the next wake-up
