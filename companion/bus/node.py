@@ -180,9 +180,9 @@ class BusNode:
 class Waiter:
     """Sleeps until any of several readers (its triggers) has data, or a timeout passes.
 
-    Readers that are not triggers wake nobody: their data waits for the next wake-up (a
-    navigator woken by its IMU only, its aiding samples being held for the next IMU sample
-    anyway), and their notifications are cleared then.
+    Readers that are not triggers wake nobody: their data waits for the next wake-up (the
+    supervisor woken by commands only, the plug-ins' counters read when it wakes anyway),
+    and their notifications are cleared then.
     """
 
     def __init__(
