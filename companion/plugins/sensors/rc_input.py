@@ -32,9 +32,9 @@ from companion.messages import (
 )
 from companion.params.live import LiveParams
 from companion.plugin import FLIGHT_NICE, NO_VEHICLE, DeviceProbe, Plugin, PluginContext
-from companion.plugins.sensors.read_batching import BatchedReads, batch_setting
+from companion.plugins.sensors.read_batching import DeviceReads, batch_setting
 from companion.plugins.sensors.serial_sensor import serial_settings
-from companion.sensors.framed_stream import spread_since, spread_stamps
+from companion.sensors.framed_stream import spread_stamps
 from companion.sensors.rc_channels import RC_PARAMS, StickMap
 from companion.sensors.sbus import SbusDecoder, SbusFrame, SbusStream
 from companion.sensors.serial_port import ReopeningSerial
@@ -56,7 +56,6 @@ class RcInput(Plugin):
     }
     params = RC_PARAMS
     optional_inputs = ("params/changes", "vehicle/status")
-    _last_read_us: int | None = None
     outputs = ("sensors/rc", "sensors/rc_switch")
 
     @classmethod
@@ -83,25 +82,17 @@ class RcInput(Plugin):
         # mode wherever the switch happens to be.
         self.announced: int | None = None
         self.candidate = -1  # a new position seen once, waiting for a second frame
-        rate_hz = ctx.settings["rate_hz"]
-        self.period_us = 1e6 / rate_hz if rate_hz > 0 else 0.0
         # The autopilot's modes look at the receiver for its switch and its failsafe only.
-        self.batching = BatchedReads(ctx, _pilot_flies)
+        self.reads = DeviceReads(ctx, self.port, _pilot_flies)
 
     def step(self) -> None:
-        with self.ctx.bus.idle:  # waiting for the receiver is not busy time
-            self.batching.wait()
-            data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
+        data, t_us, since = self.reads.read()
         frames = self.decoder.feed(data)
         if frames and self.live.poll():
             self.stick_map = StickMap.from_params(self.live.values)
-        since = spread_since(self._last_read_us, self.ctx.health.reported_us)
-        stamps = spread_stamps(len(frames), t_us, since, self.period_us)
+        stamps = spread_stamps(len(frames), t_us, since, self.reads.period_us)
         for frame, t in zip(frames, stamps, strict=True):
             self._publish(frame, t)
-        if data:
-            self._last_read_us = t_us
-            self.batching.read_done(t_us)
         c = self.decoder.counters
         self.ctx.health.frames_ok = c.ok
         self.ctx.health.frames_bad = c.bad_frames

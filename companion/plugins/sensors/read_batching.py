@@ -14,7 +14,9 @@ from collections.abc import Callable
 
 from companion.messages import VehicleStatus
 from companion.plugin import PluginContext, Setting
+from companion.sensors.framed_stream import spread_since
 from companion.sensors.read_pacing import ReadPacer
+from companion.sensors.serial_port import ReopeningSerial
 
 
 def batch_setting(what: str) -> Setting:
@@ -54,3 +56,35 @@ class BatchedReads:
         """A read happened at vehicle time ``t_us``."""
         if self.status is not None:
             self.pacer.read_at(t_us, time.monotonic())
+
+
+class DeviceReads:
+    """A sensor plug-in's reads of its port: batched while ``per_frame`` allows it (when the
+    plug-in has a ``batch_s`` setting), each stamped when its first byte came, and the mark
+    its frames' own stamps may not go before (``spread_since``)."""
+
+    def __init__(
+        self,
+        ctx: PluginContext,
+        port: ReopeningSerial,
+        per_frame: Callable[[VehicleStatus], bool],
+    ) -> None:
+        self.ctx, self.port = ctx, port
+        rate_hz = ctx.settings["rate_hz"]
+        self.period_us = 1e6 / rate_hz if rate_hz > 0 else 0.0  # the device's frame period
+        self.batching = BatchedReads(ctx, per_frame) if "batch_s" in ctx.settings else None
+        self._last_read_us: int | None = None
+
+    def read(self) -> tuple[bytes, int, int | None]:
+        """What came (after the batch's wait), when its first byte came, and the time no
+        frame of it can be stamped before."""
+        with self.ctx.bus.idle:  # waiting for the device is not busy time
+            if self.batching is not None:
+                self.batching.wait()
+            data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
+        since = spread_since(self._last_read_us, self.ctx.health.reported_us)
+        if data:
+            self._last_read_us = t_us
+            if self.batching is not None:
+                self.batching.read_done(t_us)
+        return data, t_us, since

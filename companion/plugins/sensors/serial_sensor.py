@@ -16,9 +16,9 @@ from typing import Any, ClassVar, Generic, TypeVar
 
 from companion.messages import VehicleStatus
 from companion.plugin import NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
-from companion.plugins.sensors.read_batching import BatchedReads
+from companion.plugins.sensors.read_batching import DeviceReads
 from companion.sensors.codec_types import Framer, SentenceDecoder
-from companion.sensors.framed_stream import FramedStream, spread_since
+from companion.sensors.framed_stream import FramedStream
 from companion.sensors.line_framer import LineFramer
 from companion.sensors.serial_port import ReopeningSerial
 
@@ -44,7 +44,6 @@ class SerialSensor(Plugin, Generic[ReadingT]):
     # One frame per sample, sent every 1/rate_hz (an IMU, not a GPS's several sentences a
     # fix): frames a late read finds together are stamped a period apart, not alike.
     periodic_frames: ClassVar[bool] = False
-    _last_read_us: int | None = None
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
@@ -54,10 +53,8 @@ class SerialSensor(Plugin, Generic[ReadingT]):
         self.framer = self.make_framer()
         self.decoder = self.make_decoder(ctx.settings)
         self.stream = FramedStream(self.framer, self.decoder)
-        rate_hz = ctx.settings["rate_hz"]
-        self.period_us = 1e6 / rate_hz if rate_hz > 0 else 0.0
         # A device whose plug-in has a ``batch_s`` setting is read in batches when it may be.
-        self.batching = BatchedReads(ctx, self.per_frame) if "batch_s" in ctx.settings else None
+        self.reads = DeviceReads(ctx, self.port, self.per_frame)
 
     def per_frame(self, status: VehicleStatus) -> bool:
         """Whether the vehicle, in this ``status``, needs each frame as it comes (a plug-in
@@ -88,18 +85,9 @@ class SerialSensor(Plugin, Generic[ReadingT]):
         """Put one decoded reading on the bus."""
 
     def step(self) -> None:
-        with self.ctx.bus.idle:  # waiting for the device is not busy time
-            if self.batching is not None:
-                self.batching.wait()
-            data, t_us = self.port.read_stamped(self.ctx.clock.now_us)
-        if data and self.batching is not None:
-            self.batching.read_done(t_us)
+        data, t_us, since = self.reads.read()
         if self.periodic_frames:
-            since = spread_since(self._last_read_us, self.ctx.health.reported_us)
-            stamped = self.stream.feed_spaced(data, t_us, since, self.period_us)
-            if data:
-                self._last_read_us = t_us
-            for reading, t in stamped:
+            for reading, t in self.stream.feed_spaced(data, t_us, since, self.reads.period_us):
                 self.publish(reading, t)
         else:
             for reading in self.stream.feed(data, t_us):
