@@ -1,6 +1,6 @@
 """Lockstep simulation speed with the whole vehicle running.
 
-Usage: uv run python benchmarks/sitl_speed.py [--aircraft c172p] [--seconds 300]
+Usage: uv run python benchmarks/sitl_speed.py [--aircraft c172p] [--seconds 300] [--config TOML]
 
 Runs ``companion sim --speed max --airborne`` for the given simulated time, arms it and
 makes it loiter (so the controller and the servo card are in the loop, in lockstep with
@@ -92,6 +92,7 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=300.0)
     parser.add_argument("--disarmed", action="store_true", help="do not arm")
     parser.add_argument("--exact", action="store_true", help="lockstep with the control loop")
+    parser.add_argument("--config", type=Path, help="vehicle config (default: the shipped sim)")
     args = parser.parse_args()
     port = free_udp_port()
     station = mavutil.mavlink_connection(f"udpin:127.0.0.1:{port}", source_system=255)
@@ -103,6 +104,8 @@ def main() -> None:
             "--state-dir", tmp, "--link", f"udpout://127.0.0.1:{port}",
             "--exact" if args.exact else "--fast",
         ]  # fmt: skip
+        if args.config is not None:
+            cmd += ["--config", str(args.config)]
         proc = subprocess.Popen(cmd, cwd=REPO, env=env, text=True, stdout=subprocess.PIPE,
                                 stderr=subprocess.STDOUT)  # fmt: skip
         root, cpu = psutil.Process(proc.pid), {}
