@@ -13,18 +13,26 @@ until the restarted controller commands it. Holding the last surfaces instead he
 whatever the controller was doing: killed while rolling into a turn with full aileron, the
 aircraft rolled on at 40°/s and was inverted and in the ground 6 s later, before the
 vehicle was back; the card's centre positions rolled it 35° in a second.
+
+Started in flight (this process restarted after a crash while the controller says the
+aircraft is not landed, or the vehicle restarted after its supervisor died and the card was
+left trimmed), nothing is written until the first command: the card keeps its last pulses,
+and the safe positions written at a start on the ground would cut the throttle in the air.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 from companion.actuators import minissc
 from companion.actuators.airframe import Airframe, load_airframe
 from companion.actuators.flying_trim import FlyingTrim
 from companion.messages import ActuatorCommand, ServoOutput
+from companion.params.atomic import atomic_write_text
 from companion.plugin import FLIGHT_NICE, NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
 from companion.sensors.serial_port import ReopeningSerial, open_problem
 
@@ -33,6 +41,9 @@ CYCLE_MIN_S, CYCLE_MAX_S = 0.01, 0.1
 FRAME_BYTES = 3
 # Trimmed when the supervisor dies; the rest (throttle, flaps, brakes) is held.
 FLIGHT_SURFACES = ("aileron", "elevator", "rudder")
+# Left by a process that trimmed the card as its supervisor died, for the restarted vehicle's
+# servo plug-in; older than this (wall seconds) it says nothing of the card.
+HELD_MARK_MAX_S = 60.0
 
 
 def surface_value(cmd: ActuatorCommand, surface: str) -> float:
@@ -64,7 +75,7 @@ class MiniSscOutput(Plugin):
             min=0.05,
         ),
     }
-    optional_inputs = ("control/actuators",)
+    optional_inputs = ("control/actuators", "control/status")
     outputs = ("actuators/servos",)
 
     @classmethod
@@ -103,9 +114,24 @@ class MiniSscOutput(Plugin):
         self.stale = True
         self.flying = False  # the last command was armed
         self.trim = FlyingTrim()  # what the surfaces flew on lately
+        self.held_mark = Path(ctx.vehicle.get("state_dir", ".")) / f"{ctx.name}_held_in_flight"
+        if self._started_in_flight(ctx):
+            ctx.log.warning("started in flight: the card holds its positions until a command")
+            self.flying, self.stale = True, False  # stale after flight_hold_s without one
         # Every channel safe at once, so the first command finds the same card every time.
-        if self._send(len(self.safe)):
+        elif self._send(len(self.safe)):
             self._publish(-1)
+
+    def _started_in_flight(self, ctx: PluginContext) -> bool:
+        """Whether the aircraft may be in the air: the controller's last status says it is
+        not landed, or the last servo process trimmed the card as its supervisor died."""
+        status = ctx.bus.latest_reader("control/status").get()
+        try:
+            age_s = time.time() - self.held_mark.stat().st_mtime
+            self.held_mark.unlink()
+        except OSError:
+            age_s = math.inf
+        return (status is not None and not status.landed) or 0 <= age_s < HELD_MARK_MAX_S
 
     def step(self) -> None:
         self.waiter.wait(WAIT_S)  # the waiter counts its own idle time
@@ -127,6 +153,10 @@ class MiniSscOutput(Plugin):
             self.flying = bool(received[-1].armed)
             if self.flying:
                 self.trim.update(self.wanted, now)
+        elif self.last_command_at is None and not self.stale:
+            # Started in flight: held from the first wake-up that knows the time (a held
+            # simulation reads 0 until its next frame).
+            self.last_command_at = now if now > 0 else None
         elif (
             not self.stale
             and self.last_command_at is not None
@@ -153,7 +183,8 @@ class MiniSscOutput(Plugin):
             self.wanted.update({s: self.trim.position(s, self.safe[s]) for s in trimmed})
             for servo in trimmed:
                 self.sent.pop(servo, None)  # sent again, whatever the card had
-            self._send(len(trimmed))
+            if self._send(len(trimmed)):
+                self._mark_held()
         else:
             self.wanted = dict(self.safe)
             self.sent = {}  # everything counts as changed: all channels go out
@@ -161,6 +192,13 @@ class MiniSscOutput(Plugin):
                 self._publish(-1)
         self.waiter.close()
         self.port.close()
+
+    def _mark_held(self) -> None:
+        """Tell the restarted vehicle's servo plug-in that the card was left flying."""
+        try:
+            atomic_write_text(self.held_mark, "trimmed as the supervisor died\n")
+        except OSError as exc:
+            self.ctx.log.warning("could not leave %s: %s", self.held_mark, exc)
 
     def _stale_after_s(self) -> float:
         """Armed, throttle off and trimmed surfaces would put the aircraft into a glide or a
