@@ -122,18 +122,20 @@ class PolygonZone:
         """Strictly inside."""
         return not self._on_boundary(p) and self._inside(p)
 
-    def _boundary_gap(self, a: Point, b: Point) -> float:
-        return min(_segment_gap(a, b, c, d) for c, d in self.edges)
+    def _clear_of_boundary(self, a: Point, b: Point, width: float) -> bool:
+        """The segment a-b nowhere on the boundary nor nearer it than ``width``."""
+        gap = min(_segment_gap(a, b, c, d) for c, d in self.edges)
+        return gap > 0.0 and gap >= width
 
     def holds(self, a: Point, b: Point, width: float) -> bool:
         """Whether every point within ``width`` of the segment a-b is inside: both ends
-        inside and the segment nowhere nearer the boundary than ``width``."""
-        return self.covers(a) and self.covers(b) and self._boundary_gap(a, b) >= width
+        inside and the segment nowhere on the boundary nor nearer it than ``width``."""
+        return self.covers(a) and self.covers(b) and self._clear_of_boundary(a, b, width)
 
     def clear_of(self, a: Point, b: Point, width: float) -> bool:
         """Whether no point within ``width`` of the segment a-b is inside (an end outside
         and the boundary never that near: neither crosses nor encloses the other)."""
-        return not self.covers(a) and self._boundary_gap(a, b) >= width
+        return not self.covers(a) and self._clear_of_boundary(a, b, width)
 
 
 @dataclass(frozen=True)
