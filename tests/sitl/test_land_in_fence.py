@@ -15,6 +15,7 @@ import logging
 import math
 import re
 import time
+from collections.abc import Callable
 
 import pytest
 
@@ -25,7 +26,7 @@ from companion.control.modes import BY_MODE
 from companion.geodesy import LocalFrame, wrap_pi
 from companion.messages import FlightMode
 from companion.navigation.estimate_csv import read_estimate
-from ground.campaign.landing_score import score_landing
+from ground.campaign.landing_score import LandingScore, score_landing
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import GroundStation
 from tests.support.vehicle import REPO
@@ -34,6 +35,9 @@ log = logging.getLogger(__name__)
 PLAN = REPO / "qgc_plans" / "square.plan"
 pytestmark = pytest.mark.vehicle(airframe="c172p", duration=1500)
 WALL_S = 1500.0  # a hang guard only: the flight is judged by the vehicle's telemetry
+HOME = LocalFrame(-37.9105, 145.134)  # the plan's home, where the simulation starts
+NEAR_HOME_M = 500.0  # Land from Return once this near home, as in the click-through
+CLIMB_OUT_CHECK_M = 200.0  # the roll and the wings-level climb-out follow the runway line
 SAID = re.compile(r"Land: course (\d+), (\d+) m final, loiter (right|left)")
 
 
@@ -42,31 +46,41 @@ def _accepted(qgc: GroundStation, command: int, *params: float) -> None:
     assert qgc.ack(command).result == d.MAV_RESULT_ACCEPTED
 
 
-def _until_disarmed(qgc: GroundStation) -> tuple[list[FlightMode], list[str]]:
-    """The modes the heartbeat showed and the texts said, until the vehicle disarmed; the
-    ground station beats once a second meanwhile, as QGroundControl does."""
-    modes: list[FlightMode] = []
-    texts: list[str] = []
-    by_px4 = {m.px4: mode for mode, m in BY_MODE.items()}
-    end, beat = time.monotonic() + WALL_S, 0.0
-    while time.monotonic() < end:
-        if time.monotonic() > beat:
-            qgc.heartbeat()
-            beat = time.monotonic() + 1.0
-        msg = qgc.conn.recv_match(type=["HEARTBEAT", "STATUSTEXT"], blocking=True, timeout=1)
-        if msg is None or msg.get_srcSystem() != 1:
-            continue
-        if msg.get_type() == "STATUSTEXT":
-            texts.append(msg.text)
-            continue
-        if msg.get_srcComponent() != 1:
-            continue
-        mode = by_px4.get(msg.custom_mode)
-        if mode is not None and (not modes or modes[-1] != mode):
-            modes.append(mode)
-        if not msg.base_mode & d.MAV_MODE_FLAG_SAFETY_ARMED:
-            return modes, texts
-    raise AssertionError(f"never disarmed; modes {modes}, texts {texts[-10:]}")
+class Heard:
+    """What QGroundControl's Fly view shows: the modes in turn, the messages, the position.
+    ``pump`` beats once a second meanwhile, as QGroundControl does."""
+
+    def __init__(self, qgc: GroundStation) -> None:
+        self.qgc = qgc
+        self.modes: list[FlightMode] = []
+        self.texts: list[str] = []
+        self.armed = True
+        self.home_m = math.inf  # from home (the plan's, where the simulation starts)
+        self._by_px4 = {m.px4: mode for mode, m in BY_MODE.items()}
+
+    def pump(self, done: Callable[[], bool], what: str) -> None:
+        end, beat = time.monotonic() + WALL_S, 0.0
+        kinds = ["HEARTBEAT", "STATUSTEXT", "GLOBAL_POSITION_INT"]
+        while time.monotonic() < end and not done():
+            if time.monotonic() > beat:
+                self.qgc.heartbeat()
+                beat = time.monotonic() + 1.0
+            msg = self.qgc.conn.recv_match(type=kinds, blocking=True, timeout=1)
+            if msg is not None and msg.get_srcSystem() == 1 and msg.get_srcComponent() == 1:
+                self._take(msg)
+        assert done(), f"never {what}; modes {self.modes}, texts {self.texts[-10:]}"
+
+    def _take(self, msg) -> None:
+        kind = msg.get_type()
+        if kind == "STATUSTEXT":
+            self.texts.append(msg.text)
+        elif kind == "GLOBAL_POSITION_INT":
+            self.home_m = math.hypot(*HOME.ne(msg.lat / 1e7, msg.lon / 1e7))
+        else:
+            mode = self._by_px4.get(msg.custom_mode)
+            if mode is not None and (not self.modes or self.modes[-1] != mode):
+                self.modes.append(mode)
+            self.armed = bool(msg.base_mode & d.MAV_MODE_FLAG_SAFETY_ARMED)
 
 
 @pytest.mark.timeout(1800)
@@ -74,19 +88,25 @@ def test_qgc_land_with_the_square_plans_fence_lands_inside_it(sim):
     sim.wait_ready()
     counts = sim.upload_plan(PLAN)  # as the Plan view's Upload: each type it has
     assert counts[d.MAV_MISSION_TYPE_FENCE] == 4
+    sim.arm_and_start()
+    sim.run_until_item(2)  # on the square, past its first waypoint
+    # QGroundControl joins now: from here on it beats once a second (its loss would be
+    # the ground-station failsafe's Return, not the fence's).
     qgc = GroundStation(sim.ports.pymavlink)
+    heard = Heard(qgc)
     try:
         qgc.connect()
-        sim.arm_and_start()
-        sim.run_until_item(2)  # on the square, past its first waypoint
         flag = d.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
-        _accepted(qgc, d.MAV_CMD_DO_SET_MODE, flag, BY_MODE[FlightMode.RTL].px4)
-        _accepted(qgc, d.MAV_CMD_NAV_LAND, 0, 0, 0, 0, 0, 0, 0)  # the custom action
-        modes, texts = _until_disarmed(qgc)
+        _accepted(qgc, d.MAV_CMD_DO_SET_MODE, flag, BY_MODE[FlightMode.RTL].px4)  # Return
+        heard.pump(lambda: heard.home_m < NEAR_HOME_M, "back near home")
+        _accepted(qgc, d.MAV_CMD_NAV_LAND, 0, 0, 0, 0, 0, 0, 0)  # the custom action Land
+        heard.pump(lambda: not heard.armed, "disarmed")
     finally:
         qgc.close()
+    modes, texts = heard.modes, heard.texts
     assert not any("Fence breached" in t for t in texts), texts
-    assert modes[-1] == FlightMode.LAND, modes  # never Return again once landing
+    landing = modes[modes.index(FlightMode.LAND) :] if FlightMode.LAND in modes else []
+    assert landing == [FlightMode.LAND], modes  # Land to the end: no Return after it
     said = next((m for t in texts if (m := SAID.search(t))), None)
     assert said is not None, texts
     truth = read_estimate(sim.truth_path)
@@ -97,17 +117,25 @@ def test_qgc_land_with_the_square_plans_fence_lands_inside_it(sim):
     score = _score(truth, int(said[1]), float(said[2]), said[3] == "right")
     log.info("landing on the pattern it said (%s): %s", said[0], score)
     assert score.landed and score.stopped and score.on_runway, score
+    # The take-off was eastwards and the default loiter west of home, outside: it landed
+    # the other way along the runway.
+    assert math.cos(math.radians(int(said[1])) - _runway(truth)[1]) < -0.9, said[0]
     assert abs(score.along_m) < 30.0 and abs(score.across_m) < 5.0, score
     assert score.sink_m_s < 1.5, score
 
 
-def _score(truth, course_deg: int, approach_m: float, clockwise: bool):
-    """The landing judged on the pattern the vehicle said it flies: the runway is the take-off
-    roll's (from where the aircraft stood, along the way it rolled)."""
+def _runway(truth) -> tuple[LocalFrame, float]:
+    """The take-off's runway: from where the aircraft stood along the line it rolled and
+    climbed out on (the line the vehicle believed; its heading at rest was 2 degrees off)."""
     frame = LocalFrame(truth["lat"][0], truth["lon"][0])
-    speed = [math.hypot(n, e) for n, e in zip(truth["vn"], truth["ve"], strict=True)]
-    moving = next(k for k, v in enumerate(speed) if v > 5.0)
-    heading = math.atan2(truth["ve"][moving], truth["vn"][moving])
+    track = [frame.ne(lat, lon) for lat, lon in zip(truth["lat"], truth["lon"], strict=True)]
+    rolled = next(p for p in track if math.hypot(*p) > CLIMB_OUT_CHECK_M)
+    return frame, math.atan2(rolled[1], rolled[0])
+
+
+def _score(truth, course_deg: int, approach_m: float, clockwise: bool) -> LandingScore:
+    """The landing judged on the pattern the vehicle said it flies."""
+    frame, heading = _runway(truth)
     course = math.radians(course_deg)
     pattern = min(
         (p for p in patterns((0.0, 0.0), heading, approach_m) if p.clockwise == clockwise),
