@@ -86,9 +86,9 @@ class LandingFlight:
         self.range_reading: RangeReading | None = None
         self.range_steps = 0  # landing steps that flew on the rangefinder's height
         self.runway: RunwayTakeoff | None = None  # this flight's take-off roll, kept after
-        self.landing_home = False  # the executor flies ``home_landing``, not the mission
+        self.landing_home = False  # the executor flies ``_home_landing``'s, not the mission
         self.return_lands = False  # this Return ends in the mission's landing
-        self.fence: Fence | None = None  # the stored geofence, which ``home_landing`` keeps in
+        self.fence: Fence | None = None  # the stored geofence: Land's own pattern keeps inside
         self.refused = False  # no pattern fits in the fence: this Land circles instead
         self.said: list[tuple[int, str]] = []  # (MAV_SEVERITY, text) for the operator
 
