@@ -18,7 +18,7 @@ from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
 from mavsdk.component_type import ComponentType
 from mavsdk.plugins.telemetry import FlightMode, LandedState
 
-from companion.control.flight.landing_flight import HOME_TOUCHDOWN_M
+from companion.control.flight.landing_pattern import HOME_TOUCHDOWN_M
 from companion.geodesy import LocalFrame
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim

@@ -15,6 +15,11 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from companion.control.flight.landing import AircraftState, Landing, LandingDemand, LandPhase
+from companion.control.flight.landing_pattern import (
+    HOME_TOUCHDOWN_M,
+    choose_pattern,
+    least_approach,
+)
 from companion.control.flight.range_height import range_height
 from companion.control.laws.l1_guidance import bank_for
 from companion.control.mission.executor import Kind, MissionExecutor, Setpoint
@@ -29,14 +34,11 @@ if TYPE_CHECKING:
     from companion.control.laws.attitude import AttitudeController
     from companion.control.laws.l1_guidance import LateralDemand
     from companion.control.laws.tecs import Tecs
+    from companion.control.mission.fence import Fence
     from companion.geodesy import LocalFrame
 
 FLARE_PITCH_GAIN = 2.5
 GO_AROUND_MARGIN_M = 5.0  # this close to the go-around height: come round again
-# Land without a landing in the mission: QGroundControl's fixed-wing landing pattern, as
-# the benchmark plans fly it (a loiter down to 50 m, 800 m out, left on the tangent).
-HOME_APPROACH_M, HOME_APPROACH_AGL_M, HOME_LOITER_RADIUS_M = 800.0, 50.0, 250.0
-HOME_TOUCHDOWN_M = 100.0  # down the runway from where the take-off roll began
 
 
 def land_start(items: list[MissionItem]) -> int | None:
@@ -54,28 +56,6 @@ def approach_start(items: list[MissionItem], land_index: int) -> int:
         if items[k].x or items[k].y:
             return k
     return land_index
-
-
-def home_landing(frame: LocalFrame, base: tuple[float, float], heading: float) -> list[MissionItem]:
-    """The landing pattern onto a runway: touchdown ``HOME_TOUCHDOWN_M`` from ``base`` (m
-    north and east of home) along ``heading``, the loiter down to its right, clockwise."""
-    un, ue = math.cos(heading), math.sin(heading)
-    touchdown = (base[0] + HOME_TOUCHDOWN_M * un, base[1] + HOME_TOUCHDOWN_M * ue)
-    back, side = HOME_APPROACH_M, HOME_LOITER_RADIUS_M
-    centre = (touchdown[0] - back * un - side * ue, touchdown[1] - back * ue + side * un)
-
-    def item(
-        seq: int, command: int, point: tuple[float, float], agl: float,
-        p1: float, p2: float, p3: float, p4: float,
-    ) -> MissionItem:  # fmt: skip
-        lat, lon = frame.latlon(*point)
-        return MissionItem(seq, d.MAV_FRAME_GLOBAL_RELATIVE_ALT, command, 0, 1, p1, p2, p3, p4,
-                           round(lat * 1e7), round(lon * 1e7), agl)  # fmt: skip
-
-    return [
-        item(0, d.MAV_CMD_NAV_LOITER_TO_ALT, centre, HOME_APPROACH_AGL_M, 1.0, side, 0.0, 1.0),
-        item(1, d.MAV_CMD_NAV_LAND, touchdown, 0.0, 0.0, 0.0, 0.0, math.nan),
-    ]
 
 
 @dataclass
@@ -106,8 +86,11 @@ class LandingFlight:
         self.range_reading: RangeReading | None = None
         self.range_steps = 0  # landing steps that flew on the rangefinder's height
         self.runway: RunwayTakeoff | None = None  # this flight's take-off roll, kept after
-        self.landing_home = False  # the executor flies ``home_landing``, not the mission
+        self.landing_home = False  # the executor flies ``_home_landing``'s, not the mission
         self.return_lands = False  # this Return ends in the mission's landing
+        self.fence: Fence | None = None  # the stored geofence: Land's own pattern keeps inside
+        self.refused = False  # no pattern fits in the fence: this Land circles instead
+        self.said: list[tuple[int, str]] = []  # (MAV_SEVERITY, text) for the operator
 
     def fly(
         self,
@@ -250,20 +233,20 @@ class LandingFlight:
         plan: MissionRef,
         config: FlightConfig,
         turn_radius: float,
-    ) -> Setpoint:
+    ) -> Setpoint | None:
         """Land (MAVSDK's land(), MAV_CMD_NAV_LAND without a position) with no landing in
         the mission: back onto the runway of this flight's take-off, along its roll; without
         one (started in the air), straight in from here to home. PX4 loiters down where the
-        aircraft is; a fixed wing with wheels needs a runway, and this one is known."""
+        aircraft is; a fixed wing with wheels needs a runway, and this one is known. The
+        pattern keeps inside the fence (landing_pattern.py); when none does, None: the
+        controller circles where the aircraft is, as Land entered without a pattern."""
+        if self.refused:
+            return None
         if not self.landing_home or plan.executor is None:
             assert plan.frame is not None
-            if self.runway is not None:
-                base, heading = self.runway.start, self.runway.heading
-            elif math.hypot(*pos) > HOME_TOUCHDOWN_M:
-                base, heading = (0.0, 0.0), math.atan2(-pos[1], -pos[0])
-            else:
-                base, heading = (0.0, 0.0), nav.yaw_rad
-            items = home_landing(plan.frame, base, heading)
+            items = self._home_landing(pos, nav.yaw_rad, plan.frame, config, turn_radius)
+            if items is None:
+                return None
             ex = MissionExecutor(items, plan.frame, plan.home_alt, config.executor)
             ex.start(0, pos, nav.alt_msl_m)
             plan.executor, self.landing_home, self.landing = ex, True, None
@@ -271,9 +254,43 @@ class LandingFlight:
         plan.executor.drain_reached()  # not the stored mission's items: nothing to report
         return sp
 
+    def _home_landing(
+        self,
+        pos: tuple[float, float],
+        yaw: float,
+        frame: LocalFrame,
+        config: FlightConfig,
+        turn_radius: float,
+    ) -> list[MissionItem] | None:
+        """The pattern's items, or None (said why) when none fits inside the fence."""
+        if self.runway is not None:
+            base, heading = self.runway.start, self.runway.heading
+        elif math.hypot(*pos) > HOME_TOUCHDOWN_M:
+            base, heading = (0.0, 0.0), math.atan2(-pos[1], -pos[0])
+        else:
+            base, heading = (0.0, 0.0), yaw
+        fence = self.fence
+
+        def keeps(a: tuple[float, float], b: tuple[float, float], width: float) -> bool:
+            if fence is None or fence.empty:
+                return True
+            return fence.keeps(frame.latlon(*a), frame.latlon(*b), width)
+
+        least = least_approach(config.values)
+        pattern = choose_pattern(base, heading, keeps, least, turn_radius)
+        if pattern is None:
+            self.refused = True
+            self.said.append((d.MAV_SEVERITY_CRITICAL, "Land: no pattern fits the fence, circling"))
+            return None
+        if fence is not None and not fence.empty:
+            self.said.append((d.MAV_SEVERITY_NOTICE, pattern.described()))
+        return pattern.items(frame)
+
     def leave_home_landing(self, mode: FlightMode) -> bool:
         """Another mode: True when the controller is to drop the executor (the stored
         mission's is made afresh when it is flown)."""
+        if mode != FlightMode.LAND:
+            self.refused = False
         if self.landing_home and mode != FlightMode.LAND:
             self.landing_home = False
             return True

@@ -72,6 +72,15 @@ class Fence:
             return "inside an exclusion zone"
         return None
 
+    def keeps(self, a: tuple[float, float], b: tuple[float, float], width_m: float) -> bool:
+        """Whether the strip ``width_m`` either side of the straight path from ``a`` to
+        ``b`` (lat, lon in degrees; the same point twice: a disc) breaches nothing: inside
+        every inclusion zone, clear of every exclusion zone. A planned track is judged by
+        this before it is flown (the landing pattern Land builds, landing_pattern.py)."""
+        pa, pb = self.frame.ne(*a), self.frame.ne(*b)
+        inside = all(zone.holds(pa, pb, width_m) for zone in self.inclusions)
+        return inside and all(zone.clear_of(pa, pb, width_m) for zone in self.exclusions)
+
 
 def honoured(items: list[MissionItem]) -> tuple[list[MissionItem], list[str]]:
     """The fence items without the zones that enclose nothing, and why each was left out.

@@ -38,6 +38,27 @@ def _segments_meet(a: Point, b: Point, c: Point, d: Point) -> bool:
     )
 
 
+def _point_to_segment(p: Point, a: Point, b: Point) -> float:
+    """The distance from p to the closed segment a-b."""
+    dn, de = b[0] - a[0], b[1] - a[1]
+    length2 = dn * dn + de * de
+    k = 0.0 if length2 == 0.0 else ((p[0] - a[0]) * dn + (p[1] - a[1]) * de) / length2
+    k = max(0.0, min(1.0, k))
+    return math.hypot(p[0] - a[0] - k * dn, p[1] - a[1] - k * de)
+
+
+def _segment_gap(a: Point, b: Point, c: Point, d: Point) -> float:
+    """The least distance between the closed segments a-b and c-d (0 where they meet)."""
+    if _segments_meet(a, b, c, d):
+        return 0.0
+    return min(
+        _point_to_segment(a, c, d),
+        _point_to_segment(b, c, d),
+        _point_to_segment(c, a, b),
+        _point_to_segment(d, a, b),
+    )
+
+
 @dataclass(frozen=True)
 class PolygonZone:
     """A polygon given by its vertices in order (not repeated at the end)."""
@@ -101,6 +122,21 @@ class PolygonZone:
         """Strictly inside."""
         return not self._on_boundary(p) and self._inside(p)
 
+    def _clear_of_boundary(self, a: Point, b: Point, width: float) -> bool:
+        """The segment a-b nowhere on the boundary nor nearer it than ``width``."""
+        gap = min(_segment_gap(a, b, c, d) for c, d in self.edges)
+        return gap > 0.0 and gap >= width
+
+    def holds(self, a: Point, b: Point, width: float) -> bool:
+        """Whether every point within ``width`` of the segment a-b is inside: both ends
+        inside and the segment nowhere on the boundary nor nearer it than ``width``."""
+        return self.covers(a) and self.covers(b) and self._clear_of_boundary(a, b, width)
+
+    def clear_of(self, a: Point, b: Point, width: float) -> bool:
+        """Whether no point within ``width`` of the segment a-b is inside (an end outside
+        and the boundary never that near: neither crosses nor encloses the other)."""
+        return not self.covers(a) and self._clear_of_boundary(a, b, width)
+
 
 @dataclass(frozen=True)
 class CircleZone:
@@ -127,6 +163,15 @@ class CircleZone:
 
     def contains(self, p: Point) -> bool:
         return self._distance(p) < self.radius_m
+
+    def holds(self, a: Point, b: Point, width: float) -> bool:
+        """Whether every point within ``width`` of the segment a-b is inside (a circle
+        is convex: both ends far enough inside is enough)."""
+        return max(self._distance(a), self._distance(b)) + width <= self.radius_m
+
+    def clear_of(self, a: Point, b: Point, width: float) -> bool:
+        """Whether no point within ``width`` of the segment a-b is inside."""
+        return _point_to_segment(self.centre, a, b) >= self.radius_m + width
 
 
 Zone = PolygonZone | CircleZone

@@ -22,6 +22,7 @@ from companion.actuators.airframe import AirframeError, load_airframe
 from companion.control.flight.attitude_modes import pilot_sticks
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.flight_params import control_params, flight_config
+from companion.control.mission.fence import Fence
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.messages import (
@@ -30,6 +31,7 @@ from companion.messages import (
     ControlStatus,
     FlightMode,
     MissionState,
+    StatusText,
     VehicleCommand,
     VehicleStatus,
 )
@@ -42,6 +44,7 @@ WAIT_S = 0.5
 STATUS_WAIT_S = 5.0  # the commander's last status, once, when this process starts
 OUTPUT_WAIT_S = 5.0  # ... and the servo output's process, started with this one, listening
 STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item is reached)
+FENCE = d.MAV_MISSION_TYPE_FENCE
 RECENT = 4  # receiver and rangefinder values kept between steps (100 Hz against 50 Hz)
 
 
@@ -63,7 +66,7 @@ class FixedWingPlugin(Plugin):
         "actuators/servos",
         "sensors/range",
     )
-    outputs = ("control/actuators", "control/status", "link/commands")
+    outputs = ("control/actuators", "control/status", "link/commands", "vehicle/statustext")
 
     @classmethod
     def validate(
@@ -95,6 +98,8 @@ class FixedWingPlugin(Plugin):
             flight_config(self.live_params.values), self.missions.items[0]
         )
         self.controller.jumps = JumpCounts(state_dir)
+        # The geofence the landing pattern Land builds keeps inside (landing_pattern.py).
+        self.controller.lander.fence = Fence.from_items(self.missions.items[FENCE])
         bus = ctx.bus
         self.nav = bus.latest_reader("nav/state")
         self.status_in = bus.latest_reader("vehicle/status")
@@ -110,6 +115,7 @@ class FixedWingPlugin(Plugin):
         # Landed and stopped: the controller disarms as a pilot would (execution control
         # stops the flight group, servos safe).
         self.commands = bus.writer("link/commands")
+        self.texts = bus.writer("vehicle/statustext")
         self.disarm_sent = False
         self.refusing = False  # the last step's inputs were not usable
         self.reached_count = 0
@@ -121,9 +127,12 @@ class FixedWingPlugin(Plugin):
         if self.live_params.poll():
             self.controller.set_config(flight_config(self.live_params.values))
         # Only a different mission restarts it: the same list stored again changes nothing.
-        if d.MAV_MISSION_TYPE_MISSION in self.follower.follow(self.mission_changes.get()):
+        changed = self.follower.follow(self.mission_changes.get())
+        if d.MAV_MISSION_TYPE_MISSION in changed:
             self.controller.set_mission(self.missions.items[d.MAV_MISSION_TYPE_MISSION])
             self.ctx.log.info("new mission: %d items", len(self.missions.items[0]))
+        if FENCE in changed:
+            self.controller.lander.fence = Fence.from_items(self.missions.items[FENCE])
 
     def step(self) -> None:
         nav = self.nav.wait(WAIT_S)
@@ -148,6 +157,7 @@ class FixedWingPlugin(Plugin):
             self.ctx.log.info("landing: flaring on the rangefinder's height")
             self.range_said = True
         self._count(self.controller.rejected > rejected, nav.t_us)
+        self._say(now_us)
         cmd = ActuatorCommand(t_us=nav.t_us, armed=1)
         cmd.aileron, cmd.elevator, cmd.rudder = out.aileron, out.elevator, out.rudder
         cmd.throttle = out.throttle
@@ -163,6 +173,16 @@ class FixedWingPlugin(Plugin):
         if out.reached or now_us >= self.next_status_us:
             self.status_out.publish(self._status(now_us, out, status))
             self.next_status_us = now_us + STATUS_PERIOD_US
+
+    def _say(self, now_us: int) -> None:
+        """What the landing told the operator (the pattern it chose, or why none)."""
+        said = self.controller.lander.said
+        for severity, text in said:
+            self.ctx.log.info("%s", text)
+            msg = StatusText(t_us=now_us, severity=severity)
+            msg.text = text.encode()[:199]
+            self.texts.publish(msg)
+        said.clear()
 
     def _count(self, refused: bool, t_us: int) -> None:
         """Count the step; an unusable solution or status is said once per stretch of them."""

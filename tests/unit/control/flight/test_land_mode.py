@@ -10,11 +10,11 @@ import math
 import pytest
 
 from companion.control.commander import Commander
-from companion.control.flight.landing_flight import (
+from companion.control.flight.landing_flight import land_start
+from companion.control.flight.landing_pattern import (
     HOME_APPROACH_AGL_M,
     HOME_APPROACH_M,
     HOME_TOUCHDOWN_M,
-    land_start,
 )
 from companion.control.mission.plan import checked_plan
 from companion.messages import (

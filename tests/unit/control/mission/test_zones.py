@@ -63,3 +63,31 @@ def test_a_circle_is_exact_where_a_polygon_of_it_was_not():
     assert not CircleZone((0.0, 0.0), math.inf).is_valid
     assert not CircleZone((0.0, 0.0), 0.0).is_valid  # no area: encloses nothing
     assert not CircleZone((0.0, 0.0), -5.0).is_valid
+
+
+# An L: the square 0..100 x 0..100 without its north-east quarter.
+ELL = PolygonZone(
+    ((0.0, 0.0), (100.0, 0.0), (100.0, 50.0), (50.0, 50.0), (50.0, 100.0), (0.0, 100.0))
+)
+
+
+def test_a_path_is_held_only_when_it_and_its_width_stay_inside():
+    assert ELL.holds((10.0, 10.0), (90.0, 10.0), 5.0)
+    assert not ELL.holds((10.0, 10.0), (90.0, 10.0), 15.0)  # the width reaches the edge
+    # Both ends inside the L, the path across its missing corner: not held.
+    assert ELL.covers((90.0, 40.0)) and ELL.covers((40.0, 90.0))
+    assert not ELL.holds((90.0, 40.0), (40.0, 90.0), 0.0)
+    assert ELL.holds((25.0, 25.0), (25.0, 25.0), 20.0)  # a disc
+    assert not ELL.holds((25.0, 25.0), (25.0, 25.0), 30.0)
+
+
+def test_a_path_is_clear_of_a_zone_only_when_no_part_of_its_width_is_in_it():
+    assert ELL.clear_of((75.0, 75.0), (75.0, 75.0), 20.0)  # in the missing corner
+    assert not ELL.clear_of((75.0, 75.0), (75.0, 75.0), 30.0)
+    assert not ELL.clear_of((-10.0, -10.0), (110.0, 110.0), 0.0)  # across it
+    assert not ELL.clear_of((50.0, -500.0), (50.0, -500.0), 1000.0)  # a disc round it all
+    circle = CircleZone((0.0, 0.0), 100.0)
+    assert circle.holds((0.0, -50.0), (0.0, 50.0), 50.0)
+    assert not circle.holds((0.0, -50.0), (0.0, 50.0), 51.0)
+    assert circle.clear_of((150.0, -500.0), (150.0, 500.0), 50.0)  # passing beside it
+    assert not circle.clear_of((150.0, -500.0), (150.0, 500.0), 51.0)
