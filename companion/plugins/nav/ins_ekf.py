@@ -99,6 +99,7 @@ class InsEkfPlugin(Plugin):
 
     def close(self) -> None:
         self.waiter.close()
+        self.warm_file.close()
 
 
 class _Drains(Protocol):

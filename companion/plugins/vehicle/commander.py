@@ -19,7 +19,12 @@ from companion.control.battery_failsafe import BATTERY_FS_PARAMS, BatteryFailsaf
 from companion.control.commander import COMMANDER_PARAMS, MIN_ALT_PARAM, MODE_COMMANDS, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.control.flight.landing_flight import land_start
-from companion.control.flight_state import in_the_air, load_flight_state, save_flight_state
+from companion.control.flight_state import (
+    FlightState,
+    in_the_air,
+    load_flight_state,
+    save_flight_state,
+)
 from companion.control.ground_rules import ground_notice, standing
 from companion.control.mission.fence import Fence
 from companion.control.mission.mission_files import MissionStore, StoreFollower
@@ -169,6 +174,7 @@ class CommanderPlugin(Plugin):
         self.resume_until_us: int | None = None
         self.rearm_until_us = 0  # asked to be armed again: armed, whatever the table says yet
         self.written = ""  # the flight state last written
+        self.judged: FlightState | None = None  # the state last compared with it
         # Whether the file says armed (a start on the ground after a flight rewrites it).
         self.written_armed = self.saved is not None and self.saved.armed
 
@@ -219,6 +225,11 @@ class CommanderPlugin(Plugin):
         if flying_mission and control is not None and control.fresh(now):
             c.mission_first = max(0, int(control.mission_seq))
         state = c.snapshot()
+        # The same state as last step (nearly every step): the same verdict, without the
+        # JSON it would be judged by (a NaN field only makes the two unequal).
+        if state == self.judged:
+            return
+        self.judged = state
         text = state.to_json()
         # Disarmed, the file changes only to say a flight has ended: a vehicle on the bench
         # writes nothing to its state directory (nothing to resume from there).
