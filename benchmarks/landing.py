@@ -11,7 +11,10 @@ QGroundControl landing pattern; ground/campaign/flight_run.py), watched until th
 completes. Printed from the truth CSV (ground/campaign/landing_score.py): touchdown
 along (+ past) and across (+ right of) the landing point, vertical speed and bank at
 touchdown, the highest bounce, where the aircraft stopped, and whether the vehicle's last
-heartbeat said it was disarmed.
+heartbeat said it was disarmed. ``est x`` is where the vehicle's own navigation solution
+(its flight log) put it across the line at that moment: the controller's error, the rest
+of ``across`` being the navigation's (the emulated GPS wanders 1 m per axis, 60 s
+correlated, the same sequence for a seed whatever is flown).
 Criteria (issue 24, along and across from issue 42 item 8): |along| ≤ 15 m,
 |across| ≤ 2 m, sink ≤ 1.5 m/s, bounce ≤ 1 m, |bank| ≤ 10°, stopped on the runway,
 disarmed. benchmarks/plans/circuit_*.plan are circuits without QGroundControl's pattern
@@ -28,10 +31,18 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+import numpy as np  # noqa: E402
+from pyulog import ULog  # noqa: E402
+
 from companion.control.mission.plan import checked_plan  # noqa: E402
 from companion.navigation.estimate_csv import read_estimate  # noqa: E402
 from ground.campaign.flight_run import FlightJob, fly_flight  # noqa: E402
-from ground.campaign.landing_score import LandingScore, landing_score_for_plan  # noqa: E402
+from ground.campaign.landing_score import (  # noqa: E402
+    LandingScore,
+    landing_score_for_plan,
+    line_coordinates,
+    plan_line,
+)
 from ground.campaign.spec import SIM_CONFIG, Flight  # noqa: E402
 
 CONDITIONS = {"calm": ((0.0, 0.0, 0.0), "none"), "xwind 5 S + light": ((5.0, 0.0, 0.0), "light")}
@@ -48,7 +59,8 @@ def main() -> None:
     conditions = {"calm": CONDITIONS["calm"]} if args.calm_only else CONDITIONS
     plans = [_plan(p) for p in (args.plan or ["land_east.plan"])]
     print(
-        f"{'airframe':8} {'plan':10} {'condition':18} {'along':>6} {'across':>6} {'sink':>5} "
+        f"{'airframe':8} {'plan':10} {'condition':18} {'along':>6} {'across':>6} {'est x':>6} "
+        f"{'sink':>5} "
         f"{'bounce':>6} {'bank':>5} {'stop@':>6} {'stop x':>6} {'stopped':7} {'runway':6} "
         f"{'disarm':6} {'pass':5}"
     )
@@ -61,7 +73,8 @@ def main() -> None:
                     row = fly_flight(FlightJob(flight, tmp, timeout_s=900.0))
                     truth = Path(tmp) / flight.flight_id / "truth.csv"
                     score = _score(truth, plan)
-                print(_row(name, plan.stem, cond, score, row), flush=True)
+                    est = _estimate_across(truth, plan, score)
+                print(_row(name, plan.stem, cond, score, est, row), flush=True)
 
 
 def _plan(name: str) -> Path:
@@ -77,11 +90,28 @@ def _score(truth: Path, plan: Path) -> LandingScore:
     return landing_score_for_plan(read_estimate(truth), checked_plan(plan)[0])
 
 
-def _row(name: str, plan: str, cond: str, s: LandingScore, row: dict) -> str:
+def _estimate_across(truth: Path, plan: Path, s: LandingScore) -> float:
+    """The navigation solution's across at the touchdown, from the flight log beside
+    ``truth`` (NaN: no landing or no log)."""
+    log = truth.parent / "flight.ulg"
+    if not s.landed or not log.exists():
+        return float("nan")
+    t = read_estimate(truth)
+    line = plan_line(checked_plan(plan)[0])
+    along, across = line_coordinates(t["lat"], t["lon"], *line)
+    at = np.nonzero((along == s.along_m) & (across == s.across_m))[0]
+    nav = ULog(str(log), ["nav_state"]).get_dataset("nav_state").data
+    _, nav_across = line_coordinates(nav["lat_deg"], nav["lon_deg"], *line)
+    k = np.searchsorted(nav["timestamp"] / 1e6, t["t"][at[0]])
+    return float(nav_across[min(k, len(nav_across) - 1)])
+
+
+def _row(name: str, plan: str, cond: str, s: LandingScore, est: float, row: dict) -> str:
     disarmed = row.get("armed_at_end") is False
     ok = s.passed() and disarmed
     text = (
-        f"{name:8} {plan:10} {cond:18} {s.along_m:6.1f} {s.across_m:6.2f} {s.sink_m_s:5.2f} "
+        f"{name:8} {plan:10} {cond:18} {s.along_m:6.1f} {s.across_m:6.2f} {est:6.2f} "
+        f"{s.sink_m_s:5.2f} "
         f"{s.bounce_m:6.2f} {s.bank_deg:5.1f} {s.stop_along_m:6.0f} {s.stop_across_m:6.2f} "
         f"{s.stopped!s:7} {s.on_runway!s:6} {disarmed!s:6} {ok!s:5}"
     )

@@ -87,15 +87,8 @@ def score_landing(
     When the approach point is a LOITER_TO_ALT centre, the line starts at its tangent
     point: give the radius (and direction) to have it found.
     """
-    frame = LocalFrame(*land)
-    n, e = frame.ne(truth["lat"], truth["lon"])
-    a = frame.ne(*approach)
-    if loiter_radius_m > 0.0:
-        a = _tangent_point(a, loiter_radius_m, clockwise)
-    heading = math.atan2(-a[1], -a[0])
-    u = (math.cos(heading), math.sin(heading))
-    along = n * u[0] + e * u[1]
-    across = -n * u[1] + e * u[0]
+    line = (approach, land, loiter_radius_m, clockwise)
+    along, across = line_coordinates(truth["lat"], truth["lon"], *line)
     alt = truth["alt"]
     rest = float(alt[0])
     height = alt - rest
@@ -135,6 +128,26 @@ def score_landing(
     )
 
 
+def line_coordinates(
+    lat: np.ndarray,
+    lon: np.ndarray,
+    approach: tuple[float, float],
+    land: tuple[float, float],
+    loiter_radius_m: float = 0.0,
+    clockwise: bool = True,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Metres along (+ past the landing point) and across (+ right of) the landing line
+    ``approach`` → ``land`` (lat, lon; the loiter as for ``score_landing``)."""
+    frame = LocalFrame(*land)
+    n, e = frame.ne(lat, lon)
+    a = frame.ne(*approach)
+    if loiter_radius_m > 0.0:
+        a = _tangent_point(a, loiter_radius_m, clockwise)
+    heading = math.atan2(-a[1], -a[0])
+    u = (math.cos(heading), math.sin(heading))
+    return n * u[0] + e * u[1], -n * u[1] + e * u[0]
+
+
 def _first_stop(height: np.ndarray, speed: np.ndarray, took_off: int) -> int:
     """Where the aircraft first stands still on the ground after ``took_off`` (the last
     sample if it never does): the end of the landing.
@@ -163,9 +176,17 @@ def _tangent_point(
 
 def landing_score_for_plan(truth: dict[str, np.ndarray], items: list[MissionItem]) -> LandingScore:
     """``score_landing`` on the plan's last landing (its final approach as planned)."""
+    return score_landing(truth, *plan_line(items))
+
+
+def plan_line(
+    items: list[MissionItem],
+) -> tuple[tuple[float, float], tuple[float, float], float, bool]:
+    """The plan's last landing line as ``score_landing`` takes it: approach, land point,
+    and the radius and direction of a LOITER_TO_ALT left on its tangent (0: none)."""
     approach, land = landing_line(items)
     final = next(it for it in reversed(items) if it.command != d.MAV_CMD_NAV_LAND and it.x)
     radius, clockwise = 0.0, True
     if final.command == d.MAV_CMD_NAV_LOITER_TO_ALT and final.param1 >= 0.5:
         radius, clockwise = abs(final.param2), final.param2 >= 0
-    return score_landing(truth, approach, land, radius, clockwise)
+    return approach, land, radius, clockwise

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from companion.geodesy import LocalFrame
-from ground.campaign.landing_score import score_landing
+from ground.campaign.landing_score import line_coordinates, score_landing
 
 LAND = (-37.9105, 145.134)
 APPROACH = (-37.9105, 145.110)  # west of the touchdown point: the approach flies east
@@ -58,3 +58,12 @@ def test_what_a_simulator_does_with_the_parked_aircraft_afterwards_is_not_the_la
     assert score.along_m == pytest.approx(12.0, abs=4.0)
     assert score.sink_m_s == pytest.approx(1.2)
     assert score.passed(), score
+
+
+def test_a_position_is_measured_along_and_across_the_landing_line():
+    """What the benchmark reads the navigator's track by: 3 m south of an eastbound
+    runway is 3 m right of it, 20 m east of the point 20 m past it."""
+    lat, lon = LocalFrame(*LAND).latlon(np.array([-3.0]), np.array([20.0]))
+    along, across = line_coordinates(lat, lon, APPROACH, LAND)
+    assert along[0] == pytest.approx(20.0, abs=0.01)
+    assert across[0] == pytest.approx(3.0, abs=0.01)
