@@ -148,7 +148,11 @@ def test_garbage_and_bad_crc_are_counted_and_the_link_survives(link):
     frame[-1] ^= 0xFF  # break the CRC
     sock_send(bytes(frame), gcs.conn.destination_addr)
     sock_send(b"\xfd\x09garbage" + bytes(range(256)), gcs.conn.destination_addr)
-    wait_for(lambda: vehicle.row("link").frames_bad > 0, 5, "bad frames counted")
+    wait_for(
+        lambda: (row := vehicle.row("link")) is not None and row.frames_bad > 0,
+        5,
+        "bad frames counted",
+    )
     gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AUTOPILOT_VERSION)
     assert gcs.ack(m.MAV_CMD_REQUEST_MESSAGE).result == m.MAV_RESULT_ACCEPTED
     assert gcs.recv("AUTOPILOT_VERSION").capabilities != 0

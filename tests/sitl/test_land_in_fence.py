@@ -25,11 +25,10 @@ from companion.control.mission.plan import checked_plan
 from companion.control.modes import BY_MODE
 from companion.geodesy import LocalFrame, wrap_pi
 from companion.messages import FlightMode
-from companion.navigation.estimate_csv import read_estimate
 from ground.campaign.landing_score import LandingScore, score_landing
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import GroundStation
-from tests.support.vehicle import REPO
+from tests.support.vehicle import REPO, wait_for
 
 log = logging.getLogger(__name__)
 PLAN = REPO / "qgc_plans" / "square.plan"
@@ -103,13 +102,17 @@ def test_qgc_land_with_the_square_plans_fence_lands_inside_it(sim):
         heard.pump(lambda: not heard.armed, "disarmed")
     finally:
         qgc.close()
+    # The simulator writes its truth file as it goes: read it once it holds the aircraft
+    # standing after the disarm (a busy machine flushes it late).
+    settled = sim.run_until_time(sim.run_until_time(0.0) + 5.0)
+    wait_for(lambda: sim.truth()["t"][-1] >= settled, 120, "the truth file past the disarm")
     modes, texts = heard.modes, heard.texts
     assert not any("Fence breached" in t for t in texts), texts
     landing = modes[modes.index(FlightMode.LAND) :] if FlightMode.LAND in modes else []
     assert landing == [FlightMode.LAND], modes  # Land to the end: no Return after it
     said = next((m for t in texts if (m := SAID.search(t))), None)
     assert said is not None, texts
-    truth = read_estimate(sim.truth_path)
+    truth = sim.truth()
     fence = Fence.from_items(checked_plan(PLAN)[d.MAV_MISSION_TYPE_FENCE])
     track = zip(truth["lat"], truth["lon"], strict=True)
     outside = [k for k, (lat, lon) in enumerate(track) if fence.breach(lat, lon)]
