@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass
 
 from companion.control.mission.executor import SKIPPED, Kind, MissionExecutor, Setpoint
+from companion.control.mission.zones import point_to_segment
 from mavlink_dialect import companion as d
 
 # On the leg or the corner's arc into it: within this many turn radii of the segment (an
@@ -75,7 +76,7 @@ def resumed_leg(ex: MissionExecutor, first: int, pos: Point, turn_radius: float)
     tolerance = items[first].acceptance_m(ex.config.wp_radius)
     if waypoint:
         tolerance = max(tolerance, ON_LEG_RADII * turn_radius)
-    if prev is not None and _segment_distance(ex.point_of(items[prev], pos), b, pos) <= tolerance:
+    if prev is not None and point_to_segment(pos, ex.point_of(items[prev], pos), b) <= tolerance:
         before = _previous_place(ex, prev) if waypoint else None
         corner_from = ex.point_of(items[before], pos) if before is not None else None
         return ResumedLeg(ex.point_of(items[prev], pos), corner_from, speed)
@@ -106,11 +107,3 @@ def _speed_before(ex: MissionExecutor, seq: int) -> float:
         if item.command == d.MAV_CMD_DO_CHANGE_SPEED:
             return item.param2 if item.param2 > 0 else math.nan
     return math.nan
-
-
-def _segment_distance(a: Point, b: Point, pos: Point) -> float:
-    ab = (b[0] - a[0], b[1] - a[1])
-    length2 = ab[0] * ab[0] + ab[1] * ab[1]
-    t = 0.0 if length2 < 1e-6 else ((pos[0] - a[0]) * ab[0] + (pos[1] - a[1]) * ab[1]) / length2
-    t = max(0.0, min(1.0, t))
-    return math.hypot(pos[0] - a[0] - t * ab[0], pos[1] - a[1] - t * ab[1])

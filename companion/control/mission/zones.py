@@ -38,8 +38,8 @@ def _segments_meet(a: Point, b: Point, c: Point, d: Point) -> bool:
     )
 
 
-def _point_to_segment(p: Point, a: Point, b: Point) -> float:
-    """The distance from p to the closed segment a-b."""
+def point_to_segment(p: Point, a: Point, b: Point) -> float:
+    """The distance from p to the closed segment a-b (m, in a local frame)."""
     dn, de = b[0] - a[0], b[1] - a[1]
     length2 = dn * dn + de * de
     k = 0.0 if length2 == 0.0 else ((p[0] - a[0]) * dn + (p[1] - a[1]) * de) / length2
@@ -52,10 +52,10 @@ def _segment_gap(a: Point, b: Point, c: Point, d: Point) -> float:
     if _segments_meet(a, b, c, d):
         return 0.0
     return min(
-        _point_to_segment(a, c, d),
-        _point_to_segment(b, c, d),
-        _point_to_segment(c, a, b),
-        _point_to_segment(d, a, b),
+        point_to_segment(a, c, d),
+        point_to_segment(b, c, d),
+        point_to_segment(c, a, b),
+        point_to_segment(d, a, b),
     )
 
 
@@ -171,7 +171,7 @@ class CircleZone:
 
     def clear_of(self, a: Point, b: Point, width: float) -> bool:
         """Whether no point within ``width`` of the segment a-b is inside."""
-        return _point_to_segment(self.centre, a, b) >= self.radius_m + width
+        return point_to_segment(self.centre, a, b) >= self.radius_m + width
 
 
 Zone = PolygonZone | CircleZone
