@@ -47,3 +47,10 @@ class StatusText(Message):
         ("severity", ctypes.c_uint8),  # MAV_SEVERITY
         ("text", ctypes.c_char * 200),  # sent on MAVLink in 50-byte chunks when longer
     ]
+
+    @classmethod
+    def of(cls, t_us: int, severity: int, text: str) -> StatusText:
+        """The line ``text``, cut to what the field holds (with its terminating NUL)."""
+        msg = cls(t_us=t_us, severity=severity)
+        msg.text = text.encode()[:199]
+        return msg

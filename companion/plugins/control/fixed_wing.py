@@ -179,9 +179,7 @@ class FixedWingPlugin(Plugin):
         said = self.controller.lander.said
         for severity, text in said:
             self.ctx.log.info("%s", text)
-            msg = StatusText(t_us=now_us, severity=severity)
-            msg.text = text.encode()[:199]
-            self.texts.publish(msg)
+            self.texts.publish(StatusText.of(now_us, severity, text))
         said.clear()
 
     def _count(self, refused: bool, t_us: int) -> None:

@@ -343,9 +343,7 @@ class CommanderPlugin(Plugin):
         return changed
 
     def _say(self, now: int, text: str, severity: int) -> None:
-        msg = StatusText(t_us=now, severity=severity)
-        msg.text = text.encode()[:199]
-        self.texts.publish(msg)
+        self.texts.publish(StatusText.of(now, severity, text))
 
     def _act(self, now: int, actions: list[Any]) -> bool:
         c = self.commander
