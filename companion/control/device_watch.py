@@ -9,6 +9,8 @@ plug-in has run for the whole window its device is judged only by whether it has
 good frame yet: a device just opened may be slow to start, but the vehicle is not ready to
 arm on a device it has not heard at all (else the pre-arm bit a ground station reads in
 SYS_STATUS would say ready in the first seconds after a start and then take it back).
+Time is the plug-in's own stamp on its counters, so a device is not judged silent
+because its plug-in had not reported again when the table was made.
 The RC receiver may be excused by the caller while a ground station's joystick flies the
 aircraft (PX4's "RC and Joystick with fallback"). Pure: tables in, reasons out.
 """
@@ -56,13 +58,18 @@ class DeviceWatch:
             if row.kind.decode() not in self.kinds or row.group.decode() != "core":
                 continue
             running = row.state == PluginState.RUNNING
-            now = _Counts(health.t_us, row.pid if running else 0, row.bytes_in,
+            # Judged on the plug-in's own time of its counters: the table's time may run
+            # ahead of counters not yet reported again (a busy or fast-simulating machine).
+            t_us = row.counted_us or health.t_us
+            now = _Counts(t_us, row.pid if running else 0, row.bytes_in,
                           row.frames_ok, row.frames_bad)  # fmt: skip
             name = row.name.decode()
             self.kind_of[name] = row.kind.decode()
             history = self.history.setdefault(name, deque())
             if history and history[-1].pid != now.pid:
                 history.clear()  # a new process counts from zero: judge it afresh
+            elif history and history[-1].t_us >= t_us:
+                continue  # the same report again: nothing new was counted
             history.append(now)
             # Keep the newest table at least a window old, and every one since.
             while len(history) > 1 and now.t_us - history[1].t_us >= WINDOW_US:

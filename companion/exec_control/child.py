@@ -141,7 +141,7 @@ class Child:
         row.cpu_pct, row.rss_kib = self.cpu_pct, self.rss_kib
         s = self.stats
         row.frames_ok, row.frames_bad, row.dropped = s.frames_ok, s.frames_bad, s.dropped
-        row.refused, row.bytes_in = s.refused, s.bytes_in
+        row.refused, row.bytes_in, row.counted_us = s.refused, s.bytes_in, s.t_us
         row.step_p50_us, row.step_p99_us = s.step_p50_us, s.step_p99_us
         return row
 

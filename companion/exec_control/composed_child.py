@@ -70,5 +70,6 @@ class ComposedChild(Child):
             stats.dropped,
         )
         row.refused, row.bytes_in = stats.refused, stats.bytes_in
+        row.counted_us = stats.t_us
         row.step_p50_us, row.step_p99_us = stats.step_p50_us, stats.step_p99_us
         return row

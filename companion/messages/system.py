@@ -64,6 +64,10 @@ class PluginHealth(Message):
         ("step_p50_us", ctypes.c_double),
         ("step_p99_us", ctypes.c_double),
         ("process", ctypes.c_char * NAME_LEN),  # the OS process it shares ("": its own)
+        # The plug-in's own time of the counters above (0: none yet). A device's silence is
+        # judged over this time, not the table's: a plug-in reports once a wall second, so
+        # two tables of a lockstep simulation running 10x may carry the same counters.
+        ("counted_us", ctypes.c_int64),
     ]
 
 

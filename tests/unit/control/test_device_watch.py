@@ -16,14 +16,21 @@ ROWS = (("gps", "sensors.nmea_gps", "core"), ("compass", "sensors.os3000", "core
         ("nav", "nav.ins_ekf", "core"), ("servos", "actuators.minissc", "flight"))  # fmt: skip
 
 
-def table(t_s: float, counts: dict[str, tuple[int, int, int]], pid: int = 100) -> SystemHealth:
-    """A health table at ``t_s``: counts are (bytes, frames ok, frames bad) by name."""
+def table(
+    t_s: float,
+    counts: dict[str, tuple[int, int, int]],
+    pid: int = 100,
+    counted_s: dict[str, float] | None = None,
+) -> SystemHealth:
+    """A health table at ``t_s``: counts are (bytes, frames ok, frames bad) by name, each
+    counted at the table's time unless ``counted_s`` gives the plug-in's own time."""
     msg = SystemHealth(t_us=round(t_s * 1e6), count=len(ROWS))
     for i, (name, kind, group) in enumerate(ROWS):
         row = msg.plugins[i]
         row.name, row.kind, row.group = name.encode(), kind.encode(), group.encode()
         row.state, row.pid = int(PluginState.RUNNING), pid
         row.bytes_in, row.frames_ok, row.frames_bad = counts.get(name, (0, 0, 0))
+        row.counted_us = round((counted_s or {}).get(name, t_s) * 1e6)
     return msg
 
 
@@ -64,6 +71,21 @@ def test_a_device_that_fell_silent_is_named_and_a_restarted_plugin_is_judged_afr
     assert watch.failures() == ["compass: waiting for data from its device"]
     watch.update(table(11, {"gps": (4400, 55, 0), "compass": (60, 1, 0)}, pid=200))
     assert watch.failures() == []  # one good frame from the new process: no verdict yet
+
+
+def test_counters_not_reported_again_are_not_silence_however_far_the_table_ran():
+    # A lockstep simulation at 10x: the tables are 10 s of vehicle time apart, and under
+    # load a plug-in's once-a-second report can miss one (the pre-arm refused MAVSDK's arm
+    # with "compass: no data from its device" while the compass talked all along).
+    watch = DeviceWatch(PLUGINS)
+    reports = [(1, 1), (10, 10), (20, 10), (30, 30), (40, 40)]  # (table s, compass s)
+    for t, counted in reports:
+        counts = {"gps": (400 * t, 5 * t, 0), "compass": (600 * counted, 20 * counted, 0)}
+        watch.update(table(t, counts, counted_s={"compass": counted}))
+        assert watch.failures() == [], t
+    # ... while counters that are reported again unchanged are silence.
+    watch.update(table(50, {"gps": (20000, 250, 0), "compass": (24000, 800, 0)}))
+    assert watch.failures() == ["compass: no data from its device"]
 
 
 def test_an_excused_kind_is_not_judged_silent_or_waiting():
