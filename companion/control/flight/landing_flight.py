@@ -17,7 +17,9 @@ from typing import TYPE_CHECKING
 from companion.control.flight.landing import AircraftState, Landing, LandingDemand, LandPhase
 from companion.control.flight.landing_pattern import (
     HOME_TOUCHDOWN_M,
+    Approach,
     choose_pattern,
+    go_around_run,
     least_approach,
 )
 from companion.control.flight.range_height import range_height
@@ -277,13 +279,22 @@ class LandingFlight:
             return fence.keeps(frame.latlon(*a), frame.latlon(*b), width)
 
         least = least_approach(config.values)
-        pattern = choose_pattern(base, heading, keeps, least, turn_radius)
+        approach = Approach(pos, go_around_run(config.values))
+        pattern = choose_pattern(base, heading, keeps, least, turn_radius, approach)
         if pattern is None:
             self.refused = True
             self.said.append((d.MAV_SEVERITY_CRITICAL, "Land: no pattern fits the fence, circling"))
             return None
         if fence is not None and not fence.empty:
             self.said.append((d.MAV_SEVERITY_NOTICE, pattern.described()))
+            if not pattern.leg_kept:
+                self.said.append(
+                    (d.MAV_SEVERITY_WARNING, "Land: the way to the loiter crosses the fence")
+                )
+            elif not pattern.around_kept:
+                self.said.append(
+                    (d.MAV_SEVERITY_WARNING, "Land: a go-around would cross the fence")
+                )
         return pattern.items(frame)
 
     def leave_home_landing(self, mode: FlightMode) -> bool:

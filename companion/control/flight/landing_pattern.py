@@ -13,6 +13,11 @@ PX4 user lays a landing pattern inside their fence:
 3. all four again with the approach shortened in ``APPROACH_STEP_M`` steps, down to the
    shortest whose glide the airframe still flies (``least_approach``).
 
+Each of these is tried first with the leg from the aircraft to the loiter and a go-around
+(the climb-out along the runway to the loiter's height, the turn, the leg back) inside the
+fence too, then with the leg only, then alone: a pattern whose go-around or way there
+would cross the fence is flown only when no other fits, and said.
+
 None fitting is None: the caller refuses the landing and says so, rather than fly a
 pattern that breaches the fence (the fence failsafe would turn the landing into Return).
 """
@@ -21,7 +26,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from companion.control.mission.executor import tangent_angle
 from companion.control.mission.items import MissionItem
@@ -57,6 +62,8 @@ class Pattern:
     clockwise: bool  # loiter on the right of the approach, turning right
     approach_m: float  # the loiter's centre abeam this far before the touchdown point
     radius: float = HOME_LOITER_RADIUS_M
+    leg_kept: bool = False  # the way there from the aircraft keeps the fence too
+    around_kept: bool = False  # and so does a go-around's climb-out and turn back
 
     def path(self, turn_radius: float) -> list[tuple[Point, Point, float]]:
         """The pattern as flown, as straight paths with their half-width: the loiter (a
@@ -119,16 +126,67 @@ def least_approach(config: Mapping[str, float]) -> float:
     return min(HOME_APPROACH_M, least)
 
 
+@dataclass(frozen=True)
+class Approach:
+    """Where the aircraft starts for the pattern, and how far a go-around climbs out."""
+
+    start: Point
+    go_around_m: float
+
+
+def go_around_run(config: Mapping[str, float]) -> float:
+    """How far past the touchdown point a go-around climbs before it turns back to the
+    loiter: to the loiter's height at the cruise airspeed and full-throttle climb rate."""
+    climb = max(config["TECS_CLMB_MAX"], 0.1)
+    return HOME_APPROACH_AGL_M * config["AIRSPEED_CRUISE"] / climb
+
+
+def _way_there_and_around(p: Pattern, a: Approach, turn_radius: float) -> tuple[list, list]:
+    """The leg from the aircraft to the loiter; the go-around's climb-out along the
+    runway, its turn (either way: a disc) and the leg back to the loiter."""
+    u = (math.cos(p.heading), math.sin(p.heading))
+    end = (p.touchdown[0] + a.go_around_m * u[0], p.touchdown[1] + a.go_around_m * u[1])
+    around = [(p.touchdown, end, 0.0), (end, end, turn_radius), (end, p.centre, 0.0)]
+    return [(a.start, p.centre, 0.0)], around
+
+
 def choose_pattern(
-    base: Point, heading: float, keeps: Keeps, least_m: float, turn_radius: float
+    base: Point,
+    heading: float,
+    keeps: Keeps,
+    least_m: float,
+    turn_radius: float,
+    approach: Approach | None = None,
 ) -> Pattern | None:
     """The first pattern (in the module's order) whose every path ``keeps`` allows with
-    ``FENCE_MARGIN_M`` to spare; None when none does down to an approach of ``least_m``."""
+    ``FENCE_MARGIN_M`` to spare; None when none does down to an approach of ``least_m``.
+
+    With an ``approach``, a pattern whose way there from the aircraft and whose go-around
+    also keep the fence is preferred, then one whose way there does, then the pattern
+    alone (``leg_kept`` and ``around_kept`` say which: the caller warns of the rest)."""
+    tiers = [(True, True), (True, False), (False, False)] if approach else [(False, False)]
+    for leg, around in tiers:
+
+        def paths(p: Pattern, leg: bool = leg, around: bool = around) -> list:
+            flown = p.path(turn_radius)
+            if approach is not None:
+                way, go_around = _way_there_and_around(p, approach, turn_radius)
+                flown += (way if leg else []) + (go_around if around else [])
+            return flown
+
+        found = _first_fitting(base, heading, keeps, least_m, paths)
+        if found is not None:
+            return replace(found, leg_kept=leg, around_kept=around)
+    return None
+
+
+def _first_fitting(
+    base: Point, heading: float, keeps: Keeps, least_m: float, paths: Callable[[Pattern], list]
+) -> Pattern | None:
     approach = HOME_APPROACH_M
     while True:
         for pattern in patterns(base, heading, approach):
-            paths = pattern.path(turn_radius)
-            if all(keeps(a, b, width + FENCE_MARGIN_M) for a, b, width in paths):
+            if all(keeps(a, b, width + FENCE_MARGIN_M) for a, b, width in paths(pattern)):
                 return pattern
         if approach <= least_m:
             return None

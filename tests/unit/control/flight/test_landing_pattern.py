@@ -15,7 +15,9 @@ from companion.control.flight.landing_pattern import (
     HOME_LOITER_RADIUS_M,
     HOME_TOUCHDOWN_M,
     ROLLOUT_M,
+    Approach,
     choose_pattern,
+    go_around_run,
     least_approach,
 )
 from companion.control.mission.fence import Fence
@@ -43,11 +45,11 @@ def _fence(inclusions=(), exclusions=()) -> Fence:
     return Fence(FRAME, list(inclusions), list(exclusions))
 
 
-def _choose(fence: Fence, heading: float = EAST):
+def _choose(fence: Fence, heading: float = EAST, approach: Approach | None = None):
     def keeps(a, b, width):
         return fence.keeps(FRAME.latlon(*a), FRAME.latlon(*b), width)
 
-    return choose_pattern((0.0, 0.0), heading, keeps, LEAST, TURN_RADIUS)
+    return choose_pattern((0.0, 0.0), heading, keeps, LEAST, TURN_RADIUS, approach)
 
 
 def test_without_a_fence_the_pattern_is_qgroundcontrols_along_the_take_off():
@@ -130,3 +132,45 @@ def test_the_chosen_pattern_is_said_when_a_fence_is_kept():
     assert controller.lander.said == [
         (d.MAV_SEVERITY_NOTICE, "Land: course 180, 800 m final, loiter right")
     ]
+
+
+GO_AROUND_M = go_around_run({"TECS_CLMB_MAX": 3.0, "AIRSPEED_CRUISE": 30.0})  # 500 m
+
+
+def test_a_pattern_whose_go_around_turns_into_an_exclusion_zone_is_passed_over():
+    """A mast 250 m north of the runway's extension, 650 m east of home: the default
+    landing's go-around (climbing east 500 m past the touchdown point, then turning) would
+    meet it; the landing the other way goes around to the west."""
+    mast = CircleZone((250.0, 650.0), 50.0)
+    alone = _choose(_fence(exclusions=[mast]))
+    assert alone is not None and alone.heading == EAST  # the pattern itself is clear of it
+    p = _choose(_fence(exclusions=[mast]), approach=Approach((-1000.0, 0.0), GO_AROUND_M))
+    assert p is not None and p.leg_kept and p.around_kept
+    assert math.sin(p.heading) == pytest.approx(-1.0)  # westward
+    assert p.approach_m == HOME_APPROACH_M
+
+
+def test_the_way_to_the_loiter_keeps_clear_of_an_exclusion_zone_on_it():
+    """The aircraft 1.5 km north of the default loiter with a hill in between: the loiter
+    it can reach without crossing the hill is chosen."""
+    hill = CircleZone((600.0, -700.0), 100.0)
+    p = _choose(_fence(exclusions=[hill]), approach=Approach((1500.0, -700.0), GO_AROUND_M))
+    assert p is not None and p.leg_kept and p.around_kept
+    assert p.centre[1] > 0.0  # not the loiter 700 m west, behind the hill
+    assert _choose(_fence(exclusions=[hill])).centre == pytest.approx((-250.0, -700.0))
+
+
+def test_when_no_go_around_fits_the_pattern_is_flown_and_the_operator_warned():
+    """The fence 350 m past the rollout's end: no go-around fits either way, so the
+    landing is still laid (a go-around that breaches would turn into Return) and said."""
+    fence = _fence([_box(-600.0, 300.0, -1100.0, 450.0)])
+    p = _choose(fence, approach=Approach((0.0, -300.0), GO_AROUND_M))
+    assert p is not None and p.leg_kept and not p.around_kept
+    assert (p.heading, p.clockwise, p.approach_m) == (EAST, True, HOME_APPROACH_M)
+    # The same fence turned to the controller's landing (330 m north of home: south).
+    controller = _controller(checked_plan(REPO / "qgc_plans" / "square.plan")[0])
+    controller.lander.fence = _fence([_box(-450.0, 1100.0, -600.0, 300.0)])
+    controller.step(_in_the_air(0.0), _status(FlightMode.LAND), 0.0)
+    said = controller.lander.said
+    assert (d.MAV_SEVERITY_WARNING, "Land: a go-around would cross the fence") in said
+    assert controller.lander.landing_home
