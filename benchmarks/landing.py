@@ -1,7 +1,7 @@
 """Automatic landings of both airframes, scored from the simulator's truth.
 
 Usage: uv run python benchmarks/landing.py [--aircraft c172p] [--plan land_east.plan]
-       [--calm-only]
+       [--calm-only] [--seeds N]
 (aircraft and plan repeatable; default: c172p and J3Cub, benchmarks/plans/land_east.plan)
 
 Each airframe, plan and condition (calm; 5 m/s crosswind from the south with light
@@ -14,7 +14,9 @@ touchdown, the highest bounce, where the aircraft stopped, and whether the vehic
 heartbeat said it was disarmed. ``est x`` is where the vehicle's own navigation solution
 (its flight log) put it across the line at that moment: the controller's error, the rest
 of ``across`` being the navigation's (the emulated GPS wanders 1 m per axis, 60 s
-correlated, the same sequence for a seed whatever is flown).
+correlated, the same sequence for a seed whatever is flown). ``--seeds N`` flies each
+row with the simulator's seeds 1 to N (the GPS's wander, the turbulence) and ends with how
+many passed.
 Criteria (issue 24, along and across from issue 42 item 8): |along| ≤ 15 m,
 |across| ≤ 2 m, sink ≤ 1.5 m/s, bounce ≤ 1 m, |bank| ≤ 10°, stopped on the runway,
 disarmed. benchmarks/plans/circuit_*.plan are circuits without QGroundControl's pattern
@@ -55,26 +57,36 @@ def main() -> None:
     ap.add_argument("--aircraft", action="append")
     ap.add_argument("--plan", action="append")
     ap.add_argument("--calm-only", action="store_true")
+    ap.add_argument("--seeds", type=int, default=1, help="fly seeds 1..N of each row")
     args = ap.parse_args()
     conditions = {"calm": CONDITIONS["calm"]} if args.calm_only else CONDITIONS
     plans = [_plan(p) for p in (args.plan or ["land_east.plan"])]
     print(
-        f"{'airframe':8} {'plan':10} {'condition':18} {'along':>6} {'across':>6} {'est x':>6} "
-        f"{'sink':>5} "
+        f"{'airframe':8} {'plan':10} {'condition':18} {'seed':>4} {'along':>6} {'across':>6} "
+        f"{'est x':>6} {'sink':>5} "
         f"{'bounce':>6} {'bank':>5} {'stop@':>6} {'stop x':>6} {'stopped':7} {'runway':6} "
         f"{'disarm':6} {'pass':5}"
     )
+    passed = flown = 0
     for name in args.aircraft or ["c172p", "J3Cub"]:
         for plan in plans:
             for cond, (wind, turbulence) in conditions.items():
-                flight = Flight(str(plan), name, wind, turbulence, (), 1, str(SIM_CONFIG),
-                                False, 900.0, START_AT_S)  # fmt: skip
-                with tempfile.TemporaryDirectory() as tmp:
-                    row = fly_flight(FlightJob(flight, tmp, timeout_s=900.0))
-                    truth = Path(tmp) / flight.flight_id / "truth.csv"
-                    score = _score(truth, plan)
-                    est = _estimate_across(truth, plan, score)
-                print(_row(name, plan.stem, cond, score, est, row), flush=True)
+                for seed in range(1, args.seeds + 1):
+                    flight = Flight(str(plan), name, wind, turbulence, (), seed,
+                                    str(SIM_CONFIG), False, 900.0, START_AT_S)  # fmt: skip
+                    text, ok = _fly(flight, plan)
+                    print(f"{name:8} {plan.stem:10} {cond:18} {seed:4d} {text}", flush=True)
+                    passed, flown = passed + ok, flown + 1
+    print(f"passed {passed} of {flown}")
+
+
+def _fly(flight: Flight, plan: Path) -> tuple[str, bool]:
+    with tempfile.TemporaryDirectory() as tmp:
+        row = fly_flight(FlightJob(flight, tmp, timeout_s=900.0))
+        truth = Path(tmp) / flight.flight_id / "truth.csv"
+        score = _score(truth, plan)
+        est = _estimate_across(truth, plan, score)
+    return _row(score, est, row)
 
 
 def _plan(name: str) -> Path:
@@ -106,18 +118,18 @@ def _estimate_across(truth: Path, plan: Path, s: LandingScore) -> float:
     return float(nav_across[min(k, len(nav_across) - 1)])
 
 
-def _row(name: str, plan: str, cond: str, s: LandingScore, est: float, row: dict) -> str:
+def _row(s: LandingScore, est: float, row: dict) -> tuple[str, bool]:
     disarmed = row.get("armed_at_end") is False
     ok = s.passed() and disarmed
     text = (
-        f"{name:8} {plan:10} {cond:18} {s.along_m:6.1f} {s.across_m:6.2f} {est:6.2f} "
+        f"{s.along_m:6.1f} {s.across_m:6.2f} {est:6.2f} "
         f"{s.sink_m_s:5.2f} "
         f"{s.bounce_m:6.2f} {s.bank_deg:5.1f} {s.stop_along_m:6.0f} {s.stop_across_m:6.2f} "
         f"{s.stopped!s:7} {s.on_runway!s:6} {disarmed!s:6} {ok!s:5}"
     )
     if row["status"] != "ok":
         text += f"  ({row['error']})"
-    return text
+    return text, ok
 
 
 if __name__ == "__main__":
