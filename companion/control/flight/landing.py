@@ -22,6 +22,11 @@ Heights are above the touchdown point's altitude, from the navigator's altitude 
 fuses the barometer and GPS); the flare (when to begin it, its sink demand, the touchdown)
 takes the rangefinder's height instead whenever the state carries one
 (``range_height.py``: valid, fresh, wings near level), as ArduPlane's ``RNGFND_LANDING``.
+Once the rangefinder reaches the ground on the approach, it also corrects where the
+navigator's altitude puts the runway (``ground_alt``), as ArduPlane's rangefinder
+correction does: the touchdown point's altitude is home's, taken from the navigator at
+arming, and a GPS-aided height that read 3 m high then (and is right by the landing) laid
+the glide path 3 m too high, and the Cub touched down 40 m long.
 """
 
 from __future__ import annotations
@@ -57,6 +62,10 @@ MIN_GLIDE = math.radians(1.5)  # a flatter path cannot be flown with the throttl
 # Never more than the nominal: a flare that dives for a point it would float past reaches
 # the ground before its pitch has caught up (short and hard); long is the lesser harm.
 AIM_LOW, AIM_HIGH = 0.6, 1.0
+# The runway's altitude follows the rangefinder's ground with this time constant: a few
+# readings' noise is smoothed, and the glide path moves down no faster than it can be flown.
+GROUND_TAU_S = 1.5
+GROUND_CORRECTION_MAX_M = 10.0  # a ground further from the runway's is not the runway
 SINK_P = 0.10  # rad of pitch per m/s of sink-rate error in the flare
 SINK_I = 0.05  # rad per (m/s·s)
 
@@ -144,6 +153,7 @@ class Landing:
     ) -> None:
         self.start, self.touchdown = start, touchdown
         self.start_alt, self.land_alt = start_alt_msl, land_alt_msl
+        self.ground_alt = land_alt_msl  # the runway as the navigator's altitude reads it
         dn, de = touchdown[0] - start[0], touchdown[1] - start[1]
         self.length = max(math.hypot(dn, de), 1.0)
         self.heading = math.atan2(de, dn)
@@ -206,15 +216,22 @@ class Landing:
         return dist
 
     def _slope(self, flare_dist: float, flare_alt: float) -> float:
-        drop = self.start_alt - self.land_alt - flare_alt
+        drop = self.start_alt - self.ground_alt - flare_alt
         return max(drop / max(self.length - flare_dist, 1.0), math.tan(MIN_GLIDE))
 
     def glide_alt(self, pos: Point, flare_dist: float, v: Mapping[str, float]) -> float:
         """The glide path's height (MSL) abeam ``pos``."""
         h_f = self.flare_alt if math.isfinite(self.flare_alt) else v["LAND_FLARE_ALT"]
         to_flare = -self.along(pos) - flare_dist
-        alt = self.land_alt + h_f + to_flare * self._slope(flare_dist, h_f)
-        return min(alt, max(self.start_alt, self.land_alt + h_f))
+        alt = self.ground_alt + h_f + to_flare * self._slope(flare_dist, h_f)
+        return min(alt, max(self.start_alt, self.ground_alt + h_f))
+
+    def _correct_ground(self, s: AircraftState, dt: float) -> None:
+        """Move ``ground_alt`` towards the ground the rangefinder finds under the aircraft."""
+        found = s.alt_msl - s.range_height
+        if not math.isfinite(found) or abs(found - self.land_alt) > GROUND_CORRECTION_MAX_M:
+            return
+        self.ground_alt += (found - self.ground_alt) * min(dt / GROUND_TAU_S, 1.0)
 
     # -- the phases ------------------------------------------------------------------
 
@@ -225,7 +242,9 @@ class Landing:
 
     def step(self, s: AircraftState, v: Mapping[str, float], dt: float) -> LandingDemand:
         """The demand for this step; ``v`` holds the parameters by name."""
-        height = s.range_height if math.isfinite(s.range_height) else s.alt_msl - self.land_alt
+        if self.phase == LandPhase.APPROACH:
+            self._correct_ground(s, dt)
+        height = s.range_height if math.isfinite(s.range_height) else s.alt_msl - self.ground_alt
         ground_speed = math.hypot(*s.vel)
         if self.phase == LandPhase.APPROACH and self._flare_due(height, s.climb_rate, v):
             self.phase = LandPhase.FLARE

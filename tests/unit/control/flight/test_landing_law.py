@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from dataclasses import replace
 
 import pytest
 
@@ -89,3 +90,24 @@ def test_the_glide_ends_the_airframes_flare_aim_share_of_the_modelled_flare_befo
     assert aimed == pytest.approx(0.8 * modelled, rel=0.05)
     dem = land.step(_state(TOUCHDOWN[1] - aimed - 1.0, 40.0), V | {"LAND_FLARE_AIM": 80.0}, 0.02)
     assert dem.alt_msl - 100.0 == pytest.approx(land.flare_alt, abs=0.3)
+
+
+def test_the_rangefinder_moves_the_glide_path_onto_the_runway_the_navigator_misplaced():
+    """Home's altitude, taken at arming from a navigator that read 3 m high then, puts the
+    runway 3 m above the ground. Once the rangefinder reaches the ground on the approach the
+    glide path comes down those 3 m, and the flare begins at its height above the ground."""
+    land = Landing(START, 150.0, TOUCHDOWN, 103.0)  # the runway really at 100 m
+    flare_at = TOUCHDOWN[1] - land.flare_distance(28.0, V)
+    blind = land.step(_state(flare_at - 1.0, 10.0), V, 0.02)  # nothing from the rangefinder
+    assert blind.alt_msl - 103.0 == pytest.approx(land.flare_alt, abs=0.3)  # 3 m too high
+    land = Landing(START, 150.0, TOUCHDOWN, 103.0)
+    for _ in range(500):  # 10 s over the ground at the glide's height
+        land.step(replace(_state(flare_at - 150.0, 12.0), range_height=12.0), V, 0.02)
+    assert land.ground_alt == pytest.approx(100.0, abs=0.05)
+    dem = land.step(_state(flare_at - 1.0, 10.0), V, 0.02)
+    assert dem.alt_msl - 100.0 == pytest.approx(land.flare_alt, abs=0.3)
+    # A mast or a ditch under the beam, far from the runway's height, is not the ground.
+    other = Landing(START, 150.0, TOUCHDOWN, 103.0)
+    for _ in range(100):
+        other.step(replace(_state(-100.0, 30.0), range_height=2.0), V, 0.02)
+    assert other.ground_alt == 103.0
