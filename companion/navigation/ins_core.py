@@ -112,8 +112,12 @@ class InsCore:
         phi[V, TH] = (r @ rot.skew(self.cov_f)) * -dt  # a matrix product: BLAS rounding kept
         # The rest of Φ in one scatter (a numpy call per block costs more than the sums).
         nd = -dt
+        (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = self.cov_r
+        # Written out: a generator over the nine entries cost more than the products.
         phi.flat[_PHI_FLAT] = [
-            dt, dt, dt, *(c * nd for row in self.cov_r for c in row),
+            dt, dt, dt,
+            r00 * nd, r01 * nd, r02 * nd, r10 * nd, r11 * nd, r12 * nd,
+            r20 * nd, r21 * nd, r22 * nd,
             w2 * dt, -(w1 * dt), -(w2 * dt), w0 * dt, w1 * dt, -(w0 * dt),
             nd, -0.0, -0.0, -0.0, nd, -0.0, -0.0, -0.0, nd,
         ]  # fmt: skip
@@ -121,7 +125,7 @@ class InsCore:
         accel, gyro = self.noise.densities()
         qa, qg = accel**2 * dt, gyro**2 * dt
         self.P.ravel()[::16] += [0.0, 0.0, 0.0, qa, qa, qa, qg, qg, qg,
-                                 *(d * dt for d in self.walk_density)]  # fmt: skip
+                                 *[d * dt for d in self.walk_density]]  # fmt: skip
         self.cov_dt = 0.0
 
     # -- updates --------------------------------------------------------------------
@@ -201,7 +205,8 @@ class InsCore:
         msg.roll_rate_rad_s, msg.pitch_rate_rad_s, msg.yaw_rate_rad_s = self.rate
         msg.lat_deg, msg.lon_deg, msg.alt_msl_m = self.frame.geodetic(self.p)
         msg.vn_m_s, msg.ve_m_s, msg.vd_m_s = self.v
-        std = np.sqrt(np.diag(self.P)).tolist()
+        # math.sqrt rounds as np.sqrt does; np.diag's own cost was most of this line.
+        std = [math.sqrt(v) if v >= 0.0 else math.nan for v in self.P.diagonal()[:9].tolist()]
         msg.pos_std_m[:] = std[0:3]
         msg.vel_std_m_s[:] = std[3:6]
         msg.att_std_rad[:] = std[6:9]

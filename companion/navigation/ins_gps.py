@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from itertools import chain
 
 import numpy as np
 
@@ -53,16 +54,25 @@ class StateHistory:
             t1, p1, v1 = rows[i]
             if t0 <= t_us <= t1:
                 w = (t_us - t0) / (t1 - t0) if t1 > t0 else 1.0
-                p = np.add(np.multiply(p0, 1 - w), np.multiply(p1, w))
-                return p, np.add(np.multiply(v0, 1 - w), np.multiply(v1, w))
+                u = 1 - w
+                # Floats, then one array each: the same products and sums as numpy's
+                # elementwise ones, without five numpy calls on lists of three.
+                p = [a * u + b * w for a, b in zip(p0, p1, strict=True)]
+                v = [a * u + b * w for a, b in zip(v0, v1, strict=True)]
+                return np.array(p), np.array(v)
         _, first_p, first_v = rows[0]
         return np.array(first_p), np.array(first_v)
 
     def velocities(self) -> tuple[np.ndarray, np.ndarray]:
         """Times (µs) and velocities (N×3) of the history, as arrays."""
-        if not self.rows:
+        rows = self.rows
+        n = len(rows)
+        if not n:
             return np.zeros(0), np.zeros((0, 3))
-        return np.array([r[0] for r in self.rows], float), np.array([r[2] for r in self.rows])
+        # fromiter over the floats: np.array over a hundred lists of three cost ~170 µs.
+        ts = np.fromiter((r[0] for r in rows), float, n)
+        vs = np.fromiter(chain.from_iterable(r[2] for r in rows), float, 3 * n)
+        return ts, vs.reshape(n, 3)
 
 
 class GpsLag:
