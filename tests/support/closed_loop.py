@@ -19,7 +19,7 @@ from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.mission.items import MissionItem
 from companion.geodesy import LocalFrame
-from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
+from companion.messages import FlightMode, NavFlags, NavState, RangeReading, VehicleStatus
 from mavlink_dialect import companion as d
 
 PHYSICS_HZ = 100
@@ -54,6 +54,9 @@ class ClosedLoop:
     airborne_agl_m: float | None = None
     overrides: dict[str, float] = field(default_factory=dict)
     sticks: Sticks | None = None  # a pilot's, for Manual and Stabilized
+    # Home's altitude as a navigator that read this much high at arming took it.
+    home_alt_error_m: float = 0.0
+    range_max_m: float = 0.0  # a downward rangefinder reaching this far (0: none)
 
     def __post_init__(self) -> None:
         frame = load_airframe(self.airframe)
@@ -71,6 +74,8 @@ class ClosedLoop:
         # Home is where the navigator is at arming: the resting aircraft, not the ground.
         airborne = bool(self.airborne_agl_m)
         self.status.home_alt_msl_m = s.alt_msl_m - s.alt_agl_m if airborne else s.alt_msl_m
+        self.status.home_alt_msl_m += self.home_alt_error_m
+        self.wheels_agl_m = 0.0 if airborne else s.alt_agl_m  # JSBSim's AGL is the CG's
         self.status.target_lat_deg = self.status.target_lon_deg = math.nan
         self.status.target_alt_msl_m = math.nan
         self.samples: list[Sample] = []
@@ -104,6 +109,8 @@ class ClosedLoop:
 
     def _control(self) -> None:
         s = self.flight.state()
+        if self.range_max_m > 0.0:
+            self.controller.lander.range_reading = self._range(s)
         out = self.controller.step(self.nav(), self.status, s.t_s, self.sticks)
         self.reached += out.reached
         controls = {
@@ -118,6 +125,15 @@ class ClosedLoop:
         self.flight.set_controls(controls)
         truth = (s.lat_deg, s.lon_deg, s.alt_msl_m, s.alt_agl_m, s.airspeed_m_s, s.roll, s.yaw)
         self.samples.append(Sample(s.t_s, *truth, out, (s.vn, s.ve, s.vd)))
+
+    def _range(self, s: object) -> RangeReading:
+        """The true height along a body-down beam, valid within ``range_max_m``."""
+        slant = s.alt_agl_m / max(math.cos(s.roll) * math.cos(s.pitch), 0.1)  # type: ignore[attr-defined]
+        reading = RangeReading(t_us=round(s.t_s * 1e6), distance_m=slant)  # type: ignore[attr-defined]
+        reading.max_distance_m = self.range_max_m
+        reading.ground_clearance_m = self.wheels_agl_m  # read standing on the wheels
+        reading.valid = int(0.0 < slant <= self.range_max_m)
+        return reading
 
     def truth(self) -> dict[str, np.ndarray]:
         """The record as the columns of a truth file (those the scoring reads)."""

@@ -51,6 +51,23 @@ def test_the_landing_pattern_is_flown_to_a_stop_on_the_target(airframe: str, win
     assert score.passed(), score
 
 
+@pytest.mark.parametrize(("airframe", "error_m"), [("J3Cub", -3.2), ("c172p", 3.2)])
+def test_a_home_altitude_misread_at_arming_is_corrected_by_the_rangefinder(airframe, error_m):  # type: ignore[no-untyped-def]
+    """The navigator's GPS-aided height read 3.2 m off when home was taken (as in a
+    simulated Cub flight): the glide path lies 3.2 m off, and with the flare on the
+    rangefinder alone the landing is 70-100 m off; a 12 m rangefinder that also finds the
+    runway on the approach puts it on target."""
+    items = checked_plan(PLAN)[0]
+    blind = ClosedLoop(airframe, items, home_alt_error_m=error_m)
+    _fly(blind, 600.0)  # touched down far off the point (it may not stop to disarm)
+    off = landing_score_for_plan(blind.truth(), items)
+    loop = ClosedLoop(airframe, items, home_alt_error_m=error_m, range_max_m=12.0)
+    assert _fly(loop, 600.0)
+    score = landing_score_for_plan(loop.truth(), items)
+    assert score.passed(), score
+    assert abs(off.along_m) > abs(score.along_m) + 50.0, (off, score)
+
+
 def test_a_go_around_on_the_approach_climbs_away_and_the_second_approach_lands():
     items = checked_plan(PLAN)[0]
     loop = ClosedLoop("c172p", items)
