@@ -181,6 +181,9 @@ class SimBridge:
             # The flight log's reader, a period behind at most, so its queues never overflow.
             logged = self.bus.latest_reader("system/logged")
             self.logged = FlightSync(period_us, logged, self.bus.waiter([logged]), 1, "t_us", True)
+        for holding in (self.sync, self.navigated, self.nav_sync, self.samples, self.logged):
+            if holding is not None and self.clock is not None:
+                holding.on_hold = self.clock.update_connections
 
     def device_paths(self) -> dict[str, str]:
         """Device name → the pty path the vehicle's driver opens."""

@@ -103,6 +103,10 @@ class _BusWait:
         self.waiter = waiter
         self.wait_s = 0.0
         self.cancelled = False  # the simulation is ending: wait for nothing more
+        # Called every ``EVENT_WAIT_S`` while the simulation is held: the bridge hands its
+        # clock to readers that joined meanwhile (a plug-in restarted during the hold read
+        # simulation time 0 until the next frame, which waited for that very plug-in).
+        self.on_hold: Callable[[], None] | None = None
 
     def _until(self, done: Callable[[], bool], limit_s: float) -> bool:
         """True once ``done()`` (or cancelled); False when ``limit_s`` passed first."""
@@ -115,6 +119,8 @@ class _BusWait:
                 if waited > limit_s:
                     return False
                 self.waiter.wait(min(limit_s - waited, EVENT_WAIT_S))
+                if self.on_hold is not None and waited >= EVENT_WAIT_S:
+                    self.on_hold()
             return True
         finally:
             self.wait_s += time.perf_counter() - started
