@@ -166,6 +166,12 @@ class Plugin(ABC):
     # FLIGHT_NICE: on a board short of CPU the link, the flight log and the slower sensors
     # give way to them, not the other way round. Other work on the board keeps nice 0.
     nice: ClassVar[int] = 0
+    # The input whose every sample starts a step (the navigator's IMU, the controller's
+    # navigation state), if there is one. When the config places the plug-in in the same
+    # process as the plug-in that publishes it, the process runs this one right after that
+    # one's step that published, on the same wake-up (docs/dev/process_model.md). The
+    # plug-in's code is the same either way: its wait then finds the sample already there.
+    trigger: ClassVar[str | None] = None
 
     @classmethod
     def ports(cls, settings: Mapping[str, Any]) -> Ports:

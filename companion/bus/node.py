@@ -95,6 +95,13 @@ class BusNode:
             self._latest_writers.append(port)
         return port
 
+    def reader_of(self, name: str) -> Reader[Any] | None:
+        """This node's first reader of channel ``name`` (None: it has none)."""
+        for port in self._ports:
+            if isinstance(port, Reader) and port.name == name:
+                return port
+        return None
+
     def update_connections(self) -> None:
         """Give late readers of this node's Latest channels the last value published."""
         for port in self._latest_writers:

@@ -29,7 +29,13 @@ from typing import Any
 from companion.bus.node import BusNode
 from companion.bus.patterns import Writer
 from companion.exec_control.backoff import MAX_BACKOFF_S, SECOND_BACKOFF_S, STABLE_AFTER_S
-from companion.exec_control.plugin_host import EXIT_INIT_FAILED, PluginHost, _signal_pipe
+from companion.exec_control.chain import ChainLink, chain_links, run_followers
+from companion.exec_control.plugin_host import (
+    EXIT_INIT_FAILED,
+    EXIT_STEP_FAILED,
+    PluginHost,
+    _signal_pipe,
+)
 from companion.exec_control.priority import apply_nice
 from companion.exec_control.registry import load
 from companion.messages import PluginStats
@@ -42,8 +48,11 @@ log = logging.getLogger("companion.composed_host")
 class Member:
     """One hosted plug-in: its thread, restarted in place when the plug-in fails."""
 
-    def __init__(self, spec: dict[str, Any]) -> None:
+    def __init__(self, spec: dict[str, Any], link: ChainLink | None = None) -> None:
         self.spec = spec
+        self.link = link  # run by the plug-in that publishes its trigger (``chain``)
+        # Chained to this one: run on this thread after its steps.
+        self.followers: list[ChainLink] = link.followers if link else []
         self.name: str = spec["name"]
         self._stop_r, self._stop_w = os.pipe()
         self.stopping = False
@@ -89,7 +98,12 @@ class Member:
             return EXIT_INIT_FAILED
         self.host = host
         host.stopping = self.stopping  # a stop that came while it was being made
+        if self.followers:
+            followers = self.followers
+            host.after_step = lambda: run_followers(followers, host)
         try:
+            if self.link is not None:
+                return self.run_chained(host, self.link)
             return host.run(load(self.spec["kind"])())
         except BaseException:  # a plug-in's SystemExit ends its thread, not the others
             log.exception("%s failed", self.name)
@@ -97,6 +111,23 @@ class Member:
         finally:
             self.host = None
             host.bus.close()
+
+    def run_chained(self, host: PluginHost, link: ChainLink) -> int:
+        """Init, steps (on the producer's thread, or here while it delivers nothing),
+        close; the exit status."""
+        if not host.start(load(self.spec["kind"])()):
+            return EXIT_INIT_FAILED
+        code = 0
+        try:
+            if not link.serve(host, self._stop_r):
+                code = EXIT_STEP_FAILED  # raised on the producer's thread, said there
+        except Exception:
+            log.exception("%s: step failed", self.name)
+            code = EXIT_STEP_FAILED
+        finally:
+            host.failed = code != 0
+            host.finish()
+        return code
 
 
 def member_specs(spec: dict[str, Any]) -> list[dict[str, Any]]:
@@ -123,7 +154,13 @@ def main(spec: dict[str, Any]) -> int:
     wake = _signal_pipe()  # readable once a signal has come
     for sig in (signal.SIGTERM, signal.SIGINT):
         signal.signal(sig, lambda *_: stopping.set())
-    members = [Member(s) for s in member_specs(spec)]
+    specs = member_specs(spec)
+    links = chain_links(specs)
+    members = [Member(s, links[s["name"]][1] if s["name"] in links else None) for s in specs]
+    by_name = {m.name: m for m in members}
+    for name, (producer, link) in links.items():
+        by_name[producer].followers.append(link)
+        log.info("%s runs after %s on its wake-up", name, producer)
     for member in members:
         member.thread.start()
     # The main thread sleeps until a signal: the plug-ins' threads do the work.

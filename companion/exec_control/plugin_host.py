@@ -13,8 +13,10 @@ import logging
 import os
 import signal
 import sys
+import threading
 import time
 from collections import deque
+from collections.abc import Callable
 from typing import Any
 
 from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
@@ -66,6 +68,10 @@ class StepTimer:
         return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
 
 
+def _nothing() -> None:
+    pass
+
+
 def _signal_pipe() -> int:
     """The read end of a pipe Python writes a byte to whenever a signal arrives."""
     read_fd, write_fd = os.pipe()
@@ -96,7 +102,14 @@ class PluginHost:
         self.composed = stop_fd is not None
         self.restarts = restarts
         self.failed = False
-        self._cpu_mark = (time.thread_time(), time.monotonic())
+        # The thread that runs this plug-in (its own, or its process's) and the CPU time of
+        # its steps run on another thread (a composed process's chain), minus what the
+        # steps of others took on this one: its own share of the process's CPU.
+        self._cpu_clock = time.pthread_getcpuclockid(threading.get_ident())
+        self.cpu_moved_s = 0.0
+        self._cpu_mark = (self._cpu_s(), time.monotonic())
+        # Run after each step on this plug-in's thread (the composed host's chain).
+        self.after_step: Callable[[], None] = _nothing
         self.bus = BusNode(spec["namespace"], spec["name"])
         self.timer = StepTimer()
         # A composed plug-in's host gives a writer that outlives this instance: the counters
@@ -115,6 +128,9 @@ class PluginHost:
             stop_fd=_signal_pipe() if stop_fd is None else stop_fd,
             supervisor_pid=os.getppid(),  # adopted by the supervisor before the host starts
         )
+
+    def _cpu_s(self) -> float:
+        return time.clock_gettime(self._cpu_clock) + self.cpu_moved_s
 
     def _clock(self, kind: str) -> VehicleClock:
         if kind == "sim":
@@ -137,7 +153,7 @@ class PluginHost:
         msg.step_p99_us = self.timer.percentile(0.99)
         if self.composed:
             # The process's CPU is shared: this plug-in's share is its own thread's.
-            cpu, wall = time.thread_time(), time.monotonic()
+            cpu, wall = self._cpu_s(), time.monotonic()
             msg.cpu_pct = 100 * (cpu - self._cpu_mark[0]) / max(wall - self._cpu_mark[1], 1e-3)
             self._cpu_mark = (cpu, wall)
             msg.restarts = self.restarts + int(self.failed)
@@ -145,7 +161,10 @@ class PluginHost:
         self.stats.publish(msg)
         health.reported_us = msg.t_us
 
-    def run(self, plugin: Plugin) -> int:
+    def start(self, plugin: Plugin) -> bool:
+        """``init``, then the first counters; False (counters said, for a composed one) when
+        ``init`` raised."""
+        self.plugin = plugin
         try:
             plugin.init(self.ctx)
         except Exception:
@@ -153,35 +172,51 @@ class PluginHost:
             self.failed = True
             if self.composed:  # its row says BACKOFF; a process of its own just dies
                 self.publish_stats()
-            return EXIT_INIT_FAILED
-        code = 0
+            return False
         # Up: the health table has the new process's own counters before its first step,
         # which waits for its device (a silent one: the read timeout, a second).
         self.publish_stats()
-        next_stats = next_connections = time.monotonic()
+        self._next_stats = self._next_connections = time.monotonic()
+        return True
+
+    def step_once(self) -> None:
+        """One ``step()``, timed, then what falls due: late readers handed this plug-in's
+        Latest values, its counters published. Raises what the step raised."""
+        started, idle_before = time.perf_counter(), self.bus.idle.seconds
+        self.plugin.step()
+        # Busy time only: the wait for input is not the plug-in's cost.
+        idle = self.bus.idle.seconds - idle_before
+        self.timer.add(time.perf_counter() - started - idle)
+        if (now := time.monotonic()) >= self._next_connections:
+            self.bus.update_connections()
+            self._next_connections = now + CONNECTIONS_PERIOD_S
+        if now >= self._next_stats:
+            self.publish_stats()
+            self._next_stats = time.monotonic() + STATS_PERIOD_S
+
+    def finish(self) -> None:
+        """``close``, then the last counters."""
+        try:
+            self.plugin.close()
+        except Exception:
+            log.exception("%s: close failed", self.spec["name"])
+        self.publish_stats()
+
+    def run(self, plugin: Plugin) -> int:
+        """Init, steps until stopped, close; the exit status."""
+        if not self.start(plugin):
+            return EXIT_INIT_FAILED
+        code = 0
         try:
             while not self.stopping:
-                started, idle_before = time.perf_counter(), self.bus.idle.seconds
-                plugin.step()
-                # Busy time only: the wait for input is not the plug-in's cost.
-                idle = self.bus.idle.seconds - idle_before
-                self.timer.add(time.perf_counter() - started - idle)
-                if (now := time.monotonic()) >= next_connections:
-                    self.bus.update_connections()
-                    next_connections = now + CONNECTIONS_PERIOD_S
-                if now >= next_stats:
-                    self.publish_stats()
-                    next_stats = time.monotonic() + STATS_PERIOD_S
+                self.step_once()
+                self.after_step()
         except Exception:
             log.exception("%s: step failed", self.spec["name"])
             code = EXIT_STEP_FAILED
             self.failed = True
         finally:
-            try:
-                plugin.close()
-            except Exception:
-                log.exception("%s: close failed", self.spec["name"])
-            self.publish_stats()
+            self.finish()
         return code
 
 

@@ -70,6 +70,7 @@ class MiniSscOutput(Plugin):
     """Writes changed channels first, never more than one cycle of frames ahead of the wire."""
 
     nice = FLIGHT_NICE
+    trigger = "control/actuators"
 
     settings = {
         "device": Setting(str, doc="serial:///dev/ttyS1:9600, a pty path or a pyserial URL"),

@@ -52,6 +52,7 @@ class FixedWingPlugin(Plugin):
     """Guidance, energy and attitude control for one airframe."""
 
     nice = FLIGHT_NICE
+    trigger = "nav/state"
 
     # The airframe (gains, limits, speeds as parameter defaults) is the vehicle's:
     # [vehicle] airframe, the same file the servo output and the flight log read.

@@ -29,6 +29,7 @@ class InsEkfPlugin(Plugin):
     """IMU-driven navigation aided by GPS and a heading."""
 
     nice = FLIGHT_NICE
+    trigger = "sensors/imu"
 
     settings = {
         "publish_hz": Setting(float, 50.0, "nav/state rate, in vehicle time", min=1.0, max=400),

@@ -1,0 +1,161 @@
+"""Plug-ins of one process run one after another on a single wake-up (a work queue).
+
+A plug-in that declares a ``trigger`` (``Plugin.trigger``: the navigator's IMU, the
+controller's navigation state, the servos' commands) and shares its process with the one
+plug-in that publishes that channel is *chained* to it: after each step in which the
+producer published the trigger, the producer's thread runs the follower's step at once.
+The follower's wait then finds the sample already there and returns without sleeping, so
+the sample costs the process one wake-up however many plug-ins it passes through, as a
+PX4 work queue runs the modules scheduled on it. A wake-up of a Python thread costs far
+more than the bus work it starts (``benchmarks/wake_floor.py``).
+
+The follower keeps a thread of its own, which does three things the chain cannot:
+- it runs ``init`` and ``close`` (and restarts the plug-in after a failure, with the
+  composed host's back-off);
+- while the producer has not run it for ``IDLE_S`` (the producer stopped publishing, or
+  has not started), it steps the plug-in itself, as a plug-in of its own would, so its
+  timeouts (the servos' safe positions when commands stop) still act;
+- it is the thread the follower's failures are handled on: a step that raises on the
+  producer's thread is logged and hands the plug-in back to its own thread, which closes
+  and restarts it; the producer goes on.
+
+A lock keeps the two threads from stepping the plug-in at once. The producer never waits
+for it: a follower busy stepping itself (in its own wait) receives the sample there.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import select
+import threading
+import time
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+from companion.exec_control.registry import load
+
+if TYPE_CHECKING:
+    from companion.bus.patterns import Reader
+    from companion.exec_control.plugin_host import PluginHost
+
+# Not run by its producer for this long, a chained plug-in steps itself (and so waits on
+# its own inputs again): the servos' shortest refresh without commands.
+IDLE_S = 0.1
+
+log = logging.getLogger("companion.chain")
+
+
+class ChainLink:
+    """A chained plug-in: what its producer's thread needs to run its step."""
+
+    def __init__(self, name: str, trigger: str) -> None:
+        self.name = name
+        self.trigger = trigger
+        self.followers: list[ChainLink] = []  # chained to this one in turn
+        self.host: PluginHost | None = None  # set while its plug-in is up
+        self.failed = False
+        self._lock = threading.Lock()
+        self._last_run = -float("inf")  # when the producer last ran it (or tried to)
+        self._wake_r, self._wake_w = os.pipe()
+        os.set_blocking(self._wake_r, False)
+        self._reader: Reader[Any] | None = None
+        self._reader_host: PluginHost | None = None
+
+    def _has_input(self, host: PluginHost) -> bool:
+        """Whether the plug-in's reader of its trigger holds a sample (its wait would then
+        return at once: a step run without one would sleep on the producer's thread)."""
+        if self._reader_host is not host:
+            self._reader_host, self._reader = host, host.bus.reader_of(self.trigger)
+        return self._reader is not None and self._reader.has_samples()
+
+    def run_after(self, producer: PluginHost) -> None:
+        """On the producer's thread, after its step: this plug-in's step, if a sample of
+        its trigger waits for it and it is not busy on its own thread."""
+        host = self.host
+        if host is None or not self._has_input(host):
+            return
+        self._last_run = time.monotonic()  # the producer delivers: no step of its own
+        if not self._lock.acquire(blocking=False):
+            return  # busy in its own step: its own wait takes the sample
+        try:
+            if self.host is not host or self.failed:
+                return
+            cpu_before = time.thread_time()
+            try:
+                host.step_once()
+            except (Exception, SystemExit):
+                log.exception("%s: step failed", self.name)
+                self.failed = True
+                os.write(self._wake_w, b"f")  # its own thread closes and restarts it
+                return
+            finally:
+                took = time.thread_time() - cpu_before
+                host.cpu_moved_s += took
+                producer.cpu_moved_s -= took
+        finally:
+            self._lock.release()
+        run_followers(self.followers, host)
+
+    def serve(self, host: PluginHost, stop_fd: int) -> bool:
+        """On the plug-in's own thread, after its ``init``: step it whenever the producer
+        has not for ``IDLE_S``, until stopped or a chained step failed (False then)."""
+        self.failed = False
+        self.host = host
+        try:
+            while not host.stopping and not self.failed:
+                left = self._last_run + IDLE_S - time.monotonic()
+                if left > 0:
+                    ready, _, _ = select.select([stop_fd, self._wake_r], [], [], left)
+                    if self._wake_r in ready:
+                        os.read(self._wake_r, 64)
+                    continue
+                with self._lock:
+                    if host.stopping or self.failed:
+                        break
+                    host.step_once()
+                run_followers(self.followers, host)
+        finally:
+            with self._lock:  # a step in progress on the producer's thread ends first
+                self.host = None
+        return not self.failed
+
+
+def run_followers(followers: Sequence[ChainLink], producer: PluginHost) -> None:
+    """Run each follower whose trigger ``producer`` just published."""
+    for link in followers:
+        link.run_after(producer)
+
+
+def chain_links(members: Sequence[dict[str, Any]]) -> dict[str, tuple[str, ChainLink]]:
+    """For each plug-in chained to another of these specs: its producer's name and its
+    link. A plug-in is chained when exactly one other plug-in here publishes its trigger;
+    a cycle is left unchained (one of its plug-ins must wake on its own)."""
+    outputs = {m["name"]: set(load(m["kind"]).ports(m["settings"]).outputs) for m in members}
+    producer_of: dict[str, str] = {}
+    for m in members:
+        trigger = load(m["kind"]).trigger
+        if trigger is None:
+            continue
+        producers = [n for n, outs in outputs.items() if trigger in outs and n != m["name"]]
+        if len(producers) == 1:
+            producer_of[m["name"]] = producers[0]
+    for name in list(producer_of):
+        seen, at = {name}, producer_of[name]
+        while at in producer_of and at not in seen:
+            seen.add(at)
+            at = producer_of[at]
+        if at in seen:  # back at a plug-in already on the way: a cycle
+            producer_of.pop(name)
+    return {
+        name: (producer, ChainLink(name, load_trigger(members, name)))
+        for name, producer in producer_of.items()
+    }
+
+
+def load_trigger(members: Sequence[dict[str, Any]], name: str) -> str:
+    """The trigger channel of the plug-in ``name`` among ``members``."""
+    kind = next(m["kind"] for m in members if m["name"] == name)
+    trigger = load(kind).trigger
+    assert trigger is not None
+    return trigger

@@ -1,0 +1,79 @@
+"""A plug-in chained to the one that feeds it in a composed process: run on that one's
+wake-up (its thread), restarted alone when it raises there, and still acting on its own
+timeouts when its input stops."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from companion.messages import PluginState
+from tests.support.configs import plugin, vehicle_config
+from tests.support.vehicle import wait_for
+
+TICKER = "tests.support.chained_plugins:ThreadTicker"
+CHAINED = "tests.support.chained_plugins:ChainedRelay"
+
+
+def in_one_process(*entries):
+    return vehicle_config("chain", *(replace(e, process="core") for e in entries))
+
+
+def states(reader, want: int, timeout_s: float = 20.0) -> list:
+    """At least ``want`` navigation values with a sample's count (roll > 0)."""
+    got: list = []
+
+    def enough() -> bool:
+        got.extend(v for v in reader.drain() if v.roll_rad > 0)
+        return len(got) >= want
+
+    wait_for(enough, timeout_s, f"{want} relayed samples")
+    return got
+
+
+def test_a_chained_plugin_runs_on_the_wake_up_of_the_plugin_that_publishes_its_input(
+    vehicle_factory,
+):
+    vehicle = vehicle_factory(
+        in_one_process(plugin("imu", TICKER, rate_hz=100.0), plugin("relay", CHAINED))
+    )
+    nav = vehicle.bus.latest_reader("nav/state", keep=64)
+    states(nav, 20)  # the first may be taken on its own thread, before the chain runs
+    relayed = states(nav, 100)
+    on_producer = [s for s in relayed if s.pitch_rad == s.yaw_rad]
+    assert len(on_producer) >= 0.95 * len(relayed), "steps ran on the relay's own thread"
+    counts = [int(s.roll_rad) for s in relayed]
+    assert counts == list(range(counts[0], counts[0] + len(counts))), "a sample was skipped"
+    assert vehicle.row("relay").state == PluginState.RUNNING
+
+
+def test_a_chained_plugin_that_raises_is_restarted_alone_while_its_producer_goes_on(
+    vehicle_factory,
+):
+    vehicle = vehicle_factory(
+        in_one_process(plugin("imu", TICKER, rate_hz=100.0), plugin("relay", CHAINED, crash_at=60))
+    )
+    nav = vehicle.bus.latest_reader("nav/state", keep=64)
+    pid = vehicle.wait_running("imu")
+    wait_for(lambda: (r := vehicle.row("relay")) and r.restarts >= 1, 20, "the relay restarted")
+    after = states(nav, 50)
+    assert max(s.roll_rad for s in after) > 60, "no sample relayed after the crash"
+    imu = vehicle.row("imu")
+    assert (imu.pid, imu.restarts, imu.state) == (pid, 0, PluginState.RUNNING)
+    assert vehicle.row("relay").pid == pid, "the process itself did not die"
+
+
+def test_a_chained_plugin_acts_on_its_own_timeouts_when_its_producer_falls_silent(
+    vehicle_factory,
+):
+    vehicle = vehicle_factory(
+        in_one_process(plugin("imu", TICKER, rate_hz=100.0, count=300), plugin("relay", CHAINED))
+    )
+    nav = vehicle.bus.latest_reader("nav/state", keep=64)
+    producer_thread = states(nav, 30)[-1].yaw_rad
+
+    def timed_out():
+        return next((v for v in nav.drain() if v.roll_rad == -1.0), None)
+
+    # The ticker stops after 300 samples (3 s); the relay's own wait then ends empty.
+    silent = wait_for(timed_out, 15, "the relay's own timeout after the IMU fell silent")
+    assert silent.pitch_rad != producer_thread, "the timeout ran on the producer's thread"

@@ -1,0 +1,66 @@
+"""Test plug-ins that declare a trigger, for the composed process's chain (run on the
+wake-up of the plug-in that publishes their input), named as module:Class in configs."""
+
+from __future__ import annotations
+
+import threading
+
+from companion.messages import Imu, NavState
+from companion.plugin import Plugin, PluginContext, Setting
+
+
+class ThreadTicker(Plugin):
+    """A pretend IMU at ``rate_hz`` that stops after ``count`` samples: each sample carries
+    its count (``ax``) and the native id of the thread that published it (``gx``)."""
+
+    settings = {
+        "rate_hz": Setting(float, 50.0, "samples per second", min=0.1, max=10000),
+        "count": Setting(int, 1_000_000, "samples before it falls silent", min=0),
+    }
+    outputs = ("sensors/imu",)
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.writer = ctx.bus.writer("sensors/imu")
+        self.period_s = 1.0 / ctx.settings["rate_hz"]
+        self.count = 0
+        self._pace = threading.Event()  # stands in for a device's read timing
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:
+            self._pace.wait(self.period_s)
+        if self.count >= self.ctx.settings["count"]:
+            return
+        self.count += 1
+        sample = Imu(t_us=self.ctx.clock.now_us(), ax_m_s2=float(self.count))
+        sample.gx_rad_s = float(threading.get_native_id())
+        self.writer.publish(sample)
+
+
+class ChainedRelay(Plugin):
+    """Each IMU sample as nav/state: ``roll`` its count, ``pitch`` the native id of the
+    thread this step ran on, ``yaw`` the id of the thread that published the sample. A wait
+    that ends with no sample publishes ``roll`` -1 (what a plug-in's own timeout does)."""
+
+    trigger = "sensors/imu"
+    inputs = ("sensors/imu",)
+    outputs = ("nav/state",)
+    settings = {"crash_at": Setting(int, 0, "raise on the sample with this count (0: never)")}
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.imu = ctx.bus.queue_reader("sensors/imu")
+        self.nav = ctx.bus.writer("nav/state")
+
+    def step(self) -> None:
+        samples = self.imu.take(timeout_s=0.3)
+        me = float(threading.get_native_id())
+        if not samples:
+            self.nav.publish(NavState(t_us=self.ctx.clock.now_us(), roll_rad=-1.0, pitch_rad=me))
+        for sample in samples:
+            if sample.ax_m_s2 == self.ctx.settings["crash_at"]:
+                raise RuntimeError("deliberate crash on the producer's thread")
+            out = NavState(t_us=sample.t_us, roll_rad=sample.ax_m_s2, pitch_rad=me)
+            out.yaw_rad = sample.gx_rad_s
+            self.nav.publish(out)
+            self.ctx.health.ok()
