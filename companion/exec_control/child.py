@@ -64,6 +64,10 @@ class Child:
         self.state = PluginState.RUNNING
         log.info("started %s (%s) pid %d", self.spec.name, self.spec.kind, self.proc.pid)
 
+    def flight_changed(self, running: bool) -> None:
+        """The flight group started (True) or stopped: nothing to a plug-in's own process,
+        which the supervisor starts or stops itself."""
+
     def reap(self, now: float) -> bool:
         """If the process died unasked, schedule its restart; True when it did."""
         code = self.proc.poll() if self.proc is not None else None

@@ -12,6 +12,7 @@ import json
 from typing import Any
 
 from companion.exec_control.child import Child, _spec_dict
+from companion.exec_control.composition import process_group
 from companion.exec_control.plugin_spec import PluginSpec
 from companion.messages import NAME_LEN, PluginHealth, PluginState, PluginStats
 from companion.plugin import Ports
@@ -23,20 +24,38 @@ class ComposedChild(Child):
     """The process ``name`` and the plug-ins it hosts."""
 
     def __init__(self, name: str, members: list[PluginSpec], base: dict[str, Any]) -> None:
-        spec = PluginSpec(name, COMPOSED_KIND, members[0].group, {}, Ports(), members[0].line)
+        group = process_group(members)
+        spec = PluginSpec(name, COMPOSED_KIND, group, {}, Ports(), members[0].line)
         super().__init__(spec, base)
         self.members = members
-        self._argv_spec = json.dumps(
-            {**base, **_spec_dict(spec), "members": [_spec_dict(m) for m in members]}
-        )
+        self._base = base
+        # A core process that also holds flight plug-ins runs them while the flight group
+        # runs (the supervisor tells it here; the process reads it from system/health).
+        self.flight_running = False
+        self._argv_spec = self._argv()
         self.member_stats: dict[str, PluginStats] = {}
         # Restarts inside earlier runs of the process (a new one counts from zero).
         self.carried: dict[str, int] = {m.name: 0 for m in members}
+
+    def _argv(self) -> str:
+        members = [_spec_dict(m) for m in self.members]
+        return json.dumps(
+            {
+                **self._base,
+                **_spec_dict(self.spec),
+                "members": members,
+                "flight_running": self.flight_running,
+            }
+        )
+
+    def flight_changed(self, running: bool) -> None:
+        self.flight_running = running
 
     def start(self) -> None:
         for name, stats in self.member_stats.items():
             self.carried[name] += stats.restarts
         self.member_stats = {}
+        self._argv_spec = self._argv()  # started in the air: its flight plug-ins at once
         super().start()
 
     def absorb(self, stats: PluginStats) -> bool:
@@ -52,11 +71,13 @@ class ComposedChild(Child):
 
     def _row(self, member: PluginSpec) -> PluginHealth:
         stats = self.member_stats.get(member.name, PluginStats())
-        state = self.state
-        if state == PluginState.RUNNING and stats.state:
+        state, pid = self.state, self.pid
+        if member.group != self.spec.group and not self.flight_running:
+            state, pid = PluginState.STOPPED, 0  # a flight plug-in of a core process, disarmed
+        elif state == PluginState.RUNNING and stats.state:
             state = PluginState(stats.state)  # the plug-in is in its back-off in there
         restarts = self.restarts + self.carried[member.name] + stats.restarts
-        row = PluginHealth(state=int(state), pid=self.pid, restarts=restarts)
+        row = PluginHealth(state=int(state), pid=pid, restarts=restarts)
         row.name = member.name.encode()[: NAME_LEN - 1]
         row.kind = member.kind.encode()[:47]
         row.group = member.group.encode()

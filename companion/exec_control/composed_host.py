@@ -30,6 +30,7 @@ from companion.bus.node import BusNode
 from companion.bus.patterns import Writer
 from companion.exec_control.backoff import MAX_BACKOFF_S, SECOND_BACKOFF_S, STABLE_AFTER_S
 from companion.exec_control.chain import ChainLink, chain_links, run_followers
+from companion.exec_control.composition import flight_members
 from companion.exec_control.plugin_host import (
     EXIT_INIT_FAILED,
     EXIT_STEP_FAILED,
@@ -41,6 +42,8 @@ from companion.exec_control.registry import load
 from companion.messages import PluginStats
 
 JOIN_GRACE_S = 1.0  # the supervisor kills the process 1.2 s after its SIGTERM
+# A change of the health table's flight state wakes the process; this is a second look.
+FLIGHT_LOOK_S = 1.0
 
 log = logging.getLogger("companion.composed_host")
 
@@ -48,17 +51,31 @@ log = logging.getLogger("companion.composed_host")
 class Member:
     """One hosted plug-in: its thread, restarted in place when the plug-in fails."""
 
-    def __init__(self, spec: dict[str, Any], link: ChainLink | None = None) -> None:
+    def __init__(
+        self,
+        spec: dict[str, Any],
+        link: ChainLink | None = None,
+        followers: list[ChainLink] | None = None,
+    ) -> None:
         self.spec = spec
         self.link = link  # run by the plug-in that publishes its trigger (``chain``)
         # Chained to this one: run on this thread after its steps.
-        self.followers: list[ChainLink] = link.followers if link else []
+        if followers is None:
+            followers = link.followers if link else []
+        self.followers = followers
         self.name: str = spec["name"]
         self._stop_r, self._stop_w = os.pipe()
         self.stopping = False
         self.restarts = 0
         self.host: PluginHost | None = None
         self.thread = threading.Thread(target=self.run, name=self.name, daemon=True)
+
+    def renewed(self) -> Member:
+        """A fresh member for the same plug-in (a thread starts once), its restarts and
+        its place in the chain kept."""
+        member = Member(self.spec, self.link, self.followers)
+        member.restarts = self.restarts
+        return member
 
     def stop(self) -> None:
         """Ask the plug-in to stop after its current step (its stop descriptor turns
@@ -130,15 +147,61 @@ class Member:
         return code
 
 
+_PROCESS_KEYS = ("members", "name", "kind", "group", "flight_running")
+
+
 def member_specs(spec: dict[str, Any]) -> list[dict[str, Any]]:
     """Each hosted plug-in's spec as a process of its own would get it."""
-    shared = {k: v for k, v in spec.items() if k not in ("members", "name", "kind", "group")}
+    shared = {k: v for k, v in spec.items() if k not in _PROCESS_KEYS}
     tables = {k: shared.pop(k) for k in ("param_decls", "plugins") if k in shared}
     out = []
     for member in spec["members"]:
         wants = load(member["kind"]).wants_vehicle_tables
         out.append({**shared, **(tables if wants else {}), **member})
     return out
+
+
+class FlightSwitch:
+    """The flight plug-ins of a core process: started while the flight group runs (the
+    supervisor's ``system/health`` says so; ``flight_running`` of the spec when the process
+    started), stopped when it stops. Each start is a fresh thread and instance, with the
+    restarts counted so far and its place in the chain kept."""
+
+    def __init__(self, members: list[Member]) -> None:
+        self.members = members
+        self.running = False
+
+    def set(self, running: bool) -> None:
+        if running == self.running or not self.members:
+            return
+        self.running = running
+        if running:
+            self.members = [m.renewed() for m in self.members]
+            for member in self.members:
+                member.thread.start()
+        else:
+            stop_all(self.members)
+        log.info("flight plug-ins %s", "started" if running else "stopped")
+
+
+def stop_all(members: list[Member]) -> None:
+    """Stop the members' plug-ins and wait (within the supervisor's grace) for them."""
+    for member in members:
+        member.stop()
+    deadline = time.monotonic() + JOIN_GRACE_S
+    for member in members:
+        member.thread.join(max(0.0, deadline - time.monotonic()))
+
+
+def wire(specs: list[dict[str, Any]]) -> list[Member]:
+    """A member for each spec, each chained plug-in among its producer's followers."""
+    links = chain_links(specs)
+    members = [Member(s, links[s["name"]][1] if s["name"] in links else None) for s in specs]
+    by_name = {m.name: m for m in members}
+    for name, (producer, link) in links.items():
+        by_name[producer].followers.append(link)
+        log.info("%s runs after %s on its wake-up", name, producer)
+    return members
 
 
 def main(spec: dict[str, Any]) -> int:
@@ -155,24 +218,43 @@ def main(spec: dict[str, Any]) -> int:
     for sig in (signal.SIGTERM, signal.SIGINT):
         signal.signal(sig, lambda *_: stopping.set())
     specs = member_specs(spec)
-    links = chain_links(specs)
-    members = [Member(s, links[s["name"]][1] if s["name"] in links else None) for s in specs]
-    by_name = {m.name: m for m in members}
-    for name, (producer, link) in links.items():
-        by_name[producer].followers.append(link)
-        log.info("%s runs after %s on its wake-up", name, producer)
-    for member in members:
+    members = wire(specs)
+    in_flight = set(flight_members(specs))
+    always = [m for m in members if m.name not in in_flight]
+    flight = FlightSwitch([m for m in members if m.name in in_flight])
+    for member in always:
         member.thread.start()
-    # The main thread sleeps until a signal: the plug-ins' threads do the work.
+    flight.set(bool(spec.get("flight_running")))
+    # The main thread sleeps until a signal (the plug-ins' threads do the work), or a
+    # change of the flight group when it hosts flight plug-ins.
+    if in_flight:
+        follow_flight_group(spec, flight, stopping, wake)
     while not stopping.is_set():
         select.select([wake], [], [])
-        try:
-            os.read(wake, 64)
-        except BlockingIOError:
-            pass
-    for member in members:
-        member.stop()
-    deadline = time.monotonic() + JOIN_GRACE_S
-    for member in members:
-        member.thread.join(max(0.0, deadline - time.monotonic()))
+        _drain(wake)
+    stop_all(always + (flight.members if flight.running else []))
     return 0
+
+
+def follow_flight_group(
+    spec: dict[str, Any], flight: FlightSwitch, stopping: threading.Event, wake: int
+) -> None:
+    """Start and stop the flight plug-ins as the supervisor's table says, until a signal."""
+    with BusNode(spec["namespace"], f"{spec['name']}_flight") as node:
+        health = node.latest_reader("system/health")
+        waiter = node.waiter([health])
+        while not stopping.is_set():
+            _, ready = waiter.wait_with_fds(FLIGHT_LOOK_S, [wake])
+            if ready:
+                _drain(wake)
+            table = health.get()
+            if table is not None:
+                flight.set(bool(table.flight_running))
+        waiter.close()
+
+
+def _drain(fd: int) -> None:
+    try:
+        os.read(fd, 64)
+    except BlockingIOError:
+        pass

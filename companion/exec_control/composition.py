@@ -3,7 +3,10 @@
 A plug-in entry without ``process`` runs in an OS process of its own, as always. Entries
 that name the same process share one: the supervisor starts it as one child, and inside it
 each plug-in runs on its own thread with the same init/step/close contract, bus channels
-and health row (``composed_host``). These are the config's checks of such a grouping.
+and health row (``composed_host``). A process may hold plug-ins of both groups: it runs
+while the vehicle does, and starts and stops its ``flight`` plug-ins itself as START and
+STOP start and stop the flight group (``flight_members``). These are the config's checks
+of such a grouping.
 """
 
 from __future__ import annotations
@@ -46,17 +49,6 @@ def check_processes(error: ConfigFault, specs: list[PluginSpec]) -> None:
             members[spec.process].append(index)
     names = {spec.name for spec in specs}
     for process, indexes in members.items():
-        first = specs[indexes[0]]
-        for index in indexes[1:]:
-            spec = specs[index]
-            if spec.group != first.group:
-                # START and STOP start and stop whole processes: half a process cannot be.
-                raise error(
-                    ("plugins", index, "process"),
-                    f"process {process!r} would hold the {first.group} plug-in {first.name!r}"
-                    f" and the {spec.group} plug-in {spec.name!r}: a process holds plug-ins of"
-                    " one group (START and STOP start and stop the flight group's processes)",
-                )
         hosted = {specs[i].name for i in indexes}
         if process in names and process not in hosted:
             raise error(
@@ -64,6 +56,19 @@ def check_processes(error: ConfigFault, specs: list[PluginSpec]) -> None:
                 f"process {process!r} has the name of a plug-in it does not hold;"
                 " `companion status` would be ambiguous",
             )
+
+
+def process_group(members: list[PluginSpec]) -> str:
+    """The group a process of these plug-ins belongs to: ``flight`` only when all of them
+    are (START and STOP then start and stop the whole process), else ``core``."""
+    return "flight" if all(m.group == "flight" for m in members) else "core"
+
+
+def flight_members(members: list[dict[str, Any]]) -> list[str]:
+    """The plug-ins (their specs) a ``core`` process starts and stops itself with the flight
+    group: its ``flight`` ones, when it holds plug-ins of both groups."""
+    groups = {m["group"] for m in members}
+    return [m["name"] for m in members if m["group"] == "flight"] if len(groups) > 1 else []
 
 
 def processes(specs: list[PluginSpec]) -> list[tuple[str, list[PluginSpec]]]:

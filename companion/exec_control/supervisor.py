@@ -125,10 +125,10 @@ class Supervisor:
                     log.warning("arming refused: %s", self.reason)
                     return CommandResult.DENIED
             self.start_group("flight")
-            self.flight_running = True
+            self._flight(True)
         elif kind == CommandId.STOP:
             self.stop_children(self.group("flight"))
-            self.flight_running = False
+            self._flight(False)
         elif kind == CommandId.RESTART_PLUGINS:
             wanted = [c for c in self.children if c.wanted]
             self.stop_children(wanted)
@@ -139,6 +139,11 @@ class Supervisor:
         else:
             return None
         return CommandResult.ACCEPTED
+
+    def _flight(self, running: bool) -> None:
+        self.flight_running = running
+        for child in self.children:
+            child.flight_changed(running)
 
     def publish_health(self, writer: Writer[SystemHealth]) -> None:
         msg = SystemHealth(t_us=self.clock.now_us(), supervisor_pid=os.getpid())

@@ -139,3 +139,37 @@ def test_start_and_stop_toggle_exactly_the_composed_flight_group(vehicle_factory
     assert not psutil.pid_exists(flight_pid) or psutil.Process(flight_pid).status() == "zombie"
     assert {vehicle.row(n).pid for n in ("imu", "idle")} == {core_pid}
     assert vehicle.row("imu").restarts == 0
+
+
+def test_start_and_stop_run_the_flight_plugins_inside_a_process_that_holds_both_groups(
+    vehicle_factory,
+):
+    entries = composed(
+        plugin("imu", TICKER, rate_hz=50.0),
+        plugin("relay", RELAY, group="flight"),
+        plugin("wait", WAITING, group="flight"),
+        process="vehicle",
+    )
+    vehicle = vehicle_factory(vehicle_config("onebox", *entries))
+    vehicle.commands = vehicle.bus.writer("link/commands")
+    vehicle.acks = vehicle.bus.queue_reader("link/command_acks")
+    nav = vehicle.bus.latest_reader("nav/state")
+    pid = vehicle.wait_running("imu")
+    assert (vehicle.row("relay").state, vehicle.row("relay").pid) == (PluginState.STOPPED, 0)
+    assert nav.wait(0.5) is None, "nothing flies before START"
+
+    for round_ in range(2):  # started, stopped and started again: fresh instances each time
+        seq = 10 * round_
+        assert send(vehicle, CommandId.START, seq + 1).result == CommandResult.ACCEPTED
+        wait_for(lambda: vehicle.row("wait").state == PluginState.RUNNING, 5, "flight running")
+        assert {vehicle.row(n).pid for n in ("imu", "relay", "wait")} == {pid}
+        assert wait_for(lambda: nav.wait(0.2), 5, "nav/state from the flight plug-in")
+
+        assert send(vehicle, CommandId.STOP, seq + 2).result == CommandResult.ACCEPTED
+        wait_for(lambda: vehicle.row("relay").state == PluginState.STOPPED, 5, "flight stopped")
+        time.sleep(0.3)  # the relay's last step ends within its wait
+        nav.get()
+        assert nav.wait(0.5) is None, "the relay still runs after STOP"
+    imu = vehicle.row("imu")
+    assert (imu.pid, imu.restarts, imu.state) == (pid, 0, PluginState.RUNNING)
+    assert all(vehicle.row(n).restarts == 0 for n in ("relay", "wait"))

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from companion.exec_control.composition import processes
+from companion.exec_control.composition import process_group, processes
 from companion.exec_control.config import ConfigError, load_config
 from tests.support.configs import RELAY, TICKER, WAITING, plugin, vehicle_config
 
@@ -35,14 +35,14 @@ def test_plugins_naming_one_process_share_it_and_the_others_keep_their_own(tmp_p
     assert layout == [("sensors", ["imu", "relay"]), ("", ["idle"])]
 
 
-def test_a_process_of_core_and_flight_plugins_is_refused(tmp_path):
-    message = refused(
+def test_a_process_of_core_and_flight_plugins_is_a_core_process(tmp_path):
+    cfg = load(
         tmp_path,
         replace(plugin("imu", TICKER), process="all"),
         replace(plugin("relay", RELAY, group="flight"), process="all"),
     )
-    assert "plugins[1].process" in message
-    assert "one group" in message and "'imu'" in message and "'relay'" in message
+    [(name, members)] = processes(cfg.plugins)
+    assert (name, process_group(members)) == ("all", "core")
 
 
 @pytest.mark.parametrize("name", ["", "Core", "1st", "a-very-long-process-name", "exec_control"])
@@ -65,7 +65,7 @@ def test_a_process_named_after_its_only_plugin_is_fine(tmp_path):
     assert cfg.plugins[0].process == "imu"
 
 
-def test_the_shipped_composed_config_is_sim_toml_in_two_processes():
+def test_the_shipped_composed_config_is_sim_toml_in_one_process():
     import tomllib
 
     from tests.support.vehicle import REPO
@@ -77,5 +77,5 @@ def test_the_shipped_composed_config_is_sim_toml_in_two_processes():
         k: v for k, v in own.items() if k != "plugins"
     }
     for a, b in zip(own["plugins"], composed["plugins"], strict=True):
-        assert b.pop("process") == ("flight" if a.get("group") == "flight" else "core")
+        assert b.pop("process") == "vehicle"
         assert a == b, "sim_composed.toml must fly the vehicle sim.toml flies"
