@@ -172,6 +172,10 @@ class Plugin(ABC):
     # one's step that published, on the same wake-up (docs/dev/process_model.md). The
     # plug-in's code is the same either way: its wait then finds the sample already there.
     trigger: ClassVar[str | None] = None
+    # How long its step waits for the trigger before going on without one (its timeouts:
+    # the servos' safe positions when commands stop). Chained, and not run by its producer
+    # for this long, it is stepped by a thread of its own meanwhile.
+    trigger_timeout_s: ClassVar[float] = 0.1
 
     @classmethod
     def ports(cls, settings: Mapping[str, Any]) -> Ports:

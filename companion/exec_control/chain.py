@@ -12,9 +12,9 @@ more than the bus work it starts (``benchmarks/wake_floor.py``).
 The follower keeps a thread of its own, which does three things the chain cannot:
 - it runs ``init`` and ``close`` (and restarts the plug-in after a failure, with the
   composed host's back-off);
-- while the producer has not run it for ``IDLE_S`` (the producer stopped publishing, or
-  has not started), it steps the plug-in itself, as a plug-in of its own would, so its
-  timeouts (the servos' safe positions when commands stop) still act;
+- while the producer has not run it for its ``trigger_timeout_s`` (the producer stopped
+  publishing, or has not started), it steps the plug-in itself, as a plug-in of its own
+  would, so its timeouts (the servos' safe positions when commands stop) still act;
 - it is the thread the follower's failures are handled on: a step that raises on the
   producer's thread is logged and hands the plug-in back to its own thread, which closes
   and restarts it; the producer goes on.
@@ -27,21 +27,18 @@ from __future__ import annotations
 
 import logging
 import os
-import select
 import threading
 import time
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from companion.exec_control.registry import load
+from companion.fd_wait import wait_readable
 
 if TYPE_CHECKING:
     from companion.bus.patterns import Reader
     from companion.exec_control.plugin_host import PluginHost
-
-# Not run by its producer for this long, a chained plug-in steps itself (and so waits on
-# its own inputs again): the servos' shortest refresh without commands.
-IDLE_S = 0.1
+    from companion.plugin import Plugin
 
 log = logging.getLogger("companion.chain")
 
@@ -49,9 +46,12 @@ log = logging.getLogger("companion.chain")
 class ChainLink:
     """A chained plug-in: what its producer's thread needs to run its step."""
 
-    def __init__(self, name: str, trigger: str) -> None:
+    def __init__(self, name: str, trigger: str, idle_s: float) -> None:
         self.name = name
         self.trigger = trigger
+        # Not run by its producer for this long (the plug-in's ``trigger_timeout_s``), it
+        # steps itself, and so waits on its own inputs again.
+        self.idle_s = idle_s
         self.followers: list[ChainLink] = []  # chained to this one in turn
         self.host: PluginHost | None = None  # set while its plug-in is up
         self.failed = False
@@ -99,14 +99,14 @@ class ChainLink:
 
     def serve(self, host: PluginHost, stop_fd: int) -> bool:
         """On the plug-in's own thread, after its ``init``: step it whenever the producer
-        has not for ``IDLE_S``, until stopped or a chained step failed (False then)."""
+        has not for ``idle_s``, until stopped or a chained step failed (False then)."""
         self.failed = False
         self.host = host
         try:
             while not host.stopping and not self.failed:
-                left = self._last_run + IDLE_S - time.monotonic()
+                left = self._last_run + self.idle_s - time.monotonic()
                 if left > 0:
-                    ready, _, _ = select.select([stop_fd, self._wake_r], [], [], left)
+                    ready = wait_readable([stop_fd, self._wake_r], left)
                     if self._wake_r in ready:
                         os.read(self._wake_r, 64)
                     continue
@@ -147,15 +147,10 @@ def chain_links(members: Sequence[dict[str, Any]]) -> dict[str, tuple[str, Chain
             at = producer_of[at]
         if at in seen:  # back at a plug-in already on the way: a cycle
             producer_of.pop(name)
-    return {
-        name: (producer, ChainLink(name, load_trigger(members, name)))
-        for name, producer in producer_of.items()
-    }
+    kinds = {m["name"]: load(m["kind"]) for m in members}
+    return {name: (producer, _link(name, kinds[name])) for name, producer in producer_of.items()}
 
 
-def load_trigger(members: Sequence[dict[str, Any]], name: str) -> str:
-    """The trigger channel of the plug-in ``name`` among ``members``."""
-    kind = next(m["kind"] for m in members if m["name"] == name)
-    trigger = load(kind).trigger
-    assert trigger is not None
-    return trigger
+def _link(name: str, kind: type[Plugin]) -> ChainLink:
+    assert kind.trigger is not None
+    return ChainLink(name, kind.trigger, kind.trigger_timeout_s)

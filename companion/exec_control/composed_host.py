@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import logging
 import os
-import select
 import signal
 import threading
 import time
@@ -39,6 +38,7 @@ from companion.exec_control.plugin_host import (
 )
 from companion.exec_control.priority import apply_nice
 from companion.exec_control.registry import load
+from companion.fd_wait import wait_readable
 from companion.messages import PluginStats
 
 JOIN_GRACE_S = 1.0  # the supervisor kills the process 1.2 s after its SIGTERM
@@ -103,7 +103,7 @@ class Member:
             self.restarts += 1
             log.warning("%s failed (status %d); restart in %.1f s", self.name, code, backoff_s)
             # Waits on the stop descriptor: a stop during the back-off ends it.
-            select.select([self._stop_r], [], [], backoff_s)
+            wait_readable([self._stop_r], backoff_s)
             backoff_s = min(max(backoff_s * 2, SECOND_BACKOFF_S), MAX_BACKOFF_S)
 
     def run_once(self, stats: Writer[PluginStats]) -> int:
@@ -230,7 +230,7 @@ def main(spec: dict[str, Any]) -> int:
     if in_flight:
         follow_flight_group(spec, flight, stopping, wake)
     while not stopping.is_set():
-        select.select([wake], [], [])
+        wait_readable([wake], None)
         _drain(wake)
     stop_all(always + (flight.members if flight.running else []))
     return 0

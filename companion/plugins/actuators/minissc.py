@@ -71,6 +71,7 @@ class MiniSscOutput(Plugin):
 
     nice = FLIGHT_NICE
     trigger = "control/actuators"
+    trigger_timeout_s = WAIT_S
 
     settings = {
         "device": Setting(str, doc="serial:///dev/ttyS1:9600, a pty path or a pyserial URL"),

@@ -53,6 +53,7 @@ class FixedWingPlugin(Plugin):
 
     nice = FLIGHT_NICE
     trigger = "nav/state"
+    trigger_timeout_s = WAIT_S
 
     # The airframe (gains, limits, speeds as parameter defaults) is the vehicle's:
     # [vehicle] airframe, the same file the servo output and the flight log read.

@@ -30,6 +30,7 @@ class InsEkfPlugin(Plugin):
 
     nice = FLIGHT_NICE
     trigger = "sensors/imu"
+    trigger_timeout_s = WAIT_S
 
     settings = {
         "publish_hz": Setting(float, 50.0, "nav/state rate, in vehicle time", min=1.0, max=400),

@@ -8,10 +8,10 @@ bus nothing is known of the flight, and every frame is read as it comes.
 
 from __future__ import annotations
 
-import select
 import time
 from collections.abc import Callable
 
+from companion.fd_wait import wait_readable
 from companion.messages import VehicleStatus
 from companion.plugin import PluginContext, Setting
 from companion.sensors.framed_stream import spread_since
@@ -50,7 +50,7 @@ class BatchedReads:
             return
         pause = self.pacer.pause_s(self.clock.now_us())
         if pause > 0:
-            select.select([] if self.stop_fd is None else [self.stop_fd], [], [], pause)
+            wait_readable([] if self.stop_fd is None else [self.stop_fd], pause)
 
     def read_done(self, t_us: int) -> None:
         """A read happened at vehicle time ``t_us``."""
