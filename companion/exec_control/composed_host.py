@@ -18,6 +18,7 @@ ends within its timeout.
 
 from __future__ import annotations
 
+import ctypes
 import logging
 import os
 import signal
@@ -41,6 +42,7 @@ from companion.exec_control.registry import load
 from companion.fd_wait import wait_readable
 from companion.messages import PluginStats
 
+_PR_SET_NAME = 15
 JOIN_GRACE_S = 1.0  # the supervisor kills the process 1.2 s after its SIGTERM
 # A change of the health table's flight state wakes the process; this is a second look.
 FLIGHT_LOOK_S = 1.0
@@ -88,6 +90,7 @@ class Member:
     def run(self) -> None:
         """The thread: run the plug-in, and again after each failure, until stopped."""
         apply_nice(self.name, self.spec.get("nice", 0))  # this thread's own
+        name_thread(self.name)
         with BusNode(self.spec["namespace"], f"{self.name}_stats") as node:
             self.loop(node.writer("system/plugin_stats"))
 
@@ -148,6 +151,16 @@ class Member:
 
 
 _PROCESS_KEYS = ("members", "name", "kind", "group", "flight_running")
+
+
+def name_thread(name: str) -> None:
+    """Give the calling thread the plug-in's name as Linux shows it (``top -H``, ``ps -L``,
+    /proc/PID/task/TID/comm: 15 characters), so a composed process's CPU is told apart."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_NAME, ctypes.c_char_p(name.encode()[:15]), 0, 0, 0)
+    except (OSError, AttributeError):  # not Linux: the name is only cosmetic
+        pass
 
 
 def member_specs(spec: dict[str, Any]) -> list[dict[str, Any]]:
