@@ -173,3 +173,28 @@ def test_start_and_stop_run_the_flight_plugins_inside_a_process_that_holds_both_
     imu = vehicle.row("imu")
     assert (imu.pid, imu.restarts, imu.state) == (pid, 0, PluginState.RUNNING)
     assert all(vehicle.row(n).restarts == 0 for n in ("relay", "wait"))
+
+
+def test_a_process_holding_both_groups_killed_in_the_air_runs_its_flight_plugins_at_once(
+    vehicle_factory,
+):
+    entries = composed(
+        plugin("imu", TICKER, rate_hz=50.0),
+        plugin("relay", RELAY, group="flight"),
+        process="vehicle",
+    )
+    vehicle = vehicle_factory(vehicle_config("onebox", *entries))
+    vehicle.commands = vehicle.bus.writer("link/commands")
+    vehicle.acks = vehicle.bus.queue_reader("link/command_acks")
+    nav = vehicle.bus.latest_reader("nav/state")
+    old = vehicle.wait_running("imu")
+    assert send(vehicle, CommandId.START, 1).result == CommandResult.ACCEPTED
+    wait_for(lambda: nav.wait(0.2), 5, "nav/state from the flight plug-in")
+
+    os.kill(old, signal.SIGKILL)
+    new = wait_for(lambda: (r := vehicle.row("relay")) and r.pid not in (0, old) and r.pid, 5,
+                   "the new process in the table")  # fmt: skip
+    # No second START: the new process was told the flight group runs.
+    wait_for(lambda: (v := nav.wait(0.2)) and v.t_us > 0 and vehicle.row("imu").pid == new, 5,
+             "nav/state from the restarted process's flight plug-in")  # fmt: skip
+    assert vehicle.row("relay").state == PluginState.RUNNING
