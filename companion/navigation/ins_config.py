@@ -28,8 +28,8 @@ class InsEkfConfig:
     baro_std: float = 0.5  # m, barometric height over seconds
     baro_interval_s: float = 0.1
     baro_timeout_s: float = 1.0  # barometer silent this long: GPS height again
-    baro_offset_tau_s: float = 300.0  # how slowly GPS pulls the barometer's datum
-    gps_vert_with_baro_std: float = 10.0  # GPS height still anchors the datum, weakly
+    baro_offset_tau_s: float = 300.0  # how slowly GPS pulls the baro datum (standing only)
+    gps_vert_with_baro_std: float = 10.0  # GPS height beside the barometer's, weakly
     compass_std: float = math.radians(2.0)
     mag_heading_std: float = math.radians(4.0)
     mag_window_s: float = 5.0  # the magnetometer's consistency is judged over this

@@ -122,6 +122,7 @@ class InsEkf(InsCore):
         # tilt (gravity, GPS), and with the propellers turning they shift from the ground's
         # (vibration, g-sensitivity); the yaw-rate bias has nothing but a magnetometer in
         # flight, and a stationary window measures it to a few thousandths of a degree/s.
+        self.baro.standing(self.t_us)  # on the ground: GPS may set the barometer's datum
         ok = self._update(gyro_mean[2:] - self.bg[2:], [14], np.array([[variance]]))
         if ok:
             self.still_updates += 1
@@ -327,9 +328,8 @@ class InsEkf(InsCore):
         p_then, v_then = then if then is not None else (np.array(self.p), np.array(self.v))
         std = fix.eph_m if math.isfinite(fix.eph_m) and fix.eph_m > 0 else self.cfg.gps_pos_std
         vstd = fix.epv_m if math.isfinite(fix.epv_m) and fix.epv_m > 0 else 1.5 * std
-        if self.baro.fresh(fix.t_us):
-            since = (fix.t_us - self.last_gps_us) / 1e6 if self.last_gps_us is not None else 0.0
-            self.baro.follow_gps(z_p[2], self.p[2], since)
+        if self.baro.fresh(fix.t_us):  # the datum follows GPS on the ground only
+            self.baro.follow_gps(z_p[2], self.p[2], fix.t_us, self.last_gps_us)
             vstd = max(vstd, self.cfg.gps_vert_with_baro_std)
         rows = [0, 1] + ([2] if math.isfinite(fix.alt_msl_m) else [])
         rows += [3 + i for i in range(3) if math.isfinite(z_v[i])]
