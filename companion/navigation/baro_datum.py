@@ -58,9 +58,10 @@ class BaroDatum:
         self.last_us, self.last_m = t_us, baro_m
         return baro_m + self.offset
 
-    def standing(self, t_us: int) -> None:
-        """The INS found the aircraft standing still at this time."""
-        self.still_us = t_us
+    def standing(self, t_us: int | None) -> None:
+        """The INS found the aircraft standing still at this time (None: it has no time yet)."""
+        if t_us is not None:
+            self.still_us = t_us
 
     def follow_gps(self, gps_down: float, ins_down: float, t_us: int, last_us: int | None) -> None:
         """Standing on the ground, move the datum a little towards what GPS says the height
