@@ -64,6 +64,12 @@ _VEHICLE_KEYS: dict[str, Setting] = {
         "airframe name (companion/airframes) or TOML path: the controller's gains, the servo"
         " map and the flight log's INFO all come from it (`companion sim --aircraft` replaces it)",
     ),
+    "process": Setting(
+        str,
+        "",
+        "the OS process every plug-in without a `process` of its own shares (a small board's"
+        " choice: one interpreter, the flight path on one wake-up); empty: one per plug-in",
+    ),
     "state_dir": Setting(
         str,
         "",
@@ -169,6 +175,8 @@ def _vehicle_and_fleet(
     check: _Checker, data: dict[str, Any], namespace: str | None = None, airframe: str | None = None
 ) -> tuple[dict, dict]:
     vehicle = _table(check, data, "vehicle", _VEHICLE_KEYS)
+    if vehicle["process"]:
+        process_name(check.error, vehicle, ("vehicle",))
     if airframe is not None:
         vehicle["airframe"] = airframe
     try:
@@ -297,7 +305,7 @@ def _plugin_spec(
         ports=cls.ports(settings),
         line=line_of(check.lines, where),
         params=cls.param_decls(settings, vehicle),
-        process=process_name(check.error, entry, where),
+        process=process_name(check.error, entry, where) or vehicle.get("process", ""),
         nice=_nice(check, entry.get("nice", cls.nice), where),
     )
 

@@ -73,9 +73,28 @@ def test_the_shipped_composed_config_is_sim_toml_in_one_process():
     configs = REPO / "companion" / "configs"
     own = tomllib.loads((configs / "sim.toml").read_text())
     composed = tomllib.loads((configs / "sim_composed.toml").read_text())
-    assert {k: v for k, v in composed.items() if k != "plugins"} == {
-        k: v for k, v in own.items() if k != "plugins"
-    }
-    for a, b in zip(own["plugins"], composed["plugins"], strict=True):
-        assert b.pop("process") == "vehicle"
-        assert a == b, "sim_composed.toml must fly the vehicle sim.toml flies"
+    assert composed["vehicle"].pop("process") == "vehicle"
+    assert composed == own, "sim_composed.toml must fly the vehicle sim.toml flies"
+
+
+def test_a_vehicle_wide_process_holds_every_plugin_without_its_own(tmp_path):
+    text = vehicle_config(
+        "small",
+        plugin("imu", TICKER),
+        replace(plugin("relay", RELAY), process="apart"),
+        plugin("idle", WAITING),
+        process="vehicle",
+    )
+    path = tmp_path / "small.toml"
+    path.write_text(text)
+    cfg = load_config(path)
+    layout = [(name, [s.name for s in specs]) for name, specs in processes(cfg.plugins)]
+    assert layout == [("vehicle", ["imu", "idle"]), ("apart", ["relay"])]
+
+
+def test_a_vehicle_wide_process_that_is_no_fit_name_is_refused(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(vehicle_config("small", plugin("imu", TICKER), process="Vehicle"))
+    with pytest.raises(ConfigError) as err:
+        load_config(path)
+    assert "vehicle.process" in str(err.value) and "1-15 characters" in str(err.value)
