@@ -141,20 +141,24 @@ def test_start_and_stop_toggle_exactly_the_composed_flight_group(vehicle_factory
     assert vehicle.row("imu").restarts == 0
 
 
-def test_start_and_stop_run_the_flight_plugins_inside_a_process_that_holds_both_groups(
-    vehicle_factory,
-):
-    entries = composed(
-        plugin("imu", TICKER, rate_hz=50.0),
-        plugin("relay", RELAY, group="flight"),
-        plugin("wait", WAITING, group="flight"),
-        process="vehicle",
-    )
+def both_groups_in_one_process(vehicle_factory, *flight):
+    """A vehicle whose one process holds a core ticker and the ``flight`` plug-ins, with
+    its command writer, its ack reader, the nav/state reader and the process's pid."""
+    entries = composed(plugin("imu", TICKER, rate_hz=50.0), *flight, process="vehicle")
     vehicle = vehicle_factory(vehicle_config("onebox", *entries))
     vehicle.commands = vehicle.bus.writer("link/commands")
     vehicle.acks = vehicle.bus.queue_reader("link/command_acks")
-    nav = vehicle.bus.latest_reader("nav/state")
-    pid = vehicle.wait_running("imu")
+    return vehicle, vehicle.bus.latest_reader("nav/state"), vehicle.wait_running("imu")
+
+
+def test_start_and_stop_run_the_flight_plugins_inside_a_process_that_holds_both_groups(
+    vehicle_factory,
+):
+    vehicle, nav, pid = both_groups_in_one_process(
+        vehicle_factory,
+        plugin("relay", RELAY, group="flight"),
+        plugin("wait", WAITING, group="flight"),
+    )
     assert (vehicle.row("relay").state, vehicle.row("relay").pid) == (PluginState.STOPPED, 0)
     assert nav.wait(0.5) is None, "nothing flies before START"
 
@@ -178,16 +182,9 @@ def test_start_and_stop_run_the_flight_plugins_inside_a_process_that_holds_both_
 def test_a_process_holding_both_groups_killed_in_the_air_runs_its_flight_plugins_at_once(
     vehicle_factory,
 ):
-    entries = composed(
-        plugin("imu", TICKER, rate_hz=50.0),
-        plugin("relay", RELAY, group="flight"),
-        process="vehicle",
+    vehicle, nav, old = both_groups_in_one_process(
+        vehicle_factory, plugin("relay", RELAY, group="flight")
     )
-    vehicle = vehicle_factory(vehicle_config("onebox", *entries))
-    vehicle.commands = vehicle.bus.writer("link/commands")
-    vehicle.acks = vehicle.bus.queue_reader("link/command_acks")
-    nav = vehicle.bus.latest_reader("nav/state")
-    old = vehicle.wait_running("imu")
     assert send(vehicle, CommandId.START, 1).result == CommandResult.ACCEPTED
     wait_for(lambda: nav.wait(0.2), 5, "nav/state from the flight plug-in")
 

@@ -7,24 +7,17 @@ import threading
 
 from companion.messages import Imu, NavState
 from companion.plugin import Plugin, PluginContext, Setting
+from tests.support.plugins import Ticker
 
 
-class ThreadTicker(Plugin):
-    """A pretend IMU at ``rate_hz`` that stops after ``count`` samples: each sample carries
-    its count (``ax``) and the native id of the thread that published it (``gx``)."""
+class ThreadTicker(Ticker):
+    """The pretend IMU, falling silent after ``count`` samples: each sample carries its
+    count (``ax``) and the native id of the thread that published it (``gx``)."""
 
     settings = {
-        "rate_hz": Setting(float, 50.0, "samples per second", min=0.1, max=10000),
+        **Ticker.settings,
         "count": Setting(int, 1_000_000, "samples before it falls silent", min=0),
     }
-    outputs = ("sensors/imu",)
-
-    def init(self, ctx: PluginContext) -> None:
-        super().init(ctx)
-        self.writer = ctx.bus.writer("sensors/imu")
-        self.period_s = 1.0 / ctx.settings["rate_hz"]
-        self.count = 0
-        self._pace = threading.Event()  # stands in for a device's read timing
 
     def step(self) -> None:
         with self.ctx.bus.idle:

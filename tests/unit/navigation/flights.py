@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import functools
+import math
 
-from companion.messages import NavState
+from companion.messages import Baro, NavState
 from companion.navigation.offline import Navigator
 from companion.navigation.scoring import Errors
 from ground.simulation import evaluation
@@ -30,3 +31,12 @@ def fly(
 ) -> tuple[Errors, list[NavState]]:
     """Fly and score with the test flights' declination and outage."""
     return evaluation.fly(navigator, flight_, DECLINATION, OUTAGE, drop)
+
+
+def perfect_baro(flight_: SyntheticFlight) -> list[Baro]:
+    """A barometer that reads the true height above the start, at 25 Hz."""
+    h0 = flight_.truth[0].alt_msl_m
+    return [
+        Baro(t_us=round(s.t_s * 1e6), alt_rel_m=s.alt_msl_m - h0, pressure_pa=math.nan)
+        for s in flight_.truth[::4]  # the truth is at 100 Hz
+    ]

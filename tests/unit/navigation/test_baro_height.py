@@ -13,7 +13,7 @@ from companion.navigation.offline import NAVIGATORS, run_navigator, true_heading
 from ground.simulation.evaluation import messages
 from ground.simulation.synthetic_flight import FlightSpec, Leg
 from ground.simulation.synthetic_log import synthesize
-from tests.unit.navigation.flights import DECLINATION
+from tests.unit.navigation.flights import DECLINATION, perfect_baro
 from tests.unit.navigation.test_ins_still import samples
 
 HOME_S = 20.0  # "arming": home's altitude is the navigator's at this time
@@ -28,11 +28,7 @@ def test_a_wandering_gps_height_does_not_move_the_height_above_home():
     legs = (Leg(90), Leg(30, turn_deg_s=6), Leg(120), Leg(30, turn_deg_s=-6), Leg(90))
     spec = FlightSpec(legs=legs, heading_deg=90.0, noise=NoiseModel(scale=0.0), seed=3)
     synthetic = synthesize(spec)
-    h0 = synthetic.truth[0].alt_msl_m
-    baro = [
-        Baro(t_us=round(s.t_s * 1e6), alt_rel_m=s.alt_msl_m - h0, pressure_pa=math.nan)
-        for s in synthetic.truth[::4]  # 25 Hz
-    ]
+    baro = perfect_baro(synthetic)
     sensors = messages(synthetic)
     fixes = [m for m in sensors if isinstance(m, GpsFix)]
     walk = np.cumsum(np.random.default_rng(7).normal(0.0, 0.12, len(fixes)))  # 5 Hz

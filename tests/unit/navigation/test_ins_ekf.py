@@ -8,13 +8,13 @@ import math
 import pytest
 
 from bridges.sensor_models.sensor_errors import NoiseModel
-from companion.messages import Baro, GpsFix, Imu, NavFlags
+from companion.messages import GpsFix, Imu, NavFlags
 from companion.navigation.ins_ekf import InsEkfConfig
 from companion.navigation.offline import NAVIGATORS, InsEkfRunner, run_navigator, true_headings
 from ground.simulation.evaluation import messages
 from ground.simulation.synthetic_flight import FlightSpec, Leg
 from ground.simulation.synthetic_log import synthesize
-from tests.unit.navigation.flights import DECLINATION, OUTAGE, flight, fly
+from tests.unit.navigation.flights import DECLINATION, OUTAGE, flight, fly, perfect_baro
 
 
 def test_meets_the_accuracy_targets_and_bridges_a_30_s_outage():
@@ -108,11 +108,7 @@ def test_height_holds_kilometres_from_where_the_frame_was_set():
     legs = (Leg(280, speed_m_s=25.0), Leg(7.2, turn_deg_s=25.0), Leg(280, speed_m_s=25.0))
     spec = FlightSpec(legs=legs, heading_deg=0.0, noise=NoiseModel(scale=0.0), seed=3)
     synthetic = synthesize(spec)
-    h0 = synthetic.truth[0].alt_msl_m
-    baro = [
-        Baro(t_us=round(s.t_s * 1e6), alt_rel_m=s.alt_msl_m - h0, pressure_pa=math.nan)
-        for s in synthetic.truth[::4]  # 25 Hz
-    ]
+    baro = perfect_baro(synthetic)
     sensors = sorted(messages(synthetic) + baro, key=lambda m: m.t_us)
     nav = NAVIGATORS["ins_ekf"](DECLINATION)
     states = list(run_navigator(nav, true_headings(sensors, DECLINATION)))
