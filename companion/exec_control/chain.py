@@ -122,7 +122,7 @@ class ChainLink:
 
 
 def run_followers(followers: Sequence[ChainLink], producer: PluginHost) -> None:
-    """Run each follower whose trigger ``producer`` just published."""
+    """Run each follower that has a sample of its trigger waiting, after ``producer``'s step."""
     for link in followers:
         link.run_after(producer)
 
