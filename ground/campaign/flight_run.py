@@ -340,7 +340,12 @@ def _clean(namespace: str) -> None:
     still shutting down (seconds, on a busy machine) is a living node to iceoryx2, while
     which nothing is removed. So again, until nothing is left or the time is up."""
     deadline = time.monotonic() + CLEANUP_S
-    while cleanup_namespace(namespace) == 0 and leftover_files(namespace):
+    while True:
+        # Until nothing is left: a pass that removed some files (a dead node's) may leave
+        # those of a node still alive then, whose process is still ending.
+        cleanup_namespace(namespace)
+        if not leftover_files(namespace):
+            return
         if time.monotonic() > deadline:
             log.warning("flight namespace %s: files left in /dev/shm", namespace)
             return
