@@ -11,6 +11,7 @@ with the reason; its processes are ended by their own process group.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import math
@@ -23,6 +24,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import psutil
 
 from companion.bus.namespace import cleanup_namespace, leftover_files
 from companion.control.mission.plan import PlanError, load_plan
@@ -173,6 +176,7 @@ def _fly(job: FlightJob, folder: Path, tl: Timeline) -> None:
         finally:
             _end(proc)
             gcs.close()
+            _end_stragglers(namespace)
             _clean(namespace)
 
 
@@ -332,6 +336,29 @@ def _end(proc: subprocess.Popen) -> None:
             log.warning("flight pid %d did not stop: killing its group", proc.pid)
     _signal_group(proc.pid, signal.SIGKILL)  # the group outlives a clean leader sometimes
     proc.wait()
+
+
+def _end_stragglers(namespace: str) -> None:
+    """SIGKILL what is left of the flight outside its process group (its plug-ins run in
+    sessions of their own and end with their parent, seconds later on a busy machine, and
+    one still retrying its device may open bus files after the namespace was cleaned), and
+    wait until it is gone. The flight's processes carry its namespace on their command
+    line (forked plug-ins keep ``companion sim``'s)."""
+    token = f"--namespace {namespace} "
+    deadline = time.monotonic() + CLEANUP_S
+    while time.monotonic() < deadline:
+        left = [
+            p
+            for p in psutil.process_iter(["cmdline"])
+            if token in " ".join(p.info["cmdline"] or []) + " "
+        ]
+        if not left:
+            return
+        for proc in left:
+            with contextlib.suppress(psutil.Error):
+                proc.kill()
+        psutil.wait_procs(left, timeout=1.0)
+    log.warning("flight namespace %s: processes left", namespace)
 
 
 def _clean(namespace: str) -> None:
