@@ -95,7 +95,7 @@ class ChainLink:
                 producer.cpu_moved_s -= took
         finally:
             self._lock.release()
-        run_followers(self.followers, host)
+        host.after_step()  # its own followers
 
     def serve(self, host: PluginHost, stop_fd: int) -> bool:
         """On the plug-in's own thread, after its ``init``: step it whenever the producer
@@ -114,7 +114,7 @@ class ChainLink:
                     if host.stopping or self.failed:
                         break
                     host.step_once()
-                run_followers(self.followers, host)
+                host.after_step()  # its own followers
         finally:
             with self._lock:  # a step in progress on the producer's thread ends first
                 self.host = None

@@ -18,7 +18,6 @@ ends within its timeout.
 
 from __future__ import annotations
 
-import ctypes
 import logging
 import os
 import signal
@@ -36,13 +35,13 @@ from companion.exec_control.plugin_host import (
     EXIT_STEP_FAILED,
     PluginHost,
     _signal_pipe,
+    set_name,
 )
 from companion.exec_control.priority import apply_nice
 from companion.exec_control.registry import load
 from companion.fd_wait import wait_readable
 from companion.messages import PluginStats
 
-_PR_SET_NAME = 15
 JOIN_GRACE_S = 1.0  # the supervisor kills the process 1.2 s after its SIGTERM
 # A change of the health table's flight state wakes the process; this is a second look.
 FLIGHT_LOOK_S = 1.0
@@ -90,7 +89,7 @@ class Member:
     def run(self) -> None:
         """The thread: run the plug-in, and again after each failure, until stopped."""
         apply_nice(self.name, self.spec.get("nice", 0))  # this thread's own
-        name_thread(self.name)
+        set_name(self.name)  # its thread's, as top -H shows it
         with BusNode(self.spec["namespace"], f"{self.name}_stats") as node:
             self.loop(node.writer("system/plugin_stats"))
 
@@ -151,16 +150,6 @@ class Member:
 
 
 _PROCESS_KEYS = ("members", "name", "kind", "group", "flight_running")
-
-
-def name_thread(name: str) -> None:
-    """Give the calling thread the plug-in's name as Linux shows it (``top -H``, ``ps -L``,
-    /proc/PID/task/TID/comm: 15 characters), so a composed process's CPU is told apart."""
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(_PR_SET_NAME, ctypes.c_char_p(name.encode()[:15]), 0, 0, 0)
-    except (OSError, AttributeError):  # not Linux: the name is only cosmetic
-        pass
 
 
 def member_specs(spec: dict[str, Any]) -> list[dict[str, Any]]:

@@ -35,8 +35,19 @@ STATS_PERIOD_S = 1.0
 # How often late readers of this process's Latest channels are handed the last value.
 CONNECTIONS_PERIOD_S = 0.05
 _PR_SET_PDEATHSIG = 1
+_PR_SET_NAME = 15
 
 log = logging.getLogger("companion.plugin_host")
+
+
+def set_name(name: str) -> None:
+    """The plug-in's name for ps and top, on the calling thread (a forked process keeps its
+    parent's otherwise; a composed process's threads would all show the process's)."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_NAME, ctypes.c_char_p(name.encode()[:15]), 0, 0, 0)
+    except (OSError, AttributeError):  # not Linux: the name is only cosmetic
+        pass
 
 
 def die_with_parent() -> None:

@@ -50,7 +50,6 @@ READY_TIMEOUT_S = 20.0  # a first start on a busy machine (imports from a cold d
 REPLY_TIMEOUT_S = 2.0
 REPARENT_TIMEOUT_S = 2.0
 _PR_SET_CHILD_SUBREAPER = 36
-_PR_SET_NAME = 15
 # The vehicle's matrices are tiny: one BLAS thread, and no thread alive at fork time.
 CHILD_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
@@ -261,8 +260,10 @@ def _run_child(spec_json: str, middle: int, supervisor: int, fds: tuple[int, ...
         while os.getppid() == middle and time.monotonic() < deadline:
             time.sleep(0.0002)
         logging.root.handlers.clear()
-        _set_name(json.loads(spec_json).get("name", "plugin"))
         from companion.exec_control.host_main import main
+        from companion.exec_control.plugin_host import set_name
+
+        set_name(json.loads(spec_json).get("name", "plugin"))
 
         if os.getppid() == supervisor:  # not adopted: the supervisor is gone, so stop
             code = main([spec_json])
@@ -275,15 +276,6 @@ def _run_child(spec_json: str, middle: int, supervisor: int, fds: tuple[int, ...
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(code)
-
-
-def _set_name(name: str) -> None:
-    """The plug-in's name for ps and top (a forked process keeps its parent's otherwise)."""
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(_PR_SET_NAME, ctypes.c_char_p(name.encode()[:15]), 0, 0, 0)
-    except (OSError, AttributeError):
-        pass
 
 
 def _fork_plugin(spec_json: str, supervisor: int, fds: tuple[int, int]) -> int:
