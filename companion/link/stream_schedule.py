@@ -36,6 +36,9 @@ FOLLOWS_NAV = frozenset(
         d.MAVLINK_MSG_ID_VFR_HUD,
     )
 )
+# A stream last sent longer ago than this many periods missed a turn (sent early with
+# another, a stream goes out up to half a period ahead; skipped once, two periods pass).
+MISSED_TURN = 1.6
 
 
 def _hold(period: float) -> float:
@@ -81,14 +84,18 @@ class StreamSchedule:
         return -1 if period <= 0 else round(period * 1e6)
 
     def due(self, now_s: float, nav_at_s: float = float("inf"), early_s: float = 0.0) -> list[int]:
-        """The streams to send now, least recently sent first; schedules their next time.
+        """The streams to send now; schedules their next time.
+
+        Order: a stream that missed its last turn (the link's budget ran out before it)
+        first, least recently sent first, so a fast stream cannot starve the slow ones;
+        then those that carry the navigation state, so the newest state reaches the
+        ground station before the slower streams riding its wake-up are framed; then the
+        rest, least recently sent first.
 
         ``nav_at_s`` is when the newest navigation state arrived: a stream that follows
         the navigator is sent once one has arrived since it fell due (or it waited
         NAV_HOLD_S for one). ``early_s``: a stream due within this (and half its period)
-        goes now, with the others. When the link's budget cannot carry every stream, the
-        ones it had to skip come first next time, so a fast stream cannot starve the slow
-        ones.
+        goes now, with the others.
         """
         out = []
         for mid, period in self.period_s.items():
@@ -100,7 +107,13 @@ class StreamSchedule:
                 continue
             out.append(mid)
             self.next_due[mid] = max(due_s + period, now_s - period)
-        return sorted(out, key=self.last_sent.__getitem__)
+        return sorted(out, key=lambda mid: self._turn(mid, now_s))
+
+    def _turn(self, msg_id: int, now_s: float) -> tuple[bool, bool, float]:
+        """``due``'s sort key: missed its last turn, carries the state, last sent."""
+        last = self.last_sent[msg_id]
+        missed = now_s - last > MISSED_TURN * self.period_s[msg_id]
+        return (not missed, msg_id not in FOLLOWS_NAV, last)
 
     def mark_sent(self, msg_id: int, now_s: float) -> None:
         self.last_sent[msg_id] = now_s

@@ -5,7 +5,7 @@ from __future__ import annotations
 from itertools import pairwise
 
 from companion.link.codec import dialect as d
-from companion.link.stream_schedule import NAV_HOLD_S, StreamSchedule
+from companion.link.stream_schedule import FOLLOWS_NAV, NAV_HOLD_S, StreamSchedule
 
 ATTITUDE = d.MAVLINK_MSG_ID_ATTITUDE
 SYS_STATUS = d.MAVLINK_MSG_ID_SYS_STATUS
@@ -61,3 +61,23 @@ def test_a_rate_above_the_navigators_is_kept():
     gaps = sorted(b - a for a, b in pairwise(sent))
     assert 245 <= len(sent) <= 255
     assert 15 <= gaps[len(gaps) // 2] <= 25
+
+
+def test_the_state_goes_first_and_a_skipped_stream_before_it():
+    # One wake-up with ATTITUDE and the slower streams riding it: the streams carrying the
+    # state are framed first, though sent most recently (each stream had its last turn).
+    schedule = StreamSchedule()
+    for mid, period in schedule.period_s.items():
+        schedule.mark_sent(mid, 1.0 - period)
+    schedule.next_due = dict.fromkeys(schedule.next_due, 1.0)
+    due = schedule.due(1.0, nav_at_s=1.0)
+    carrying = [mid for mid in due if mid in FOLLOWS_NAV]
+    assert due[: len(carrying)] == carrying and ATTITUDE in carrying and SYS_STATUS in due
+    # SYS_STATUS's turn at 1.0 was skipped (out of budget, never marked sent): at its next
+    # turn it goes before the state, so a fast stream cannot starve it.
+    for mid, period in schedule.period_s.items():
+        if mid != SYS_STATUS:
+            schedule.mark_sent(mid, 2.0 - period)  # the others had their turns since
+    schedule.next_due = dict.fromkeys(schedule.next_due, 2.0)
+    due = schedule.due(2.0, nav_at_s=2.0)
+    assert due.index(SYS_STATUS) < due.index(ATTITUDE)
