@@ -78,24 +78,32 @@ class ChainLink:
         self._last_run = time.monotonic()  # the producer delivers: no step of its own
         if not self._lock.acquire(blocking=False):
             return  # busy in its own step: its own wait takes the sample
+        # The CPU of this step and of its own followers' is moved from the producer's row to
+        # this one; each follower moves its own share on from here, so every plug-in's row
+        # holds its own steps, however deep in the chain they ran.
+        cpu_before = time.thread_time()
+        try:
+            if self._step_locked(host):
+                host.after_step()  # its own followers
+        finally:
+            took = time.thread_time() - cpu_before
+            host.cpu_moved_s += took
+            producer.cpu_moved_s -= took
+
+    def _step_locked(self, host: PluginHost) -> bool:
+        """One step under the lock ``run_after`` took; whether it ran and succeeded."""
         try:
             if self.host is not host or self.failed:
-                return
-            cpu_before = time.thread_time()
-            try:
-                host.step_once()
-            except (Exception, SystemExit):
-                log.exception("%s: step failed", self.name)
-                self.failed = True
-                os.write(self._wake_w, b"f")  # its own thread closes and restarts it
-                return
-            finally:
-                took = time.thread_time() - cpu_before
-                host.cpu_moved_s += took
-                producer.cpu_moved_s -= took
+                return False
+            host.step_once()
+            return True
+        except (Exception, SystemExit):
+            log.exception("%s: step failed", self.name)
+            self.failed = True
+            os.write(self._wake_w, b"f")  # its own thread closes and restarts it
+            return False
         finally:
             self._lock.release()
-        host.after_step()  # its own followers
 
     def serve(self, host: PluginHost, stop_fd: int) -> bool:
         """On the plug-in's own thread, after its ``init``: step it whenever the producer

@@ -4,6 +4,7 @@ timeouts when its input stops."""
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 
 from companion.messages import PluginState
@@ -12,6 +13,7 @@ from tests.support.vehicle import wait_for
 
 TICKER = "tests.support.chained_plugins:ThreadTicker"
 CHAINED = "tests.support.chained_plugins:ChainedRelay"
+BURNER = "tests.support.chained_plugins:ChainedBurner"
 
 
 def in_one_process(*entries):
@@ -77,3 +79,29 @@ def test_a_chained_plugin_acts_on_its_own_timeouts_when_its_producer_falls_silen
     # The ticker stops after 300 samples (3 s); the relay's own wait then ends empty.
     silent = wait_for(timed_out, 15, "the relay's own timeout after the IMU fell silent")
     assert silent.pitch_rad != producer_thread, "the timeout ran on the producer's thread"
+
+
+def test_each_plugin_of_a_chain_is_charged_its_own_cpu(vehicle_factory):
+    # imu -> relay -> burner, all on the IMU's thread: the burner's 1 ms a state at 100 Hz
+    # (a tenth of a core) shows in its own row, not in the IMU's or the relay's.
+    vehicle = vehicle_factory(
+        in_one_process(
+            plugin("imu", TICKER, rate_hz=100.0),
+            plugin("relay", CHAINED),
+            plugin("burner", BURNER, burn_ms=1.0),
+        )
+    )
+    nav = vehicle.bus.latest_reader("nav/state", keep=64)
+    states(nav, 100)
+
+    def cpu() -> dict[str, float]:
+        rows = {n: vehicle.row(n) for n in ("imu", "relay", "burner")}
+        return {n: r.cpu_pct for n, r in rows.items() if r is not None}
+
+    # The backlog of states the burner found at its start is burnt at a whole core first.
+    wait_for(lambda: 6.0 < cpu().get("burner", 0.0) < 15.0, 30, "the burner at its rate")
+    for _ in range(3):  # each second's rows, once a second
+        share = cpu()
+        assert 6.0 < share["burner"] < 15.0, share
+        assert share["imu"] < 5.0 and 0.0 <= share["relay"] < 5.0, share
+        time.sleep(1.0)

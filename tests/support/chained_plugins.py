@@ -4,8 +4,9 @@ wake-up of the plug-in that publishes their input), named as module:Class in con
 from __future__ import annotations
 
 import threading
+import time
 
-from companion.messages import Imu, NavState
+from companion.messages import ActuatorCommand, Imu, NavState
 from companion.plugin import Plugin, PluginContext, Setting
 from tests.support.plugins import Ticker
 
@@ -57,3 +58,26 @@ class ChainedRelay(Plugin):
             out.yaw_rad = sample.gx_rad_s
             self.nav.publish(out)
             self.ctx.health.ok()
+
+
+class ChainedBurner(Plugin):
+    """Chained to the relay's nav/state: burns ``burn_ms`` of CPU a state (a controller's
+    work), and says so on control/actuators."""
+
+    trigger = "nav/state"
+    inputs = ("nav/state",)
+    outputs = ("control/actuators",)
+    settings = {"burn_ms": Setting(float, 2.0, "CPU burnt a state, ms", min=0.0)}
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        self.nav = ctx.bus.latest_reader("nav/state", keep=64)
+        self.out = ctx.bus.writer("control/actuators")
+
+    def step(self) -> None:
+        self.nav.wait_event(0.05)  # within its trigger_timeout_s
+        for state in self.nav.drain():
+            end = time.thread_time() + self.ctx.settings["burn_ms"] / 1000
+            while time.thread_time() < end:
+                pass
+            self.out.publish(ActuatorCommand(t_us=state.t_us))
