@@ -32,6 +32,24 @@ MAX_NOTIFIERS = MAX_PLUGINS + 8
 MAX_LISTENERS = MAX_SUBSCRIBERS + 4
 
 
+def new_node(namespace: str, name: str = "") -> iox2.Node:
+    """An iceoryx2 node of the namespace, named ``name.pid``.
+
+    Making one costs milliseconds (its files in /dev/shm, its monitoring token): a
+    process hosting many plug-ins makes one and opens each plug-in's channels on it.
+    """
+    # Signals belong to the Python process (the plug-in runner and supervisor install
+    # their own SIGTERM/SIGINT handlers); iceoryx2 must not swallow them.
+    builder = (
+        iox2.NodeBuilder.new()
+        .config(make_config(namespace))
+        .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
+    )
+    if name:
+        builder = builder.name(iox2.NodeName.new(f"{name}.{os.getpid()}"))
+    return builder.create(iox2.ServiceType.Ipc)
+
+
 class BusNode:
     """A process's node on the bus of one namespace.
 
@@ -40,19 +58,18 @@ class BusNode:
     >>> nav = bus.latest_reader("nav/state")        # doctest: +SKIP
     """
 
-    def __init__(self, namespace: str | None = None, name: str = "") -> None:
+    def __init__(
+        self,
+        namespace: str | None = None,
+        name: str = "",
+        node: iox2.Node | None = None,
+    ) -> None:
+        """``node``: an iceoryx2 node of this namespace to open the channels on, shared
+        with other BusNodes of the process and left open by ``close`` (``new_node``);
+        else one of its own."""
         self.namespace = namespace or default_namespace()
-        self._config = make_config(self.namespace)
-        # Signals belong to the Python process (the plug-in runner and supervisor install
-        # their own SIGTERM/SIGINT handlers); iceoryx2 must not swallow them.
-        builder = (
-            iox2.NodeBuilder.new()
-            .config(self._config)
-            .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
-        )
-        if name:
-            builder = builder.name(iox2.NodeName.new(f"{name}.{os.getpid()}"))
-        self._node = builder.create(iox2.ServiceType.Ipc)
+        self._owns_node = node is None
+        self._node = new_node(self.namespace, name) if node is None else node
         self._ports: list[Writer[Any] | Reader[Any]] = []
         self._latest_writers: list[Writer[Any]] = []
         self.idle = IdleTally()
@@ -175,7 +192,8 @@ class BusNode:
                 log.debug("closing %s: %s", port.name, exc)
         self._ports.clear()
         self._latest_writers.clear()
-        del self._node
+        if self._owns_node:
+            del self._node
 
     def __enter__(self) -> BusNode:
         return self

@@ -23,9 +23,9 @@ import os
 import signal
 import threading
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from companion.bus.node import BusNode
+from companion.bus.node import BusNode, new_node
 from companion.bus.patterns import Writer
 from companion.exec_control.backoff import MAX_BACKOFF_S, SECOND_BACKOFF_S, STABLE_AFTER_S
 from companion.exec_control.chain import ChainLink, chain_links, run_followers
@@ -42,6 +42,9 @@ from companion.exec_control.registry import load
 from companion.fd_wait import wait_readable
 from companion.messages import PluginStats
 
+if TYPE_CHECKING:
+    import iceoryx2 as iox2
+
 JOIN_GRACE_S = 1.0  # the supervisor kills the process 1.2 s after its SIGTERM
 # A change of the health table's flight state wakes the process; this is a second look.
 FLIGHT_LOOK_S = 1.0
@@ -57,8 +60,10 @@ class Member:
         spec: dict[str, Any],
         link: ChainLink | None = None,
         followers: list[ChainLink] | None = None,
+        node: iox2.Node | None = None,
     ) -> None:
         self.spec = spec
+        self.node = node  # the process's bus node, each instance's channels opened on it
         self.link = link  # run by the plug-in that publishes its trigger (``chain``)
         # Chained to this one: run on this thread after its steps.
         if followers is None:
@@ -74,7 +79,7 @@ class Member:
     def renewed(self) -> Member:
         """A fresh member for the same plug-in (a thread starts once), its restarts and
         its place in the chain kept."""
-        member = Member(self.spec, self.link, self.followers)
+        member = Member(self.spec, self.link, self.followers, self.node)
         member.restarts = self.restarts
         return member
 
@@ -90,7 +95,7 @@ class Member:
         """The thread: run the plug-in, and again after each failure, until stopped."""
         apply_nice(self.name, self.spec.get("nice", 0))  # this thread's own
         set_name(self.name)  # its thread's, as top -H shows it
-        with BusNode(self.spec["namespace"], f"{self.name}_stats") as node:
+        with BusNode(self.spec["namespace"], f"{self.name}_stats", self.node) as node:
             self.loop(node.writer("system/plugin_stats"))
 
     def loop(self, stats: Writer[PluginStats]) -> None:
@@ -111,7 +116,7 @@ class Member:
     def run_once(self, stats: Writer[PluginStats]) -> int:
         """Init, steps and close of one instance on a fresh bus node; its exit status."""
         try:
-            host = PluginHost(self.spec, self._stop_r, self.restarts, stats)
+            host = PluginHost(self.spec, self._stop_r, self.restarts, stats, self.node)
         except Exception:
             log.exception("%s: no bus node", self.name)
             return EXIT_INIT_FAILED
@@ -195,10 +200,12 @@ def stop_all(members: list[Member]) -> None:
         member.thread.join(max(0.0, deadline - time.monotonic()))
 
 
-def wire(specs: list[dict[str, Any]]) -> list[Member]:
-    """A member for each spec, each chained plug-in among its producer's followers."""
+def wire(specs: list[dict[str, Any]], node: iox2.Node | None = None) -> list[Member]:
+    """A member for each spec, each chained plug-in among its producer's followers, all
+    on the bus ``node`` (None: each instance a node of its own)."""
     links = chain_links(specs)
-    members = [Member(s, links[s["name"]][1] if s["name"] in links else None) for s in specs]
+    members = [Member(s, links[s["name"]][1] if s["name"] in links else None, node=node)
+               for s in specs]  # fmt: skip
     by_name = {m.name: m for m in members}
     for name, (producer, link) in links.items():
         by_name[producer].followers.append(link)
@@ -220,7 +227,12 @@ def main(spec: dict[str, Any]) -> int:
     for sig in (signal.SIGTERM, signal.SIGINT):
         signal.signal(sig, lambda *_: stopping.set())
     specs = member_specs(spec)
-    members = wire(specs)
+    # One iceoryx2 node for every plug-in here: making one costs milliseconds, and a
+    # process restarted in the air made two dozen of them, each cleaning up after the
+    # dead ones, under the interpreter's lock before its servos answered again. The
+    # process is the unit that dies; a plug-in restarted alone closes its own ports.
+    node = new_node(spec["namespace"], spec["name"])
+    members = wire(specs, node)
     in_flight = set(flight_members(specs))
     always = [m for m in members if m.name not in in_flight]
     flight = FlightSwitch([m for m in members if m.name in in_flight])
@@ -230,7 +242,7 @@ def main(spec: dict[str, Any]) -> int:
     # The main thread sleeps until a signal (the plug-ins' threads do the work), or a
     # change of the flight group when it hosts flight plug-ins.
     if in_flight:
-        follow_flight_group(spec, flight, stopping, wake)
+        follow_flight_group(spec, flight, stopping, wake, node)
     while not stopping.is_set():
         wait_readable([wake], None)
         _drain(wake)
@@ -239,10 +251,14 @@ def main(spec: dict[str, Any]) -> int:
 
 
 def follow_flight_group(
-    spec: dict[str, Any], flight: FlightSwitch, stopping: threading.Event, wake: int
+    spec: dict[str, Any],
+    flight: FlightSwitch,
+    stopping: threading.Event,
+    wake: int,
+    process_node: iox2.Node | None = None,
 ) -> None:
     """Start and stop the flight plug-ins as the supervisor's table says, until a signal."""
-    with BusNode(spec["namespace"], f"{spec['name']}_flight") as node:
+    with BusNode(spec["namespace"], f"{spec['name']}_flight", process_node) as node:
         health = node.latest_reader("system/health")
         waiter = node.waiter([health])
         while not stopping.is_set():

@@ -17,7 +17,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
 from companion.bus.node import BusNode
@@ -28,6 +28,9 @@ from companion.exec_control.registry import load
 from companion.messages import NAME_LEN, PluginState, PluginStats
 from companion.params import ParamDecl
 from companion.plugin import Plugin, PluginContext
+
+if TYPE_CHECKING:
+    import iceoryx2 as iox2
 
 EXIT_INIT_FAILED = 3
 EXIT_STEP_FAILED = 4
@@ -107,6 +110,7 @@ class PluginHost:
         stop_fd: int | None = None,
         restarts: int = 0,
         stats: Writer[PluginStats] | None = None,
+        node: iox2.Node | None = None,
     ) -> None:
         self.spec = spec
         self.stopping = False
@@ -121,7 +125,7 @@ class PluginHost:
         self._cpu_mark = (self._cpu_s(), time.monotonic())
         # Run after each step on this plug-in's thread (the composed host's chain).
         self.after_step: Callable[[], None] = _nothing
-        self.bus = BusNode(spec["namespace"], spec["name"])
+        self.bus = BusNode(spec["namespace"], spec["name"], node)
         self.timer = StepTimer()
         # A composed plug-in's host gives a writer that outlives this instance: the counters
         # of one that failed at once must not vanish with its bus node, unread.
