@@ -211,6 +211,14 @@ class Reader(Generic[M]):
         # timed_wait has consumed the notifications it returned.
         return bool(events) or self._subscriber.has_samples()
 
+    def take_notifications(self) -> bool:
+        """Whether a writer notified since the last wait (the notifications are taken): a
+        sample published without waking (``Writer.publish``'s ``wake``) leaves none."""
+        try:
+            return bool(self.listener.try_wait())
+        except iox2.ListenerWaitError:
+            return False
+
     def consume_events(self) -> None:
         """Clear pending notifications (they are only wake-ups; data is in the queue)."""
         with contextlib.suppress(iox2.ListenerWaitError):

@@ -69,6 +69,9 @@ class ChainLink:
             self._reader_host, self._reader = host, host.bus.reader_of(self.trigger)
         return self._reader is not None and self._reader.has_samples()
 
+    def _reader_notified(self) -> bool:
+        return self._reader is not None and self._reader.take_notifications()
+
     def run_after(self, producer: PluginHost) -> None:
         """On the producer's thread, after its step: this plug-in's step, if a sample of
         its trigger waits for it and it is not busy on its own thread."""
@@ -91,9 +94,15 @@ class ChainLink:
             producer.cpu_moved_s -= took
 
     def _step_locked(self, host: PluginHost) -> bool:
-        """One step under the lock ``run_after`` took; whether it ran and succeeded."""
+        """One step under the lock ``run_after`` took; whether it ran and succeeded.
+
+        Only when the producer notified: a sample published without waking its readers
+        (the IMU's between two navigation states) would wake a plug-in of its own process
+        neither, and goes with the next one. Taken under the lock: the plug-in's own
+        thread is then not asleep on the same notifications.
+        """
         try:
-            if self.host is not host or self.failed:
+            if self.host is not host or self.failed or not self._reader_notified():
                 return False
             host.step_once()
             return True

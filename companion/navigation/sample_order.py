@@ -19,6 +19,7 @@ from collections.abc import Iterable
 from typing import Any
 
 from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
+from companion.time_grid import TimeGrid
 
 # Aiding samples of one instant are fed in this order (then any other kind), not as they came.
 _KIND_RANK = {GpsFix: 0, Magnetometer: 1, Compass: 2, Baro: 3}
@@ -33,15 +34,11 @@ class PublishGrid:
     fixed grid of vehicle time, whatever batches the samples came in."""
 
     def __init__(self, rate_hz: float) -> None:
-        self.period_us = round(1e6 / rate_hz)
-        self.next_us = 0
+        self.grid = TimeGrid(rate_hz)
 
     def due(self, t_us: int | None, sample: Any) -> bool:
         """Whether to publish after feeding ``sample`` (the navigator now at ``t_us``)."""
-        if t_us is None or not isinstance(sample, Imu) or t_us < self.next_us:
-            return False
-        self.next_us = (t_us // self.period_us + 1) * self.period_us
-        return True
+        return t_us is not None and isinstance(sample, Imu) and self.grid.passed(t_us)
 
 
 class SampleOrder:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import time
 
 import pytest
 
@@ -94,3 +95,25 @@ def test_samples_found_together_keep_their_own_times(vehicle_factory, tmp_path):
     # No more than the configured period (40 Hz: 25 ms) apart within a burst.
     gaps = [b - a for a, b in itertools.pairwise(stamps)]
     assert min(gaps) <= 25_000, gaps
+
+
+@pytest.mark.timeout(60)
+def test_with_wake_hz_every_sample_comes_but_readers_wake_on_its_grid(vehicle_factory, tmp_path):
+    # 100 samples a second, readers woken 10 times a second (the navigator's states).
+    pty = Pty(tmp_path / "ttyImu")
+    config = plugin("imu", "sensors.serial_imu", device=pty.link, rate_hz=100.0, wake_hz=10.0)
+    vehicle = vehicle_factory(vehicle_config("imu", config))
+    imu = vehicle.bus.queue_reader("sensors/imu")
+    vehicle.wait_running("imu")
+    wait_for(lambda: pty.write(GOOD) or imu.take(0.05), 15, "the IMU heard")
+    imu.take_notifications()
+    samples = woken = 0
+    for _ in range(100):  # a second of frames, the reader looking every 5 ms
+        pty.write(GOOD)
+        for _ in range(2):
+            time.sleep(0.005)
+            woken += imu.take_notifications()
+            samples += len(list(imu.drain()))
+    samples += len(imu.take(0.5))
+    assert samples >= 95, "samples lost"
+    assert 5 <= woken <= 20, f"{woken} wake-ups for {samples} samples"

@@ -105,3 +105,28 @@ def test_each_plugin_of_a_chain_is_charged_its_own_cpu(vehicle_factory):
         assert 6.0 < share["burner"] < 15.0, share
         assert share["imu"] < 5.0 and 0.0 <= share["relay"] < 5.0, share
         time.sleep(1.0)
+
+
+def test_a_sample_published_without_waking_goes_with_the_next_one(vehicle_factory):
+    # The IMU wakes its readers on every other sample (its wake_hz): the chained relay
+    # steps once per two samples, and relays every one of them.
+    vehicle = vehicle_factory(
+        in_one_process(plugin("imu", TICKER, rate_hz=100.0, wake_every=2), plugin("relay", CHAINED))
+    )
+    nav = vehicle.bus.latest_reader("nav/state", keep=64)
+    states(nav, 20)
+    stats = vehicle.bus.queue_reader("system/plugin_stats")
+    relayed = states(nav, 200)
+    counts = [int(s.roll_rad) for s in relayed]
+    assert counts == list(range(counts[0], counts[0] + len(counts))), "a sample was skipped"
+    steps: dict[str, list[int]] = {}
+    wait_for(
+        lambda: (
+            [steps.setdefault(m.name.decode(), []).append(m.steps) for m in stats.drain()]
+            and all(len(steps.get(n, [])) >= 2 for n in ("imu", "relay"))
+        ),
+        10,
+        "two counters of each",
+    )
+    imu, relay = (steps[n][-1] - steps[n][0] for n in ("imu", "relay"))
+    assert 0.4 * imu <= relay <= 0.6 * imu, (imu, relay)

@@ -18,6 +18,7 @@ class ThreadTicker(Ticker):
     settings = {
         **Ticker.settings,
         "count": Setting(int, 1_000_000, "samples before it falls silent", min=0),
+        "wake_every": Setting(int, 1, "wake the readers on every n-th sample only", min=1),
     }
 
     def step(self) -> None:
@@ -28,7 +29,7 @@ class ThreadTicker(Ticker):
         self.count += 1
         sample = Imu(t_us=self.ctx.clock.now_us(), ax_m_s2=float(self.count))
         sample.gx_rad_s = float(threading.get_native_id())
-        self.writer.publish(sample)
+        self.writer.publish(sample, self.count % self.ctx.settings["wake_every"] == 0)
 
 
 class ChainedRelay(Plugin):

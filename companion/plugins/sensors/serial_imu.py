@@ -22,6 +22,7 @@ from companion.plugins.sensors.serial_sensor import SerialSensor, serial_setting
 from companion.sensors.barometer import pressure_altitude_m
 from companion.sensors.imu_calibration import IMU_CAL_PARAMS, ImuCalibration
 from companion.sensors.vectornav import VectorNavDecoder, VectorNavReading
+from companion.time_grid import TimeGrid
 
 if TYPE_CHECKING:
     from companion.bus.patterns import Writer
@@ -41,6 +42,15 @@ class SerialImu(SerialSensor[VectorNavReading]):
         **serial_settings("serial:///dev/ttyUSB1:115200", 115200, 40.0),
         "publish_mag": Setting(bool, True, "also publish the magnetometer on sensors/mag"),
         "publish_baro": Setting(bool, True, "also publish $VNIMU's pressure on sensors/baro"),
+        "wake_hz": Setting(
+            float,
+            0.0,
+            "wake the readers (the navigator) at this rate of vehicle time, on the grid the"
+            " navigator publishes on: set it to the navigator's publish_hz; the samples"
+            " between go with the next wake-up, every one of them (0: on every sample)",
+            min=0.0,
+            max=1000.0,
+        ),
     }
 
     params = IMU_CAL_PARAMS
@@ -61,6 +71,8 @@ class SerialImu(SerialSensor[VectorNavReading]):
         self.live = LiveParams(ctx.bus, self.params, Path(ctx.vehicle.get("state_dir", ".")))
         self._calibrate(self.live.values)
         self.params_due_us = 0
+        wake_hz = ctx.settings["wake_hz"]
+        self.wake_grid = TimeGrid(wake_hz) if wake_hz > 0 else None
 
     def make_decoder(self, settings: Mapping[str, Any]) -> VectorNavDecoder:
         return VectorNavDecoder()
@@ -77,16 +89,24 @@ class SerialImu(SerialSensor[VectorNavReading]):
                 self._calibrate(self.live.values)
         if not self.identity:
             self.calibration.correct(reading.imu, reading.mag, self.rotation)
-        self.imu.publish(reading.imu)
+        # The sample that completes a navigation period wakes the navigator (and takes
+        # the ones before it along): a wake-up costs the navigator its whole step.
+        wake = self.wake_grid is None or self.wake_grid.passed(t_us)
+        # Its heading and height first: woken, the navigator finds them there.
         if self.mag is not None:
-            self.mag.publish(reading.mag)
+            self.mag.publish(reading.mag, wake)
         if self.baro is not None:
-            self._publish_baro(self.baro, t_us, reading.pressure_pa)
+            self._publish_baro(self.baro, t_us, reading.pressure_pa, wake)
+        self.imu.publish(reading.imu, wake)
 
-    def _publish_baro(self, baro: Writer[Baro], t_us: int, pressure_pa: float) -> None:
+    def _publish_baro(
+        self, baro: Writer[Baro], t_us: int, pressure_pa: float, wake: bool = True
+    ) -> None:
         height = pressure_altitude_m(pressure_pa)
         if not math.isfinite(height):
             return  # $VNYMR has no pressure
         if self.baro_ref_m is None:
             self.baro_ref_m = height
-        baro.publish(Baro(t_us=t_us, alt_rel_m=height - self.baro_ref_m, pressure_pa=pressure_pa))
+        baro.publish(
+            Baro(t_us=t_us, alt_rel_m=height - self.baro_ref_m, pressure_pa=pressure_pa), wake
+        )
