@@ -255,8 +255,11 @@ STREAMS: dict[int, Stream] = {
     s.msg_id: s
     for s in (
         Stream("ATTITUDE", d.MAVLINK_MSG_ID_ATTITUDE, 10.0, _attitude),
+        # On by default, as PX4 streams it: QGroundControl 4.4.5 takes the attitude and
+        # heading from it alone once one has come (Vehicle::_handleAttitude), so a stream
+        # that its PID Tuning page turned on and then back to the default (off) froze them.
         Stream(
-            "ATTITUDE_QUATERNION", d.MAVLINK_MSG_ID_ATTITUDE_QUATERNION, 0.0, _attitude_quaternion
+            "ATTITUDE_QUATERNION", d.MAVLINK_MSG_ID_ATTITUDE_QUATERNION, 10.0, _attitude_quaternion
         ),
         Stream("GLOBAL_POSITION_INT", d.MAVLINK_MSG_ID_GLOBAL_POSITION_INT, 5.0, _global_position),
         Stream("GPS_RAW_INT", d.MAVLINK_MSG_ID_GPS_RAW_INT, 2.0, _gps_raw),

@@ -50,6 +50,13 @@ def test_qgroundcontrol_pid_tuning_pages_get_every_rate_they_ask_for(gcs):
             assert said.interval_us == HUNDRED_HZ
         for msg_id in reversed(page):  # leaving it: the default rate
             assert _set(station, msg_id, 0) == m.MAV_RESULT_ACCEPTED, msg_id
+    # Back at the default the attitude still comes: QGroundControl 4.4.5 reads the attitude
+    # and heading from ATTITUDE_QUATERNION alone once it has seen one, and froze them when
+    # the stream stopped after the page was left.
+    station.conn.recv_match(type="NONE", blocking=True, timeout=0.3)  # the 100 Hz tail
+    stamps = [station.recv("ATTITUDE_QUATERNION", 2.0).time_boot_ms for _ in range(12)]
+    gaps = sorted(b - a for a, b in itertools.pairwise(stamps))
+    assert 60 <= gaps[len(gaps) // 2] <= 150, gaps  # 10 Hz, as PX4 streams it
     # While on the page the attitude comes at 100 Hz by the vehicle's own clock.
     assert _set(station, m.MAVLINK_MSG_ID_ATTITUDE_QUATERNION, HUNDRED_HZ) == 0
     stamps = [station.recv("ATTITUDE_QUATERNION", 5.0).time_boot_ms for _ in range(60)]
