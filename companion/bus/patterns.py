@@ -15,7 +15,6 @@ full buffer made it lose.
 
 from __future__ import annotations
 
-import contextlib
 import ctypes
 import logging
 import random
@@ -221,8 +220,7 @@ class Reader(Generic[M]):
 
     def consume_events(self) -> None:
         """Clear pending notifications (they are only wake-ups; data is in the queue)."""
-        with contextlib.suppress(iox2.ListenerWaitError):
-            self.listener.try_wait()
+        self.take_notifications()
 
     def has_samples(self) -> bool:
         """True when a sample is waiting."""
