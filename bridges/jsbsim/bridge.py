@@ -38,7 +38,9 @@ log = logging.getLogger(__name__)
 SENSORS = ("gps", "compass", "imu", "rc", "range")
 # What the vehicle's driver of each emulated device publishes (the sim config's drivers).
 DEVICE_CHANNELS = {
-    "imu": ("sensors/imu", "sensors/mag", "sensors/baro"),
+    # The driver publishes a reading's magnetometer and pressure (a few times a second,
+    # its aiding_hz) before its IMU sample: that sample's arrival says they are there too.
+    "imu": ("sensors/imu",),
     "compass": ("sensors/compass",),
     "gps": ("sensors/gps",),
     # A Latest channel: the controller and the commander read the sticks' newest frame, so

@@ -117,3 +117,35 @@ def test_with_wake_hz_every_sample_comes_but_readers_wake_on_its_grid(vehicle_fa
     samples += len(imu.take(0.5))
     assert samples >= 95, "samples lost"
     assert 5 <= woken <= 20, f"{woken} wake-ups for {samples} samples"
+
+
+@pytest.mark.timeout(60)
+def test_the_magnetometer_and_pressure_come_on_their_own_grid_every_imu_sample_still_comes(
+    vehicle_factory, tmp_path
+):
+    # The sensor sends all three 100 times a second; the navigator fuses a heading at
+    # 5 Hz and a height at 10 Hz, so the driver publishes those at aiding_hz (20 Hz).
+    pty = Pty(tmp_path / "ttyImu")
+    config = plugin("imu", "sensors.serial_imu", device=pty.link, rate_hz=100.0)
+    vehicle = vehicle_factory(vehicle_config("imu", config))
+    imu, mag, baro = (vehicle.bus.queue_reader(f"sensors/{c}") for c in ("imu", "mag", "baro"))
+    vehicle.wait_running("imu")
+    wait_for(lambda: pty.write(GOOD) or imu.take(0.05), 15, "the IMU heard")
+    for reader in (imu, mag, baro):
+        list(reader.drain())
+    imus, mags, baros = [], [], []
+    for _ in range(100):  # a second of frames
+        pty.write(GOOD)
+        time.sleep(0.01)
+        imus += [s.t_us for s in imu.drain()]
+        mags += [s.t_us for s in mag.drain()]
+        baros += [s.t_us for s in baro.drain()]
+    imus += [s.t_us for s in imu.take(0.5)]
+    mags += [s.t_us for s in mag.drain()]
+    baros += [s.t_us for s in baro.drain()]
+    assert len(imus) >= 95, "IMU samples lost"
+    span_s = (imus[-1] - imus[0]) / 1e6
+    assert 15 * span_s <= len(mags) <= 25 * span_s + 1, (len(mags), span_s)
+    assert len(baros) == len(mags)
+    # Each one is a reading's own: stamped as the IMU sample it came with.
+    assert set(mags) <= set(imus) and set(baros) == set(mags)

@@ -42,6 +42,15 @@ class SerialImu(SerialSensor[VectorNavReading]):
         **serial_settings("serial:///dev/ttyUSB1:115200", 115200, 40.0),
         "publish_mag": Setting(bool, True, "also publish the magnetometer on sensors/mag"),
         "publish_baro": Setting(bool, True, "also publish $VNIMU's pressure on sensors/baro"),
+        "aiding_hz": Setting(
+            float,
+            20.0,
+            "publish the magnetometer and the pressure at most this often (vehicle time):"
+            " the sensor sends them with every IMU sample, the navigator fuses a heading at"
+            " most every 0.2 s and a height every 0.1 s (0: with every sample)",
+            min=0.0,
+            max=1000.0,
+        ),
         "wake_hz": Setting(
             float,
             0.0,
@@ -73,6 +82,8 @@ class SerialImu(SerialSensor[VectorNavReading]):
         self.params_due_us = 0
         wake_hz = ctx.settings["wake_hz"]
         self.wake_grid = TimeGrid(wake_hz) if wake_hz > 0 else None
+        aiding_hz = ctx.settings["aiding_hz"]
+        self.aiding_grid = TimeGrid(aiding_hz) if aiding_hz > 0 else None
 
     def make_decoder(self, settings: Mapping[str, Any]) -> VectorNavDecoder:
         return VectorNavDecoder()
@@ -92,11 +103,14 @@ class SerialImu(SerialSensor[VectorNavReading]):
         # The sample that completes a navigation period wakes the navigator (and takes
         # the ones before it along): a wake-up costs the navigator its whole step.
         wake = self.wake_grid is None or self.wake_grid.passed(t_us)
-        # Its heading and height first: woken, the navigator finds them there.
-        if self.mag is not None:
-            self.mag.publish(reading.mag, wake)
-        if self.baro is not None:
-            self._publish_baro(self.baro, t_us, reading.pressure_pa, wake)
+        # Its heading and height first: woken, the navigator finds them there. Not with
+        # every sample: each one costs its readers (the navigator, the logger) a receive,
+        # and the navigator would drop all but one in five of them.
+        if self.aiding_grid is None or self.aiding_grid.passed(t_us):
+            if self.mag is not None:
+                self.mag.publish(reading.mag, wake)
+            if self.baro is not None:
+                self._publish_baro(self.baro, t_us, reading.pressure_pa, wake)
         self.imu.publish(reading.imu, wake)
 
     def _publish_baro(
