@@ -1,7 +1,7 @@
 """Automatic landings of both airframes, scored from the simulator's truth.
 
 Usage: uv run python benchmarks/landing.py [--aircraft c172p] [--plan land_east.plan]
-       [--calm-only] [--seeds N]
+       [--calm-only] [--seeds N] [--start-at S ...]
 (aircraft and plan repeatable; default: c172p and J3Cub, benchmarks/plans/land_east.plan)
 
 Each airframe, plan and condition (calm; 5 m/s crosswind from the south with light
@@ -15,8 +15,11 @@ heartbeat said it was disarmed. ``est x`` is where the vehicle's own navigation 
 (its flight log) put it across the line at that moment: the controller's error, the rest
 of ``across`` being the navigation's (the emulated GPS wanders 1 m per axis, 60 s
 correlated, the same sequence for a seed whatever is flown). ``--seeds N`` flies each
-row with the simulator's seeds 1 to N (the GPS's wander, the turbulence) and ends with how
-many passed.
+row with the simulator's seeds 1 to N (the GPS's wander, the sensors' noise) and ends with
+how many passed. The light turbulence is JSBSim's own sequence in simulated time, the same
+for every seed: ``--start-at S`` (repeatable; default 10) starts the mission at
+another second, so the approach meets other gusts (a ground station arms on its own clock:
+tests/sitl/test_landing.py armed at second 4.8 in one run).
 Criteria (issue 24, along and across from issue 42 item 8): |along| ≤ 15 m,
 |across| ≤ 2 m, sink ≤ 1.5 m/s, bounce ≤ 1 m, |bank| ≤ 10°, stopped on the runway,
 disarmed. benchmarks/plans/circuit_*.plan are circuits without QGroundControl's pattern
@@ -28,6 +31,7 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
+from itertools import product
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -58,24 +62,28 @@ def main() -> None:
     ap.add_argument("--plan", action="append")
     ap.add_argument("--calm-only", action="store_true")
     ap.add_argument("--seeds", type=int, default=1, help="fly seeds 1..N of each row")
+    ap.add_argument("--start-at", type=float, action="append", help="simulated second(s)")
     args = ap.parse_args()
     conditions = {"calm": CONDITIONS["calm"]} if args.calm_only else CONDITIONS
     plans = [_plan(p) for p in (args.plan or ["land_east.plan"])]
     print(
-        f"{'airframe':8} {'plan':10} {'condition':18} {'seed':>4} {'along':>6} {'across':>6} "
+        f"{'airframe':8} {'plan':10} {'condition':18} {'start':>5} {'seed':>4} {'along':>6} "
+        f"{'across':>6} "
         f"{'est x':>6} {'sink':>5} "
         f"{'bounce':>6} {'bank':>5} {'stop@':>6} {'stop x':>6} {'stopped':7} {'runway':6} "
         f"{'disarm':6} {'pass':5}"
     )
     passed = flown = 0
+    seeds = range(1, args.seeds + 1)
     for name in args.aircraft or ["c172p", "J3Cub"]:
         for plan in plans:
             for cond, (wind, turbulence) in conditions.items():
-                for seed in range(1, args.seeds + 1):
+                for start, seed in product(args.start_at or [START_AT_S], seeds):
                     flight = Flight(str(plan), name, wind, turbulence, (), seed,
-                                    str(SIM_CONFIG), False, 900.0, START_AT_S)  # fmt: skip
+                                    str(SIM_CONFIG), False, 900.0, start)  # fmt: skip
                     text, ok = _fly(flight, plan)
-                    print(f"{name:8} {plan.stem:10} {cond:18} {seed:4d} {text}", flush=True)
+                    row = f"{name:8} {plan.stem:10} {cond:18} {start:5g} {seed:4d} {text}"
+                    print(row, flush=True)
                     passed, flown = passed + ok, flown + 1
     print(f"passed {passed} of {flown}")
 

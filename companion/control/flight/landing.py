@@ -11,7 +11,8 @@ PX4 publish for their fixed-wing landings, written here from their descriptions:
 - **Flare**: below ``LAND_FLARE_ALT`` above the runway, or when the ground is less than
   ``LAND_FLARE_SEC`` away at the present sink rate, the throttle is cut and pitch flies
   an exponential flare: a sink-rate demand that falls with height towards ``TECS_LAND_SINK``
-  at the ground. Bank is limited to ``LEVEL_ROLL_LIMIT``; the crab is kept, so a
+  at the ground, from the sink rate at its start (the glide path's, when a gust has just
+  slowed the sink below it). Bank is limited to ``LEVEL_ROLL_LIMIT``; the crab is kept, so a
   crosswind does not drift the aircraft off the centreline in the flare.
 - **Rollout**: on the wheels the rudder (and the steered wheel) holds the centreline,
   the wings are held level, the throttle is idle (the brakes come on with it).
@@ -166,6 +167,7 @@ class Landing:
         self._stopped_s = 0.0
         self._touchdown_pitch = 0.0
         self._tau = 1.0
+        self._glide_sink = 0.0  # m/s: the glide path's sink rate at the last approach step
         self.flare_alt = math.nan  # where the flare is planned to begin (flare_distance)
         self._decel = DecelEstimate()
 
@@ -252,9 +254,12 @@ class Landing:
             self._flare_sink = -s.climb_rate
             self._flare_integ = 0.0
             self._decel = DecelEstimate()
-            # The flare's time constant makes its first sink demand the sink rate now.
+            # The flare's time constant makes its first sink demand the sink rate now, or
+            # the glide's when a gust has just slowed the sink: a flare slower than the one
+            # planned (flare_distance) floated, and a C172 touched down 47 m long.
             s_t = max(v["TECS_LAND_SINK"], 0.05)
-            self._tau = max(height, 0.5) / max(-s.climb_rate - s_t, 0.3)
+            sink0 = max(-s.climb_rate, self._glide_sink)
+            self._tau = max(height, 0.5) / max(sink0 - s_t, 0.3)
         # On the wheels: low and no longer sinking, or slower than anything that flies.
         slow = ground_speed < 0.5 * v["TECS_LAND_ARSPD"]
         level = height < TOUCHDOWN_AGL_M and s.climb_rate > TOUCHDOWN_CLIMB
@@ -276,6 +281,7 @@ class Landing:
         speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
         slope = self._slope(flare_dist, self.flare_alt)
         ff = -max(speed_along, 0.0) * slope if on_slope else 0.0
+        self._glide_sink = max(speed_along, 0.0) * slope
         return LandingDemand(
             self.phase, line, alt, v["TECS_LAND_ARSPD"], flaps=_flaps(v), climb_ff=ff
         )

@@ -111,3 +111,24 @@ def test_the_rangefinder_moves_the_glide_path_onto_the_runway_the_navigator_misp
     for _ in range(100):
         other.step(replace(_state(-100.0, 30.0), range_height=2.0), V, 0.02)
     assert other.ground_alt == 103.0
+
+
+def test_a_flare_begun_as_a_gust_slows_the_sink_is_no_slower_than_the_glides():
+    """A gust that has just slowed the sink when the flare begins does not make the flare
+    slower than the glide's (it floated, and a C172 touched down 47 m long): its sink demand
+    starts from the glide's. Sinking faster than the glide (a dive back onto the path), the
+    flare starts from the sink rate now, as before."""
+    v = V | {"LAND_PITCH_CD": -500.0}
+    flare_at = TOUCHDOWN[1] - Landing(START, 150.0, TOUCHDOWN, 100.0).flare_distance(28.0, v)
+
+    def flare_pitch(approached: bool, sink: float) -> float:
+        land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+        if approached:
+            land.step(_state(flare_at - 30.0, 8.0), v, 0.02)
+        dem = land.step(_state(flare_at, 2.9, sink=sink), v, 0.02)
+        assert dem.phase == LandPhase.FLARE
+        return dem.pitch
+
+    # The glide's sink here is about 28 m/s times 50 m over 800 m: 1.7 m/s.
+    assert flare_pitch(True, 0.8) < flare_pitch(False, 0.8) - math.radians(1.0)
+    assert flare_pitch(True, 3.0) == pytest.approx(flare_pitch(False, 3.0))
