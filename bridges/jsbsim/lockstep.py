@@ -218,10 +218,11 @@ class SampleSync(_BusWait):
     Every write of a device gives a sample on its first channel (``DEVICE_CHANNELS``), so
     that one is waited for from the first write on, as long as a driver has a writer on it
     (``grace_s``, counted in ``late`` when it passes: the frame is then no longer the same
-    run after run). A further channel of the device that has never carried anything (an
-    IMU whose sentence has no pressure never publishes a barometer) is waited for only
-    ``first_grace_s`` after the first channel's sample came, the driver publishing both
-    from the same reading.
+    run after run). A further channel of the device that has never carried anything is
+    waited for only ``first_grace_s`` after the first channel's sample came, the driver
+    publishing both from the same reading. (No emulated device has one today: the IMU's
+    driver publishes its magnetometer and pressure before the IMU sample, and not with
+    every one, so they are not waited for.)
     """
 
     def __init__(

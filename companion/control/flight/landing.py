@@ -280,8 +280,8 @@ class Landing:
         on_slope = alt < self.start_alt
         speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
         slope = self._slope(flare_dist, self.flare_alt)
-        ff = -max(speed_along, 0.0) * slope if on_slope else 0.0
         self._glide_sink = max(speed_along, 0.0) * slope
+        ff = -self._glide_sink if on_slope else 0.0
         return LandingDemand(
             self.phase, line, alt, v["TECS_LAND_ARSPD"], flaps=_flaps(v), climb_ff=ff
         )
