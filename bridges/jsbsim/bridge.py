@@ -147,10 +147,14 @@ class SimBridge:
         if lockstep:
             self._keep_in_step(round(1e6 / opts.sync_hz), exact)
         self.commands = (
-            VehicleCommands(self.bus, self.failures, self.sync, opts.start_at_s, self.navigated)
+            VehicleCommands(
+                self.bus, self.failures, self.sync, opts.start_at_s, self.navigated, opts.hold_at_s
+            )
             if self.bus
             else None
         )
+        if self.commands is not None and self.clock is not None:
+            self.commands.on_hold = self.clock.update_connections
         self.frames = 0
         self.stopping = False
         if self.clock is not None:
@@ -227,6 +231,8 @@ class SimBridge:
         for waiting in (self.sync, self.nav_sync, self.navigated, self.samples, self.logged):
             if waiting is not None:
                 waiting.cancelled = True
+        if self.commands is not None:
+            self.commands.cancelled = True
 
     def step(self) -> None:
         """One physics frame, then what the devices say about it, then pacing."""
@@ -263,8 +269,8 @@ class SimBridge:
             self.pacer.wait(s.t_s)
         else:
             self.lockstep.wait()
-        if self.commands is not None:
-            self.commands.serve(t_us)
+        if self.commands is not None and self.commands.serve(t_us) and self.pacer is not None:
+            self.pacer.restart()  # real time goes on from the held frame, not catching up
         # Exact: the navigator answers the grid once an IMU sample at or past its tick came.
         if self.nav_sync is not None and (sampled is None or "imu" in sampled):
             self.nav_sync.wait(t_us)

@@ -84,6 +84,10 @@ class RealTime:
         self.start_wall: float | None = None
         self.late_s = 0.0  # the most the simulation has fallen behind
 
+    def restart(self) -> None:
+        """Pace on from the next frame, as if the simulation had started there."""
+        self.start_wall = None
+
     def wait(self, t_s: float) -> None:
         """Sleep until wall time catches up with simulation time ``t_s``."""
         now = time.monotonic()

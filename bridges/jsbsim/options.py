@@ -57,6 +57,9 @@ class BridgeOptions:
     physics_hz: float = 100.0
     exact: bool = False  # lockstep also with the control loop (companion sim --exact)
     start_at_s: float | None = None  # arm and start the mission at this simulated second
+    # Hold the simulation at this simulated second until a ground station has armed the
+    # vehicle and started its mission (bridges/jsbsim/vehicle_commands.py).
+    hold_at_s: float | None = None
     sync_hz: float = 0.0  # the vehicle's nav/state grid, for exact lockstep; 0: off
     wind_ned: tuple[float, float, float] = (0.0, 0.0, 0.0)
     turbulence: str = "none"
@@ -89,6 +92,8 @@ class BridgeOptions:
             raise ValueError("the GPS wander must lie within 0-100 m")
         if self.speed is not None and self.speed <= 0:
             raise ValueError("speed must be positive (or None for lockstep)")
+        if self.start_at_s is not None and self.hold_at_s is not None:
+            raise ValueError("start-at arms the vehicle itself; hold-at waits for a ground station")
         if self.lines:
             self._check_hardware_in_the_loop()
 
@@ -107,6 +112,8 @@ class BridgeOptions:
             raise ValueError("hardware in the loop runs in real time (speed 1)")
         if self.exact or self.start_at_s is not None or self.hold or self.sync_hz:
             raise ValueError("lockstep, start-at and hold need the vehicle on this bus")
+        if self.hold_at_s is not None:
+            raise ValueError("hold-at needs the vehicle on this bus")
 
     def to_json(self) -> str:
         """The options as one JSON line."""

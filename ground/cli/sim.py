@@ -118,6 +118,15 @@ def sim(
             " for both acks (every run starts at the same frame)",
         ),
     ] = None,
+    hold_at: Annotated[
+        float | None,
+        typer.Option(
+            min=0,
+            help="hold the simulation at this simulated second until a ground station has"
+            " armed the vehicle and started its mission (with --exact, a flight flown from a"
+            " ground station repeats to the frame)",
+        ),
+    ] = None,
     noise: Annotated[float, typer.Option(help="sensor noise scale (0: perfect)")] = 1.0,
     gps_wander: Annotated[
         float | None,
@@ -187,7 +196,7 @@ def sim(
             gps_wander_m=gps_wander,
             mount=mount, airborne_bank_deg=airborne_bank,
             rates=DeviceRates(imu_hz=imu_hz),
-            exact=exact, start_at_s=start_at,
+            exact=exact, start_at_s=start_at, hold_at_s=hold_at,
             duration_s=duration, truth_path=str(truth) if truth else None,
             pilot_path=str(pilot) if pilot else None,
             servo_log_path=str(servo_log) if servo_log else None,

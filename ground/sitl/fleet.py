@@ -125,6 +125,8 @@ def shared_args(req: FleetRequest) -> list[str]:
         args += ["--exact"]
     if o.start_at_s is not None:  # each vehicle arms and starts its mission then
         args += ["--start-at", _number(o.start_at_s)]
+    if o.hold_at_s is not None:  # each vehicle waits there for its ground station
+        args += ["--hold-at", _number(o.hold_at_s)]
     for outage in o.outages:
         args += ["--gps-outage", f"{_number(outage.start_s)}:{_number(outage.duration_s)}"]
     if req.plan is not None:

@@ -90,3 +90,13 @@ def test_hardware_in_the_loop_options_are_checked():
         BridgeOptions(speed=1.0, lines=lines, exact=True)
     opts = BridgeOptions(speed=1.0, lines=lines)
     assert BridgeOptions.from_json(opts.to_json()).lines == lines
+
+
+def test_holding_for_a_ground_station_is_checked():
+    """--hold-at waits for a ground station's arming on the bus: not with a vehicle on
+    serial lines, and not beside --start-at, which arms the vehicle itself."""
+    with pytest.raises(ValueError, match="hold-at needs the vehicle"):
+        BridgeOptions(speed=1.0, lines={"servos": "pty:/tmp/x/servos"}, hold_at_s=10.0)
+    with pytest.raises(ValueError, match="start-at arms the vehicle itself"):
+        BridgeOptions(start_at_s=10.0, hold_at_s=10.0)
+    assert BridgeOptions.from_json(BridgeOptions(hold_at_s=10.0).to_json()).hold_at_s == 10.0
