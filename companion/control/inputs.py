@@ -42,7 +42,9 @@ def _rate_usable(value: float) -> bool:
 
 def rates_or_zero(nav: NavState) -> NavState:
     """``nav`` with unmeasured (NaN) body rates as zero: the loops fly without damping terms."""
-    if not any(math.isnan(getattr(nav, f)) for f in NAV_RATES):
+    # Written out: asked at every step, where a generator over the names cost more.
+    isnan = math.isnan
+    if not (isnan(nav.roll_rate_rad_s) or isnan(nav.pitch_rate_rad_s) or isnan(nav.yaw_rate_rad_s)):
         return nav
     copy = NavState.from_buffer_copy(nav)
     for f in NAV_RATES:

@@ -41,6 +41,8 @@ LANDED_SPEED = 8.0  # m/s: slower than this near the ground is "on the ground"
 # the airspeed a turn gains or loses.
 TURN_BANK_FRACTION = 0.7
 MAX_TURN_WIND = 15.0  # m/s: a wind estimate beyond this is not trusted to size turns
+# The mode of a status's number, without an enum call a step (status_usable has checked it).
+_MODE_OF = {int(m): m for m in FlightMode}
 
 
 class FlightController:
@@ -132,7 +134,7 @@ class FlightController:
         self.jumps.first_solution(bool(self.landed))  # before a mission takes them up
         out = ControlOutput(airspeed=airspeed, landed=bool(self.landed))
         out.brakes = self.config["LAND_BRAKE"] if self.landed else 0.0
-        mode = FlightMode(status.mode) if status.mode else FlightMode.LOITER
+        mode = _MODE_OF[status.mode] if status.mode else FlightMode.LOITER
         if mode in PILOT_MODES and sticks is not None:
             return self._fly_sticks(mode, sticks, (pos, vel, nav, airspeed, dt), out)
         if mode == FlightMode.MANUAL:
