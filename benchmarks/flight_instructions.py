@@ -1,18 +1,27 @@
 """Instructions per simulated second of the composed vehicle process, counted by callgrind.
 
-    uv run python benchmarks/flight_instructions.py [--from-s 20] [--window-s 10]
+    uv run python benchmarks/flight_instructions.py [--from-s 20] [--window-s 5]
 
 Flies ``companion sim`` in exact lockstep (``--speed max --exact``, armed in the air at
 simulated second 10 on ``qgc_plans/square.plan``) with the composed process ("vehicle" of
 ``sim_composed.toml``) started under ``valgrind --tool=callgrind --instr-atstart=no`` through
 ``COMPANION_WRAP`` (``companion/exec_control/profiling.py``). Counting is switched on at
 simulated second ``--from-s`` and off ``--window-s`` later (``callgrind_control -i``), so
-start-up and imports are not in it. Instructions do not depend on the machine's load, unlike
-CPU seconds: a change to the flight path's cost shows even on a busy machine. Prints the
-instructions per simulated second, the window and the callgrind file; read the file with
-``callgrind_annotate --inclusive=yes FILE`` (C-level: under Python 3.11 the interpreter's
-own functions, numpy's, iceoryx2's and the kernel calls, not Python function names).
-The lockstep makes the flight the same run after run; the count varies by well under 1 %.
+start-up and imports are not in it. Prints the instructions per simulated second of the
+process and of each of its threads (a plug-in's thread; the chained flight path, IMU →
+navigator → controller → servos, runs on the IMU driver's), and the callgrind files; read
+one with ``callgrind_annotate FILE`` (C level: under Python 3.11 the interpreter's own
+functions, numpy's, iceoryx2's, not Python function names).
+
+Instructions do not depend on the machine's load as CPU seconds do, with one exception the
+window's wall seconds (printed) show: under callgrind the vehicle runs some 5-20 times
+slower than real time, so what runs per wall second (counters and step-time percentiles
+once a second, timeouts of threads whose input the chain takes, bus connection upkeep)
+weighs that much more than in flight. Compare runs of similar wall seconds, or the IMU
+thread plus the navigator's, controller's and servos' own threads, whose samples move
+between them as the timeouts fall. Exact lockstep also makes the logger wake for every
+sample (``in_step``), which it does not do in real time. Kernel time (system calls, thread
+switches) is not counted at all.
 """
 
 from __future__ import annotations
@@ -63,8 +72,8 @@ def toggle(pid: int, on: bool, v: Vehicle) -> float:
     return (before + v.sim_s()) / 2
 
 
-def fly(args: argparse.Namespace, out: Path) -> tuple[float, Path, int]:
-    """Fly, count the window; (simulated seconds counted, the folder, the process id)."""
+def fly(args: argparse.Namespace, out: Path) -> tuple[float, int, list[str]]:
+    """Fly, count the window; (simulated seconds counted, the process id, its threads)."""
     tmp = Path(tempfile.mkdtemp(prefix="flight_instr"))
     namespace = f"fi{os.getpid()}_{int(time.time() * 1000) % 100000}"
     footprint.ENV["COMPANION_WRAP"] = (
@@ -87,8 +96,8 @@ def fly(args: argparse.Namespace, out: Path) -> tuple[float, Path, int]:
         subprocess.run(["callgrind_control", "-d", str(pid)], check=True, stdout=subprocess.DEVNULL)
     finally:
         v.stop()
-    print(f"window: {end - start:.2f} simulated s in {wall:.0f} wall s; threads {names}")
-    return end - start, out, pid
+    print(f"window: {end - start:.2f} simulated s in {wall:.0f} wall s")
+    return end - start, pid, names
 
 
 def thread_names(pid: int) -> list[str]:
@@ -100,7 +109,7 @@ def thread_names(pid: int) -> list[str]:
 
 def thread_instructions(out: Path, pid: int) -> dict[str, int]:
     """Instructions of each thread of the dump (``--separate-threads``), by file name."""
-    totals = {}
+    totals: dict[str, int] = {}
     for path in sorted(out.glob(f"cg.{pid}*")):
         text = path.read_text(errors="replace")
         count = max((int(n) for n in re.findall(r"^(?:summary|totals): (\d+)", text, re.M)),
@@ -116,19 +125,21 @@ def main() -> None:
     ap.add_argument("--plan", default="qgc_plans/square.plan")
     ap.add_argument("--process", default="vehicle", help="the process to count")
     ap.add_argument("--from-s", type=float, default=20.0, help="simulated second to start")
-    ap.add_argument("--window-s", type=float, default=10.0, help="simulated seconds counted")
-    ap.add_argument("--out", type=Path, default=None, help="folder for the callgrind file")
+    ap.add_argument("--window-s", type=float, default=5.0, help="simulated seconds counted")
+    ap.add_argument("--out", type=Path, default=None, help="folder for the callgrind files")
     args = ap.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="flight_instr_out"))
     out.mkdir(parents=True, exist_ok=True)
     use_bytecode()
-    seconds, out, pid = fly(args, out)
+    seconds, pid, names = fly(args, out)
     threads = thread_instructions(out, pid)
     total = sum(threads.values())
     print(f"{args.process}: {total / seconds / 1e6:.1f} M instructions per simulated second "
           f"({total:,} in {seconds:.2f} simulated s from {args.from_s:g} s); {out}")  # fmt: skip
-    for name, count in sorted(threads.items(), key=lambda kv: -kv[1]):
-        print(f"  {name}: {count / seconds / 1e6:.1f} M/s")
+    for file, count in sorted(threads.items(), key=lambda kv: -kv[1]):
+        number = int(file.rsplit("-", 1)[1])  # callgrind's thread number, from 1
+        name = names[number - 1] if number <= len(names) else "?"
+        print(f"  {name:12s} {count / seconds / 1e6:7.1f} M/s  ({file})")
 
 
 if __name__ == "__main__":
