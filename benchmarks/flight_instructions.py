@@ -82,7 +82,7 @@ def fly(args: argparse.Namespace, out: Path) -> tuple[float, int, list[str]]:
     )
     footprint.ENV["COMPANION_WRAP_ONLY"] = args.process
     cmd = [sys.executable, "-m", "companion", "sim", "--config", str(args.config),
-           "--plan", args.plan, "--airborne", "--start-at", str(ARM_AT_S), "--speed", "max",
+           "--plan", args.plan, "--airborne", "--start-at", str(ARM_AT_S), "--speed", args.speed,
            "--exact", "--namespace", namespace, "--state-dir", str(tmp / "state"),
            "--link", "udpout://127.0.0.1:9", "--log-level", "ERROR"]  # fmt: skip
     v = Vehicle(cmd, namespace, None)
@@ -126,6 +126,8 @@ def main() -> None:
     ap.add_argument("--process", default="vehicle", help="the process to count")
     ap.add_argument("--from-s", type=float, default=20.0, help="simulated second to start")
     ap.add_argument("--window-s", type=float, default=5.0, help="simulated seconds counted")
+    pace = "companion sim --speed: a pace (0.1) below callgrind's keeps the wall seconds alike"
+    ap.add_argument("--speed", default="max", help=pace)
     ap.add_argument("--out", type=Path, default=None, help="folder for the callgrind files")
     args = ap.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="flight_instr_out"))

@@ -333,12 +333,12 @@ class LatestReader(Reader[M]):
         """Wait up to ``timeout_s`` for a NEW value; None if none arrived."""
         deadline = time.monotonic() + timeout_s
         fresh: M | None = None
-        for msg in self.drain():
-            fresh = msg
+        if msgs := self.pending():
+            fresh = msgs[-1]
         while fresh is None and (left := deadline - time.monotonic()) > 0:
             self.wait_event(left)
-            for msg in self.drain():
-                fresh = msg
+            if msgs := self.pending():
+                fresh = msgs[-1]
         if fresh is not None:
             self._latest = fresh
         return fresh
