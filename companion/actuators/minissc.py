@@ -25,6 +25,17 @@ def frame(servo: int, position: int) -> bytes:
     return bytes((SYNC, servo, min(POSITION_MAX, max(0, position))))
 
 
+def frames(plan: Iterable[tuple[int, int]]) -> bytes:
+    """``frame`` of each (servo, position) of ``plan``, back to back: one call for a cycle's
+    frames (the servo plug-in sends one 50 times a second)."""
+    out: list[int] = []
+    for servo, position in plan:
+        if not 0 <= servo <= SYNC - 1:
+            raise ValueError(f"servo id {servo} out of 0-254")
+        out += (SYNC, servo, POSITION_MAX if position > POSITION_MAX else max(0, position))
+    return bytes(out)
+
+
 def pulse_us(position: int) -> int:
     """The pulse width, in µs, the card puts out for a position (90° range)."""
     return PULSE_MIN_US + round(position * PULSE_SPAN_US / POSITION_MAX)

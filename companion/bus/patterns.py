@@ -193,6 +193,20 @@ class Reader(Generic[M]):
         while (msg := self._receive_one()) is not None:
             yield msg
 
+    def pending(self) -> list[M]:
+        """What ``drain`` gives, as a list: without a generator and a call a sample (the
+        navigator asks its five readers at every IMU sample, most of them holding none)."""
+        out: list[M] = []
+        receive, copy, bytes_at = self._subscriber.receive, self._copy, self._bytes_at
+        while (sample := receive()) is not None:
+            if self.counts_losses:
+                header = _header_at(sample.user_header_ptr)
+                self._count_gap(header.writer_id, header.seq)
+            out.append(copy(bytes_at(sample.payload_ptr)))
+            sample.delete()
+            self.received += 1
+        return out
+
     def wait_event(self, timeout_s: float) -> bool:
         """Sleep until a writer notifies or the timeout passes; True when woken by data.
 
@@ -245,11 +259,11 @@ class QueueReader(Reader[M]):
     def take(self, timeout_s: float = 0.0) -> list[M]:
         """All pending samples, waiting up to ``timeout_s`` for the first one."""
         deadline = time.monotonic() + timeout_s
-        msgs = list(self.drain())
+        msgs = self.pending()
         # A wake-up can be stale (its sample already taken): sleep again until the deadline.
         while not msgs and (left := deadline - time.monotonic()) > 0:
             self.wait_event(left)
-            msgs = list(self.drain())
+            msgs = self.pending()
         return msgs
 
 
@@ -297,7 +311,7 @@ class LatestReader(Reader[M]):
         depends on the data alone. Its reader keeps (``latest_reader(keep=...)``) the values
         that come between two calls; use either this or ``get()`` on one reader.
         """
-        for msg in self.drain():
+        for msg in self.pending():
             self._latest = msg
             self._ahead.append(msg)
         while self._ahead and self._ahead[0].t_us < t_us:
@@ -319,12 +333,12 @@ class LatestReader(Reader[M]):
         """Wait up to ``timeout_s`` for a NEW value; None if none arrived."""
         deadline = time.monotonic() + timeout_s
         fresh: M | None = None
-        for msg in self.drain():
-            fresh = msg
+        if msgs := self.pending():
+            fresh = msgs[-1]
         while fresh is None and (left := deadline - time.monotonic()) > 0:
             self.wait_event(left)
-            for msg in self.drain():
-                fresh = msg
+            if msgs := self.pending():
+                fresh = msgs[-1]
         if fresh is not None:
             self._latest = fresh
         return fresh

@@ -37,6 +37,11 @@ FAILSAFE_PARAMS = (
     ParamDecl("FENCE_ENABLE", 1.0, 0.0, 1.0, "", "return home when the fence is breached"),
 )
 
+# Plain ints: ``flags & NavFlags.X`` makes an enum value through Python code (~1.5 us).
+_DEAD_RECKONING = int(NavFlags.DEAD_RECKONING)
+_POSITION_VALID = int(NavFlags.POSITION_VALID)
+_ALIGNING = int(NavFlags.ALIGNING)
+
 
 @dataclass(frozen=True)
 class Action:
@@ -161,7 +166,7 @@ class Failsafes:
         gps.back_us = round(self.params["FS_GPS_BACK_S"] * 1e6)
         if s.nav_t_us is None or self._realigning(s):
             return []
-        usable = not s.nav_flags & NavFlags.DEAD_RECKONING and s.nav_flags & NavFlags.POSITION_VALID
+        usable = not s.nav_flags & _DEAD_RECKONING and s.nav_flags & _POSITION_VALID
         gps.update(s.nav_t_us, bool(usable))
         # Lost while on the ground is said once airborne (arming checks should prevent it).
         if gps.bad and not self.gps_lost and s.flying:
@@ -178,7 +183,7 @@ class Failsafes:
     def _realigning(self, s: Situation) -> bool:
         """A navigator that is aligning (restarted in flight: its first seconds) says
         nothing of the GPS; only one that stays so for ``ALIGN_GRACE_US`` counts as lost."""
-        if not s.nav_flags & NavFlags.ALIGNING:
+        if not s.nav_flags & _ALIGNING:
             self.aligning_since_us = None
             return False
         assert s.nav_t_us is not None

@@ -30,19 +30,20 @@ KNOWN_MODES = frozenset(int(m) for m in FlightMode)
 NAV_RATES = ("roll_rate_rad_s", "pitch_rate_rad_s", "yaw_rate_rad_s")
 
 
-def _within(value: float, limit: float) -> bool:
-    """Finite and no larger than ``limit`` either way (NaN and infinity fail)."""
-    return abs(value) <= limit
+# ``abs(x) <= limit`` throughout: finite and no larger than ``limit`` either way (NaN and
+# infinity fail), written out because the controller asks at every step.
 
 
 def _rate_usable(value: float) -> bool:
     """A body rate within an IMU's range, or NaN: not measured (gps_compass has no gyro)."""
-    return math.isnan(value) or _within(value, MAX_RATE_RAD_S)
+    return math.isnan(value) or abs(value) <= MAX_RATE_RAD_S
 
 
 def rates_or_zero(nav: NavState) -> NavState:
     """``nav`` with unmeasured (NaN) body rates as zero: the loops fly without damping terms."""
-    if not any(math.isnan(getattr(nav, f)) for f in NAV_RATES):
+    # Written out: asked at every step, where a generator over the names cost more.
+    isnan = math.isnan
+    if not (isnan(nav.roll_rate_rad_s) or isnan(nav.pitch_rate_rad_s) or isnan(nav.yaw_rate_rad_s)):
         return nav
     copy = NavState.from_buffer_copy(nav)
     for f in NAV_RATES:
@@ -53,7 +54,7 @@ def rates_or_zero(nav: NavState) -> NavState:
 
 def place_usable(lat_deg: float, lon_deg: float, alt_msl_m: float) -> bool:
     """A place on Earth at a sane height (every coordinate given)."""
-    return _within(lat_deg, 90.0) and _within(lon_deg, 180.0) and _within(alt_msl_m, MAX_ALT_M)
+    return abs(lat_deg) <= 90.0 and abs(lon_deg) <= 180.0 and abs(alt_msl_m) <= MAX_ALT_M
 
 
 def position_usable(nav: NavState) -> bool:
@@ -85,10 +86,10 @@ def _target_usable(status: VehicleStatus) -> bool:
     lat, lon, alt = status.target_lat_deg, status.target_lon_deg, status.target_alt_msl_m
     radius = status.target_radius_m
     return (
-        (math.isnan(lat) or _within(lat, 90.0))
-        and (math.isnan(lon) or _within(lon, 180.0))
-        and (math.isnan(alt) or _within(alt, MAX_ALT_M))
-        and (math.isnan(radius) or _within(radius, MAX_RADIUS_M))
+        (math.isnan(lat) or abs(lat) <= 90.0)
+        and (math.isnan(lon) or abs(lon) <= 180.0)
+        and (math.isnan(alt) or abs(alt) <= MAX_ALT_M)
+        and (math.isnan(radius) or abs(radius) <= MAX_RADIUS_M)
     )
 
 
@@ -108,8 +109,8 @@ def sticks_usable(sticks: Sticks | None) -> bool:
     if sticks is None:
         return True
     return (
-        _within(sticks.roll, 1.0)
-        and _within(sticks.pitch, 1.0)
-        and _within(sticks.yaw, 1.0)
+        abs(sticks.roll) <= 1.0
+        and abs(sticks.pitch) <= 1.0
+        and abs(sticks.yaw) <= 1.0
         and 0.0 <= sticks.throttle <= 1.0
     )

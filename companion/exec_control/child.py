@@ -20,6 +20,7 @@ from companion.exec_control.backoff import (
     STABLE_AFTER_S,
 )
 from companion.exec_control.plugin_spec import PluginSpec
+from companion.exec_control.profiling import exec_wrapper
 from companion.exec_control.zygote import CHILD_ENV, ForkedProcess, ForkServer
 from companion.messages import NAME_LEN, PluginHealth, PluginState, PluginStats
 
@@ -52,9 +53,11 @@ class Child:
     def start(self) -> None:
         """Start the plug-in process now: forked by the fork server, or else spawned."""
         self.stats = PluginStats()  # the dead process's counters are not the new one's
-        forked = self.forker.spawn(self._argv_spec) if self.forker is not None else None
+        wrapper = exec_wrapper(self.spec.name)  # a profiler's command: needs an exec
+        forker = None if wrapper else self.forker
+        forked = forker.spawn(self._argv_spec) if forker is not None else None
         self.proc = forked or subprocess.Popen(
-            [sys.executable, "-m", "companion.exec_control.host_main", self._argv_spec],
+            [*wrapper, sys.executable, "-m", "companion.exec_control.host_main", self._argv_spec],
             start_new_session=True,  # a terminal's Ctrl-C reaches the supervisor only
             env={**os.environ, **CHILD_ENV},
         )

@@ -12,6 +12,12 @@ plug-ins through the supervisor's and the fork server's environment, so
 profiles a whole real-time flight. Read a file with ``python -m pstats DIR/imu.123.prof``
 (``sort tottime``, ``stats 20``). cProfile slows Python calls severalfold: compare
 functions within one profile, never a profiled run's CPU with an unprofiled one's.
+
+``COMPANION_WRAP="valgrind --tool=callgrind ..."`` (off when unset) starts plug-in processes
+as that command followed by a fresh interpreter instead of forking them from the fork
+server, so a tool that needs an ``exec`` (valgrind) sees them; ``COMPANION_WRAP_ONLY``
+(comma-separated plug-in or composed process names) limits it to those.
+``benchmarks/flight_instructions.py`` uses it to count a composed vehicle's instructions.
 """
 
 from __future__ import annotations
@@ -19,6 +25,7 @@ from __future__ import annotations
 import cProfile
 import logging
 import os
+import shlex
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -27,6 +34,8 @@ from typing import TypeVar
 ENV_DIR = "COMPANION_PROFILE"
 ENV_ONLY = "COMPANION_PROFILE_ONLY"
 ENV_CLOCK = "COMPANION_PROFILE_CLOCK"
+ENV_WRAP = "COMPANION_WRAP"
+ENV_WRAP_ONLY = "COMPANION_WRAP_ONLY"
 T = TypeVar("T")
 
 log = logging.getLogger(__name__)
@@ -39,6 +48,15 @@ def profile_path(name: str) -> Path | None:
     if not folder or (only and name not in only):
         return None
     return Path(folder) / f"{name}.{os.getpid()}.prof"
+
+
+def exec_wrapper(name: str) -> list[str]:
+    """The command to start plug-in process ``name`` under; [] (forked as usual) unless
+    the environment asks for one."""
+    only = {n.strip() for n in os.environ.get(ENV_WRAP_ONLY, "").split(",") if n.strip()}
+    if only and name not in only:
+        return []
+    return shlex.split(os.environ.get(ENV_WRAP, ""))
 
 
 def run_profiled(name: str, run: Callable[[], T]) -> T:

@@ -55,13 +55,13 @@ def pilot_sticks(now_us: int, *inputs: PilotInput | None) -> Sticks | None:
     for p in inputs:
         if p is None or not p.usable() or now_us - p.t_us > STICKS_STALE_US:
             continue
-        values = (p.roll, p.pitch, p.yaw, p.throttle)
-        if not all(math.isfinite(v) for v in values):
+        roll, pitch, yaw, throttle = p.roll, p.pitch, p.yaw, p.throttle
+        finite = math.isfinite  # written out: a receiver's frame is looked at every step
+        if not (finite(roll) and finite(pitch) and finite(yaw) and finite(throttle)):
             continue
         return Sticks(
-            clamp(p.roll, -1, 1), clamp(p.pitch, -1, 1), clamp(p.yaw, -1, 1),
-            clamp(p.throttle, 0, 1),
-        )  # fmt: skip
+            clamp(roll, -1, 1), clamp(pitch, -1, 1), clamp(yaw, -1, 1), clamp(throttle, 0, 1)
+        )
     return None
 
 

@@ -32,6 +32,9 @@ from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 
+# Plain ints: ``flags & NavFlags.X`` makes an enum value through Python code (~1.5 us).
+_DEAD_RECKONING = int(NavFlags.DEAD_RECKONING)
+
 AIRBORNE_AGL_M = 10.0
 # An implicit take-off (a mission without one, started on the ground) climbs at least this
 # high before it turns towards the first item: a take-off's wings-level climb-out and more.
@@ -41,6 +44,8 @@ LANDED_SPEED = 8.0  # m/s: slower than this near the ground is "on the ground"
 # the airspeed a turn gains or loses.
 TURN_BANK_FRACTION = 0.7
 MAX_TURN_WIND = 15.0  # m/s: a wind estimate beyond this is not trusted to size turns
+# The mode of a status's number, without an enum call a step (status_usable has checked it).
+_MODE_OF = {int(m): m for m in FlightMode}
 
 
 class FlightController:
@@ -132,7 +137,7 @@ class FlightController:
         self.jumps.first_solution(bool(self.landed))  # before a mission takes them up
         out = ControlOutput(airspeed=airspeed, landed=bool(self.landed))
         out.brakes = self.config["LAND_BRAKE"] if self.landed else 0.0
-        mode = FlightMode(status.mode) if status.mode else FlightMode.LOITER
+        mode = _MODE_OF[status.mode] if status.mode else FlightMode.LOITER
         if mode in PILOT_MODES and sticks is not None:
             return self._fly_sticks(mode, sticks, (pos, vel, nav, airspeed, dt), out)
         if mode == FlightMode.MANUAL:
@@ -173,7 +178,7 @@ class FlightController:
         growing error; a straight course at a known height is the safe thing until GPS
         returns (then the commander has the aircraft loiter).
         """
-        if not nav.flags & NavFlags.DEAD_RECKONING or self.landed:
+        if not nav.flags & _DEAD_RECKONING or self.landed:
             self._hold_course = None
             return setpoint
         if self._hold_course is None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 from companion.control.flight.landing import LANDING_PARAMS
 from companion.control.laws.attitude import AttitudeGains
@@ -101,7 +102,7 @@ class FlightConfig:
     executor: ExecutorConfig
     values: Mapping[str, float]
 
-    @property
+    @cached_property  # read several times a step; a new config comes with new values
     def roll_limit(self) -> float:
         return math.radians(self.values["ROLL_LIMIT_DEG"])
 

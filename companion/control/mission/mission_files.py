@@ -71,14 +71,20 @@ class StoreFollower:
     def __init__(self, store: MissionStore) -> None:
         self.store = store
         self.sums = {t: store.checksum(t) for t in MISSION_TYPES}
+        self._seen: MissionChanged | None = None
 
     def follow(self, msg: MissionChanged | None) -> set[int]:
         """The mission types whose lists changed (reloaded from disk)."""
-        if msg is None:
+        # A Latest reader hands the same object back until a new value comes (every step
+        # but a handful): once the lists held here matched it, it says nothing new.
+        if msg is None or msg is self._seen:
             return set()
         announced = msg.checksums  # a ctypes array field: fetched once, not once a type
         if all(announced[t] == self.sums[t] for t in MISSION_TYPES):
+            self._seen = msg
             return set()
         self.store.reload()
         before, self.sums = self.sums, {t: self.store.checksum(t) for t in MISSION_TYPES}
+        if all(announced[t] == self.sums[t] for t in MISSION_TYPES):
+            self._seen = msg
         return {t for t in MISSION_TYPES if self.sums[t] != before[t]}

@@ -244,7 +244,7 @@ class MiniSscOutput(Plugin):
         plan = minissc.plan_cycle(self.wanted, self.sent, self.refresh_order, room)
         if not plan:
             return False
-        data = b"".join(minissc.frame(s, p) for s, p in plan)
+        data = minissc.frames(plan)
         if self.port.write(data) != len(data):
             self.ctx.health.bad()
             return False

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Protocol
 
@@ -105,7 +105,7 @@ class InsEkfPlugin(Plugin):
 
 
 class _Drains(Protocol):
-    def drain(self) -> Iterable[Message]: ...
+    def pending(self) -> list[Message]: ...
 
 
 def received(readers: Sequence[_Drains]) -> list[Message]:
@@ -122,9 +122,9 @@ def received(readers: Sequence[_Drains]) -> list[Message]:
     parted from the same flight in separate processes (issue 46.4).
     """
     imu, *aiding = readers
-    taken = list(imu.drain())
+    taken = imu.pending()
     for reader in aiding:
-        taken.extend(reader.drain())
+        taken += reader.pending()
     return taken
 
 

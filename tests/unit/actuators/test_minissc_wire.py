@@ -27,3 +27,16 @@ def test_decoder_resynchronises_after_garbage_and_split_frames():
     out = dec.feed(stream[:4]) + dec.feed(stream[4:])
     assert out == [(1, 10), (2, 20)]
     assert dec.garbage == 4  # two leading bytes, and the cut-off frame's two
+
+
+def test_frames_are_each_frame_back_to_back():
+    plan = [(0, 300), (3, 127), (7, -5), (1, 254)]
+    assert minissc.frames(plan) == b"".join(minissc.frame(s, p) for s, p in plan)
+    assert minissc.frames([]) == b""
+
+
+def test_frames_refuse_the_sync_byte_as_a_servo_id():
+    import pytest
+
+    with pytest.raises(ValueError):
+        minissc.frames([(1, 10), (255, 0)])

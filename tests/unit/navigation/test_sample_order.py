@@ -105,6 +105,9 @@ class _Channel:
                 self.then, then = None, self.then
                 then()
 
+    def pending(self):
+        return list(self.drain())
+
 
 def test_a_fix_published_while_the_imu_is_read_is_fed_before_the_next_imu_sample():
     # nav.ins_ekf woken by the IMU sample of 0 ms: while it reads it, the GPS driver
