@@ -1,6 +1,6 @@
 """Instructions per simulated second of the composed vehicle process, counted by callgrind.
 
-    uv run python benchmarks/flight_instructions.py [--from-s 20] [--window-s 5]
+    uv run python benchmarks/flight_instructions.py [--speed 0.1] [--from-s 20] [--window-s 5]
 
 Flies ``companion sim`` in exact lockstep (``--speed max --exact``, armed in the air at
 simulated second 10 on ``qgc_plans/square.plan``) with the composed process ("vehicle" of
