@@ -24,7 +24,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from companion.control.modes import PILOT_MODES  # the operator flies
-from companion.messages import FlightMode, NavFlags
+from companion.messages import FlightMode
+from companion.messages.navigation import NAV_ALIGNING, NAV_DEAD_RECKONING, NAV_POSITION_VALID
 from companion.params import ParamDecl
 from mavlink_dialect import companion as d
 
@@ -36,11 +37,6 @@ FAILSAFE_PARAMS = (
     ParamDecl("FS_GPS_BACK_S", 3.0, 0.0, 60.0, "s", "good fixes this long: GPS back"),
     ParamDecl("FENCE_ENABLE", 1.0, 0.0, 1.0, "", "return home when the fence is breached"),
 )
-
-# Plain ints: ``flags & NavFlags.X`` makes an enum value through Python code (~1.5 us).
-_DEAD_RECKONING = int(NavFlags.DEAD_RECKONING)
-_POSITION_VALID = int(NavFlags.POSITION_VALID)
-_ALIGNING = int(NavFlags.ALIGNING)
 
 
 @dataclass(frozen=True)
@@ -166,7 +162,7 @@ class Failsafes:
         gps.back_us = round(self.params["FS_GPS_BACK_S"] * 1e6)
         if s.nav_t_us is None or self._realigning(s):
             return []
-        usable = not s.nav_flags & _DEAD_RECKONING and s.nav_flags & _POSITION_VALID
+        usable = not s.nav_flags & NAV_DEAD_RECKONING and s.nav_flags & NAV_POSITION_VALID
         gps.update(s.nav_t_us, bool(usable))
         # Lost while on the ground is said once airborne (arming checks should prevent it).
         if gps.bad and not self.gps_lost and s.flying:
@@ -183,7 +179,7 @@ class Failsafes:
     def _realigning(self, s: Situation) -> bool:
         """A navigator that is aligning (restarted in flight: its first seconds) says
         nothing of the GPS; only one that stays so for ``ALIGN_GRACE_US`` counts as lost."""
-        if not s.nav_flags & _ALIGNING:
+        if not s.nav_flags & NAV_ALIGNING:
             self.aligning_since_us = None
             return False
         assert s.nav_t_us is not None

@@ -18,11 +18,9 @@ from pathlib import Path
 from typing import Any
 
 from companion.control.flight.controller import LANDED_SPEED
-from companion.messages import FlightMode, NavFlags
+from companion.messages import FlightMode
+from companion.messages.navigation import NAV_POSITION_VALID
 from companion.params.atomic import atomic_write_text
-
-# Plain ints: ``flags & NavFlags.X`` makes an enum value through Python code (~1.5 us).
-_POSITION_VALID = int(NavFlags.POSITION_VALID)
 
 log = logging.getLogger(__name__)
 
@@ -95,7 +93,7 @@ def load_flight_state(state_dir: Path) -> FlightState | None:
 
 def in_the_air(nav: Any, home: tuple[float, float, float] | None) -> bool:
     """Whether the navigator says the aircraft flies: fast, or high above home."""
-    if nav is None or not nav.flags & _POSITION_VALID:
+    if nav is None or not nav.flags & NAV_POSITION_VALID:
         return False
     if math.hypot(nav.vn_m_s, nav.ve_m_s) >= LANDED_SPEED:
         return True

@@ -13,10 +13,8 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from companion.link.codec import dialect as d
-from companion.messages import BatteryLevel, NavFlags
-
-# Plain ints: ``flags & NavFlags.X`` makes an enum value through Python code (~1.5 us).
-_ATTITUDE_VALID = int(NavFlags.ATTITUDE_VALID)
+from companion.messages import BatteryLevel
+from companion.messages.navigation import NAV_ATTITUDE_VALID
 
 if TYPE_CHECKING:
     from companion.link.snapshot import Snapshot
@@ -79,7 +77,7 @@ def sensor_bits(s: Snapshot) -> tuple[int, int]:
             healthy |= d.MAV_SYS_STATUS_SENSOR_LASER_POSITION
     if s.nav is not None:
         present |= d.MAV_SYS_STATUS_AHRS
-        if s.nav.flags & _ATTITUDE_VALID:
+        if s.nav.flags & NAV_ATTITUDE_VALID:
             healthy |= d.MAV_SYS_STATUS_AHRS
     if s.prearm_ok is not None:  # as ArduPilot: QGroundControl shows "Ready To Fly" on it
         present |= d.MAV_SYS_STATUS_PREARM_CHECK

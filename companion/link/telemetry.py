@@ -23,14 +23,7 @@ from companion.link.system_messages import (
     sensor_bits,
     sys_status,
 )
-from companion.messages import (
-    NavFlags,
-)
-
-# Plain ints: ``flags & NavFlags.X`` makes an enum value through Python code (~1.5 us).
-_ATTITUDE_VALID = int(NavFlags.ATTITUDE_VALID)
-_POSITION_VALID = int(NavFlags.POSITION_VALID)
-_VELOCITY_VALID = int(NavFlags.VELOCITY_VALID)
+from companion.messages.navigation import NAV_ATTITUDE_VALID, NAV_POSITION_VALID, NAV_VELOCITY_VALID
 
 __all__ = ["SNAPSHOT_CHANNELS", "STREAMS", "Snapshot", "sensor_bits"]
 
@@ -63,7 +56,7 @@ def _f32(x: float) -> float:
 
 def _attitude(mav: Any, s: Snapshot) -> Any:
     n = s.nav
-    if n is None or not n.flags & _ATTITUDE_VALID:
+    if n is None or not n.flags & NAV_ATTITUDE_VALID:
         return None
     return mav.attitude_encode(
         s.time_boot_ms,
@@ -78,7 +71,7 @@ def _attitude(mav: Any, s: Snapshot) -> Any:
 
 def _attitude_quaternion(mav: Any, s: Snapshot) -> Any:
     n = s.nav
-    if n is None or not n.flags & _ATTITUDE_VALID:
+    if n is None or not n.flags & NAV_ATTITUDE_VALID:
         return None
     q = [_f32(v) for v in n.q]
     rates = tuple(
@@ -89,7 +82,7 @@ def _attitude_quaternion(mav: Any, s: Snapshot) -> Any:
 
 def _global_position(mav: Any, s: Snapshot) -> Any:
     n = s.nav
-    if n is None or not n.flags & _POSITION_VALID:
+    if n is None or not n.flags & NAV_POSITION_VALID:
         return None
     rel = n.alt_msl_m - s.home_alt_m if math.isfinite(s.home_alt_m) else 0.0
     heading = _deg360(n.yaw_rad)
@@ -179,7 +172,7 @@ def _extended_sys_state(mav: Any, s: Snapshot) -> Any:
     landed = d.MAV_LANDED_STATE_UNDEFINED
     if (controlled := landed_state(s.control)) is not None:
         landed = controlled
-    elif s.nav is not None and s.nav.flags & _VELOCITY_VALID:
+    elif s.nav is not None and s.nav.flags & NAV_VELOCITY_VALID:
         moving = math.hypot(_finite(s.nav.vn_m_s), _finite(s.nav.ve_m_s)) > 5.0
         landed = d.MAV_LANDED_STATE_IN_AIR if moving else d.MAV_LANDED_STATE_ON_GROUND
     return mav.extended_sys_state_encode(d.MAV_VTOL_STATE_UNDEFINED, landed)

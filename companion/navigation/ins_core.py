@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from companion.messages import NavFlags, NavState
+from companion.messages.navigation import NAV_DEAD_RECKONING, NAV_GPS_REJECTED, NAV_HEADING_REJECTED
 from companion.navigation import rotations as rot
 from companion.navigation.imu_noise import ImuNoise
 from companion.navigation.ins_config import InsEkfConfig
@@ -33,9 +34,6 @@ _SOLUTION_VALID = int(
     NavFlags.ATTITUDE_VALID | NavFlags.HEADING_VALID | NavFlags.VELOCITY_VALID
     | NavFlags.POSITION_VALID | NavFlags.ALTITUDE_VALID
 )  # fmt: skip
-_DEAD_RECKONING = int(NavFlags.DEAD_RECKONING)
-_GPS_REJECTED = int(NavFlags.GPS_REJECTED)
-_HEADING_REJECTED = int(NavFlags.HEADING_REJECTED)
 
 
 def _picker(rows: list[int]) -> slice | list[int]:
@@ -221,9 +219,9 @@ class InsCore:
         # Dead reckoning means no fix is coming; fixes that come but are rejected say so
         # in GPS_REJECTED (and reset the filter to GPS after ``reset_after`` of them).
         if self.last_fix_us is None or (t - self.last_fix_us) / 1e6 > self.cfg.gps_timeout_s:
-            flags |= _DEAD_RECKONING
+            flags |= NAV_DEAD_RECKONING
         if not self.last_gps_ok:
-            flags |= _GPS_REJECTED
+            flags |= NAV_GPS_REJECTED
         if not self.last_heading_ok:
-            flags |= _HEADING_REJECTED
+            flags |= NAV_HEADING_REJECTED
         return flags

@@ -35,11 +35,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from companion.messages import GpsFix, NavFlags, NavState
+from companion.messages import GpsFix, NavState
+from companion.messages.navigation import NAV_ATTITUDE_VALID
 from companion.navigation import rotations as rot
-
-# Plain ints: ``flags & NavFlags.X`` makes an enum value through Python code (~1.5 us).
-_ATTITUDE_VALID = int(NavFlags.ATTITUDE_VALID)
 
 if TYPE_CHECKING:
     from companion.navigation.ins_align import Alignment
@@ -83,7 +81,7 @@ def warm_state(nav: NavState, gps_lag_s: float) -> WarmState | None:
     """The solution to write, or None: none yet (aligning), or not flying (only a restart
     in the air reads it, and a vehicle on the bench writes nothing to its state directory)."""
     flying = math.hypot(nav.vn_m_s, nav.ve_m_s) >= IN_AIR_SPEED_M_S
-    if not flying or not nav.flags & _ATTITUDE_VALID or not math.isfinite(nav.lat_deg):
+    if not flying or not nav.flags & NAV_ATTITUDE_VALID or not math.isfinite(nav.lat_deg):
         return None
     return WarmState(
         int(nav.t_us), nav.lat_deg, nav.lon_deg, nav.alt_msl_m,

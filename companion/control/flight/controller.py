@@ -30,10 +30,8 @@ from companion.control.mission.resume import start_mission
 from companion.control.modes import PILOT_MODES
 from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import LocalFrame
-from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
-
-# Plain ints: ``flags & NavFlags.X`` makes an enum value through Python code (~1.5 us).
-_DEAD_RECKONING = int(NavFlags.DEAD_RECKONING)
+from companion.messages import FlightMode, NavState, VehicleStatus
+from companion.messages.navigation import NAV_DEAD_RECKONING
 
 AIRBORNE_AGL_M = 10.0
 # An implicit take-off (a mission without one, started on the ground) climbs at least this
@@ -178,7 +176,7 @@ class FlightController:
         growing error; a straight course at a known height is the safe thing until GPS
         returns (then the commander has the aircraft loiter).
         """
-        if not nav.flags & _DEAD_RECKONING or self.landed:
+        if not nav.flags & NAV_DEAD_RECKONING or self.landed:
             self._hold_course = None
             return setpoint
         if self._hold_course is None:
