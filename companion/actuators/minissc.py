@@ -20,9 +20,7 @@ POSITION_MAX = 254
 
 def frame(servo: int, position: int) -> bytes:
     """One command frame."""
-    if not 0 <= servo <= SYNC - 1:
-        raise ValueError(f"servo id {servo} out of 0-254")
-    return bytes((SYNC, servo, min(POSITION_MAX, max(0, position))))
+    return frames(((servo, position),))
 
 
 def frames(plan: Iterable[tuple[int, int]]) -> bytes:

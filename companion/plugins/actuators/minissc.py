@@ -102,7 +102,7 @@ class MiniSscOutput(Plugin):
         """The card only listens: it is sent every channel at its safe position (the
         vehicle's airframe says where that is)."""
         safe = load_airframe(vehicle["airframe"]).channels
-        neutral = b"".join(minissc.frame(c.servo, c.safe) for c in safe)
+        neutral = minissc.frames((c.servo, c.safe) for c in safe)
         return [DeviceProbe(settings["device"], settings["baud"], None, neutral=neutral)]
 
     def init(self, ctx: PluginContext) -> None:

@@ -31,7 +31,10 @@ def test_decoder_resynchronises_after_garbage_and_split_frames():
 
 def test_frames_are_each_frame_back_to_back():
     plan = [(0, 300), (3, 127), (7, -5), (1, 254)]
-    assert minissc.frames(plan) == b"".join(minissc.frame(s, p) for s, p in plan)
+    # Each a sync byte, the servo and its position clamped to 0-254 (frame() is frames()).
+    want = bytes((255, 0, 254, 255, 3, 127, 255, 7, 0, 255, 1, 254))
+    assert minissc.frames(plan) == want
+    assert b"".join(minissc.frame(s, p) for s, p in plan) == want
     assert minissc.frames([]) == b""
 
 
