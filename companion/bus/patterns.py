@@ -194,17 +194,11 @@ class Reader(Generic[M]):
             yield msg
 
     def pending(self) -> list[M]:
-        """What ``drain`` gives, as a list: without a generator and a call a sample (the
-        navigator asks its five readers at every IMU sample, most of them holding none)."""
+        """What ``drain`` gives, as a list: without a generator (the navigator asks its five
+        readers at every IMU sample, most of them holding none)."""
         out: list[M] = []
-        receive, copy, bytes_at = self._subscriber.receive, self._copy, self._bytes_at
-        while (sample := receive()) is not None:
-            if self.counts_losses:
-                header = _header_at(sample.user_header_ptr)
-                self._count_gap(header.writer_id, header.seq)
-            out.append(copy(bytes_at(sample.payload_ptr)))
-            sample.delete()
-            self.received += 1
+        while (msg := self._receive_one()) is not None:
+            out.append(msg)
         return out
 
     def wait_event(self, timeout_s: float) -> bool:
