@@ -88,10 +88,10 @@ class VehicleCommands:
 
     def _take_commands(self, t_us: int) -> None:
         for cmd in self.commands.drain():
-            if cmd.command == CommandId.STOP and self.sync is not None:
-                self.sync.started(False)
             if cmd.command == CommandId.STOP:
                 self.accepted.discard(CommandId.START)
+                if self.sync is not None:
+                    self.sync.started(False)
             if cmd.command == CommandId.INJECT_FAILURE:
                 self._inject(cmd, t_us)
 

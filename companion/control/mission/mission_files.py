@@ -79,12 +79,17 @@ class StoreFollower:
         # but a handful): once the lists held here matched it, it says nothing new.
         if msg is None or msg is self._seen:
             return set()
-        announced = msg.checksums  # a ctypes array field: fetched once, not once a type
-        if all(announced[t] == self.sums[t] for t in MISSION_TYPES):
-            self._seen = msg
+        if self._holds(msg):
             return set()
         self.store.reload()
         before, self.sums = self.sums, {t: self.store.checksum(t) for t in MISSION_TYPES}
+        self._holds(msg)
+        return {t for t in MISSION_TYPES if self.sums[t] != before[t]}
+
+    def _holds(self, msg: MissionChanged) -> bool:
+        """Whether the lists held here are the ones ``msg`` announces (then it is seen)."""
+        announced = msg.checksums  # a ctypes array field: fetched once, not once a type
         if all(announced[t] == self.sums[t] for t in MISSION_TYPES):
             self._seen = msg
-        return {t for t in MISSION_TYPES if self.sums[t] != before[t]}
+            return True
+        return False
