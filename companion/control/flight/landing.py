@@ -12,7 +12,8 @@ PX4 publish for their fixed-wing landings, written here from their descriptions:
   ``LAND_FLARE_SEC`` away at the present sink rate, the throttle is cut and pitch flies
   an exponential flare: a sink-rate demand that falls with height towards ``TECS_LAND_SINK``
   at the ground, from the sink rate at its start (the glide path's, when a gust has just
-  slowed the sink below it). Bank is limited to ``LEVEL_ROLL_LIMIT``; the crab is kept, so a
+  slowed the sink below it) and from the glide's pitch and sink averaged over its last
+  seconds (not a gust's moment). Bank is limited to ``LEVEL_ROLL_LIMIT``; the crab is kept, so a
   crosswind does not drift the aircraft off the centreline in the flare.
 - **Rollout**: on the wheels the rudder (and the steered wheel) holds the centreline,
   the wings are held level, the throttle is idle (the brakes come on with it).
@@ -69,6 +70,9 @@ GROUND_TAU_S = 1.5
 GROUND_CORRECTION_MAX_M = 10.0  # a ground further from the runway's is not the runway
 SINK_P = 0.10  # rad of pitch per m/s of sink-rate error in the flare
 SINK_I = 0.05  # rad per (m/s·s)
+# The flare starts from the glide's pitch and sink averaged over this long, not from the
+# moment's: a gust that had just pitched the nose down or changed the sink is not the trim.
+GLIDE_TRIM_TAU_S = 2.0
 
 
 LANDING_PARAMS = (
@@ -161,8 +165,8 @@ class Landing:
         self.unit = (math.cos(self.heading), math.sin(self.heading))
         self.phase = LandPhase.APPROACH
         self._flare_integ = 0.0
-        self._flare_pitch = 0.0
-        self._flare_sink = 0.0
+        self._flare_pitch = math.nan  # the glide's smoothed pitch until the flare
+        self._flare_sink = math.nan  # and its smoothed sink
         self._level_s = 0.0
         self._stopped_s = 0.0
         self._touchdown_pitch = 0.0
@@ -246,12 +250,11 @@ class Landing:
         """The demand for this step; ``v`` holds the parameters by name."""
         if self.phase == LandPhase.APPROACH:
             self._correct_ground(s, dt)
+            self._smooth_trim(s, dt)
         height = s.range_height if math.isfinite(s.range_height) else s.alt_msl - self.ground_alt
         ground_speed = math.hypot(*s.vel)
         if self.phase == LandPhase.APPROACH and self._flare_due(height, s.climb_rate, v):
             self.phase = LandPhase.FLARE
-            self._flare_pitch = s.pitch
-            self._flare_sink = -s.climb_rate
             self._flare_integ = 0.0
             self._decel = DecelEstimate()
             # The flare's time constant makes its first sink demand the sink rate now, or
@@ -285,6 +288,13 @@ class Landing:
         return LandingDemand(
             self.phase, line, alt, v["TECS_LAND_ARSPD"], flaps=_flaps(v), climb_ff=ff
         )
+
+    def _smooth_trim(self, s: AircraftState, dt: float) -> None:
+        if not math.isfinite(self._flare_pitch):
+            self._flare_pitch, self._flare_sink = s.pitch, -s.climb_rate
+        k = min(dt / GLIDE_TRIM_TAU_S, 1.0)
+        self._flare_pitch += (s.pitch - self._flare_pitch) * k
+        self._flare_sink += (-s.climb_rate - self._flare_sink) * k
 
     def _flare_due(self, height: float, climb_rate: float, v: Mapping[str, float]) -> bool:
         sink = max(-climb_rate, 0.1)

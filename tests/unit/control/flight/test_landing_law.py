@@ -116,8 +116,7 @@ def test_the_rangefinder_moves_the_glide_path_onto_the_runway_the_navigator_misp
 def test_a_flare_begun_as_a_gust_slows_the_sink_is_no_slower_than_the_glides():
     """A gust that has just slowed the sink when the flare begins does not make the flare
     slower than the glide's (it floated, and a C172 touched down 47 m long): its sink demand
-    starts from the glide's. Sinking faster than the glide (a dive back onto the path), the
-    flare starts from the sink rate now, as before."""
+    starts from the glide's."""
     v = V | {"LAND_PITCH_CD": -500.0}
     flare_at = TOUCHDOWN[1] - Landing(START, 150.0, TOUCHDOWN, 100.0).flare_distance(28.0, v)
 
@@ -131,4 +130,24 @@ def test_a_flare_begun_as_a_gust_slows_the_sink_is_no_slower_than_the_glides():
 
     # The glide's sink here is about 28 m/s times 50 m over 800 m: 1.7 m/s.
     assert flare_pitch(True, 0.8) < flare_pitch(False, 0.8) - math.radians(1.0)
-    assert flare_pitch(True, 3.0) == pytest.approx(flare_pitch(False, 3.0))
+
+
+def test_a_flare_begun_as_a_gust_pitches_the_nose_starts_from_the_glides_pitch():
+    """The flare's pitch starts from the glide's, averaged over the last seconds: a gust
+    that had pitched the nose down 5 degrees as the flare began held the C172's flare nose
+    low for seconds, and it sank onto the runway 18 m short."""
+    v = V | {"LAND_PITCH_CD": -500.0}
+    flare_at = TOUCHDOWN[1] - Landing(START, 150.0, TOUCHDOWN, 100.0).flare_distance(28.0, v)
+
+    def first_flare_pitch(pitch_at_start: float) -> float:
+        land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+        glide = replace(_state(flare_at - 100.0, 8.0, sink=1.7), pitch=math.radians(1.0))
+        for k in range(150):  # three seconds on the glide
+            land.step(replace(glide, pos=(0.0, flare_at - 100.0 + k * 0.56)), v, 0.02)
+        start = replace(_state(flare_at, 2.9, sink=1.7), pitch=pitch_at_start)
+        dem = land.step(start, v, 0.02)
+        assert dem.phase == LandPhase.FLARE
+        return dem.pitch
+
+    gust = first_flare_pitch(math.radians(-4.0))
+    assert gust == pytest.approx(first_flare_pitch(math.radians(1.0)), abs=math.radians(0.2))
