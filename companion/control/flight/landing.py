@@ -86,6 +86,8 @@ LANDING_PARAMS = (
     ParamDecl("TECS_LAND_SINK", 0.4, 0.05, 2.0, "m/s", "landing: sink rate at touchdown"),
     ParamDecl("TECS_LAND_PMAX", 10.0, 0.0, 30.0, "deg", "landing: most pitch in the flare"),
     ParamDecl("LEVEL_ROLL_LIMIT", 5.0, 0.0, 45.0, "deg", "landing: most bank in the flare"),
+    ParamDecl("TECS_APPR_SMAX", 0.0, 0.0, 20.0, "m/s", "landing: most sink on the approach, "
+              "for a steep final or a tailwind (0: TECS_SINK_MAX)"),
     ParamDecl("TECS_LAND_SPDWGT", 0.0, 0.0, 2.0, "", "landing: TECS speed weight on the approach "
               "(0: pitch holds the glide path)"),
     ParamDecl("LAND_BRAKE", 0.5, 0.0, 1.0, "", "rollout: wheel brakes (fraction of full)"),

@@ -128,7 +128,8 @@ class LandingFlight:
             line = Setpoint(Kind.LINE, dem.line[0], dem.line[1], dem.alt_msl, speed=dem.speed)
             if dem.phase == LandPhase.APPROACH:  # the glide path before the speed
                 weight = config["TECS_LAND_SPDWGT"]
-                self.tecs.gains = replace(config.tecs, speed_weight=weight)
+                sink = config["TECS_APPR_SMAX"] or config.tecs.sink_max
+                self.tecs.gains = replace(config.tecs, speed_weight=weight, sink_max=sink)
             return fly_line(line, pos, vel, nav, airspeed, dt, out, dem.speed, dem.climb_ff)
         if dem.disarm and executor is not None and not self.landing_home:
             executor.land_complete()

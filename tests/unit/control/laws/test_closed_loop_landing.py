@@ -51,6 +51,23 @@ def test_the_landing_pattern_is_flown_to_a_stop_on_the_target(airframe: str, win
     assert score.passed(), score
 
 
+def test_a_steep_final_with_a_tailwind_is_flown_down_its_path_onto_the_target():
+    """circuit_west's 4.6° final with 5 m/s behind the aircraft needs more than 3 m/s of
+    sink to follow: held to TECS_SINK_MAX's 3 m/s, the C172 stayed metres above the path and
+    landed tens of metres long; the airframe's TECS_APPR_SMAX lets it follow the path."""
+    items = checked_plan(PLAN.with_name("circuit_west.plan"))[0]
+    tailwind = (0.0, -5.0, 0.0)  # blowing west, along the westward final
+    scores = []
+    for smax in (0.0, 5.0):  # 0: TECS_SINK_MAX on the approach too
+        loop = ClosedLoop("c172p", items, wind_ned=tailwind, turbulence="light",
+                          range_max_m=12.0, overrides={"TECS_APPR_SMAX": smax})  # fmt: skip
+        _fly(loop, 700.0)
+        scores.append(landing_score_for_plan(loop.truth(), items))
+    held, free = scores
+    assert free.passed(), free
+    assert held.along_m > 20.0, held
+
+
 @pytest.mark.parametrize(("airframe", "error_m"), [("J3Cub", -3.2), ("c172p", 3.2)])
 def test_a_home_altitude_misread_at_arming_is_corrected_by_the_rangefinder(airframe, error_m):  # type: ignore[no-untyped-def]
     """The navigator's GPS-aided height read 3.2 m off when home was taken (as in a
