@@ -262,7 +262,7 @@ def follow_flight_group(
         health = node.latest_reader("system/health")
         waiter = node.waiter([health])
         while not stopping.is_set():
-            _, ready = waiter.wait_with_fds(FLIGHT_LOOK_S, [wake])
+            _, ready = waiter.wait_with_fds(FLIGHT_LOOK_S, [wake], fds_key=wake)  # kept
             if ready:
                 _drain(wake)
             table = health.get()
