@@ -20,7 +20,7 @@ once a second, timeouts of threads whose input the chain takes, bus connection u
 weighs that much more than in flight. Compare runs of similar wall seconds, or the IMU
 thread plus the navigator's, controller's and servos' own threads, whose samples move
 between them as the timeouts fall. Exact lockstep also makes the logger wake for every
-sample (``in_step``), which it does not do in real time. Kernel time (system calls, thread
+IMU sample (``in_step``), which it does not do in real time. Kernel time (system calls, thread
 switches) is not counted at all.
 """
 

@@ -222,6 +222,9 @@ class Waiter:
         self._guards: list[Any] = []
         self._owners: dict[Any, Reader[Any]] = {}
         self._built: Any = None
+        self._fd_guards: list[Any] = []
+        self._fd_ids: dict[Any, int] = {}  # an attached descriptor's id, as the WaitSet says
+        self._fds_kept: tuple[Any, ...] | None = None  # what the attached ones were, kept
 
     @property
     def _waitset(self) -> Any:
@@ -255,27 +258,47 @@ class Waiter:
         return [r for r in self.readers if r.has_samples()]
 
     def wait_with_fds(
-        self, timeout_s: float, fds: Sequence[int]
+        self, timeout_s: float, fds: Sequence[int], fds_key: object = None
     ) -> tuple[list[Reader[Any]], list[int]]:
         """Like :meth:`wait`, also woken by any of ``fds`` becoming readable.
 
-        The descriptors are attached for this one wait only: a socket or serial port may
-        close between two waits, and a closed descriptor must never stay in the WaitSet.
-        Returns the readers with data and the descriptors that are readable.
+        ``fds_key``: a value the caller changes whenever one of its descriptors may have
+        been closed (its number then free for another file, which the WaitSet would not
+        watch: a closed file leaves the kernel's epoll set by itself). While it and ``fds``
+        stay the same the descriptors stay attached from one wait to the next: attaching
+        and detaching one cost iceoryx2 seven system calls (it reads the kernel's watch
+        limit from /proc each time), 13 a wake-up for the link's two sockets. None: they
+        are attached for this one wait only. Returns the readers with data and the
+        descriptors that are readable.
         """
-        guards = [
-            self._waitset.attach_notification_fd(iox2.FileDescriptor.non_owning_new(f)) for f in fds
-        ]
+        self._attach_fds(fds, fds_key)
         try:
             fired = self._wait(timeout_s)
-            ids = {
-                iox2.WaitSetAttachmentId.from_guard(g): f for g, f in zip(guards, fds, strict=True)
-            }
-            ready_fds = [ids[a] for a in fired if a in ids]
+            ready_fds = [self._fd_ids[a] for a in fired if a in self._fd_ids]
         finally:
-            for guard in guards:
-                guard.delete()
+            if fds_key is None:
+                self._detach_fds()
         return self._settle(fired), ready_fds
+
+    def _attach_fds(self, fds: Sequence[int], fds_key: object) -> None:
+        kept = (*fds, fds_key)
+        if fds_key is not None and kept == self._fds_kept:
+            return
+        self._detach_fds()  # first: a number reused would otherwise lose its new watch
+        waitset = self._waitset
+        self._fd_guards = [
+            waitset.attach_notification_fd(iox2.FileDescriptor.non_owning_new(f)) for f in fds
+        ]
+        self._fd_ids = {
+            iox2.WaitSetAttachmentId.from_guard(g): f
+            for g, f in zip(self._fd_guards, fds, strict=True)
+        }
+        self._fds_kept = kept if fds_key is not None else None
+
+    def _detach_fds(self) -> None:
+        for guard in self._fd_guards:
+            guard.delete()
+        self._fd_guards, self._fd_ids, self._fds_kept = [], {}, None
 
     def _wait(self, timeout_s: float) -> list[Any]:
         """The WaitSet's fired attachments; it only looks when a sample already waits."""
@@ -304,7 +327,8 @@ class Waiter:
         return [r for r in self.readers if r.has_samples()]
 
     def close(self) -> None:
-        """Detach from the readers."""
+        """Detach from the readers and the descriptors."""
+        self._detach_fds()
         for guard in self._guards:
             guard.delete()
         self._guards.clear()
@@ -333,17 +357,17 @@ class GatedWaiter:
         self._was_open = True
 
     def wait_with_fds(
-        self, timeout_s: float, fds: Sequence[int], gate_open: bool
+        self, timeout_s: float, fds: Sequence[int], gate_open: bool, fds_key: object = None
     ) -> tuple[list[Reader[Any]], list[int]]:
         """:meth:`Waiter.wait_with_fds`; the gated reader ends it only when ``gate_open``
         (and is among the readers returned only then)."""
         if not gate_open:
             self._was_open = False
-            return self._shut.wait_with_fds(timeout_s, fds)
+            return self._shut.wait_with_fds(timeout_s, fds, fds_key)
         if not self._was_open:
             self.gated.consume_events()
             self._was_open = True
-        return self._open.wait_with_fds(timeout_s, fds)
+        return self._open.wait_with_fds(timeout_s, fds, fds_key)
 
     def close(self) -> None:
         """Detach from the readers."""

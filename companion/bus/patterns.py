@@ -165,6 +165,9 @@ class Reader(Generic[M]):
         self._last_seq: dict[int, int] = {}
         self.received = 0
         self.lost = 0
+        # Its notifications were taken just now (``take_notifications``): the next
+        # ``consume_events`` has none to clear and makes no system call.
+        self._taken = False
 
     # Whether a skipped sequence number is a loss (a Latest reader skips by design, and
     # then does not read the sample's header at all: a ctypes object on every value).
@@ -210,6 +213,7 @@ class Reader(Generic[M]):
         if self._subscriber.has_samples():
             self.consume_events()
             return True
+        self._taken = False
         try:
             with self._idle:
                 events = self.listener.timed_wait(listener_timeout(timeout_s))
@@ -220,7 +224,14 @@ class Reader(Generic[M]):
 
     def take_notifications(self) -> bool:
         """Whether a writer notified since the last wait (the notifications are taken): a
-        sample published without waking (``Writer.publish``'s ``wake``) leaves none."""
+        sample published without waking (``Writer.publish``'s ``wake``) leaves none.
+
+        The next ``consume_events`` then clears nothing: a composed plug-in's chain takes
+        its trigger's notification before its step, whose wait cleared it again, two
+        ``recvfrom`` finding none (iceoryx2's ``try_wait`` on an empty listener; one
+        finding a notification is one). A notification that comes between the two stays,
+        and ends a later wait early as any stale wake-up does."""
+        self._taken = True
         try:
             return bool(self.listener.try_wait())
         except iox2.ListenerWaitError:
@@ -228,7 +239,11 @@ class Reader(Generic[M]):
 
     def consume_events(self) -> None:
         """Clear pending notifications (they are only wake-ups; data is in the queue)."""
+        if self._taken:
+            self._taken = False
+            return
         self.take_notifications()
+        self._taken = False
 
     def has_samples(self) -> bool:
         """True when a sample is waiting."""

@@ -72,26 +72,31 @@ class ChainLink:
     def _reader_notified(self) -> bool:
         return self._reader is not None and self._reader.take_notifications()
 
-    def run_after(self, producer: PluginHost) -> None:
+    def run_after(self, producer: PluginHost) -> float | None:
         """On the producer's thread, after its step: this plug-in's step, if a sample of
-        its trigger waits for it and it is not busy on its own thread."""
+        its trigger waits for it and it is not busy on its own thread. The thread's CPU
+        time when it ended (None: it did not run)."""
         host = self.host
         if host is None or not self._has_input(host):
-            return
+            return None
         self._last_run = time.monotonic()  # the producer delivers: no step of its own
         if not self._lock.acquire(blocking=False):
-            return  # busy in its own step: its own wait takes the sample
+            return None  # busy in its own step: its own wait takes the sample
         # The CPU of this step and of its own followers' is moved from the producer's row to
         # this one; each follower moves its own share on from here, so every plug-in's row
-        # holds its own steps, however deep in the chain they ran.
-        cpu_before = time.thread_time()
+        # holds its own steps, however deep in the chain they ran. A last follower's reading
+        # at its end is this one's end too (a clock read is a system call).
+        cpu_before, cpu_after = time.thread_time(), None
         try:
             if self._step_locked(host):
-                host.after_step()  # its own followers
+                cpu_after = host.after_step()  # its own followers
         finally:
-            took = time.thread_time() - cpu_before
+            if cpu_after is None:
+                cpu_after = time.thread_time()
+            took = cpu_after - cpu_before
             host.cpu_moved_s += took
             producer.cpu_moved_s -= took
+        return cpu_after
 
     def _step_locked(self, host: PluginHost) -> bool:
         """One step under the lock ``run_after`` took; whether it ran and succeeded.
@@ -138,10 +143,13 @@ class ChainLink:
         return not self.failed
 
 
-def run_followers(followers: Sequence[ChainLink], producer: PluginHost) -> None:
-    """Run each follower that has a sample of its trigger waiting, after ``producer``'s step."""
+def run_followers(followers: Sequence[ChainLink], producer: PluginHost) -> float | None:
+    """Run each follower that has a sample of its trigger waiting, after ``producer``'s step;
+    the thread's CPU time when the last one ended (None: the last did not run)."""
+    cpu_after = None
     for link in followers:
-        link.run_after(producer)
+        cpu_after = link.run_after(producer)
+    return cpu_after
 
 
 def chain_links(members: Sequence[dict[str, Any]]) -> dict[str, tuple[str, ChainLink]]:

@@ -39,7 +39,7 @@ from companion.exec_control.plugin_host import (
 )
 from companion.exec_control.priority import apply_nice
 from companion.exec_control.registry import load
-from companion.fd_wait import wait_readable
+from companion.fd_wait import drain, wait_readable
 from companion.messages import PluginStats
 
 if TYPE_CHECKING:
@@ -245,7 +245,7 @@ def main(spec: dict[str, Any]) -> int:
         follow_flight_group(spec, flight, stopping, wake, node)
     while not stopping.is_set():
         wait_readable([wake], None)
-        _drain(wake)
+        drain(wake)
     stop_all(always + (flight.members if flight.running else []))
     return 0
 
@@ -262,17 +262,10 @@ def follow_flight_group(
         health = node.latest_reader("system/health")
         waiter = node.waiter([health])
         while not stopping.is_set():
-            _, ready = waiter.wait_with_fds(FLIGHT_LOOK_S, [wake])
+            _, ready = waiter.wait_with_fds(FLIGHT_LOOK_S, [wake], fds_key=wake)  # kept
             if ready:
-                _drain(wake)
+                drain(wake)
             table = health.get()
             if table is not None:
                 flight.set(bool(table.flight_running))
         waiter.close()
-
-
-def _drain(fd: int) -> None:
-    try:
-        os.read(fd, 64)
-    except BlockingIOError:
-        pass

@@ -85,8 +85,8 @@ class StepTimer:
         return tuple(ordered[min(last, int(q * len(ordered)))] for q in qs)
 
 
-def _nothing() -> None:
-    pass
+def _nothing() -> float | None:
+    return None
 
 
 def _signal_pipe() -> int:
@@ -126,8 +126,9 @@ class PluginHost:
         self._cpu_clock = time.pthread_getcpuclockid(threading.get_ident())
         self.cpu_moved_s = 0.0
         self._cpu_mark = (self._cpu_s(), time.monotonic())
-        # Run after each step on this plug-in's thread (the composed host's chain).
-        self.after_step: Callable[[], None] = _nothing
+        # Run after each step on this plug-in's thread (the composed host's chain); it gives
+        # the thread's CPU time when it ended if it read it last (None: it did not).
+        self.after_step: Callable[[], float | None] = _nothing
         self.bus = BusNode(spec["namespace"], spec["name"], node)
         self.timer = StepTimer()
         # A composed plug-in's host gives a writer that outlives this instance: the counters

@@ -36,6 +36,7 @@ class Endpoint(ABC):
     """One transport. ``read_ready`` returns what arrived, keyed by the remote it came from."""
 
     options: EndpointOptions
+    fd_changes = 0  # descriptors closed or opened so far (a number closed may come back)
 
     def __init__(self, url: str) -> None:
         self.url = url
@@ -166,6 +167,7 @@ class TcpIn(Endpoint):
                 return []
             client.setblocking(False)
             self.clients[client.fileno()] = client
+            self.fd_changes += 1
             log.info("%s: client %s:%d connected", self.url, *addr)
             return []
         conn = self.clients.get(fd)
@@ -187,6 +189,7 @@ class TcpIn(Endpoint):
         conn = self.clients.pop(fd, None)
         if conn is not None:
             conn.close()
+            self.fd_changes += 1
 
     def has_remote(self) -> bool:
         return bool(self.clients)
@@ -244,6 +247,7 @@ class SerialEndpoint(Endpoint):
             self._retry_s = min(2 * self._retry_s, MAX_RETRY_S)
             return None
         log.info("%s: reopened", self.url)
+        self.fd_changes += 1
         self._retry_s = FIRST_RETRY_S
         return self.port
 
@@ -283,6 +287,7 @@ class SerialEndpoint(Endpoint):
     def close(self) -> None:
         port, self.port = self.port, None
         if port is not None:
+            self.fd_changes += 1
             with contextlib.suppress(*_PORT_ERRORS):
                 port.close()
 
@@ -298,7 +303,10 @@ def parse_serial_url(url: str) -> tuple[str, int]:
 
 DEFAULT_NETWORK_BYTES_S = 1_000_000.0
 SERIAL_SHARE = 0.8
-SCHEMES = frozenset({"udpout", "udpin", "tcpin", "serial"})
+KINDS: dict[str, type[Endpoint]] = dict(
+    udpout=UdpOut, udpin=UdpIn, tcpin=TcpIn, serial=SerialEndpoint
+)
+SCHEMES = frozenset(KINDS)
 
 
 @dataclass(frozen=True)
@@ -356,15 +364,9 @@ def open_endpoint(url: str) -> Endpoint:
     """Open the endpoint a URL names; EndpointError for an unknown scheme or option."""
     base, options = split_options(url)
     scheme = base.split("://", 1)[0] if "://" in base else ""
-    kinds: dict[str, type[Endpoint]] = {
-        "udpout": UdpOut,
-        "udpin": UdpIn,
-        "tcpin": TcpIn,
-        "serial": SerialEndpoint,
-    }
-    if scheme not in kinds:
+    if scheme not in KINDS:
         raise EndpointError(f"{url!r}: scheme must be one of {sorted(SCHEMES)}")
-    endpoint = kinds[scheme](base)
+    endpoint = KINDS[scheme](base)
     endpoint.options = options
     return endpoint
 

@@ -30,6 +30,7 @@ from typing import Any, Protocol
 
 import serial
 
+from companion.fd_wait import drain
 from companion.sensors.termios2_serial import port_class
 
 log = logging.getLogger(__name__)
@@ -184,7 +185,7 @@ class ReopeningSerial:
         assert self._poll is not None
         events = self._poll.poll(self._timeout_ms)
         if self.stop_fd is not None and any(ready == self.stop_fd for ready, _ in events):
-            _drain(self.stop_fd)  # a signal: its handler has run; the caller looks now
+            drain(self.stop_fd)  # a signal: its handler has run; the caller looks now
             return b"", now_us()
         if not events:
             return b"", now_us()
@@ -310,12 +311,3 @@ def _poll_for(fd: int, stop_fd: int | None) -> select.poll:
     if stop_fd is not None:
         poll.register(stop_fd, select.POLLIN)
     return poll
-
-
-def _drain(fd: int) -> None:
-    """Empty a non-blocking wake-up pipe, so it wakes the next poll only for a new signal."""
-    try:
-        while os.read(fd, 256):
-            pass
-    except OSError:  # empty (BlockingIOError), interrupted, or closed: nothing to take
-        pass

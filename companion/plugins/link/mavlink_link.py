@@ -304,7 +304,9 @@ class MavlinkLink(Plugin):
         if self.gcs.heard:  # before, link/status says "never heard": it rides other wakes
             timeout = min(timeout, max(0.0, self.next_link_status_s - now_s))
         fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
-        woken, ready = self.waker.wait_with_fds(timeout, list(fd_owner), nav_wanted)
+        # Watched from one wait to the next while no endpoint closed or opened one.
+        changes = sum(ep.fd_changes for ep in self.endpoints)
+        woken, ready = self.waker.wait_with_fds(timeout, list(fd_owner), nav_wanted, changes)
         if self.readers["nav"] in woken:
             self.nav_at_s = time.monotonic()
         for fd in ready:

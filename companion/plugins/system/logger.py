@@ -65,6 +65,9 @@ TRICKLE_WAIT_S = 5.0
 # The navigator plug-ins whose settings the log keeps.
 NAVIGATORS = ("nav.ins_ekf", "nav.gps_compass")
 _WAKERS = ("system/health", "vehicle/statustext", "link/commands", "params/changes")
+# With ``in_step`` its samples wake the logger too, and how far it wrote is their stamp: the
+# lockstep waits for that, and the other channels' samples go with each wake-up.
+STEP_CHANNEL = "sensors/imu"
 LOSS = ""  # the channel name of a loss held among the samples kept from before arming
 
 
@@ -108,7 +111,9 @@ class LoggerPlugin(Plugin):
             bool, True, "a new file at each arming and disarming (false: one from start-up)"
         ),
         "in_step": Setting(
-            bool, False, "wake on every sample and say how far it wrote (exact lockstep waits)"
+            bool,
+            False,
+            "wake on every IMU sample and say how far it wrote (exact lockstep waits)",
         ),
         "budget_mb": Setting(float, 1000.0, "disk space for logs; oldest removed", min=0.01),
         "file_mb": Setting(
@@ -153,7 +158,8 @@ class LoggerPlugin(Plugin):
         self.topics = {name: topic_name(name) for name in names}
         # Its own reader: the one in ``readers`` hands every table to the log.
         self.health = ctx.bus.latest_reader("system/health")
-        wakers = [r for n, r in self.readers.items() if s["in_step"] or n in _WAKERS]
+        step = (STEP_CHANNEL,) if s["in_step"] else ()
+        wakers = [r for n, r in self.readers.items() if n in (*_WAKERS, *step)]
         self.waiter = ctx.bus.waiter(wakers)
         self.any_sample = ctx.bus.waiter(list(self.readers.values()))
         self.trickle = False  # the last read found under TRICKLE_HZ samples a second
@@ -292,7 +298,7 @@ class LoggerPlugin(Plugin):
             self.recent.append((name, msg))
             return
         self.writer.data(self.topics[name], msg)
-        if name == "sensors/imu":
+        if name == STEP_CHANNEL:
             self.written_us = max(self.written_us, int(msg.t_us))
         if name == "vehicle/statustext":
             self.writer.log_string(msg.t_us, msg.severity, msg.text.decode(errors="replace"))
