@@ -339,4 +339,11 @@ class LoggerPlugin(Plugin):
         self.recorder.close()
 
     def close(self) -> None:
+        # What came after the last wake-up goes into the file before it closes.
+        if self.recorder.is_open:
+            try:
+                for name, reader in self.readers.items():
+                    self._drain(name, reader)
+            except OSError as exc:
+                self.ctx.log.error("flight log %s: %s", self.recorder.path, exc)
         self._close()
