@@ -202,11 +202,14 @@ class LoggerPlugin(Plugin):
         try:
             self._work()
         except OSError as exc:
-            # A full or failing card: stop this file (what reached it stays readable) and
-            # carry on reading, so nothing upstream notices; the next arming tries again.
-            self.ctx.log.error("flight log %s: %s; logging stopped", self.recorder.path, exc)
-            self.ctx.health.bad()
-            self.recorder.abandon()
+            self._give_up(exc)
+
+    def _give_up(self, exc: OSError) -> None:
+        # A full or failing card: stop this file (what reached it stays readable) and carry
+        # on reading, so nothing upstream notices; the next arming tries again.
+        self.ctx.log.error("flight log %s: %s; logging stopped", self.recorder.path, exc)
+        self.ctx.health.bad()
+        self.recorder.abandon()
 
     @property
     def writer(self) -> ULogWriter | None:
@@ -215,12 +218,7 @@ class LoggerPlugin(Plugin):
 
     def _work(self) -> None:
         self._follow_arming()
-        fill, total = 0.0, 0
-        for name, reader in self.readers.items():
-            count = self._drain(name, reader)
-            if count and name in self.depths:
-                fill = max(fill, count / self.depths[name])
-            total += count
+        fill, total = self._drain_all()
         self._adapt(fill, total)
         now_s = time.monotonic()
         self.trickle = total < TRICKLE_HZ * (now_s - self.read_at_s)
@@ -229,6 +227,16 @@ class LoggerPlugin(Plugin):
             self.progress.publish(LogProgress(t_us=self.written_us))
         if self.recorder.is_open and time.monotonic() >= self.next_flush:
             self._flush()
+
+    def _drain_all(self) -> tuple[float, int]:
+        """Record what waits on every channel: the fullest queue's share, and the samples."""
+        fill, total = 0.0, 0
+        for name, reader in self.readers.items():
+            count = self._drain(name, reader)
+            if count and name in self.depths:
+                fill = max(fill, count / self.depths[name])
+            total += count
+        return fill, total
 
     def _drain(self, name: str, reader: Reader[Any]) -> int:
         """Record what waits on one channel; the number of samples."""
@@ -342,8 +350,7 @@ class LoggerPlugin(Plugin):
         # What came after the last wake-up goes into the file before it closes.
         if self.recorder.is_open:
             try:
-                for name, reader in self.readers.items():
-                    self._drain(name, reader)
+                self._drain_all()
             except OSError as exc:
-                self.ctx.log.error("flight log %s: %s", self.recorder.path, exc)
+                self._give_up(exc)
         self._close()
