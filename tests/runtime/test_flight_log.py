@@ -218,10 +218,14 @@ def test_lost_samples_are_counted_once_and_marked_in_the_log(vehicle_factory, tm
         ax = imu_ax(read_log(logs))  # numbered from 1: the gaps are what was lost
         return int(ax[-1] - ax[0] + 1) - len(ax) if ax else -1
 
-    # All three bursts written and counted (the row comes once a second).
+    # All three bursts written and counted (the row comes once a second, the bursts 0.5 s
+    # apart: the row can match the log after the second burst, before the third is sent).
     wait_for(
         lambda: (
-            (r := vehicle.row("logger")) is not None and r.dropped > 0 and r.dropped == missing()
+            (r := vehicle.row("logger")) is not None
+            and r.dropped > 0
+            and r.dropped == missing()
+            and imu_ax(read_log(logs))[-1:] == [3 * 2000]
         ),
         30,
         "the status row's dropped count equal to the samples missing from the log",
