@@ -72,7 +72,7 @@ def fly(airframe: str, plan: Path, seed: int | None) -> Landed:
         airborne = airborne or loop.samples[-1].alt_agl > LOW_M
         if airborne and wheels is None and _weight_on_wheels(loop):
             wheels = (
-                loop.flight.fdm["position/lat-gc-deg"],
+                loop.flight.fdm["position/lat-geod-deg"],
                 loop.flight.fdm["position/long-gc-deg"],
             )
         if loop.samples[-1].out.disarm:
