@@ -28,8 +28,8 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 
-from companion.control.mission.executor import tangent_angle
 from companion.control.mission.items import MissionItem
+from companion.control.mission.leg_geometry import tangent_angle
 from companion.geodesy import LocalFrame, wrap_pi
 from mavlink_dialect import companion as d
 

@@ -9,7 +9,8 @@ import math
 
 from companion.control.flight.assisted import track_ahead
 from companion.control.flight.flight_params import FlightConfig
-from companion.control.mission.executor import Kind, Setpoint, past_point
+from companion.control.mission.executor import Kind, Setpoint
+from companion.control.mission.leg_geometry import past_point
 from companion.control.modes import PILOT_MODES
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavState, VehicleStatus

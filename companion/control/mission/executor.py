@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 
 from companion.control.laws.fillet import MIN_TURN_RAD, corner_arc
 from companion.control.mission.items import CAMERA_STOPS, MissionItem
+from companion.control.mission.leg_geometry import distance as _distance
+from companion.control.mission.leg_geometry import past_point, tangent_angle
 from companion.geodesy import LocalFrame, wrap_pi
 from mavlink_dialect import companion as d
 
@@ -369,26 +371,3 @@ class MissionExecutor:
             self._advance(True, centre, target_alt)
             return None
         return circle
-
-
-def tangent_angle(centre: Point, radius: float, clockwise: bool, target: Point) -> float | None:
-    """The angle (from north, about ``centre``) of the point where a circle flown that way
-    is left straight towards ``target``; None when the target is inside the circle."""
-    dist = _distance(centre, target)
-    if dist <= radius:
-        return None
-    bearing = math.atan2(target[1] - centre[1], target[0] - centre[0])
-    beta = math.acos(radius / dist)
-    return wrap_pi(bearing - beta if clockwise else bearing + beta)
-
-
-def _distance(a: Point, b: Point) -> float:
-    return math.hypot(b[0] - a[0], b[1] - a[1])
-
-
-def past_point(a: Point, b: Point, pos: Point) -> bool:
-    """True once ``pos`` is beyond the line through ``b`` square to the leg a→b."""
-    leg = (b[0] - a[0], b[1] - a[1])
-    if math.hypot(*leg) < 1.0:
-        return False
-    return (pos[0] - b[0]) * leg[0] + (pos[1] - b[1]) * leg[1] > 0.0

@@ -1,0 +1,33 @@
+"""Plane geometry of legs and circles in the home-centred north/east frame (metres)."""
+
+from __future__ import annotations
+
+import math
+
+from companion.geodesy import wrap_pi
+
+Point = tuple[float, float]
+
+
+def tangent_angle(centre: Point, radius: float, clockwise: bool, target: Point) -> float | None:
+    """The angle (from north, about ``centre``) of the point where a circle flown that way
+    is left straight towards ``target``; None when the target is inside the circle."""
+    dist = distance(centre, target)
+    if dist <= radius:
+        return None
+    bearing = math.atan2(target[1] - centre[1], target[0] - centre[0])
+    beta = math.acos(radius / dist)
+    return wrap_pi(bearing - beta if clockwise else bearing + beta)
+
+
+def distance(a: Point, b: Point) -> float:
+    """Straight-line distance from ``a`` to ``b``."""
+    return math.hypot(b[0] - a[0], b[1] - a[1])
+
+
+def past_point(a: Point, b: Point, pos: Point) -> bool:
+    """True once ``pos`` is beyond the line through ``b`` square to the leg a→b."""
+    leg = (b[0] - a[0], b[1] - a[1])
+    if math.hypot(*leg) < 1.0:
+        return False
+    return (pos[0] - b[0]) * leg[0] + (pos[1] - b[1]) * leg[1] > 0.0
