@@ -13,6 +13,7 @@ from dataclasses import replace
 from companion.control.flight.assisted import track_ahead
 from companion.control.flight.attitude_modes import Sticks
 from companion.control.flight.flight_params import FlightConfig
+from companion.control.flight.landing import landing_flaps
 from companion.control.flight.landing_flight import LandingFlight, MissionRef, Motion
 from companion.control.flight.mode_targets import arrive, mode_target
 from companion.control.flight.output import ControlOutput
@@ -268,6 +269,8 @@ class FlightController:
             ex.jumps_done.update(self.jumps.take_up(self.items))  # restarted in the air
             self.executor = ex
         setpoint = ex.step(pos, nav.alt_msl_m, t_s, self._turn_radius())
+        if setpoint.kind in (Kind.LINE, Kind.CIRCLE) and ex.leads_to_landing():
+            setpoint = replace(setpoint, approach=True)
         if resumed is not None:  # and the corner it may be turning through
             self._line = resumed.line_before(setpoint)
         if self.landed and setpoint.kind not in (Kind.TAKEOFF, Kind.LAND):
@@ -341,6 +344,9 @@ class FlightController:
         """Fly ``sp`` by the energy controller and the line guidance (or at ``roll_dem``)."""
         cfg = self.config
         speed_dem = sp.speed if math.isfinite(sp.speed) else cfg["AIRSPEED_CRUISE"]
+        if sp.approach:  # slowed and configured before the final: no speed left to lose on it
+            speed_dem = least_speed = cfg["TECS_LAND_ARSPD"]
+            out.flaps = landing_flaps(cfg.values)
         # The landing approach alone may fly slower than AIRSPEED_MIN.
         speed_min = min(cfg["AIRSPEED_MIN"], least_speed)
         speed_dem = max(speed_min, min(cfg["AIRSPEED_MAX"], speed_dem))

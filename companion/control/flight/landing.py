@@ -58,7 +58,6 @@ STOPPED_SPEED = 0.8  # m/s: slower than this counts as stopped
 # so a gust cannot lift the aircraft back off while it is still fast.
 WHEELS_DOWN_PITCH = math.radians(3.0)
 NOT_FLYING = 0.6  # below this fraction of the approach speed the wings cannot lift it
-MIN_GLIDE = math.radians(1.5)  # a flatter path cannot be flown with the throttle at idle
 # The flare's sink demand may aim for the point within these fractions of the nominal
 # flare's: more, and a flare that started early floats then drops onto the runway.
 # Never more than the nominal: a flare that dives for a point it would float past reaches
@@ -86,6 +85,8 @@ LANDING_PARAMS = (
     ParamDecl("TECS_LAND_SINK", 0.4, 0.05, 2.0, "m/s", "landing: sink rate at touchdown"),
     ParamDecl("TECS_LAND_PMAX", 10.0, 0.0, 30.0, "deg", "landing: most pitch in the flare"),
     ParamDecl("LEVEL_ROLL_LIMIT", 5.0, 0.0, 45.0, "deg", "landing: most bank in the flare"),
+    ParamDecl("LAND_SLOPE_MIN", 3.0, 1.0, 10.0, "deg", "landing: the least slope of the glide "
+              "path; from a lower approach the height is held until the path is met"),
     ParamDecl("TECS_APPR_SMAX", 0.0, 0.0, 20.0, "m/s", "landing: most sink on the approach, "
               "for a steep final or a tailwind (0: TECS_SINK_MAX)"),
     ParamDecl("TECS_LAND_SPDWGT", 0.0, 0.0, 2.0, "", "landing: TECS speed weight on the approach "
@@ -209,7 +210,7 @@ class Landing:
         gs = max(ground_speed, 5.0)
         dist, h_f = 0.0, v["LAND_FLARE_ALT"]
         for _ in range(4):
-            slope = self._slope(dist, h_f)
+            slope = self._slope(dist, h_f, v)
             s0 = max(gs * slope, s_t * 1.5)
             # The flare begins where _flare_due will begin it: on a path steep enough that
             # LAND_FLARE_SEC comes first, higher than LAND_FLARE_ALT (the Cub at 4-5 m).
@@ -223,15 +224,20 @@ class Landing:
         self.flare_alt = h_f
         return dist
 
-    def _slope(self, flare_dist: float, flare_alt: float) -> float:
+    def _slope(self, flare_dist: float, flare_alt: float, v: Mapping[str, float]) -> float:
+        # Never flatter than LAND_SLOPE_MIN: on a flatter path the flare starts from so
+        # little sink that it is planned long, and a C172 at idle in it sank short of the
+        # point (15-50 m on 1.3-2.2° finals). The path then starts below the approach's
+        # height, which the aircraft holds until it meets the path, as on a glide slope.
         drop = self.start_alt - self.ground_alt - flare_alt
-        return max(drop / max(self.length - flare_dist, 1.0), math.tan(MIN_GLIDE))
+        least = math.tan(math.radians(v["LAND_SLOPE_MIN"]))
+        return max(drop / max(self.length - flare_dist, 1.0), least)
 
     def glide_alt(self, pos: Point, flare_dist: float, v: Mapping[str, float]) -> float:
         """The glide path's height (MSL) abeam ``pos``."""
         h_f = self.flare_alt if math.isfinite(self.flare_alt) else v["LAND_FLARE_ALT"]
         to_flare = -self.along(pos) - flare_dist
-        alt = self.ground_alt + h_f + to_flare * self._slope(flare_dist, h_f)
+        alt = self.ground_alt + h_f + to_flare * self._slope(flare_dist, h_f, v)
         return min(alt, max(self.start_alt, self.ground_alt + h_f))
 
     def _correct_ground(self, s: AircraftState, dt: float) -> None:
@@ -284,11 +290,11 @@ class Landing:
         alt = self.glide_alt(s.pos, flare_dist, v)
         on_slope = alt < self.start_alt
         speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
-        slope = self._slope(flare_dist, self.flare_alt)
+        slope = self._slope(flare_dist, self.flare_alt, v)
         self._glide_sink = max(speed_along, 0.0) * slope
         ff = -self._glide_sink if on_slope else 0.0
         return LandingDemand(
-            self.phase, line, alt, v["TECS_LAND_ARSPD"], flaps=_flaps(v), climb_ff=ff
+            self.phase, line, alt, v["TECS_LAND_ARSPD"], flaps=landing_flaps(v), climb_ff=ff
         )
 
     def _smooth_trim(self, s: AircraftState, dt: float) -> None:
@@ -332,7 +338,7 @@ class Landing:
             pitch=clamp(pitch, pitch_min, pitch_max),
             throttle=0.0,
             roll_limit=math.radians(v["LEVEL_ROLL_LIMIT"]),
-            flaps=_flaps(v),
+            flaps=landing_flaps(v),
         )
 
     def _rollout(
@@ -360,9 +366,10 @@ class Landing:
             brakes=v["LAND_BRAKE"] if ground_speed < v["LAND_BRAKE_SPD"] or stopped else 0.0,
             roll_limit=0.0,
             disarm=disarm,
-            flaps=_flaps(v),
+            flaps=landing_flaps(v),
         )
 
 
-def _flaps(v: Mapping[str, float]) -> float:
+def landing_flaps(v: Mapping[str, float]) -> float:
+    """The flaps of the landing (0 up .. 1 fully down), from ``LAND_FLAP_PERCNT``."""
     return clamp(v["LAND_FLAP_PERCNT"] / 100.0, 0.0, 1.0)

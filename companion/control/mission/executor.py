@@ -33,6 +33,8 @@ MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO it
 SKIPPED = CAMERA_STOPS | {d.MAV_CMD_DO_LAND_START}
 LOITER_ALT_MARGIN_M = 5.0  # LOITER_TO_ALT: this close to its height counts as there
 TANGENT_WINDOW = math.radians(30.0)  # leave a LOITER_TO_ALT this soon past the tangent point
+# Items a landing's final may start from (``leads_to_landing``).
+APPROACH_FROM = {d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_NAV_LOITER_TO_ALT}
 Point = tuple[float, float]
 
 
@@ -57,6 +59,7 @@ class Setpoint:
     clockwise: bool = True
     speed: float = math.nan  # NaN: the cruise speed
     from_alt: float = math.nan  # LAND: the height at a, where the glide path starts
+    approach: bool = False  # the leg or circle a landing's final starts from (leads_to_landing)
 
 
 @dataclass
@@ -260,25 +263,42 @@ class MissionExecutor:
 
     def _next_point(self, here: Point) -> Point | None:
         """Where the leg after the current waypoint goes (None when it is not a leg)."""
+        item = self._next_nav()
+        if item is None:
+            return None
+        if item.command == d.MAV_CMD_NAV_RETURN_TO_LAUNCH:
+            return (0.0, 0.0)
+        if item.command in (d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_NAV_LAND):
+            return self.point_of(item, here)
+        return None
+
+    def leads_to_landing(self) -> bool:
+        """Whether the current item is the waypoint or circle the landing's final starts
+        from (the next item flown is a NAV_LAND): the controller slows to the approach
+        speed and sets the landing flaps on it, as a pilot does before turning final."""
+        if self.finished or self.current >= len(self.items):
+            return False
+        if self.items[self.current].command not in APPROACH_FROM:
+            return False
+        nxt = self._next_nav()
+        return nxt is not None and nxt.command == d.MAV_CMD_NAV_LAND
+
+    def _next_nav(self) -> MissionItem | None:
+        """The item flown after the current one (speed changes, markers and jumps
+        followed as they will be), or None."""
         seq, jumps = self.current + 1, dict(self.jumps_done)
         for _ in range(MAX_JUMPS_PER_STEP):
             if seq >= len(self.items):
                 return None
             item = self.items[seq]
-            if item.command == d.MAV_CMD_DO_CHANGE_SPEED:
-                seq += 1
-            elif item.command == d.MAV_CMD_DO_JUMP:
+            if item.command == d.MAV_CMD_DO_JUMP:
                 done, repeats = jumps.get(item.seq, 0), round(item.param2)
                 jumps[item.seq] = done + 1
                 seq = round(item.param1) if repeats < 0 or done < repeats else seq + 1
-            elif item.command == d.MAV_CMD_NAV_RETURN_TO_LAUNCH:
-                return (0.0, 0.0)
-            elif item.command in SKIPPED:
+            elif item.command in SKIPPED or item.command == d.MAV_CMD_DO_CHANGE_SPEED:
                 seq += 1
-            elif item.command in (d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_NAV_LAND):
-                return self.point_of(item, here)
             else:
-                return None
+                return item
         return None
 
     def _return(self, item: MissionItem, pos: Point, alt: float) -> Setpoint:
@@ -307,36 +327,33 @@ class MissionExecutor:
 
     def _loiter_to_alt(self, item: MissionItem, pos: Point, alt: float) -> Setpoint | None:
         """Circle until at the item's height, then (param1 = 1) leave on the tangent that
-        points at the next waypoint, so the next leg starts on the circle's edge."""
+        points at the next waypoint, so the next leg starts on the circle's edge.
+
+        The controller cannot fly a circle tighter than it turns: a wider one is flown
+        through the same exit point, its centre moved off the leg, so the aircraft rolls out
+        on the leg (a C172 on QGroundControl's default 75 m landing circle came off its
+        215 m one 140 m beside a 380 m final and landed 22 m beside the runway)."""
         centre = self.point_of(item, self._prev)
         given = math.isfinite(item.param2) and item.param2 != 0
-        radius = abs(item.param2) if given else self.config.loiter_radius
-        # The controller flies a circle tighter than it can turn at the tightest it can.
-        radius = max(radius, self._turn_radius)
+        nominal = abs(item.param2) if given else self.config.loiter_radius
+        radius = max(nominal, self._turn_radius)
         clockwise = item.param2 >= 0
         target_alt = self.alt_of(item)
+        nxt = self._next_point(centre) if item.param1 >= 0.5 else None
+        exit_angle = None if nxt is None else tangent_angle(centre, nominal, clockwise, nxt)
+        if exit_angle is not None:
+            out = (math.cos(exit_angle), math.sin(exit_angle))
+            start = (centre[0] + nominal * out[0], centre[1] + nominal * out[1])
+            centre = (start[0] - radius * out[0], start[1] - radius * out[1])
         circle = Setpoint(Kind.CIRCLE, centre, centre, target_alt, radius, clockwise, self.speed)
         on_circle = abs(_distance(pos, centre) - radius) <= radius * ON_CIRCLE
         if abs(alt - target_alt) > LOITER_ALT_MARGIN_M or not on_circle:
             return circle
-        nxt = self._next_point(centre)
-        nominal = abs(item.param2) if given else self.config.loiter_radius
-        exit_angle = None
-        if nxt is not None and item.param1 >= 0.5:
-            exit_angle = tangent_angle(centre, nominal, clockwise, nxt)
-        if exit_angle is None or nxt is None:  # (exit_angle is None whenever nxt is)
+        if exit_angle is None:
             self._advance(True, pos, target_alt)
             return None
-        # The leg starts at the tangent point of the circle as planned. The circle flown
-        # may be wider (the bank limit): leave it where its course is the leg's course.
-        start = (
-            centre[0] + nominal * math.cos(exit_angle),
-            centre[1] + nominal * math.sin(exit_angle),
-        )
-        course = math.atan2(nxt[1] - start[1], nxt[0] - start[0])
-        leave_at = course - math.pi / 2 if clockwise else course + math.pi / 2
         angle = math.atan2(pos[1] - centre[1], pos[0] - centre[0])
-        past = wrap_pi(angle - leave_at) * (1.0 if clockwise else -1.0)
+        past = wrap_pi(angle - exit_angle) * (1.0 if clockwise else -1.0)
         if not 0.0 <= past <= TANGENT_WINDOW:
             return circle
         self._advance(True, start, target_alt)

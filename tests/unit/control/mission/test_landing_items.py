@@ -116,3 +116,40 @@ def test_loiter_to_alt_circles_down_then_leaves_on_the_tangent_to_the_runway():
     assert sp.a == pytest.approx((0.0, -500.0), abs=0.5)  # the planned tangent point
     assert sp.from_alt == pytest.approx(HOME_ALT + 50.0)
     assert dist(sp.a, sp.b) == pytest.approx(800.0, abs=0.5)
+
+
+def test_a_circle_wider_than_planned_is_moved_to_leave_onto_the_runway_line():
+    """A 100 m landing circle for an aircraft that turns no tighter than 250 m: the circle
+    flown keeps the planned exit point (the circle's northern point, course east) and the
+    centre moves south, so the aircraft comes off it on the runway line, not 150 m beside."""
+    items = [
+        item(0, d.MAV_CMD_DO_LAND_START),
+        item(1, d.MAV_CMD_NAV_LOITER_TO_ALT, (-100.0, -500.0), z=50.0, p1=1.0, p2=100.0),
+        item(2, d.MAV_CMD_NAV_LAND, LAND, z=0.0),
+    ]
+    ex = executor(items, pos=(-100.0, -900.0), alt=HOME_ALT + 50.0)
+    sp = ex.step((-100.0, -900.0), HOME_ALT + 50.0, 0.0, turn_radius=250.0)
+    assert sp.kind == Kind.CIRCLE and sp.radius == pytest.approx(250.0)
+    assert sp.b == pytest.approx((-250.0, -500.0), abs=0.05)
+    assert ex.leads_to_landing()
+    left_at = next(
+        deg
+        for deg in range(0, 360, 5)
+        if ex.step(on_circle(sp.b, 250.0, deg), HOME_ALT + 50.0, 0.0, 250.0).kind == Kind.LAND
+    )
+    assert on_circle(sp.b, 250.0, left_at)[0] == pytest.approx(0.0, abs=2.0)  # on the line
+    assert not ex.leads_to_landing()  # on the final itself: the landing flies it
+
+
+def test_only_the_item_the_final_starts_from_leads_to_the_landing():
+    items = [
+        item(0, d.MAV_CMD_NAV_WAYPOINT, (0.0, -2000.0), z=100.0),
+        item(1, d.MAV_CMD_NAV_WAYPOINT, (0.0, -800.0), z=50.0),
+        item(2, d.MAV_CMD_DO_CHANGE_SPEED, p2=20.0),
+        item(3, d.MAV_CMD_NAV_LAND, LAND, z=0.0),
+    ]
+    ex = executor(items, pos=(0.0, -2500.0), alt=HOME_ALT + 100.0)
+    ex.step((0.0, -2500.0), HOME_ALT + 100.0, 0.0)
+    assert ex.current == 0 and not ex.leads_to_landing()
+    ex.step((0.0, -2000.0), HOME_ALT + 100.0, 0.0)
+    assert ex.current == 1 and ex.leads_to_landing()
