@@ -133,5 +133,7 @@ def flight_config(values: Mapping[str, float]) -> FlightConfig:
         pitch_min=math.radians(v["PTCH_LIM_MIN_DEG"]),
         speed_weight=v["TECS_SPDWEIGHT"],
     )
-    executor = ExecutorConfig(v["WP_RADIUS"], v["WP_LOITER_RAD"], v["RTL_ALT_M"])
+    executor = ExecutorConfig(
+        v["WP_RADIUS"], v["WP_LOITER_RAD"], v["RTL_ALT_M"], math.radians(v["LAND_SLOPE_MAX"])
+    )
     return FlightConfig(attitude, tecs, executor, v)

@@ -87,6 +87,8 @@ LANDING_PARAMS = (
     ParamDecl("LEVEL_ROLL_LIMIT", 5.0, 0.0, 45.0, "deg", "landing: most bank in the flare"),
     ParamDecl("LAND_SLOPE_MIN", 3.0, 1.0, 10.0, "deg", "landing: the least slope of the glide "
               "path; from a lower approach the height is held until the path is met"),
+    ParamDecl("LAND_SLOPE_MAX", 0.0, 0.0, 20.0, "deg", "landing: a landing circle (LOITER_TO_ALT) "
+              "descends below its height until the final is no steeper (0: off)"),
     ParamDecl("TECS_APPR_SMAX", 0.0, 0.0, 20.0, "m/s", "landing: most sink on the approach, "
               "for a steep final or a tailwind (0: TECS_SINK_MAX)"),
     ParamDecl("TECS_LAND_SPDWGT", 0.0, 0.0, 2.0, "", "landing: TECS speed weight on the approach "

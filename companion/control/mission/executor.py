@@ -69,6 +69,7 @@ class ExecutorConfig:
     wp_radius: float = 30.0
     loiter_radius: float = 80.0
     rtl_alt_rel: float = 100.0
+    final_slope_max: float = 0.0  # rad: a landing circle descends until its final is no steeper
 
 
 @dataclass
@@ -168,14 +169,8 @@ class MissionExecutor:
     def _end(self, pos: Point) -> Setpoint:
         if self._hold is None:
             self.finished = True
-            self._hold = Setpoint(
-                Kind.CIRCLE,
-                self._prev,
-                self._prev,
-                self._prev_alt,
-                self.config.loiter_radius,
-                speed=self.speed,
-            )
+            self._hold = Setpoint(Kind.CIRCLE, self._prev, self._prev, self._prev_alt,
+                                  self.config.loiter_radius, speed=self.speed)  # fmt: skip
         return self._hold
 
     def _item(self, item: MissionItem, pos: Point, alt: float, t_s: float) -> Setpoint | None:
@@ -345,6 +340,7 @@ class MissionExecutor:
             out = (math.cos(exit_angle), math.sin(exit_angle))
             start = (centre[0] + nominal * out[0], centre[1] + nominal * out[1])
             centre = (start[0] - radius * out[0], start[1] - radius * out[1])
+            target_alt = self._final_from(start, target_alt)
         circle = Setpoint(Kind.CIRCLE, centre, centre, target_alt, radius, clockwise, self.speed)
         on_circle = abs(_distance(pos, centre) - radius) <= radius * ON_CIRCLE
         if abs(alt - target_alt) > LOITER_ALT_MARGIN_M or not on_circle:
@@ -358,6 +354,15 @@ class MissionExecutor:
             return circle
         self._advance(True, start, target_alt)
         return None
+
+    def _final_from(self, start: Point, alt: float) -> float:
+        """The height to leave a landing circle at for a final no steeper than
+        ``final_slope_max`` (a Cub idling down a 6° final gained 6 m/s, floated 34 m long)."""
+        land, steepest = self._next_nav(), self.config.final_slope_max
+        if steepest <= 0.0 or land is None or land.command != d.MAV_CMD_NAV_LAND:
+            return alt
+        final = _distance(start, self.point_of(land, start))
+        return min(alt, self.alt_of(land) + final * math.tan(steepest))
 
     def _loiter_item(
         self, item: MissionItem, pos: Point, alt: float, t_s: float

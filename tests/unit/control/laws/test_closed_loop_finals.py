@@ -1,8 +1,8 @@
 """Landings on finals unlike the benchmark's, flown against JSBSim on the true state.
 
 QGroundControl's landing pattern with its own defaults (loiter down to 40 m on a 75 m
-circle, then a 6° final of 380 m) and a final much flatter than a glide (1.9°), both
-with the C172 in calm air, scored as the issue asks.
+circle, then a 6° final of 380 m) with both airframes, and a final much flatter than a
+glide (1.9°) with the C172, in calm air, scored as the issue asks.
 """
 
 from __future__ import annotations
@@ -11,6 +11,8 @@ import json
 import math
 from dataclasses import replace
 from pathlib import Path
+
+import pytest
 
 from companion.control.flight.landing import LandPhase
 from companion.control.mission.plan import checked_plan
@@ -43,12 +45,17 @@ def _qgc_default_pattern(tmp_path: Path) -> Path:
     return path
 
 
-def test_qgcs_default_landing_pattern_is_flown_slowed_and_lands_on_target(tmp_path: Path) -> None:
+@pytest.mark.parametrize("airframe", ["c172p", "J3Cub"])
+def test_qgcs_default_landing_pattern_is_flown_slowed_and_lands_on_target(
+    airframe: str, tmp_path: Path
+) -> None:
     """The C172 used to come off the loiter at its cruise speed, 36-38 m/s, with 380 m to
     lose that and 40 m of height: it floated 155 m past the point. It now flies the
-    loiter before the final at the approach speed with the landing flaps."""
+    loiter before the final at the approach speed with the landing flaps. The Cub, which
+    glides flatter than 6° at idle, gained speed down that final and floated 34 m long: its
+    circle now descends until the final is LAND_SLOPE_MAX (4°) steep."""
     items = checked_plan(_qgc_default_pattern(tmp_path))[0]
-    loop = ClosedLoop("c172p", items, range_max_m=12.0)
+    loop = ClosedLoop(airframe, items, range_max_m=12.0)
     _fly(loop, 700.0)
     approach = [s for s in loop.samples if s.out.land_phase == LandPhase.APPROACH]
     assert approach, "never on the final"

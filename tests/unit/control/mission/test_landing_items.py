@@ -153,3 +153,22 @@ def test_only_the_item_the_final_starts_from_leads_to_the_landing():
     assert ex.current == 0 and not ex.leads_to_landing()
     ex.step((0.0, -2000.0), HOME_ALT + 100.0, 0.0)
     assert ex.current == 1 and ex.leads_to_landing()
+
+
+def test_a_landing_circle_descends_below_its_height_for_a_final_no_steeper_than_allowed():
+    """A 50 m circle 800 m from the point is a 3.6° final; with the steepest final at 2°
+    the circle goes down to 800 m · tan 2° = 27.9 m, and the landing's path starts there."""
+    items = [
+        item(0, d.MAV_CMD_NAV_LOITER_TO_ALT, CENTRE, z=50.0, p1=1.0, p2=RADIUS),
+        item(1, d.MAV_CMD_NAV_LAND, LAND, z=0.0),
+    ]
+    ex = executor(items, pos=(-250.0, -900.0), alt=HOME_ALT + 50.0)
+    ex.config.final_slope_max = math.radians(2.0)
+    low = HOME_ALT + 800.0 * math.tan(math.radians(2.0))
+    sp = ex.step((-250.0, -900.0), HOME_ALT + 50.0, 0.0)
+    assert sp.kind == Kind.CIRCLE and sp.alt_msl == pytest.approx(low, abs=0.1)
+    for deg in range(0, 360, 5):
+        sp = ex.step(on_circle(CENTRE, RADIUS, deg), low, 0.0)
+        if sp.kind == Kind.LAND:
+            break
+    assert sp.kind == Kind.LAND and sp.from_alt == pytest.approx(low, abs=0.1)
