@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 from companion.control.laws.fillet import MIN_TURN_RAD, corner_arc
 from companion.control.mission.items import CAMERA_STOPS, MissionItem
+from companion.control.mission.leg_geometry import CircleProgress, past_point, tangent_angle
 from companion.control.mission.leg_geometry import distance as _distance
-from companion.control.mission.leg_geometry import past_point, tangent_angle
 from companion.geodesy import LocalFrame, wrap_pi
 from mavlink_dialect import companion as d
 
@@ -33,6 +33,7 @@ MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO it
 SKIPPED = CAMERA_STOPS | {d.MAV_CMD_DO_LAND_START}
 LOITER_ALT_MARGIN_M = 5.0  # LOITER_TO_ALT: this close to its height counts as there
 TANGENT_WINDOW = math.radians(30.0)  # leave a LOITER_TO_ALT this soon past the tangent point
+ESTABLISHED = math.radians(90.0)  # and once it has flown this far round it
 # Items a landing's final may start from (``leads_to_landing``).
 APPROACH_FROM = {d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_NAV_LOITER_TO_ALT}
 Point = tuple[float, float]
@@ -73,13 +74,6 @@ class ExecutorConfig:
 
 
 @dataclass
-class _Loiter:
-    swept: float = 0.0
-    last_angle: float | None = None
-    started_s: float | None = None
-
-
-@dataclass
 class MissionExecutor:
     """Runs a mission from ``start(first)``; ``step()`` once per control cycle."""
 
@@ -94,7 +88,7 @@ class MissionExecutor:
 
     def __post_init__(self) -> None:
         self.jumps_done: dict[int, int] = {}  # how often each DO_JUMP (by seq) jumped
-        self._loiter = _Loiter()
+        self._loiter = CircleProgress()
         self._prev: Point = (0.0, 0.0)
         self._prev_alt = self.home_alt_msl
         self._hold: Setpoint | None = None
@@ -110,7 +104,7 @@ class MissionExecutor:
         self.jumps_done.clear()
         self.finished = False
         self._hold = None
-        self._loiter = _Loiter()
+        self._loiter = CircleProgress()
         self.climb_to, self._flown_back = math.nan, False
 
     def take_off_first(self, alt_msl: float) -> None:
@@ -164,7 +158,7 @@ class MissionExecutor:
         self.current += 1
         self._prev, self._prev_alt = pos, alt
         self._flown_back = False
-        self._loiter = _Loiter()
+        self._loiter = CircleProgress()
 
     def _end(self, pos: Point) -> Setpoint:
         if self._hold is None:
@@ -343,14 +337,18 @@ class MissionExecutor:
             target_alt = self._final_from(start, target_alt)
         circle = Setpoint(Kind.CIRCLE, centre, centre, target_alt, radius, clockwise, self.speed)
         on_circle = abs(_distance(pos, centre) - radius) <= radius * ON_CIRCLE
+        way = 1.0 if clockwise else -1.0
+        angle = self._loiter.track(pos, centre, way) if on_circle else self._loiter.off()
         if abs(alt - target_alt) > LOITER_ALT_MARGIN_M or not on_circle:
             return circle
         if exit_angle is None:
             self._advance(True, pos, target_alt)
             return None
-        angle = math.atan2(pos[1] - centre[1], pos[0] - centre[0])
-        past = wrap_pi(angle - exit_angle) * (1.0 if clockwise else -1.0)
-        if not 0.0 <= past <= TANGENT_WINDOW:
+        # Flown round the circle for a while (ArduPlane: lined up), not crossing it: an
+        # aircraft that came down to the height on its way and met the circle at the
+        # exit point flying across it turned final 100° off and landed 54 m beside.
+        past = wrap_pi(angle - exit_angle) * way
+        if not 0.0 <= past <= TANGENT_WINDOW or self._loiter.swept < ESTABLISHED:
             return circle
         self._advance(True, start, target_alt)
         return None
@@ -381,10 +379,7 @@ class MissionExecutor:
             return circle  # still getting onto the circle: nothing counts yet
         if state.started_s is None:
             state.started_s = t_s
-        angle = math.atan2(pos[1] - centre[1], pos[0] - centre[0])
-        if state.last_angle is not None:
-            state.swept += abs(wrap_pi(angle - state.last_angle))
-        state.last_angle = angle
+        state.track(pos, centre)
         if item.command == d.MAV_CMD_NAV_LOITER_TIME:
             done = t_s - state.started_s >= item.param1
         else:  # NAV_LOITER_TURNS

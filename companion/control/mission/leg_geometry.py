@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 from companion.geodesy import wrap_pi
 
@@ -31,3 +32,27 @@ def past_point(a: Point, b: Point, pos: Point) -> bool:
     if math.hypot(*leg) < 1.0:
         return False
     return (pos[0] - b[0]) * leg[0] + (pos[1] - b[1]) * leg[1] > 0.0
+
+
+@dataclass
+class CircleProgress:
+    """How far an aircraft has flown round a circle, and since when."""
+
+    swept: float = 0.0  # rad
+    last_angle: float | None = None
+    started_s: float | None = None
+
+    def track(self, pos: Point, centre: Point, way: float = 0.0) -> float:
+        """Add the arc flown since the last position (``way`` +1 clockwise, -1 the other
+        way, counting back as negative; 0 either way) and return the angle of ``pos``."""
+        angle = math.atan2(pos[1] - centre[1], pos[0] - centre[0])
+        if self.last_angle is not None:
+            step = wrap_pi(angle - self.last_angle)
+            self.swept += step * way if way else abs(step)
+        self.last_angle = angle
+        return angle
+
+    def off(self) -> float:
+        """Off the circle: the next arc starts where it comes back on. Returns NaN."""
+        self.last_angle = None
+        return math.nan

@@ -134,7 +134,7 @@ def test_a_circle_wider_than_planned_is_moved_to_leave_onto_the_runway_line():
     assert ex.leads_to_landing()
     left_at = next(
         deg
-        for deg in range(0, 360, 5)
+        for deg in range(0, 720, 5)
         if ex.step(on_circle(sp.b, 250.0, deg), HOME_ALT + 50.0, 0.0, 250.0).kind == Kind.LAND
     )
     assert on_circle(sp.b, 250.0, left_at)[0] == pytest.approx(0.0, abs=2.0)  # on the line
@@ -167,8 +167,24 @@ def test_a_landing_circle_descends_below_its_height_for_a_final_no_steeper_than_
     low = HOME_ALT + 800.0 * math.tan(math.radians(2.0))
     sp = ex.step((-250.0, -900.0), HOME_ALT + 50.0, 0.0)
     assert sp.kind == Kind.CIRCLE and sp.alt_msl == pytest.approx(low, abs=0.1)
-    for deg in range(0, 360, 5):
+    for deg in range(0, 720, 5):
         sp = ex.step(on_circle(CENTRE, RADIUS, deg), low, 0.0)
         if sp.kind == Kind.LAND:
             break
     assert sp.kind == Kind.LAND and sp.from_alt == pytest.approx(low, abs=0.1)
+
+
+def test_a_landing_circle_met_at_its_exit_point_is_flown_round_before_the_final():
+    """Down at the circle's height on the way there, the aircraft meets the circle at its
+    exit point flying across it (south, the final runs east): it turns final only once it
+    has flown round the circle, not at once 90° off the runway."""
+    items = [
+        item(0, d.MAV_CMD_NAV_LOITER_TO_ALT, CENTRE, z=50.0, p1=1.0, p2=RADIUS),
+        item(1, d.MAV_CMD_NAV_LAND, LAND, z=0.0),
+    ]
+    ex = executor(items, pos=(300.0, -500.0), alt=HOME_ALT + 50.0)
+    for north in range(300, -60, -10):  # across the northern point (the exit) southwards
+        assert ex.step((float(north), -500.0), HOME_ALT + 50.0, 0.0).kind == Kind.CIRCLE
+    kinds = [ex.step(on_circle(CENTRE, RADIUS, deg), HOME_ALT + 50.0, 0.0).kind
+             for deg in range(100, 400, 5)]  # fmt: skip
+    assert Kind.LAND in kinds  # round the circle and out at its northern point (360°)
