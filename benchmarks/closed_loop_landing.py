@@ -51,14 +51,17 @@ class Landed:
     wheels_along_m: float
 
 
-def fly(airframe: str, plan: Path, seed: int | None) -> Landed:
-    """One landing: calm air when ``seed`` is None, else the crosswind with that seed."""
+def fly(
+    airframe: str, plan: Path, seed: int | None, crosswind: tuple[float, float, float] = CROSSWIND
+) -> Landed:
+    """One landing: calm air when ``seed`` is None, else ``crosswind`` (m/s north, east,
+    down) with light turbulence of that seed."""
     items = checked_plan(plan)[0]
     calm = seed is None
     loop = ClosedLoop(
         airframe,
         items,
-        wind_ned=(0.0, 0.0, 0.0) if calm else CROSSWIND,
+        wind_ned=(0.0, 0.0, 0.0) if calm else crosswind,
         turbulence="none" if calm else "light",
         range_max_m=12.0,
     )
