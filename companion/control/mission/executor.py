@@ -18,6 +18,7 @@ import math
 from dataclasses import dataclass, field
 
 from companion.control.laws.fillet import MIN_TURN_RAD, corner_arc
+from companion.control.mission.approach import circle_down, final_height
 from companion.control.mission.items import CAMERA_STOPS, MissionItem
 from companion.control.mission.leg_geometry import CircleProgress, past_point, tangent_angle
 from companion.control.mission.leg_geometry import distance as _distance
@@ -89,6 +90,7 @@ class MissionExecutor:
     def __post_init__(self) -> None:
         self.jumps_done: dict[int, int] = {}  # how often each DO_JUMP (by seq) jumped
         self._loiter = CircleProgress()
+        self._descending: MissionItem | None = None  # a waypoint flown as a circle down
         self._prev: Point = (0.0, 0.0)
         self._prev_alt = self.home_alt_msl
         self._hold: Setpoint | None = None
@@ -104,7 +106,7 @@ class MissionExecutor:
         self.jumps_done.clear()
         self.finished = False
         self._hold = None
-        self._loiter = CircleProgress()
+        self._loiter, self._descending = CircleProgress(), None
         self.climb_to, self._flown_back = math.nan, False
 
     def take_off_first(self, alt_msl: float) -> None:
@@ -158,7 +160,7 @@ class MissionExecutor:
         self.current += 1
         self._prev, self._prev_alt = pos, alt
         self._flown_back = False
-        self._loiter = CircleProgress()
+        self._loiter, self._descending = CircleProgress(), None
 
     def _end(self, pos: Point) -> Setpoint:
         if self._hold is None:
@@ -230,10 +232,20 @@ class MissionExecutor:
 
     def _waypoint(self, item: MissionItem, pos: Point, alt: float) -> Setpoint | None:
         b = self.point_of(item, pos)
+        if self._descending is not None:
+            return self._loiter_to_alt(self._descending, pos, alt)
         radius = item.acceptance_m(self.config.wp_radius)
         if not self._flown_back:
             radius = max(radius, self._turn_lead(self._prev, b))
         if _distance(pos, b) <= radius or past_point(self._prev, b, pos):
+            # Reached too high to start the final there: circle down to it first (PX4 and
+            # pilots do), else the final began 24 m above its path and the Cub floated 40 m.
+            land = self._next_point(b)
+            high = alt > self._final_from(b, self.alt_of(item)) + LOITER_ALT_MARGIN_M
+            if land is not None and high and self.leads_to_landing():
+                size = max(self.config.loiter_radius, self._turn_radius)
+                self._descending = circle_down(item, b, land, pos, size, self.frame)
+                return self._loiter_to_alt(self._descending, pos, alt)
             self._advance(True, b, self.alt_of(item))
             return None
         return Setpoint(Kind.LINE, self._prev, b, self.alt_of(item), speed=self.speed)
@@ -354,13 +366,11 @@ class MissionExecutor:
         return None
 
     def _final_from(self, start: Point, alt: float) -> float:
-        """The height to leave a landing circle at for a final no steeper than
-        ``final_slope_max`` (a Cub idling down a 6° final gained 6 m/s, floated 34 m long)."""
-        land, steepest = self._next_nav(), self.config.final_slope_max
-        if steepest <= 0.0 or land is None or land.command != d.MAV_CMD_NAV_LAND:
+        land = self._next_nav()
+        if land is None or land.command != d.MAV_CMD_NAV_LAND:
             return alt
-        final = _distance(start, self.point_of(land, start))
-        return min(alt, self.alt_of(land) + final * math.tan(steepest))
+        point = self.point_of(land, start)
+        return final_height(alt, start, point, self.alt_of(land), self.config.final_slope_max)
 
     def _loiter_item(
         self, item: MissionItem, pos: Point, alt: float, t_s: float

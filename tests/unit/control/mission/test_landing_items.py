@@ -188,3 +188,25 @@ def test_a_landing_circle_met_at_its_exit_point_is_flown_round_before_the_final(
     kinds = [ex.step(on_circle(CENTRE, RADIUS, deg), HOME_ALT + 50.0, 0.0).kind
              for deg in range(100, 400, 5)]  # fmt: skip
     assert Kind.LAND in kinds  # round the circle and out at its northern point (360°)
+
+
+def test_a_waypoint_before_the_final_reached_too_high_is_circled_down_first():
+    """The approach waypoint 800 m before the point at 30 m, reached at 60 m: the final
+    would start 30 m above its path. The aircraft circles down on a circle through the
+    waypoint, tangent to the final and on its own side (north), then turns final there."""
+    wp_ne = (0.0, -500.0)
+    items = [
+        item(0, d.MAV_CMD_NAV_WAYPOINT, wp_ne, z=30.0),
+        item(1, d.MAV_CMD_NAV_LAND, LAND, z=0.0),
+    ]
+    ex = executor(items, pos=(100.0, -1500.0), alt=HOME_ALT + 60.0)
+    sp = ex.step((10.0, -510.0), HOME_ALT + 60.0, 0.0, turn_radius=150.0)
+    assert sp.kind == Kind.CIRCLE and sp.alt_msl == pytest.approx(HOME_ALT + 30.0)
+    assert sp.b == pytest.approx((150.0, -500.0), abs=0.5) and sp.radius == pytest.approx(150.0)
+    assert not sp.clockwise  # north of an eastward final: left turns bring it back onto it
+    for deg in range(180, -400, -5):  # round it, down at the height
+        sp = ex.step(on_circle(sp.b, 150.0, deg), HOME_ALT + 30.0, 0.0, 150.0)
+        if sp.kind == Kind.LAND:
+            break
+    assert sp.kind == Kind.LAND and sp.a == pytest.approx(wp_ne, abs=0.5)
+    assert sp.from_alt == pytest.approx(HOME_ALT + 30.0)

@@ -1,0 +1,39 @@
+"""The item a landing's final starts from: flown so the final starts where the plan put it.
+
+Pure geometry on the home-centred north/east frame (metres); the executor decides when.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from companion.control.mission.items import MissionItem
+from companion.control.mission.leg_geometry import distance
+from companion.geodesy import LocalFrame
+from mavlink_dialect import companion as d
+
+Point = tuple[float, float]
+
+
+def circle_down(
+    item: MissionItem, wp: Point, land: Point, pos: Point, radius: float, frame: LocalFrame
+) -> MissionItem:
+    """A LOITER_TO_ALT standing in for the waypoint ``item`` at ``wp`` reached too high:
+    its circle passes through the waypoint tangent to the final towards ``land``, on the
+    side the aircraft is on, so it is left at the waypoint on the final's course."""
+    length = max(distance(wp, land), 1.0)
+    right = (-(land[1] - wp[1]) / length, (land[0] - wp[0]) / length)
+    side = 1.0 if (pos[0] - wp[0]) * right[0] + (pos[1] - wp[1]) * right[1] >= 0.0 else -1.0
+    lat, lon = frame.latlon(wp[0] + side * radius * right[0], wp[1] + side * radius * right[1])
+    return replace(item, command=d.MAV_CMD_NAV_LOITER_TO_ALT, param1=1.0,
+                   param2=side * radius, x=round(lat * 1e7), y=round(lon * 1e7))  # fmt: skip
+
+
+def final_height(alt: float, start: Point, land: Point, land_alt: float, steepest: float) -> float:
+    """The height to leave a landing circle at, at ``start``, for a final no steeper than
+    ``steepest`` (rad; 0: the plan's ``alt``): a Cub idling down a 6° final gained 6 m/s
+    and floated 34 m long."""
+    if steepest <= 0.0:
+        return alt
+    return min(alt, land_alt + distance(start, land) * math.tan(steepest))
