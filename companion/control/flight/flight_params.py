@@ -47,6 +47,15 @@ CONTROL_PARAMS = (
     _p("YAW_DAMP", 3.5, 0.0, 5.0, "s", "rudder per rad/s of yaw-rate error in a turn"),
     _p("SCALING_SPEED", 30.0, 5.0, 100.0, "m/s", "airspeed at which the loop gains apply as set"),
     _p("ROLL_LIMIT_DEG", 35.0, 5.0, 60.0, "deg", "largest bank angle"),
+    _p(
+        "STALL_PREVENTION",
+        1.0,
+        0.0,
+        1.0,
+        "",
+        "bank limited when slow: a level turn's load "
+        "factor at most (airspeed / AIRSPEED_MIN)², never under 25° (0: off)",
+    ),
     _p("PTCH_LIM_MAX_DEG", 20.0, 0.0, 45.0, "deg", "largest nose-up pitch"),
     _p("PTCH_LIM_MIN_DEG", -15.0, -45.0, 0.0, "deg", "largest nose-down pitch"),
     _p("NAVL1_PERIOD", 17.0, 5.0, 60.0, "s", "L1 guidance period: larger is gentler"),
@@ -77,6 +86,7 @@ CONTROL_PARAMS = (
     *ACRO_PARAMS,
 )
 BY_NAME = {p.name: p for p in CONTROL_PARAMS}
+LEAST_BANK = math.radians(25.0)  # STALL_PREVENTION never limits the bank to less
 
 
 def control_params(
@@ -105,6 +115,16 @@ class FlightConfig:
     @cached_property  # read several times a step; a new config comes with new values
     def roll_limit(self) -> float:
         return math.radians(self.values["ROLL_LIMIT_DEG"])
+
+    def bank_limit(self, airspeed: float) -> float:
+        """``roll_limit``, less when slow (``STALL_PREVENTION``, as ArduPlane's): a C172
+        turning onto its final at its 30 m/s approach speed banked 50°, slowed to 25 m/s
+        in the turn and fell out of it into the ground."""
+        if not self.values["STALL_PREVENTION"] or not math.isfinite(airspeed):
+            return self.roll_limit
+        load = (airspeed / max(self.values["AIRSPEED_MIN"], 1.0)) ** 2
+        bank = math.acos(1.0 / load) if load > 1.0 else 0.0
+        return min(self.roll_limit, max(bank, LEAST_BANK))
 
     def __getitem__(self, name: str) -> float:
         return self.values[name]

@@ -2,7 +2,8 @@
 
 QGroundControl's landing pattern with its own defaults (loiter down to 40 m on a 75 m
 circle, then a 6° final of 380 m) with both airframes, and a final much flatter than a
-glide (1.9°) with the C172, in calm air, scored as the issue asks.
+glide (1.9°) and one that begins with a turn back at its waypoint with the C172, in calm
+air, scored as the issue asks.
 """
 
 from __future__ import annotations
@@ -14,10 +15,13 @@ from pathlib import Path
 
 import pytest
 
+from bridges.jsbsim.fdm import Home
 from companion.control.flight.landing import LandPhase
+from companion.control.mission.items import MissionItem
 from companion.control.mission.plan import checked_plan
 from companion.geodesy import LocalFrame
 from ground.campaign.landing_score import landing_score_for_plan
+from mavlink_dialect import companion as d
 from tests.support.closed_loop import ClosedLoop
 
 PLANS = Path(__file__).resolve().parents[4] / "benchmarks" / "plans"
@@ -79,3 +83,30 @@ def test_a_final_flatter_than_a_glide_is_met_from_level_flight_and_lands_on_targ
     flat, met = scores
     assert met.passed(), met
     assert flat.along_m < -15.0, flat
+
+
+def test_a_turn_back_onto_the_final_at_approach_speed_does_not_stall_the_c172() -> None:
+    """Take off east, out to a waypoint 1.5 km east at 45 m, land back at home: the final
+    starts with a 180° turn. At its 30 m/s approach speed (its AIRSPEED_MIN) the C172 banked
+    50°, slowed to 25 m/s and fell out of the turn into the ground 800 m short. The bank
+    is now limited when slow (STALL_PREVENTION): 25° at AIRSPEED_MIN."""
+    home = Home()
+    frame = LocalFrame(home.lat_deg, home.lon_deg)
+
+    def at(seq: int, command: int, east_m: float, alt: float, p1: float = 0.0) -> MissionItem:
+        lat, lon = frame.latlon(0.0, east_m)
+        return MissionItem(seq, d.MAV_FRAME_GLOBAL_RELATIVE_ALT, command, 0, 1, p1, 0.0, 0.0,
+                           0.0, round(lat * 1e7), round(lon * 1e7), alt)  # fmt: skip
+
+    items = [
+        at(0, d.MAV_CMD_NAV_TAKEOFF, 600.0, 45.0, p1=15.0),
+        at(1, d.MAV_CMD_NAV_WAYPOINT, 1500.0, 45.0),
+        at(2, d.MAV_CMD_NAV_LAND, 100.0, 0.0),
+    ]
+    loop = ClosedLoop("c172p", items, range_max_m=12.0)
+    _fly(loop, 600.0)
+    approach = [s for s in loop.samples if s.out.land_phase == LandPhase.APPROACH]
+    slowest = min(s.airspeed for s in approach)
+    assert slowest > 27.0, f"slowed to {slowest:.1f} m/s on the final"
+    score = landing_score_for_plan(loop.truth(), items)
+    assert score.passed(), score
