@@ -352,7 +352,7 @@ class FlightController:
         speed_dem = max(speed_min, min(cfg["AIRSPEED_MAX"], speed_dem))
         lateral = self._lateral(sp, pos, vel, dt)
         if not math.isfinite(roll_dem):
-            roll_dem = bank_for(lateral.lat_acc, cfg.bank_limit(airspeed))
+            roll_dem = bank_for(lateral.lat_acc, cfg.bank_limit(speed_dem))
         energy = self.tecs.step(
             nav.alt_msl_m, -nav.vd_m_s, airspeed, sp.alt_msl, speed_dem, dt, climb_ff
         )

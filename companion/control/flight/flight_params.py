@@ -117,9 +117,10 @@ class FlightConfig:
         return math.radians(self.values["ROLL_LIMIT_DEG"])
 
     def bank_limit(self, airspeed: float) -> float:
-        """``roll_limit``, less when slow (``STALL_PREVENTION``, as ArduPlane's): a C172
-        turning onto its final at its 30 m/s approach speed banked 50°, slowed to 25 m/s
-        in the turn and fell out of it into the ground."""
+        """``roll_limit``, less when flying slow (``STALL_PREVENTION``, as ArduPlane's),
+        at the demanded ``airspeed`` (the measured one's gusts made a C172's turns in
+        cruise wider): a C172 turning onto its final at its 30 m/s approach speed banked
+        50°, slowed to 25 m/s in the turn and fell out of it into the ground."""
         if not self.values["STALL_PREVENTION"] or not math.isfinite(airspeed):
             return self.roll_limit
         load = (airspeed / max(self.values["AIRSPEED_MIN"], 1.0)) ** 2
