@@ -53,8 +53,8 @@ CONTROL_PARAMS = (
         0.0,
         1.0,
         "",
-        "bank limited when slow: a level turn's load "
-        "factor at most (airspeed / AIRSPEED_MIN)², never under 25° (0: off)",
+        "bank limited when flying slow: a level turn's load factor at most "
+        "(airspeed demand / AIRSPEED_MIN)², never under 35° (0: off)",
     ),
     _p("PTCH_LIM_MAX_DEG", 20.0, 0.0, 45.0, "deg", "largest nose-up pitch"),
     _p("PTCH_LIM_MIN_DEG", -15.0, -45.0, 0.0, "deg", "largest nose-down pitch"),
@@ -86,7 +86,10 @@ CONTROL_PARAMS = (
     *ACRO_PARAMS,
 )
 BY_NAME = {p.name: p for p in CONTROL_PARAMS}
-LEAST_BANK = math.radians(25.0)  # STALL_PREVENTION never limits the bank to less
+# STALL_PREVENTION never limits the bank to less. ArduPlane's 25° made a C172 at its
+# approach speed (its AIRSPEED_MIN, flaps down: stalling near 23 m/s, 25 m/s at 35°) turn
+# onto a 452 m final so wide that it landed 28 m beside the runway.
+LEAST_BANK = math.radians(35.0)
 
 
 def control_params(

@@ -89,7 +89,7 @@ def test_a_turn_back_onto_the_final_at_approach_speed_does_not_stall_the_c172() 
     """Take off east, out to a waypoint 1.5 km east at 45 m, land back at home: the final
     starts with a 180° turn. At its 30 m/s approach speed (its AIRSPEED_MIN) the C172 banked
     50°, slowed to 25 m/s and fell out of the turn into the ground 800 m short. The bank
-    is now limited when slow (STALL_PREVENTION): 25° at AIRSPEED_MIN."""
+    is now limited when slow (STALL_PREVENTION): 35° at AIRSPEED_MIN."""
     home = Home()
     frame = LocalFrame(home.lat_deg, home.lon_deg)
 
