@@ -20,7 +20,7 @@ import logging
 import random
 import time
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any, Generic, TypeVar
 
 import iceoryx2 as iox2
@@ -158,6 +158,9 @@ class Reader(Generic[M]):
         self._chunks = ReaderChunks(msg_type, headers=self.counts_losses)
         self._kept = self._chunks.kept
         self._subscriber = subscriber
+        # True when a sample is waiting: iceoryx2's own call (it gives a bool), not one of
+        # ours around it, asked by every wait and chained step.
+        self.has_samples: Callable[[], bool] = subscriber.has_samples
         self.listener = listener
         # Losses are counted from the first sample seen of each writer onwards.
         self._last_seq: dict[int, int] = {}
@@ -243,10 +246,6 @@ class Reader(Generic[M]):
             return
         self.take_notifications()
         self._taken = False
-
-    def has_samples(self) -> bool:
-        """True when a sample is waiting."""
-        return bool(self._subscriber.has_samples())
 
     def writers(self) -> int:
         """How many writers the channel has now (0 when unknown)."""
