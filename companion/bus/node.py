@@ -250,6 +250,15 @@ class Waiter:
             return self._wait_on_one(self.triggers[0], timeout_s)
         return self._settle(self._wait(timeout_s))
 
+    def sleep(self, timeout_s: float) -> None:
+        """As :meth:`wait`, for a caller that reads every one of its readers next anyway (the
+        navigator, the servo output): without asking each reader whether it holds data, a
+        call into iceoryx2 each, at every sample."""
+        if len(self.triggers) == 1:
+            self.triggers[0].wait_event(timeout_s)
+        else:
+            self._clear(self._wait(timeout_s))
+
     def _wait_on_one(self, trigger: Reader[Any], timeout_s: float) -> list[Reader[Any]]:
         """One trigger (the navigator's IMU, the servos' commands): the reader's own wait on
         its listener, which takes every notification it wakes for. The WaitSet's wait and
@@ -315,16 +324,20 @@ class Waiter:
         return list(fired)
 
     def _settle(self, fired: list[Any]) -> list[Reader[Any]]:
-        """The readers with data. The notifications of the triggers that were woken or
-        have data are cleared (the caller reads the data now, so one left would only end
-        the next wait at once); the others' are left alone, each clearing being a system
-        call, and a listener outside the WaitSet ends no wait (a writer's notification
-        never fails for want of a listener clearing them)."""
+        """The readers with data, the triggers' notifications cleared (``_clear``)."""
+        self._clear(fired)
+        return [r for r in self.readers if r.has_samples()]
+
+    def _clear(self, fired: list[Any]) -> None:
+        """The notifications of the triggers that were woken or have data are cleared (the
+        caller reads the data now, so one left would only end the next wait at once); the
+        others' are left alone, each clearing being a system call, and a listener outside
+        the WaitSet ends no wait (a writer's notification never fails for want of a
+        listener clearing them)."""
         woken = {self._owners.get(a) for a in fired}
         for trigger in self.triggers:
             if trigger in woken or trigger.has_samples():
                 trigger.consume_events()
-        return [r for r in self.readers if r.has_samples()]
 
     def close(self) -> None:
         """Detach from the readers and the descriptors."""

@@ -20,12 +20,15 @@ import logging
 import random
 import time
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any, Generic, TypeVar
 
 import iceoryx2 as iox2
 
+from companion.bus.chunks import ReaderChunks, SampleHeader, WriterChunks
 from companion.messages import Message
+
+__all__ = ["IdleTally", "LatestReader", "QueueReader", "Reader", "SampleHeader", "Writer"]
 
 log = logging.getLogger(__name__)
 
@@ -36,22 +39,12 @@ _MIN_LISTENER_WAIT_S = 1e-6
 _MAX_AHEAD = 64  # LatestReader.before(): values kept that are not older yet
 
 
-class SampleHeader(ctypes.Structure):
-    """Prepended to every bus sample: which writer sent it, and its running number."""
-
-    _fields_ = [("writer_id", ctypes.c_uint64), ("seq", ctypes.c_uint64)]
-
-
-# A sample's header and payload are read and written in place through their addresses:
-# iceoryx2's typed accessors (``user_header()``, a cast to a fresh ctypes pointer type)
-# cost more than the copy itself, several times per sample. Its Python wrappers around
-# loaning and initialising a sample check the payload's type on every sample; the channel's
-# type is fixed when its service is opened, so a writer calls what they call, once it has
-# checked the message's size itself. The payload is copied as a byte array laid over the
-# sample's address (``from_buffer_copy`` to read, a memoryview slice to write): both stay
-# in C, where ``ctypes.memmove`` goes through libffi's argument conversion, about 2 us a
-# copy against 0.6 (reading) and 1.0 (writing) here, on every sample of every reader.
-_header_at = SampleHeader.from_address
+# iceoryx2's Python wrappers around loaning and initialising a sample check the payload's
+# type on every sample; the channel's type is fixed when its service is opened, so a writer
+# calls what they call, once it has checked the message's size itself. Header and payload
+# are read and written in place (``chunks``): a copy into or out of shared memory stays in
+# C, where ``ctypes.memmove`` goes through libffi's argument conversion, several times the
+# cost, on every sample of every reader.
 _loan_uninit = getattr(iox2.Publisher, "__loan_uninit")
 _assume_init = getattr(iox2.SampleMutUninit, "__assume_init")
 
@@ -95,7 +88,8 @@ class Writer(Generic[M]):
     ) -> None:
         self.name = name
         self._size = ctypes.sizeof(msg_type)
-        self._bytes_at = (ctypes.c_char * self._size).from_address
+        self._chunks = WriterChunks(msg_type)
+        self._kept = self._chunks.kept
         self._service = service
         self._publisher = publisher
         self._notifier = notifier
@@ -110,11 +104,14 @@ class Writer(Generic[M]):
         if ctypes.sizeof(msg) != self._size:
             raise TypeError(f"{self.name}: a {type(msg).__name__} is not this channel's type")
         sample = _loan_uninit(self._publisher)
-        header = _header_at(sample.user_header_ptr)
+        header, box = self._kept.get(sample.payload_ptr) or self._chunks.add(sample)
         header.writer_id = self._writer_id
         header.seq = self._seq
         self._seq += 1
-        memoryview(self._bytes_at(sample.payload_ptr)).cast("B")[:] = memoryview(msg).cast("B")
+        try:
+            box.msg = msg
+        except TypeError:  # a message of another type, of the same size: its bytes
+            memoryview(box).cast("B")[:] = memoryview(msg).cast("B")
         _assume_init(sample).send()
         if wake:
             self._notifier.notify()
@@ -158,8 +155,12 @@ class Reader(Generic[M]):
         self._service = service
         self.msg_type = msg_type
         self._copy = msg_type.from_buffer_copy
-        self._bytes_at = (ctypes.c_char * ctypes.sizeof(msg_type)).from_address
+        self._chunks = ReaderChunks(msg_type, headers=self.counts_losses)
+        self._kept = self._chunks.kept
         self._subscriber = subscriber
+        # True when a sample is waiting: iceoryx2's own call (it gives a bool), not one of
+        # ours around it, asked by every wait and chained step.
+        self.has_samples: Callable[[], bool] = subscriber.has_samples
         self.listener = listener
         # Losses are counted from the first sample seen of each writer onwards.
         self._last_seq: dict[int, int] = {}
@@ -173,14 +174,12 @@ class Reader(Generic[M]):
     # then does not read the sample's header at all: a ctypes object on every value).
     counts_losses = True
 
-    def _receive_one(self) -> M | None:
-        sample = self._subscriber.receive()
-        if sample is None:
-            return None
-        if self.counts_losses:
-            header = _header_at(sample.user_header_ptr)
+    def _take(self, sample: Any) -> M:
+        """A received sample's message (copied out), its losses counted; the sample freed."""
+        header, payload = self._kept.get(sample.payload_ptr) or self._chunks.add(sample)
+        if header is not None:
             self._count_gap(header.writer_id, header.seq)
-        msg = self._copy(self._bytes_at(sample.payload_ptr))
+        msg = self._copy(payload)
         sample.delete()
         self.received += 1
         return msg
@@ -193,15 +192,18 @@ class Reader(Generic[M]):
 
     def drain(self) -> Iterator[M]:
         """Every sample available now, oldest first, without waiting."""
-        while (msg := self._receive_one()) is not None:
-            yield msg
+        subscriber = self._subscriber
+        while (sample := subscriber.receive()) is not None:
+            yield self._take(sample)
 
     def pending(self) -> list[M]:
         """What ``drain`` gives, as a list: without a generator (the navigator asks its five
-        readers at every IMU sample, most of them holding none)."""
+        readers at every IMU sample, most of them holding none: an empty reader costs the
+        one ``receive`` and no call of our own)."""
+        subscriber = self._subscriber
         out: list[M] = []
-        while (msg := self._receive_one()) is not None:
-            out.append(msg)
+        while (sample := subscriber.receive()) is not None:
+            out.append(self._take(sample))
         return out
 
     def wait_event(self, timeout_s: float) -> bool:
@@ -244,10 +246,6 @@ class Reader(Generic[M]):
             return
         self.take_notifications()
         self._taken = False
-
-    def has_samples(self) -> bool:
-        """True when a sample is waiting."""
-        return bool(self._subscriber.has_samples())
 
     def writers(self) -> int:
         """How many writers the channel has now (0 when unknown)."""
@@ -329,11 +327,14 @@ class LatestReader(Reader[M]):
 
     def get(self) -> M | None:
         """The newest value published so far, or None if nothing has been seen yet."""
-        # ``_receive_one`` inlined: readers of the clock and of the link's snapshot call
+        # ``pending`` and ``_take`` inlined: readers of the clock and of the link's snapshot call
         # this a dozen times a step, most often to find nothing new.
-        receive = self._subscriber.receive
-        while (sample := receive()) is not None:
-            self._latest = self._copy(self._bytes_at(sample.payload_ptr))
+        # The subscriber, not its bound ``receive``: making that method object cost more
+        # than the call itself when, as most often, there is nothing.
+        subscriber = self._subscriber
+        while (sample := subscriber.receive()) is not None:
+            chunk = self._kept.get(sample.payload_ptr) or self._chunks.add(sample)
+            self._latest = self._copy(chunk[1])
             sample.delete()
             self.received += 1
         return self._latest

@@ -102,7 +102,8 @@ class LocalFrame:
         """A point of this frame as (latitude, longitude, height)."""
         # In floats: the navigator asks at every publication, and numpy's per-call cost
         # for one 3-vector was most of the conversion.
-        n, e, d = (float(c) for c in ned)
+        n, e, d = ned  # then as floats, written out (a generator cost more than the sums)
+        n, e, d = float(n), float(e), float(d)
         (x0, y0, z0), (cx, cy, cz) = self._origin, self._ned_to_ecef
         x = x0 + cx[0] * n + cx[1] * e + cx[2] * d
         y = y0 + cy[0] * n + cy[1] * e + cy[2] * d

@@ -15,7 +15,7 @@ replayed log's times need not be the vehicle clock's).
 from __future__ import annotations
 
 import heapq
-from collections.abc import Iterable
+from collections.abc import Sequence
 from typing import Any
 
 from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
@@ -51,8 +51,10 @@ class SampleOrder:
         self._held: list[tuple[int, int, int, Any]] = []  # (time key, kind, arrival, sample)
         self._arrival = 0
 
-    def push(self, samples: Iterable[Any]) -> list[Any]:
+    def push(self, samples: Sequence[Any]) -> list[Any]:
         """Take newly received samples; return those ready to feed, in feeding order."""
+        if len(samples) == 1 and not self._held and isinstance(samples[0], Imu):
+            return self._lone_imu(samples[0])
         for sample in samples:
             t = int(sample.t_us)
             is_imu = isinstance(sample, Imu)
@@ -76,3 +78,15 @@ class SampleOrder:
                 break
             ready.append(heapq.heappop(self._held)[3])
         return ready
+
+    def _lone_imu(self, sample: Imu) -> list[Any]:
+        """What ``push`` gives for one IMU sample with nothing held: that sample, at once
+        (it is the horizon, or behind it), without the heap's round trip, as at most IMU
+        samples (aiding samples come a few times a second)."""
+        t = int(sample.t_us)
+        if self.horizon_us is None or t > self.horizon_us:
+            self.horizon_us = t
+        if self.newest_us is None or t > self.newest_us:
+            self.newest_us = t
+        self._arrival += 1
+        return [sample]

@@ -145,7 +145,7 @@ class MiniSscOutput(Plugin):
         return (status is not None and not status.landed) or 0 <= age_s < HELD_MARK_MAX_S
 
     def step(self) -> None:
-        self.waiter.wait(WAIT_S)  # the waiter counts its own idle time
+        self.waiter.sleep(WAIT_S)  # the waiter counts its own idle time; the commands are read
         received = list(self.commands.drain())
         # The wire runs on vehicle time: in a simulation, simulated seconds.
         now = self.ctx.clock.now_us() / 1e6

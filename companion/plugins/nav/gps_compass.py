@@ -31,7 +31,7 @@ class GpsCompassPlugin(Plugin):
         self.out = ctx.bus.writer("nav/state")
 
     def step(self) -> None:
-        self.waiter.wait(WAIT_S)
+        self.waiter.sleep(WAIT_S)
         samples: list[GpsFix | Compass] = [*self.gps.drain(), *self.compass.drain()]
         if not samples:
             return

@@ -83,7 +83,7 @@ class InsEkfPlugin(Plugin):
         self.runner.nav.warm = self.warm_file.read()
 
     def step(self) -> None:
-        self.waiter.wait(WAIT_S)  # the waiter counts its own idle time
+        self.waiter.sleep(WAIT_S)  # the waiter counts its own idle time; every reader is read
         samples = self.order.push(received(self.readers))
         if not samples:
             return

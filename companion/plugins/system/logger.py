@@ -198,7 +198,7 @@ class LoggerPlugin(Plugin):
             timeout, waiter = TRICKLE_WAIT_S, self.any_sample
         if self.recorder.is_open:  # the flush is due on time, whatever the period
             timeout = min(timeout, max(0.0, self.next_flush - time.monotonic()))
-        waiter.wait(timeout)
+        waiter.sleep(timeout)  # every channel is drained next
         try:
             self._work()
         except OSError as exc:

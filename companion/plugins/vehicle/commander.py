@@ -130,7 +130,7 @@ class CommanderPlugin(Plugin):
         c = self.commander
         # A flight to resume is judged as often as an armed one: a restart in the air waits
         # for the navigator's first solution, not for the next second.
-        self.waiter.wait(WAIT_S if c.armed or self.saved is not None else DISARMED_WAIT_S)
+        self.waiter.sleep(WAIT_S if c.armed or self.saved is not None else DISARMED_WAIT_S)
         now = self.ctx.clock.now_us()
         nav = self._nav()
         health = self.health.get()

@@ -42,7 +42,7 @@ class _Bus:
         return self.commands
 
     def waiter(self, readers) -> SimpleNamespace:
-        return SimpleNamespace(wait=lambda timeout_s: [], close=lambda: None)
+        return SimpleNamespace(sleep=lambda timeout_s: None, close=lambda: None)
 
     def writer(self, name: str) -> SimpleNamespace:
         return SimpleNamespace(publish=lambda msg: None)
