@@ -17,7 +17,7 @@ import pynmea2
 from pynmea2.nmea_utils import datestamp, dm_to_sd
 
 KNOT_M_S = 1852.0 / 3600.0  # exact: an international knot is one nautical mile an hour
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+_NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)")
 _TIME = re.compile(r"(\d\d)(\d\d)(\d\d)(?:\.(\d{1,6}))?")
 _GGA_QUALITIES = range(9)  # 0 none … 6 dead reckoning, 7 manual, 8 simulator
 

@@ -28,7 +28,7 @@ from companion.sensors.ascii_sentence import sentence_text, xor8
 STANDARD_GRAVITY_M_S2 = 9.80665
 MILLIGAUSS = 1e-3
 OS5000_TO_FRD = (1.0, -1.0, -1.0)  # device axes forward-left-up → body forward-right-down
-_TOKEN = re.compile(r"(Mx|My|Mz|Ax|Ay|Az|[PRTDMA])?([+-]?(?:\d+\.?\d*|\.\d+))")
+_TOKEN = re.compile(r"(Mx|My|Mz|Ax|Ay|Az|[PRTDMA])?([+-]?(?:\d+(?:\.\d*)?|\.\d+))")
 _ORDER = ("", "P", "R", "T", "D", "M", "Mx", "My", "Mz", "A", "Ax", "Ay", "Az")
 _RANGES = {"": (0.0, 360.0), "P": (-90.0, 90.0), "R": (-180.0, 180.0)}
 

@@ -34,7 +34,11 @@ from typing import NamedTuple
 from companion.messages import Imu, Magnetometer
 from companion.sensors.ascii_sentence import sentence_text, xor8
 
-_NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+# One way only to match a run of digits (the dot required before a second run): with
+# ``\d+\.?\d*`` a run could be split anywhere, and a sentence of long digit runs with a
+# right checksum and one bad field took the full match 0.2 s at 72 characters, doubling
+# with every few more (the IMU's thread stalled as long).
+_NUMBER = r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?"
 _APPENDED = r"[TS][0-9A-Fa-f]+"  # SerialCount / SerialStatus fields
 _HEADER = re.compile(r"VN[A-Z]{3}")
 _HEX = frozenset("0123456789abcdefABCDEF")
