@@ -37,8 +37,6 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-import numpy as np  # noqa: E402
-from pyulog import ULog  # noqa: E402
 
 from companion.control.mission.plan import checked_plan  # noqa: E402
 from companion.navigation.estimate_csv import read_estimate  # noqa: E402
@@ -46,8 +44,7 @@ from ground.campaign.flight_run import FlightJob, fly_flight  # noqa: E402
 from ground.campaign.landing_score import (  # noqa: E402
     LandingScore,
     landing_score_for_plan,
-    line_coordinates,
-    plan_line,
+    navigation_across,
 )
 from ground.campaign.spec import SIM_CONFIG, Flight  # noqa: E402
 
@@ -93,7 +90,7 @@ def _fly(flight: Flight, plan: Path) -> tuple[str, bool]:
         row = fly_flight(FlightJob(flight, tmp, timeout_s=900.0))
         truth = Path(tmp) / flight.flight_id / "truth.csv"
         score = _score(truth, plan)
-        est = _estimate_across(truth, plan, score)
+        est = navigation_across(truth, plan, score)
     return _row(score, est, row)
 
 
@@ -108,22 +105,6 @@ def _score(truth: Path, plan: Path) -> LandingScore:
     if not truth.exists():
         return LandingScore(False)
     return landing_score_for_plan(read_estimate(truth), checked_plan(plan)[0])
-
-
-def _estimate_across(truth: Path, plan: Path, s: LandingScore) -> float:
-    """The navigation solution's across at the touchdown, from the flight log beside
-    ``truth`` (NaN: no landing or no log)."""
-    log = truth.parent / "flight.ulg"
-    if not s.landed or not log.exists():
-        return float("nan")
-    t = read_estimate(truth)
-    line = plan_line(checked_plan(plan)[0])
-    along, across = line_coordinates(t["lat"], t["lon"], *line)
-    at = np.nonzero((along == s.along_m) & (across == s.across_m))[0]
-    nav = ULog(str(log), ["nav_state"]).get_dataset("nav_state").data
-    _, nav_across = line_coordinates(nav["lat_deg"], nav["lon_deg"], *line)
-    k = np.searchsorted(nav["timestamp"] / 1e6, t["t"][at[0]])
-    return float(nav_across[min(k, len(nav_across) - 1)])
 
 
 def _row(s: LandingScore, est: float, row: dict) -> tuple[str, bool]:

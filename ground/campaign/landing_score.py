@@ -11,11 +11,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from pathlib import Path
 
 import numpy as np
+from pyulog import ULog
 
 from companion.control.mission.items import MissionItem
+from companion.control.mission.plan import checked_plan
 from companion.geodesy import LocalFrame
+from companion.navigation.estimate_csv import read_estimate
 from mavlink_dialect import companion as d
 
 TOUCH_M = 0.6  # this close to the resting height and no longer sinking: on the wheels
@@ -190,3 +194,20 @@ def plan_line(
     if final.command == d.MAV_CMD_NAV_LOITER_TO_ALT and final.param1 >= 0.5:
         radius, clockwise = abs(final.param2), final.param2 >= 0
     return approach, land, radius, clockwise
+
+
+def navigation_across(truth: Path, plan: Path, s: LandingScore) -> float:
+    """Where the vehicle's own navigation solution put it across the line at the touchdown
+    (its flight log beside ``truth``): what the landing law steered by; the rest of
+    ``s.across_m`` is the navigation's error. NaN: no landing or no log."""
+    log = truth.parent / "flight.ulg"
+    if not s.landed or not log.exists():
+        return float("nan")
+    t = read_estimate(truth)
+    line = plan_line(checked_plan(plan)[0])
+    along, across = line_coordinates(t["lat"], t["lon"], *line)
+    at = np.nonzero((along == s.along_m) & (across == s.across_m))[0]
+    nav = ULog(str(log), ["nav_state"]).get_dataset("nav_state").data
+    _, nav_across = line_coordinates(nav["lat_deg"], nav["lon_deg"], *line)
+    k = np.searchsorted(nav["timestamp"] / 1e6, t["t"][at[0]])
+    return float(nav_across[min(k, len(nav_across) - 1)])
