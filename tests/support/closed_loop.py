@@ -107,6 +107,14 @@ class ClosedLoop:
                 self._control()
             self.flight.step()
 
+    def fly_until_disarmed(self, seconds: float) -> bool:
+        """Fly until the controller disarms (True) or the simulation reaches ``seconds``."""
+        while self.flight.t_s < seconds:
+            self.run(1.0)
+            if self.samples[-1].out.disarm:
+                return True
+        return False
+
     def _control(self) -> None:
         s = self.flight.state()
         if self.range_max_m > 0.0:

@@ -27,14 +27,6 @@ from tests.support.closed_loop import ClosedLoop
 PLANS = Path(__file__).resolve().parents[4] / "benchmarks" / "plans"
 
 
-def _fly(loop: ClosedLoop, seconds: float) -> None:
-    """Fly until the controller disarms or ``seconds`` pass."""
-    while loop.flight.t_s < seconds:
-        loop.run(1.0)
-        if loop.samples[-1].out.disarm:
-            return
-
-
 def _qgc_default_pattern(tmp_path: Path) -> Path:
     """land_east.plan with its landing pattern as QGroundControl makes one by default."""
     doc = json.loads((PLANS / "land_east.plan").read_text())
@@ -60,7 +52,7 @@ def test_qgcs_default_landing_pattern_is_flown_slowed_and_lands_on_target(
     circle now descends until the final is LAND_SLOPE_MAX (4°) steep."""
     items = checked_plan(_qgc_default_pattern(tmp_path))[0]
     loop = ClosedLoop(airframe, items, range_max_m=12.0)
-    _fly(loop, 700.0)
+    loop.fly_until_disarmed(700.0)
     approach = [s for s in loop.samples if s.out.land_phase == LandPhase.APPROACH]
     assert approach, "never on the final"
     target = loop.controller.config["TECS_LAND_ARSPD"]
@@ -78,7 +70,7 @@ def test_a_final_flatter_than_a_glide_is_met_from_level_flight_and_lands_on_targ
     scores = []
     for least in (1.5, 3.0):
         loop = ClosedLoop("c172p", items, range_max_m=12.0, overrides={"LAND_SLOPE_MIN": least})
-        _fly(loop, 700.0)
+        loop.fly_until_disarmed(700.0)
         scores.append(landing_score_for_plan(loop.truth(), items))
     flat, met = scores
     assert met.passed(), met
@@ -104,7 +96,7 @@ def test_a_turn_back_onto_the_final_at_approach_speed_does_not_stall_the_c172() 
         at(2, d.MAV_CMD_NAV_LAND, 100.0, 0.0),
     ]
     loop = ClosedLoop("c172p", items, range_max_m=12.0)
-    _fly(loop, 600.0)
+    loop.fly_until_disarmed(600.0)
     approach = [s for s in loop.samples if s.out.land_phase == LandPhase.APPROACH]
     slowest = min(s.airspeed for s in approach)
     assert slowest > 27.0, f"slowed to {slowest:.1f} m/s on the final"

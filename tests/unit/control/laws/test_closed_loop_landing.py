@@ -30,15 +30,6 @@ def _low_on_approach(loop: ClosedLoop) -> bool:
     return last.out.land_phase == LandPhase.APPROACH and last.alt_agl < 25.0
 
 
-def _fly(loop: ClosedLoop, seconds: float) -> bool:
-    """Fly until the controller disarms (True) or ``seconds`` pass."""
-    while loop.flight.t_s < seconds:
-        loop.run(1.0)
-        if loop.samples[-1].out.disarm:
-            return True
-    return False
-
-
 @pytest.mark.parametrize(
     ("airframe", "wind"),
     [("c172p", (0.0, 0.0, 0.0)), ("J3Cub", CROSSWIND)],
@@ -47,7 +38,7 @@ def _fly(loop: ClosedLoop, seconds: float) -> bool:
 def test_the_landing_pattern_is_flown_to_a_stop_on_the_target(airframe: str, wind):  # type: ignore[no-untyped-def]
     items = checked_plan(PLAN)[0]
     loop = ClosedLoop(airframe, items, wind_ned=wind, turbulence="light" if any(wind) else "none")
-    assert _fly(loop, 600.0)
+    assert loop.fly_until_disarmed(600.0)
     score = landing_score_for_plan(loop.truth(), items)
     assert score.passed(), score
 
@@ -64,7 +55,7 @@ def test_a_steep_final_with_a_tailwind_is_flown_down_its_path_onto_the_target():
     for smax in (0.0, 5.0):  # 0: TECS_SINK_MAX on the approach too
         loop = ClosedLoop("c172p", items, wind_ned=tailwind, turbulence="light",
                           range_max_m=12.0, overrides={"TECS_APPR_SMAX": smax})  # fmt: skip
-        _fly(loop, 700.0)
+        loop.fly_until_disarmed(700.0)
         scores.append(landing_score_for_plan(loop.truth(), items))
     held, free = scores
     assert free.passed(), free
@@ -79,10 +70,10 @@ def test_a_home_altitude_misread_at_arming_is_corrected_by_the_rangefinder(airfr
     runway on the approach puts it on target."""
     items = checked_plan(PLAN)[0]
     blind = ClosedLoop(airframe, items, home_alt_error_m=error_m)
-    _fly(blind, 600.0)  # touched down far off the point (it may not stop to disarm)
+    blind.fly_until_disarmed(600.0)  # touched down far off the point (it may not stop to disarm)
     off = landing_score_for_plan(blind.truth(), items)
     loop = ClosedLoop(airframe, items, home_alt_error_m=error_m, range_max_m=12.0)
-    assert _fly(loop, 600.0)
+    assert loop.fly_until_disarmed(600.0)
     score = landing_score_for_plan(loop.truth(), items)
     assert score.passed(), score
     assert abs(off.along_m) > abs(score.along_m) + 50.0, (off, score)
@@ -99,7 +90,7 @@ def test_a_go_around_on_the_approach_climbs_away_and_the_second_approach_lands()
     loop.run(30.0)
     climbed = max(s.alt_agl for s in loop.samples[-1500:])
     assert climbed > low + 15.0
-    assert _fly(loop, 900.0)
+    assert loop.fly_until_disarmed(900.0)
     assert landing_score_for_plan(loop.truth(), items).passed()
 
 
@@ -109,7 +100,7 @@ def test_return_with_rtl_autoland_flies_the_missions_landing():
     loop.run(60.0)  # airborne, on the first leg
     assert loop.samples[-1].alt_agl > 30.0
     loop.set_mode(FlightMode.RTL)
-    assert _fly(loop, 600.0)
+    assert loop.fly_until_disarmed(600.0)
     assert landing_score_for_plan(loop.truth(), items).passed()
 
 
@@ -118,5 +109,5 @@ def test_return_without_rtl_autoland_circles_home_and_does_not_land():
     loop = ClosedLoop("c172p", items)
     loop.run(60.0)
     loop.set_mode(FlightMode.RTL)
-    assert not _fly(loop, 400.0)
+    assert not loop.fly_until_disarmed(400.0)
     assert min(s.alt_agl for s in loop.samples[-1000:]) > 50.0
