@@ -240,9 +240,9 @@ class MissionExecutor:
         if _distance(pos, b) <= radius or past_point(self._prev, b, pos):
             # Reached too high to start the final there: circle down to it first (PX4 and
             # pilots do), else the final began 24 m above its path and the Cub floated 40 m.
-            land = self._next_point(b)
-            high = alt > self._final_from(b, self.alt_of(item)) + LOITER_ALT_MARGIN_M
-            if land is not None and high and self.leads_to_landing():
+            land = self._next_point(b) if self.leads_to_landing() else None
+            top = self._final_from(b, self.alt_of(item)) + LOITER_ALT_MARGIN_M
+            if land is not None and alt > top:
                 size = max(self.config.loiter_radius, self._turn_radius)
                 self._descending = circle_down(item, b, land, pos, size, self.frame)
                 return self._loiter_to_alt(self._descending, pos, alt)
@@ -366,7 +366,7 @@ class MissionExecutor:
         return None
 
     def _final_from(self, start: Point, alt: float) -> float:
-        land = self._next_nav()
+        land = self._next_nav() if self.config.final_slope_max > 0.0 else None
         if land is None or land.command != d.MAV_CMD_NAV_LAND:
             return alt
         point = self.point_of(land, start)
