@@ -39,12 +39,12 @@ sys.path.insert(0, str(REPO))
 
 
 from companion.control.mission.plan import checked_plan  # noqa: E402
-from companion.navigation.estimate_csv import read_estimate  # noqa: E402
 from ground.campaign.flight_run import FlightJob, fly_flight  # noqa: E402
 from ground.campaign.landing_score import (  # noqa: E402
     LandingScore,
     landing_score_for_plan,
     navigation_across,
+    read_truth,
 )
 from ground.campaign.spec import SIM_CONFIG, Flight  # noqa: E402
 
@@ -78,14 +78,15 @@ def main() -> None:
                 for start, seed in product(args.start_at or [START_AT_S], seeds):
                     flight = Flight(str(plan), name, wind, turbulence, (), seed,
                                     str(SIM_CONFIG), False, 900.0, start)  # fmt: skip
-                    text, ok = _fly(flight, plan)
+                    text, ok = fly_whole_vehicle(flight, plan)
                     row = f"{name:8} {plan.stem:10} {cond:18} {start:5g} {seed:4d} {text}"
                     print(row, flush=True)
                     passed, flown = passed + ok, flown + 1
     print(f"passed {passed} of {flown}")
 
 
-def _fly(flight: Flight, plan: Path) -> tuple[str, bool]:
+def fly_whole_vehicle(flight: Flight, plan: Path) -> tuple[str, bool]:
+    """Fly ``flight`` with ``companion sim``; its scored row and whether it passed."""
     with tempfile.TemporaryDirectory() as tmp:
         row = fly_flight(FlightJob(flight, tmp, timeout_s=900.0))
         truth = Path(tmp) / flight.flight_id / "truth.csv"
@@ -104,7 +105,7 @@ def _plan(name: str) -> Path:
 def _score(truth: Path, plan: Path) -> LandingScore:
     if not truth.exists():
         return LandingScore(False)
-    return landing_score_for_plan(read_estimate(truth), checked_plan(plan)[0])
+    return landing_score_for_plan(read_truth(truth), checked_plan(plan)[0])
 
 
 def _row(s: LandingScore, est: float, row: dict) -> tuple[str, bool]:

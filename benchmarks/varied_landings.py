@@ -11,6 +11,11 @@ most, 1.3° at least). Each is flown as benchmarks/closed_loop_landing.py flies 
 and once in a 5 m/s crosswind across that runway with light turbulence (seed k + 2), and
 scored by the same targets. The aircraft starts facing east whatever the runway, so the
 take-off meets the wind from any quarter.
+
+``--whole-vehicle`` flies each plan with the whole vehicle instead (``companion sim``
+in exact lockstep, its own navigation on the emulated sensors, seed 1, started at
+simulated second 10), as benchmarks/landing.py flies its plans and with its columns; the
+crosswind is the same one, across each plan's runway.
 """
 
 from __future__ import annotations
@@ -25,8 +30,11 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.closed_loop_landing import Landed, fly
+from benchmarks.closed_loop_landing import fly
+from benchmarks.landing import fly_whole_vehicle
 from companion.geodesy import LocalFrame
+from ground.campaign.landing_score import LandingScore
+from ground.campaign.spec import SIM_CONFIG, Flight
 
 HOME = (-37.9105, 145.134, 80.0)  # the simulator's home (bridges/jsbsim/fdm.py)
 CROSSWIND_M_S = 5.0
@@ -77,8 +85,7 @@ def varied_plan(k: int) -> tuple[dict, float, str]:
     )
 
 
-def _row(run: Landed) -> str:
-    s = run.score
+def _row(s: LandingScore) -> str:
     mark = "on " if s.passed() else "OFF"
     return f"{mark} {s.along_m:+7.1f} / {s.across_m:+5.2f} m, sink {s.sink_m_s:4.2f}"
 
@@ -88,23 +95,53 @@ def main() -> None:
     ap.add_argument("--plans", type=int, default=30)
     ap.add_argument("--first", type=int, default=0)
     ap.add_argument("--airframe", action="append", help="c172p, J3Cub (default: both)")
+    ap.add_argument("--whole-vehicle", action="store_true", help="fly companion sim")
     args = ap.parse_args()
     folder = Path(tempfile.mkdtemp(prefix="varied_landings"))
+    if args.whole_vehicle:
+        _whole_vehicle(args, folder)
+        return
     on: dict[tuple[str, str], int] = {}
     for k in range(args.first, args.first + args.plans):
         doc, heading, what = varied_plan(k)
         path = folder / f"plan{k}.plan"
         path.write_text(json.dumps(doc))
-        across = math.radians(heading + 90.0)
-        wind = (CROSSWIND_M_S * math.cos(across), CROSSWIND_M_S * math.sin(across), 0.0)
+        wind = _crosswind(heading)
         for airframe in args.airframe or ["c172p", "J3Cub"]:
             calm, cross = fly(airframe, path, None), fly(airframe, path, k + 2, wind)
             for name, run in (("calm", calm), ("crosswind", cross)):
-                on[airframe, name] = on.get((airframe, name), 0) + run.score.passed()
+                on[airframe, name] = on.get((airframe, name), 0) + run.passed()
             print(f"{k:3} {airframe:6} {what} | calm {_row(calm)} | crosswind {_row(cross)}",
                   flush=True)  # fmt: skip
     for (airframe, name), count in sorted(on.items()):
         print(f"{airframe:6} {name:9}: {count} of {args.plans} on target")
+
+
+def _whole_vehicle(args: argparse.Namespace, folder: Path) -> None:
+    passed: dict[str, int] = {}
+    for k in range(args.first, args.first + args.plans):
+        doc, heading, what = varied_plan(k)
+        path = folder / f"plan{k}.plan"
+        path.write_text(json.dumps(doc))
+        for airframe in args.airframe or ["c172p", "J3Cub"]:
+            weathers = (
+                ("calm", (0.0, 0.0, 0.0), "none"),
+                ("crosswind", _crosswind(heading), "light"),
+            )
+            for name, wind, turbulence in weathers:
+                flight = Flight(str(path), airframe, wind, turbulence, (), 1, str(SIM_CONFIG),
+                                False, 900.0, 10.0)  # fmt: skip
+                text, ok = fly_whole_vehicle(flight, path)
+                passed[f"{airframe} {name}"] = passed.get(f"{airframe} {name}", 0) + ok
+                print(f"{k:3} {airframe:6} {name:9} {text} | {what}", flush=True)
+    for row, count in sorted(passed.items()):
+        print(f"{row:16}: {count} of {args.plans} passed")
+
+
+def _crosswind(heading_deg: float) -> tuple[float, float, float]:
+    """The crosswind across a runway on ``heading_deg`` (m/s north, east, down)."""
+    across = math.radians(heading_deg + 90.0)
+    return (CROSSWIND_M_S * math.cos(across), CROSSWIND_M_S * math.sin(across), 0.0)
 
 
 if __name__ == "__main__":

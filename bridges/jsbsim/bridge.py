@@ -26,7 +26,7 @@ from bridges.jsbsim.ptys import PtyPort
 from bridges.jsbsim.rc_receiver import EmulatedReceiver, load_pilot
 from bridges.jsbsim.serial_lines import SerialLine, open_line
 from bridges.jsbsim.servo_card import MiniSscReader
-from bridges.jsbsim.truth_log import ServoLog, TruthLog
+from bridges.jsbsim.truth_log import ServoLog, TruthLog, WheelLog, wheels_path
 from bridges.jsbsim.vehicle_commands import VehicleCommands
 from bridges.sensor_models.sensor_errors import MagneticField, NoiseModel, SensorErrors
 from bridges.sensor_models.true_state import TrueState
@@ -133,6 +133,7 @@ class SimBridge:
         stall_s = EXACT_STALL_S if exact else STALL_S
         self.lockstep = Lockstep([self.ports[n] for n in SENSORS if n in self.ports], stall_s)
         self.truth = TruthLog(opts.truth_path) if opts.truth_path else None
+        self.wheels = WheelLog(wheels_path(opts.truth_path)) if opts.truth_path else None
         self.servo_log = ServoLog(opts.servo_log_path) if opts.servo_log_path else None
         # Hardware in the loop: the vehicle runs apart, on its own clock; no bus to share.
         self.bus = None if opts.hil else BusNode(opts.namespace, "sim_bridge")
@@ -283,6 +284,8 @@ class SimBridge:
     def _publish_truth(self, s: TrueState, t_us: int) -> None:
         if self.truth is not None:
             self.truth.add_state(s)
+        if self.wheels is not None:
+            self.wheels.add(s.t_s, self.flight.weight_on_wheels())
         if self.hil_status is not None:
             self.hil_status.report(s, self.servo_bytes_in)
         if self.truth_out is None:
@@ -346,6 +349,8 @@ class SimBridge:
         """Release the ptys, the truth file and the bus."""
         if self.truth is not None:
             self.truth.close()
+        if self.wheels is not None:
+            self.wheels.close()
         if self.servo_log is not None:
             self.servo_log.close()
         for port in self.ports.values():

@@ -49,6 +49,7 @@ class Flight:
         self.fdm.set_dt(1.0 / rate_hz)
         self.dt_s = 1.0 / rate_hz
         self.wreck: TrueState | None = None  # after a crash the model diverged at
+        self._wheels: list[str] | None = None  # the gear units that are wheels
         self._sane: TrueState | None = None  # the last state stepped to, found physical
         self.home = home
         self.turbulence = False
@@ -164,6 +165,14 @@ class Flight:
             "throttle": f["fcs/throttle-cmd-norm"],
         }
 
+    def weight_on_wheels(self) -> bool:
+        """Whether a wheel carries weight now (a wreck lies on the ground)."""
+        if self.wreck is not None:
+            return True
+        if self._wheels is None:
+            self._wheels = _wheel_properties(self.fdm)
+        return any(self.fdm[name] > 0.5 for name in self._wheels)
+
     def _above_ground(self) -> bool:
         return float(self.fdm["position/h-agl-ft"]) * FT > TURBULENCE_MIN_AGL_M
 
@@ -240,3 +249,16 @@ def _at_rest(s: TrueState, t_s: float) -> TrueState:
         s, t_s=t_s, alt_msl_m=ground, alt_agl_m=0.0, roll=0.0, pitch=0.0, vn=0.0, ve=0.0,
         vd=0.0, p=0.0, q=0.0, r=0.0, f_body=(0.0, 0.0, -STANDARD_GRAVITY), airspeed_m_s=0.0,
     )  # fmt: skip
+
+
+def _wheel_properties(fdm: jsbsim.FGFDMExec) -> list[str]:
+    """The WOW properties of the gear's wheels: JSBSim numbers the structural contact
+    points among the gear units too, and those have none."""
+    names = []
+    for i in range(int(fdm["gear/num-units"])):
+        try:
+            fdm[f"gear/unit[{i}]/WOW"]
+        except KeyError:
+            continue
+        names.append(f"gear/unit[{i}]/WOW")
+    return names

@@ -40,6 +40,37 @@ class TruthLog:
         self._file.close()
 
 
+def wheels_path(truth_path: str | Path) -> Path:
+    """Where the wheel contacts of a truth file are written: beside it, ``NAME_wheels.csv``."""
+    truth_path = Path(truth_path)
+    return truth_path.with_name(f"{truth_path.stem}_wheels.csv")
+
+
+class WheelLog:
+    """When the wheels took and lost the aircraft's weight, by simulation time: a row
+    ``t,on_wheels`` (1 or 0) at the first frame and at each change. JSBSim's own contact
+    is what a landing is judged by: the centre of gravity's height cannot tell a wheel
+    skimming 0.3 m above the runway from one rolling on it."""
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        # Line-buffered: rows are few, and a reader of a flight still running sees them all.
+        self._file: TextIO = self.path.open("w", buffering=1)
+        self._file.write("t,on_wheels\n")
+        self._last: bool | None = None
+
+    def add(self, t_s: float, on_wheels: bool) -> None:
+        """The contact at this frame (written when it changed)."""
+        if on_wheels != self._last:
+            self._file.write(f"{t_s:.4f},{int(on_wheels)}\n")
+            self._last = on_wheels
+
+    def close(self) -> None:
+        """Flush and close."""
+        self._file.close()
+
+
 class ServoLog:
     """The surface commands the simulated servos received, by simulation time: one row each
     time the servo card got bytes, ``t,aileron,elevator,rudder,throttle`` (stick convention,

@@ -1,9 +1,13 @@
 """A landing judged from the simulator's truth: where and how hard it touched down.
 
-The truth file holds the centre of gravity's height above MSL; the aircraft resting on its
-wheels before the take-off gives the height that means "on the runway". Touchdown is the
-first time after the flight that the aircraft comes within ``TOUCH_M`` of that height;
-the runway is the landing's centreline (from the final approach point through the
+Touchdown is the first time after the flight that a wheel carries weight, by JSBSim's own
+contact (the ``on_wheels`` column: the simulator writes it beside the truth file,
+``bridges/jsbsim/truth_log.py``). Without it, it is judged from the centre of gravity's
+height above MSL: the aircraft resting on its wheels before the take-off gives the height
+that means "on the runway", and touchdown is the first time after the flight that the
+aircraft comes within ``TOUCH_M`` of it and no longer sinks. That counts a C172 skimming
+0.3-0.4 m above the runway in its flare as down, 15-20 m before its wheels touch.
+The runway is the landing's centreline (from the final approach point through the
 landing point) ``RUNWAY_HALF_WIDTH_M`` either side, from the landing point on.
 """
 
@@ -16,6 +20,7 @@ from pathlib import Path
 import numpy as np
 from pyulog import ULog
 
+from bridges.jsbsim.truth_log import wheels_path
 from companion.control.mission.items import MissionItem
 from companion.control.mission.plan import checked_plan
 from companion.geodesy import LocalFrame
@@ -102,10 +107,13 @@ def score_landing(
     speed = np.hypot(truth["vn"], truth["ve"])
     end = _first_stop(height, speed, int(flying[0]))
     flying = flying[flying <= end]
-    # The wheels meet the runway where the descent stops close to it (a tail dragger on its
-    # main wheels sits higher than at rest, in its three-point attitude).
     vd = truth["vd"]
-    low = (height < TOUCH_M) & (vd < SETTLED_M_S)
+    if "on_wheels" in truth:
+        low = truth["on_wheels"] > 0.5
+    else:
+        # The wheels meet the runway where the descent stops close to it (a tail dragger on
+        # its main wheels sits higher than at rest, in its three-point attitude).
+        low = (height < TOUCH_M) & (vd < SETTLED_M_S)
     after = flying[-1] + np.nonzero(low[flying[-1] : end + 1])[0]
     if after.size == 0:
         return LandingScore(False)
@@ -178,6 +186,19 @@ def _tangent_point(
     return (centre[0] + radius * math.cos(angle), centre[1] + radius * math.sin(angle))
 
 
+def read_truth(path: str | Path) -> dict[str, np.ndarray]:
+    """A truth file's columns, with ``on_wheels`` (1: a wheel carries weight) at each row
+    when the simulator wrote the wheel contacts beside it."""
+    truth = read_estimate(path)
+    wheels = wheels_path(path)
+    rows = wheels.read_text().split()[1:] if wheels.exists() else []
+    if rows:
+        changes = np.array([[float(v) for v in row.split(",")] for row in rows])
+        at = np.searchsorted(changes[:, 0], truth["t"] + 1e-6, side="right") - 1
+        truth["on_wheels"] = np.where(at >= 0, changes[np.maximum(at, 0), 1], np.nan)
+    return truth
+
+
 def landing_score_for_plan(truth: dict[str, np.ndarray], items: list[MissionItem]) -> LandingScore:
     """``score_landing`` on the plan's last landing (its final approach as planned)."""
     return score_landing(truth, *plan_line(items))
@@ -203,7 +224,7 @@ def navigation_across(truth: Path, plan: Path, s: LandingScore) -> float:
     log = truth.parent / "flight.ulg"
     if not s.landed or not log.exists():
         return float("nan")
-    t = read_estimate(truth)
+    t = read_truth(truth)
     line = plan_line(checked_plan(plan)[0])
     along, across = line_coordinates(t["lat"], t["lon"], *line)
     at = np.nonzero((along == s.along_m) & (across == s.across_m))[0]

@@ -25,7 +25,7 @@ from companion.control.mission.plan import checked_plan
 from companion.control.modes import BY_MODE
 from companion.geodesy import LocalFrame, wrap_pi
 from companion.messages import FlightMode
-from ground.campaign.landing_score import LandingScore, score_landing
+from ground.campaign.landing_score import LandingScore, read_truth, score_landing
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import GroundStation
 from tests.support.vehicle import REPO, wait_for
@@ -112,7 +112,7 @@ def test_qgc_land_with_the_square_plans_fence_lands_inside_it(sim):
     assert landing == [FlightMode.LAND], modes  # Land to the end: no Return after it
     said = next((m for t in texts if (m := SAID.search(t))), None)
     assert said is not None, texts
-    truth = sim.truth()
+    truth = read_truth(sim.truth_path)
     fence = Fence.from_items(checked_plan(PLAN)[d.MAV_MISSION_TYPE_FENCE])
     track = zip(truth["lat"], truth["lon"], strict=True)
     outside = [k for k, (lat, lon) in enumerate(track) if fence.breach(lat, lon)]

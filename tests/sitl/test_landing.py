@@ -23,8 +23,7 @@ from pyulog import ULog
 
 from companion.control.mission.items import MissionItem
 from companion.control.mission.plan import checked_plan
-from companion.navigation.estimate_csv import read_estimate
-from ground.campaign.landing_score import landing_score_for_plan
+from ground.campaign.landing_score import landing_score_for_plan, read_truth
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.sim.sim_run import SimRun, finish, start_sim
@@ -126,7 +125,7 @@ def test_the_c172_lands_its_qgc_landing_pattern_in_a_crosswind_and_disarms(tmp_p
     # from the roll to its height, the flight, the landing to the stop, on the ground.
     flown = [d.MAV_LANDED_STATE_TAKEOFF, d.MAV_LANDED_STATE_IN_AIR, d.MAV_LANDED_STATE_LANDING]
     assert states[states.index(flown[0]) :][:4] == [*flown, d.MAV_LANDED_STATE_ON_GROUND], states
-    score = landing_score_for_plan(read_estimate(truth_path), items)
+    score = landing_score_for_plan(read_truth(truth_path), items)
     # Issue 42's limits (15 m along, 2 m across) with issue 24's: this flight touched down
     # 9 m short when the campaign flew it (benchmarks/landing.py).
     assert score.passed(), score

@@ -23,9 +23,8 @@ from pathlib import Path
 import pytest
 
 from companion.control.mission.plan import checked_plan
-from companion.navigation.estimate_csv import read_estimate
 from ground.campaign.flight_run import FlightJob, fly_flight
-from ground.campaign.landing_score import landing_score_for_plan, navigation_across
+from ground.campaign.landing_score import landing_score_for_plan, navigation_across, read_truth
 from ground.campaign.spec import SIM_CONFIG, Flight
 from tests.support.vehicle import REPO
 
@@ -60,7 +59,7 @@ def test_the_circuit_touches_down_on_the_land_point(
     assert row["status"] == "ok", row
     assert row["armed_at_end"] is False, row  # landed, stopped and disarmed itself
     truth_csv = tmp_path / flight.flight_id / "truth.csv"
-    score = landing_score_for_plan(read_estimate(truth_csv), checked_plan(PLANS / plan)[0])
+    score = landing_score_for_plan(read_truth(truth_csv), checked_plan(PLANS / plan)[0])
     assert score.landed and score.stopped and score.on_runway, score
     assert abs(score.along_m) <= MAX_ALONG_M, score
     nav_across = navigation_across(truth_csv, PLANS / plan, score)

@@ -40,6 +40,7 @@ class Sample:
     yaw: float
     out: ControlOutput
     vel_ned: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    on_wheels: bool = False  # JSBSim: a wheel carries weight
 
 
 @dataclass
@@ -132,7 +133,8 @@ class ClosedLoop:
             controls["brakes"] = out.brakes
         self.flight.set_controls(controls)
         truth = (s.lat_deg, s.lon_deg, s.alt_msl_m, s.alt_agl_m, s.airspeed_m_s, s.roll, s.yaw)
-        self.samples.append(Sample(s.t_s, *truth, out, (s.vn, s.ve, s.vd)))
+        on_wheels = self.flight.weight_on_wheels()
+        self.samples.append(Sample(s.t_s, *truth, out, (s.vn, s.ve, s.vd), on_wheels))
 
     def _range(self, s: object) -> RangeReading:
         """The true height along a body-down beam, valid within ``range_max_m``."""
@@ -150,6 +152,7 @@ class ClosedLoop:
         out["yaw"] = np.array([x.yaw for x in self.samples])
         for k, name in enumerate(("vn", "ve", "vd")):
             out[name] = np.array([x.vel_ned[k] for x in self.samples])
+        out["on_wheels"] = np.array([float(x.on_wheels) for x in self.samples])
         return out
 
 

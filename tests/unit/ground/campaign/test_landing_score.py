@@ -6,8 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from bridges.jsbsim.truth_log import WheelLog, wheels_path
 from companion.geodesy import LocalFrame
-from ground.campaign.landing_score import line_coordinates, score_landing
+from companion.navigation.estimate_csv import EstimateWriter
+from ground.campaign.landing_score import line_coordinates, read_truth, score_landing
 
 LAND = (-37.9105, 145.134)
 APPROACH = (-37.9105, 145.110)  # west of the touchdown point: the approach flies east
@@ -67,3 +69,43 @@ def test_a_position_is_measured_along_and_across_the_landing_line():
     along, across = line_coordinates(lat, lon, APPROACH, LAND)
     assert along[0] == pytest.approx(20.0, abs=0.01)
     assert across[0] == pytest.approx(3.0, abs=0.01)
+
+
+def skimming_truth() -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """A flare that levels 0.4 m above the runway for 20 m before the wheels touch at +12 m
+    (what a C172 does in JSBSim): the centre of gravity is back near its resting height and
+    no longer sinking while the wheels still carry nothing."""
+    truth = landing_truth(12.0, 10.0)
+    east = LocalFrame(*LAND).ne(truth["lat"], truth["lon"])[1]
+    skim = (east > -8.0) & (east < 12.0)
+    truth["alt"] = np.where(skim, REST_M + 0.4, truth["alt"])
+    truth["vd"] = np.where(skim, 0.0, truth["vd"])
+    return truth, east
+
+
+def test_a_skim_above_the_runway_is_not_the_touchdown_when_the_wheel_contacts_are_known():
+    truth, east = skimming_truth()
+    by_height = score_landing(truth, APPROACH, LAND)
+    assert by_height.along_m == pytest.approx(-8.0, abs=4.0)  # what the height alone says
+    truth["on_wheels"] = ((east >= 12.0) | (truth["t"] == 0.0)).astype(float)
+    score = score_landing(truth, APPROACH, LAND)
+    assert score.along_m == pytest.approx(12.0, abs=4.0)
+    assert score.passed(), score
+
+
+def test_the_simulators_wheel_contacts_are_read_beside_its_truth_file(tmp_path):
+    truth_path = tmp_path / "truth.csv"
+    writer = EstimateWriter(truth_path)
+    for k in range(10):
+        writer.add(k * 0.5, 0, 0, 0, LAND[0], LAND[1], REST_M, 0, 0, 0)
+    writer.close()
+    wheels = WheelLog(wheels_path(truth_path))
+    for k in range(10):  # on the wheels, off from 1 s, on again from 3 s
+        wheels.add(k * 0.5, not 1.0 <= k * 0.5 < 3.0)
+    wheels.close()
+    assert wheels_path(truth_path).read_text().split() == [
+        "t,on_wheels", "0.0000,1", "1.0000,0", "3.0000,1"
+    ]  # fmt: skip
+    assert list(read_truth(truth_path)["on_wheels"]) == [1, 1, 0, 0, 0, 0, 1, 1, 1, 1]
+    wheels_path(truth_path).unlink()  # an older simulator's record: the height decides
+    assert "on_wheels" not in read_truth(truth_path)
