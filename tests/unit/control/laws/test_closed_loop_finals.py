@@ -2,8 +2,8 @@
 
 QGroundControl's landing pattern with its own defaults (loiter down to 40 m on a 75 m
 circle, then a 6° final of 380 m) with both airframes, and a final much flatter than a
-glide (1.9°) and one that begins with a turn back at its waypoint with the C172, in calm
-air, scored as the issue asks.
+glide (1.9°), a short steep one off a wide landing circle and one that begins with a turn
+back at its waypoint with the C172, in calm air, scored as the issue asks.
 """
 
 from __future__ import annotations
@@ -29,14 +29,19 @@ PLANS = Path(__file__).resolve().parents[4] / "benchmarks" / "plans"
 
 def _qgc_default_pattern(tmp_path: Path) -> Path:
     """land_east.plan with its landing pattern as QGroundControl makes one by default."""
+    final_m = 40.0 / math.tan(math.radians(6.0))  # 380 m: its 6° glide slope from 40 m
+    return _landing_pattern(tmp_path, final_m, 40.0, 75.0)
+
+
+def _landing_pattern(tmp_path: Path, final_m: float, alt: float, radius: float) -> Path:
+    """land_east.plan with its landing pattern's circle ``final_m`` west of the point at
+    ``alt``, of ``radius``."""
     doc = json.loads((PLANS / "land_east.plan").read_text())
     pattern = doc["mission"]["items"][-1]
     land_lat, land_lon, _ = pattern["landCoordinate"]
-    frame = LocalFrame(land_lat, land_lon)
-    final_m = 40.0 / math.tan(math.radians(6.0))  # 380 m: its 6° glide slope from 40 m
-    lat, lon = frame.latlon(0.0, -final_m)  # the runway runs east: the loiter is west
-    pattern.update(landingApproachCoordinate=[lat, lon, 40.0], loiterRadius=75.0)
-    path = tmp_path / "qgc_default_pattern.plan"
+    lat, lon = LocalFrame(land_lat, land_lon).latlon(0.0, -final_m)  # the runway runs east
+    pattern.update(landingApproachCoordinate=[lat, lon, alt], loiterRadius=radius)
+    path = tmp_path / "landing_pattern.plan"
     path.write_text(json.dumps(doc))
     return path
 
@@ -59,6 +64,23 @@ def test_qgcs_default_landing_pattern_is_flown_slowed_and_lands_on_target(
     assert approach[0].airspeed < target + 2.0, f"turned final at {approach[0].airspeed:.1f} m/s"
     score = landing_score_for_plan(loop.truth(), items)
     assert score.passed(), score
+
+
+def test_a_short_steep_final_off_a_wide_landing_circle_is_flown_from_lower_down(
+    tmp_path: Path,
+) -> None:
+    """A 250 m circle 368 m out at 40 m leaves a 270 m final at 8.4°, and the C172's glide
+    path ends a flare's 110 m before the point: it dived at 8 m/s, flared high and floated
+    44 m long. Its circle now descends until the final is LAND_SLOPE_MAX (5°) steep."""
+    items = checked_plan(_landing_pattern(tmp_path, 368.0, 40.0, 250.0))[0]
+    scores = []
+    for overrides in ({"LAND_SLOPE_MAX": 0.0}, {}):  # off; the airframe's
+        loop = ClosedLoop("c172p", items, range_max_m=12.0, overrides=overrides)
+        loop.fly_until_disarmed(700.0)
+        scores.append(landing_score_for_plan(loop.truth(), items))
+    steep, eased = scores
+    assert eased.passed(), eased
+    assert steep.along_m > 15.0, steep
 
 
 def test_a_final_flatter_than_a_glide_is_met_from_level_flight_and_lands_on_target() -> None:
