@@ -24,6 +24,7 @@ class GcsWatch:
 
     def __init__(self) -> None:
         self.last_heard_s: float | None = None
+        self.next_status_s = 0.0  # when link/status is next published
 
     def handle(self, msg: Any, peer: Peer, now_s: float) -> list[Outgoing]:
         if msg.type == d.MAV_TYPE_GCS:
@@ -41,6 +42,18 @@ class GcsWatch:
     def status_period_s(self) -> float:
         """How often link/status is worth publishing."""
         return STATUS_PERIOD_S if self.heard else UNHEARD_STATUS_PERIOD_S
+
+    def status_due(self, now_s: float) -> bool:
+        """Whether link/status is to be published now (then its next time is set)."""
+        if now_s < self.next_status_s:
+            return False
+        self.next_status_s = now_s + self.status_period_s()
+        return True
+
+    def next_due(self) -> float:
+        """The link's wake-up for link/status once a ground station was heard; before, the
+        silence is "never heard", and link/status rides other wake-ups."""
+        return self.next_status_s if self.heard else math.inf
 
     def silence_s(self, now_s: float) -> float:
         """Seconds since the last ground-station heartbeat; NaN before the first."""
