@@ -302,8 +302,16 @@ class MavlinkLink(Plugin):
         timeout, nav_wanted = self.router.next_wake(now_s, MAX_WAIT_S, nav_known)
         fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         # Watched from one wait to the next while no endpoint closed or opened one.
-        changes = sum(ep.fd_changes for ep in self.endpoints)
-        woken, ready = self.waker.wait_with_fds(timeout, list(fd_owner), nav_wanted, changes)
+        fds, changes = list(fd_owner), sum(ep.fd_changes for ep in self.endpoints)
+        woken, ready = self.waker.wait_with_fds(timeout, fds, nav_wanted, changes)
+        # Woken by the timer only to open the gate (ATTITUDE's time): on to the next state at
+        # once, not a whole step for nothing first; what falls due before it ends the sleep.
+        while not (woken or ready or nav_wanted):
+            timeout, nav_wanted = self.router.next_wake(time.monotonic(), MAX_WAIT_S, nav_known)
+            if not nav_wanted or timeout <= 0.0:
+                break
+            self.readers["nav"].get()  # the state from before the gate opened: not the one
+            woken, ready = self.waker.wait_with_fds(timeout, fds, nav_wanted, changes)
         if self.readers["nav"] in woken:
             self.nav_at_s = time.monotonic()
         for fd in ready:
