@@ -149,7 +149,6 @@ class MavlinkLink(Plugin):
         self.param_changes = bus.writer("params/changes")
         self.link_status = bus.writer("link/status")
         self.texts = bus.queue_reader("vehicle/statustext")
-        self.next_link_status_s = 0.0
         self.next_prearm_s = 0.0
         self.reached_count = 0
         self.timesync = TimesyncService(
@@ -301,12 +300,18 @@ class MavlinkLink(Plugin):
     def _wait_input(self, now_s: float) -> None:
         nav_known = self.snapshot.nav is not None
         timeout, nav_wanted = self.router.next_wake(now_s, MAX_WAIT_S, nav_known)
-        if self.gcs.heard:  # before, link/status says "never heard": it rides other wakes
-            timeout = min(timeout, max(0.0, self.next_link_status_s - now_s))
         fd_owner = {fd: ep for ep in self.endpoints for fd in ep.filenos()}
         # Watched from one wait to the next while no endpoint closed or opened one.
-        changes = sum(ep.fd_changes for ep in self.endpoints)
-        woken, ready = self.waker.wait_with_fds(timeout, list(fd_owner), nav_wanted, changes)
+        fds, changes = list(fd_owner), sum(ep.fd_changes for ep in self.endpoints)
+        woken, ready = self.waker.wait_with_fds(timeout, fds, nav_wanted, changes)
+        # Woken by the timer only to open the gate (ATTITUDE's time): on to the next state at
+        # once, not a whole step for nothing first; what falls due before it ends the sleep.
+        while not (woken or ready or nav_wanted):
+            timeout, nav_wanted = self.router.next_wake(time.monotonic(), MAX_WAIT_S, nav_known)
+            if not nav_wanted or timeout <= 0.0:
+                break
+            self.readers["nav"].get()  # the state from before the gate opened: not the one
+            woken, ready = self.waker.wait_with_fds(timeout, fds, nav_wanted, changes)
         if self.readers["nav"] in woken:
             self.nav_at_s = time.monotonic()
         for fd in ready:
@@ -328,8 +333,7 @@ class MavlinkLink(Plugin):
             self.statustext(reason)
         for text in self.texts.drain():  # failsafes and other plug-ins' announcements
             self.statustext(text.text.decode(errors="replace"), text.severity)
-        if now_s >= self.next_link_status_s:
-            self.next_link_status_s = now_s + self.gcs.status_period_s()
+        if self.gcs.status_due(now_s):
             status = LinkStatus(t_us=self.ctx.clock.now_us())
             status.gcs_silence_s = self.gcs.silence_s(now_s)
             self.link_status.publish(status)

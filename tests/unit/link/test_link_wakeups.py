@@ -114,3 +114,29 @@ def test_slower_streams_ride_the_wakeups_of_the_fastest_at_their_own_rates(endpo
     # Two wake-ups per ATTITUDE (its time opens the gate, the next state sends it), the
     # others riding them: 25.1 a second without the batch, 21.95 with it.
     assert wakes_by_batch[BATCH_S] <= min(22.5, wakes_by_batch[0.0] - 2.0)
+
+
+def test_link_status_rides_the_wakeups_of_attitude_at_its_own_rate():
+    """Once a ground station is heard, link/status (5 Hz) goes out on the link's ATTITUDE
+    wake-ups (10 Hz, out of phase with it) up to STATUS_EARLY_S ahead of its time, so its
+    own timer no longer wakes the link; alone, its timer wakes the link at its rate."""
+    from companion.link.gcs_watch import STATUS_PERIOD_S, GcsWatch
+
+    gcs = GcsWatch()
+    gcs.last_heard_s = 0.0
+    sent, timer_wakes, now, attitude_at = [], 0, 0.0, 0.037
+    while now < 20.0:
+        if gcs.status_due(now):
+            sent.append(now)
+        if gcs.next_due() < attitude_at:  # its timer ends the sleep first
+            now, timer_wakes = gcs.next_due(), timer_wakes + 1
+        else:
+            now, attitude_at = attitude_at, attitude_at + 0.1
+    assert timer_wakes == 0
+    assert abs(len(sent) - 20.0 / STATUS_PERIOD_S) <= 1
+    alone = GcsWatch()
+    alone.last_heard_s, now, count = 0.0, 0.0, 0
+    for _ in range(100):  # woken by its own timer only
+        count += alone.status_due(now)
+        now = alone.next_due()
+    assert count == 100 and abs(now - 100 * STATUS_PERIOD_S) < STATUS_PERIOD_S
