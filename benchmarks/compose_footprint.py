@@ -108,13 +108,18 @@ def fly(config: Path, cpu_s: float, kill_core: bool) -> dict[str, float]:
             ) = restart_core(v)
     finally:
         v.stop()
-        relay.send_signal(signal.SIGTERM)
-        try:
-            relay.wait(10)
-        except subprocess.TimeoutExpired:
-            relay.kill()
-            relay.wait()
+        stop_relay(relay)
     return res
+
+
+def stop_relay(relay: subprocess.Popen[bytes]) -> None:
+    """End the relay: SIGTERM, then SIGKILL after 10 s."""
+    relay.send_signal(signal.SIGTERM)
+    try:
+        relay.wait(10)
+    except subprocess.TimeoutExpired:
+        relay.kill()
+        relay.wait()
 
 
 def restart_core(v: Vehicle) -> tuple[float, float, float, float]:

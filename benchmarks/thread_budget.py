@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
-import subprocess
 import sys
 import tempfile
 import time
@@ -30,7 +28,7 @@ from typing import Any
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from benchmarks.compose_footprint import free_port, start_relay  # noqa: E402
+from benchmarks.compose_footprint import free_port, start_relay, stop_relay  # noqa: E402
 from benchmarks.footprint import ARM_AT_S, FLYING_AFTER_S, Vehicle, use_bytecode  # noqa: E402
 
 TICK_S = 1.0 / os.sysconf("SC_CLK_TCK")
@@ -105,12 +103,7 @@ def fly(seconds: float, config: Path, relay_on: bool) -> dict[str, Any]:
     finally:
         v.stop()
         if relay is not None:
-            relay.send_signal(signal.SIGTERM)
-            try:
-                relay.wait(10)
-            except subprocess.TimeoutExpired:
-                relay.kill()
-                relay.wait()
+            stop_relay(relay)
     rows = []
     for key, (name, user, system, cpu, vol, invol) in after.items():
         if key in before:
