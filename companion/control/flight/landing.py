@@ -9,7 +9,8 @@ PX4 publish for their fixed-wing landings, written here from their descriptions:
   must begin for the flare to end there, so the aircraft touches down on the target
   instead of floating past it.
 - **Flare**: below ``LAND_FLARE_ALT`` above the runway, or when the ground is less than
-  ``LAND_FLARE_SEC`` away at the present sink rate, the throttle is cut and pitch flies
+  ``LAND_FLARE_SEC`` away at the present sink rate, the throttle is cut (power comes back
+  only against a sink that would land short of the point, ``LAND_FLARE_PWR``) and pitch flies
   an exponential flare: a sink-rate demand that falls with height towards ``TECS_LAND_SINK``
   at the ground, from the sink rate at its start (the glide path's, when a gust has just
   slowed the sink below it) and from the glide's pitch and sink averaged over its last
@@ -80,6 +81,8 @@ LANDING_PARAMS = (
     ParamDecl("LAND_FLARE_AIM", 90.0, 50.0, 150.0, "%", "landing: the glide ends this share of "
               "the modelled flare's distance before the point (lower it if the airframe lands "
               "short: its flare then begins nearer the point)"),
+    ParamDecl("LAND_FLARE_PWR", 4.0, 0.0, 10.0, "1/(m/s)", "landing: flare throttle per m/s "
+              "sunk beyond what reaches the point, at most TRIM_THROTTLE (0: idle all flare)"),
     ParamDecl("LAND_PITCH_CD", 0.0, -500.0, 1500.0, "cdeg", "landing: least pitch in the flare"),
     ParamDecl("LAND_DISARMDELAY", 3.0, 0.0, 127.0, "s", "landing: disarm this long after stop"),
     ParamDecl("TECS_LAND_ARSPD", 28.0, 5.0, 100.0, "m/s", "landing: approach airspeed"),
@@ -325,6 +328,12 @@ class Landing:
         aim = aimed_sink(height, t_go, s_t)
         sink_dem = clamp(aim, AIM_LOW * nominal, AIM_HIGH * nominal)
         error = -s.climb_rate - sink_dem  # + when sinking faster than wanted: pitch up
+        # The pitch lags the demand, and at idle with flaps a C172 sinks 4-5 m/s: a flare
+        # begun in a gust's dive stayed above its sink demand all the way and touched down
+        # 26 m short. Power holds it up, but only against a sink that lands short of the
+        # point: one begun late and high floats past it as it is.
+        short = -s.climb_rate - max(aim, sink_dem)
+        throttle = clamp(v["LAND_FLARE_PWR"] * short, 0.0, v["TRIM_THROTTLE"])
         self._flare_integ = clamp(self._flare_integ + SINK_I * error * dt, -0.1, 0.25)
         pitch_min = math.radians(v["LAND_PITCH_CD"] / 100.0)
         pitch_max = math.radians(v["TECS_LAND_PMAX"])
@@ -339,7 +348,7 @@ class Landing:
             self.land_alt,
             v["TECS_LAND_ARSPD"],
             pitch=clamp(pitch, pitch_min, pitch_max),
-            throttle=0.0,
+            throttle=throttle,
             roll_limit=math.radians(v["LEVEL_ROLL_LIMIT"]),
             flaps=landing_flaps(v),
         )

@@ -45,7 +45,7 @@ def test_the_glide_path_runs_from_the_first_point_down_to_the_flare_before_the_t
 
 def test_flare_cuts_the_throttle_then_the_rollout_steers_brakes_and_disarms_when_stopped():
     land = Landing(START, 150.0, TOUCHDOWN, 100.0)
-    dem = land.step(_state(200.0, 2.5), V, 0.02)  # below LAND_FLARE_ALT
+    dem = land.step(_state(260.0, 2.5), V, 0.02)  # below LAND_FLARE_ALT, 40 m out
     assert dem.phase == LandPhase.FLARE and dem.throttle == 0.0
     assert dem.roll_limit == pytest.approx(math.radians(V["LEVEL_ROLL_LIMIT"]))
     dem = land.step(_state(260.0, 0.1, sink=0.0), V, 0.02)  # on the wheels, a moment
@@ -62,6 +62,20 @@ def test_flare_cuts_the_throttle_then_the_rollout_steers_brakes_and_disarms_when
         assert not dem.disarm
     dem = land.step(_state(400.0, 0.0, sink=0.0, speed=0.0), V, 0.2)
     assert dem.phase == LandPhase.STOPPED and dem.disarm
+
+
+def test_the_flare_adds_power_only_against_a_sink_that_lands_short_of_the_point():
+    # 100 m out at 2.5 m, sinking 2 m/s: at idle the wheels would meet the runway short.
+    short = Landing(START, 150.0, TOUCHDOWN, 100.0).step(_state(200.0, 2.5), V, 0.02)
+    assert short.phase == LandPhase.FLARE
+    assert 0.0 < short.throttle <= V["TRIM_THROTTLE"]
+    idle = Landing(START, 150.0, TOUCHDOWN, 100.0).step(
+        _state(200.0, 2.5), V | {"LAND_FLARE_PWR": 0.0}, 0.02
+    )
+    assert idle.throttle == 0.0
+    # The same height and sink 40 m out reaches the point: no power to float past it.
+    late = Landing(START, 150.0, TOUCHDOWN, 100.0).step(_state(260.0, 2.5), V, 0.02)
+    assert late.phase == LandPhase.FLARE and late.throttle == 0.0
 
 
 def test_a_go_around_climbs_away_along_the_runway_and_cannot_start_on_the_ground():
