@@ -69,11 +69,14 @@ class ServoChannel:
         """The servo position for a normalised command (clamped to the travel)."""
         if command != command:  # NaN: hold safe rather than guess
             command = 0.0
+        # Clamped by comparisons, not min() and max(): the same numbers (the command is not
+        # NaN here) without two calls per channel, 300 a second.
         if self.one_sided:
-            c = min(1.0, max(0.0, command))
+            c = 1.0 if command > 1.0 else (0.0 if command < 0.0 else command)
             low, high = (self.max, self.min) if self.reversed else (self.min, self.max)
             return round(low + c * (high - low))
-        c = min(1.0, max(-1.0, -command if self.reversed else command))
+        c = -command if self.reversed else command
+        c = 1.0 if c > 1.0 else (-1.0 if c < -1.0 else c)
         span = (self.max - self.trim) if c >= 0 else (self.trim - self.min)
         return round(self.trim + c * span)
 

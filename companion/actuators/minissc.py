@@ -30,7 +30,11 @@ def frames(plan: Iterable[tuple[int, int]]) -> bytes:
     for servo, position in plan:
         if not 0 <= servo <= SYNC - 1:
             raise ValueError(f"servo id {servo} out of 0-254")
-        out += (SYNC, servo, POSITION_MAX if position > POSITION_MAX else max(0, position))
+        out += (
+            SYNC,
+            servo,
+            POSITION_MAX if position > POSITION_MAX else (position if position > 0 else 0),
+        )
     return bytes(out)
 
 

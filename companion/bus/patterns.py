@@ -87,6 +87,7 @@ class Writer(Generic[M]):
         service: Any = None,
     ) -> None:
         self.name = name
+        self._type = msg_type
         self._size = ctypes.sizeof(msg_type)
         self._chunks = WriterChunks(msg_type)
         self._kept = self._chunks.kept
@@ -101,7 +102,8 @@ class Writer(Generic[M]):
         """Copy the message into shared memory, send it, and notify readers (unless not
         ``wake``: a value whose news a reader only looks at when it reads, such as a table's
         counters, need not end anybody's sleep)."""
-        if ctypes.sizeof(msg) != self._size:
+        # The channel's own type needs no size check (the usual case: a call less).
+        if type(msg) is not self._type and ctypes.sizeof(msg) != self._size:
             raise TypeError(f"{self.name}: a {type(msg).__name__} is not this channel's type")
         sample = _loan_uninit(self._publisher)
         header, box = self._kept.get(sample.payload_ptr) or self._chunks.add(sample)
@@ -177,18 +179,16 @@ class Reader(Generic[M]):
     def _take(self, sample: Any) -> M:
         """A received sample's message (copied out), its losses counted; the sample freed."""
         header, payload = self._kept.get(sample.payload_ptr) or self._chunks.add(sample)
-        if header is not None:
-            self._count_gap(header.writer_id, header.seq)
+        if header is not None:  # a skipped sequence number is a loss
+            writer_id, seq = header.writer_id, header.seq
+            last = self._last_seq.get(writer_id)
+            if last is not None and seq > last + 1:
+                self.lost += seq - last - 1
+            self._last_seq[writer_id] = seq
         msg = self._copy(payload)
         sample.delete()
         self.received += 1
         return msg
-
-    def _count_gap(self, writer_id: int, seq: int) -> None:
-        last = self._last_seq.get(writer_id)
-        if last is not None and seq > last + 1:
-            self.lost += seq - last - 1
-        self._last_seq[writer_id] = seq
 
     def drain(self) -> Iterator[M]:
         """Every sample available now, oldest first, without waiting."""

@@ -62,22 +62,22 @@ class ChainLink:
         self._reader: Reader[Any] | None = None
         self._reader_host: PluginHost | None = None
 
-    def _has_input(self, host: PluginHost) -> bool:
-        """Whether the plug-in's reader of its trigger holds a sample (its wait would then
-        return at once: a step run without one would sleep on the producer's thread)."""
+    def _trigger_reader(self, host: PluginHost) -> Reader[Any] | None:
+        """The plug-in's reader of its trigger (looked up once per instance)."""
         if self._reader_host is not host:
             self._reader_host, self._reader = host, host.bus.reader_of(self.trigger)
-        return self._reader is not None and self._reader.has_samples()
-
-    def _reader_notified(self) -> bool:
-        return self._reader is not None and self._reader.take_notifications()
+        return self._reader
 
     def run_after(self, producer: PluginHost) -> float | None:
         """On the producer's thread, after its step: this plug-in's step, if a sample of
-        its trigger waits for it and it is not busy on its own thread. The thread's CPU
-        time when it ended (None: it did not run)."""
+        its trigger waits for it (its wait would then return at once: a step run without
+        one would sleep on the producer's thread) and it is not busy on its own thread.
+        The thread's CPU time when it ended (None: it did not run)."""
         host = self.host
-        if host is None or not self._has_input(host):
+        if host is None:
+            return None
+        reader = self._reader if self._reader_host is host else self._trigger_reader(host)
+        if reader is None or not reader.has_samples():
             return None
         self._last_run = time.monotonic()  # the producer delivers: no step of its own
         if not self._lock.acquire(blocking=False):
@@ -107,7 +107,13 @@ class ChainLink:
         thread is then not asleep on the same notifications.
         """
         try:
-            if self.host is not host or self.failed or not self._reader_notified():
+            reader = self._reader
+            if (
+                self.host is not host
+                or self.failed
+                or reader is None
+                or not reader.take_notifications()
+            ):
                 return False
             host.step_once()
             return True

@@ -18,6 +18,7 @@ ends within its timeout.
 
 from __future__ import annotations
 
+import functools
 import logging
 import os
 import signal
@@ -123,8 +124,8 @@ class Member:
         self.host = host
         host.stopping = self.stopping  # a stop that came while it was being made
         if self.followers:
-            followers = self.followers
-            host.after_step = lambda: run_followers(followers, host)
+            # A partial, not a lambda: one Python frame less at every step of the producer.
+            host.after_step = functools.partial(run_followers, self.followers, host)
         try:
             if self.link is not None:
                 return self.run_chained(host, self.link)

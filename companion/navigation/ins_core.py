@@ -154,19 +154,31 @@ class InsCore:
         else:
             ph = self.P @ h.T
             s = h @ ph + r
-        s_inv = 1.0 / s if len(y) == 1 else np.linalg.inv(s)  # 1×1: inv is 1/s exactly
-        if gate and float(y @ s_inv @ y) > CHI2_9999[len(y)]:
+        # One measurement (the barometer, a heading, the yaw-rate bias standing still): but
+        # for Joseph's two, every product below has an inner dimension of one, a single
+        # multiplication an entry, so it is written as an elementwise one (the same
+        # numbers; a matrix product's numpy call costs many times its arithmetic), and
+        # the gate in floats. 1×1: inv is 1/s exactly.
+        one = len(y) == 1
+        s_inv = 1.0 / s if one else np.linalg.inv(s)
+        if one:
+            y0 = float(y[0])
+            nis = y0 * float(s_inv[0, 0]) * y0
+        else:
+            nis = float(y @ s_inv @ y)
+        if gate and nis > CHI2_9999[len(y)]:
             return False
-        k = ph @ s_inv
+        k = ph * s_inv if one else ph @ s_inv
         if k_mask is not None:
             k = k * k_mask[:, None]
         if rows is None:
-            ikh = _I15 - k @ h
+            ikh = _I15 - (k * h if one else k @ h)
         else:
             ikh = _I15.copy()
             ikh[:, rows] -= k
-        self.P = ikh @ self.P @ ikh.T + k @ r @ k.T  # Joseph form: valid for any gain
-        self._correct(k @ y)
+        gain_noise = (k * r) * k.T if one else k @ r @ k.T
+        self.P = ikh @ self.P @ ikh.T + gain_noise  # Joseph form: valid for any gain
+        self._correct(k[:, 0] * y0 if one else k @ y)
         return True
 
     def _correct(self, dx: np.ndarray) -> None:

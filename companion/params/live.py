@@ -38,7 +38,7 @@ class LiveParams:
     def poll(self) -> bool:
         """Apply the changes published since the last call; True when any applied."""
         changed = False
-        for change in self._changes.drain():
+        for change in self._changes.pending():  # a list: no generator at every poll
             name = change.name.decode(errors="replace")
             if name == RELOAD_ALL:
                 self.values = self._stored()

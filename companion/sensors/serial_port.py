@@ -20,9 +20,12 @@ per read timeout (a second), not several.
 
 from __future__ import annotations
 
+import fcntl
 import logging
 import os
 import select
+import sys
+import termios
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -40,6 +43,10 @@ SCHEME = "serial://"
 # What pyserial raises when a device is gone or cannot be opened (SerialException is an
 # OSError; ValueError for a malformed URL; TypeError when a port closes under a read).
 _PORT_ERRORS = (serial.SerialException, OSError, ValueError, TypeError)
+# The ioctl pyserial's out_waiting makes, asked of a descriptor directly: the servo output
+# asks it on every command.
+_TIOCOUTQ = getattr(termios, "TIOCOUTQ", 0x5411)
+_UINT_ZERO = bytes(4)
 
 
 class SerialPort(Protocol):
@@ -226,6 +233,9 @@ class ReopeningSerial:
         if port is None:
             return 0
         try:
+            if self._fd is not None:
+                queued = fcntl.ioctl(self._fd, _TIOCOUTQ, _UINT_ZERO)
+                return int.from_bytes(queued, sys.byteorder)
             return int(port.out_waiting)
         except (*_PORT_ERRORS, AttributeError, NotImplementedError):
             return 0

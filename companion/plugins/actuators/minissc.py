@@ -22,10 +22,11 @@ and the safe positions written at a start on the ground would cut the throttle i
 
 from __future__ import annotations
 
+import ctypes
 import math
+import struct
 import time
-from collections.abc import Callable, Mapping
-from operator import attrgetter
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -47,23 +48,26 @@ FLIGHT_SURFACES = ("aileron", "elevator", "rudder")
 HELD_MARK_MAX_S = 60.0
 
 
+# A command read in one call, 50 times a second (a ctypes field read makes an object, the
+# ``aux`` array one more each time): ActuatorCommand's native layout, t_us, aileron,
+# elevator, rudder, throttle, aux[4], armed.
+_COMMAND = struct.Struct("=q8dB")
+_ARMED = 9
+# Where each driven surface's command is in it: ``flaps`` is aux[0], ``brakes`` aux[1];
+# other extras are not driven.
+SURFACE_AT = {"aileron": 1, "elevator": 2, "rudder": 3, "throttle": 4, "flaps": 5, "brakes": 6}
+# ServoOutput made in one call from its packed fields (native layout: t_us, pulse_us[8],
+# position[8], command_t_us, bytes_out) instead of a dozen ctypes field and item writes.
+_OUTPUT = struct.Struct("=q8H8BqQ")
+assert _COMMAND.size <= ctypes.sizeof(ActuatorCommand)
+assert _OUTPUT.size == ctypes.sizeof(ServoOutput)
+
+
 def surface_value(cmd: ActuatorCommand, surface: str) -> float:
     """The command for a surface by name; ``flaps`` is aux[0], ``brakes`` aux[1]; other
-    extras are not driven."""
-    return surface_reader(surface)(cmd)
-
-
-def surface_reader(surface: str) -> Callable[[ActuatorCommand], float]:
-    """What ``surface_value`` reads for ``surface``, chosen once (a channel's surface does
-    not change; its command is read 50 times a second)."""
-    if surface in ("aileron", "elevator", "rudder", "throttle"):
-        field = attrgetter(surface)
-        return lambda cmd: float(field(cmd))
-    if surface == "flaps":
-        return lambda cmd: float(cmd.aux[0])
-    if surface == "brakes":
-        return lambda cmd: float(cmd.aux[1])
-    return lambda cmd: math.nan
+    extras are not driven (NaN)."""
+    at = SURFACE_AT.get(surface)
+    return math.nan if at is None else _COMMAND.unpack_from(cmd)[at]
 
 
 class MiniSscOutput(Plugin):
@@ -119,7 +123,8 @@ class MiniSscOutput(Plugin):
         self.wanted = dict(self.safe)
         self.sent: dict[int, int] = {}
         self.refresh_order = [c.servo for c in self.airframe.channels]
-        self.readers = [(c, surface_reader(c.surface)) for c in self.airframe.channels]
+        # Each channel with where its command is (None: not driven), chosen once.
+        self.readers = [(c, SURFACE_AT.get(c.surface)) for c in self.airframe.channels]
         self.last_command_at: float | None = None  # vehicle seconds
         self.cycle_s = CYCLE_MAX_S
         self.stale = True
@@ -146,7 +151,7 @@ class MiniSscOutput(Plugin):
 
     def step(self) -> None:
         self.waiter.sleep(WAIT_S)  # the waiter counts its own idle time; the commands are read
-        received = list(self.commands.drain())
+        received = self.commands.pending()
         # The wire runs on vehicle time: in a simulation, simulated seconds.
         now = self.ctx.clock.now_us() / 1e6
         if received:
@@ -154,14 +159,15 @@ class MiniSscOutput(Plugin):
             # held for its answer reads time 0 until the simulator's next frame: taken as
             # the command's time, the next wake-up (a wall-clock timeout, or not, as the
             # machine ran) found it seconds old and sent safe positions for a frame.
-            now = max(now, received[-1].t_us / 1e6)
+            command = _COMMAND.unpack_from(received[-1])
+            now = max(now, command[0] / 1e6)
             if self.last_command_at is not None:
                 gap = now - self.last_command_at
                 self.cycle_s = min(CYCLE_MAX_S, max(CYCLE_MIN_S, gap))
             self.last_command_at = now
-            self.wanted = self._positions(received[-1])
+            self.wanted = self._positions(command)
             self.stale = False
-            self.flying = bool(received[-1].armed)
+            self.flying = bool(command[_ARMED])
             if self.flying:
                 self.trim.update(self.wanted, now)
         elif self.last_command_at is None and not self.stale:
@@ -181,7 +187,7 @@ class MiniSscOutput(Plugin):
             return  # refreshes ride on the commands' cycles, not on wall-clock timeouts
         if self._send(self._room()) or received:
             # Also when nothing changed: a lockstep simulator waits for this answer.
-            self._publish(int(received[-1].t_us) if received else -1)
+            self._publish(received[-1].t_us if received else -1)
 
     def close(self) -> None:
         if self.ctx.supervisor_gone():
@@ -221,12 +227,13 @@ class MiniSscOutput(Plugin):
             else settings["stale_s"]
         )
 
-    def _positions(self, cmd: ActuatorCommand) -> dict[int, int]:
-        if not cmd.armed:
+    def _positions(self, command: tuple[float, ...]) -> dict[int, int]:
+        """Each channel's position for a command (``_COMMAND``'s fields)."""
+        if not command[_ARMED]:
             return dict(self.safe)
         positions = {}
-        for c, read in self.readers:
-            value = read(cmd)
+        for c, at in self.readers:
+            value = math.nan if at is None else command[at]
             if math.isfinite(value):
                 positions[c.servo] = c.position(value)
             else:  # a broken command: this surface holds its last good position
@@ -249,20 +256,19 @@ class MiniSscOutput(Plugin):
             self.ctx.health.bad()
             return False
         self.ctx.health.ok(len(plan))
-        for servo, position in plan:
-            self.sent[servo] = position
-            self.refresh_order.remove(servo)
-            self.refresh_order.append(servo)
+        self.sent.update(plan)
+        # The channels just sent go to the back of the refresh order, in the order sent.
+        planned = [servo for servo, _ in plan]
+        self.refresh_order = [s for s in self.refresh_order if s not in planned] + planned
         return True
 
     def _publish(self, command_t_us: int) -> None:
-        msg = ServoOutput(t_us=self.ctx.clock.now_us(), command_t_us=command_t_us)
-        msg.bytes_out = self.port.bytes_out
-        # Each read of a ctypes array field makes a new array object: once, not per servo.
-        positions, pulses, table = msg.position, msg.pulse_us, minissc.PULSES_US
+        positions, pulses, table = [0] * 8, [0] * 8, minissc.PULSES_US
         for servo, position in self.sent.items():
-            positions[servo] = position
-            pulses[servo] = (
-                table[position] if 0 <= position < len(table) else minissc.pulse_us(position)
-            )
-        self.out.publish(msg)
+            # Masked as the message's uint8 and uint16 fields keep them.
+            positions[servo] = position & 0xFF
+            pulse = table[position] if 0 <= position < len(table) else minissc.pulse_us(position)
+            pulses[servo] = pulse & 0xFFFF
+        packed = _OUTPUT.pack(self.ctx.clock.now_us(), *pulses, *positions, command_t_us,
+                              self.port.bytes_out)  # fmt: skip
+        self.out.publish(ServoOutput.from_buffer_copy(packed))

@@ -40,11 +40,11 @@ def test_with_the_supervisor_gone_the_card_holds_the_surfaces_flown_lately(tmp_p
         clock.us = i * 20_000
         cmd = ActuatorCommand(t_us=clock.us, armed=1, throttle=0.7)
         cmd.aileron, cmd.elevator = 0.05 + 0.02 * math.sin(i), -0.2
-        bus.commands.pending.append(cmd)
+        bus.commands.queued.append(cmd)
         servos.step()
     clock.us += 20_000
     last = ActuatorCommand(t_us=clock.us, armed=1, aileron=-1.0, elevator=-0.5, throttle=0.7)
-    bus.commands.pending.append(last)
+    bus.commands.queued.append(last)
     servos.step()
     servos.close()
     positions = dict(FrameDecoder().feed(_written(pty.master)))

@@ -19,11 +19,11 @@ from tests.support.pty import Pty
 
 class _Commands:
     def __init__(self) -> None:
-        self.pending: list[ActuatorCommand] = []
+        self.queued: list[ActuatorCommand] = []
 
-    def drain(self):
-        while self.pending:
-            yield self.pending.pop(0)
+    def pending(self) -> list[ActuatorCommand]:
+        taken, self.queued = self.queued, []
+        return taken
 
 
 class _Bus:
@@ -78,7 +78,7 @@ def test_a_wake_up_just_after_the_first_command_keeps_the_commanded_throttle(tmp
     # Started at START at 5 s of simulation: the first command (answering the navigator's
     # state of 5.00 s) comes while this process's clock still reads 0; the next wake-up
     # (a wall-clock timeout, no command yet) comes once the simulator's next frame, 5.01 s.
-    bus.commands.pending.append(ActuatorCommand(t_us=5_000_000, armed=1, throttle=1.0))
+    bus.commands.queued.append(ActuatorCommand(t_us=5_000_000, armed=1, throttle=1.0))
     servos.step()
     clock.us = 5_010_000
     servos.step()
@@ -112,7 +112,7 @@ def test_restarted_in_flight_it_writes_nothing_until_the_first_command(tmp_path)
     clock.us += 1_000_000  # within flight_hold_s (2 s)
     servos.step()
     assert _written(pty.master) == b""  # the card keeps the pulses it had
-    bus.commands.pending.append(ActuatorCommand(t_us=clock.us, armed=1, throttle=0.8))
+    bus.commands.queued.append(ActuatorCommand(t_us=clock.us, armed=1, throttle=0.8))
     servos.step()
     positions = _decoded(pty.master)
     assert positions[throttle.servo] == throttle.position(0.8)
@@ -134,7 +134,7 @@ def test_started_on_the_ground_every_channel_goes_safe_at_once(tmp_path):
 
 def test_a_card_trimmed_as_the_supervisor_died_is_held_by_the_restarted_vehicle(tmp_path):
     servos, bus, clock, pty = started_servos(tmp_path, supervisor_pid=-1)
-    bus.commands.pending.append(ActuatorCommand(t_us=1_000_000, armed=1, throttle=0.7))
+    bus.commands.queued.append(ActuatorCommand(t_us=1_000_000, armed=1, throttle=0.7))
     clock.us = 1_000_000
     servos.step()
     servos.close()  # the supervisor is gone: trimmed, and the restarted vehicle told so

@@ -108,6 +108,9 @@ class _Channel:
     def pending(self):
         return list(self.drain())
 
+    def has_samples(self) -> bool:
+        return bool(self.samples)
+
 
 def test_a_fix_published_while_the_imu_is_read_is_fed_before_the_next_imu_sample():
     # nav.ins_ekf woken by the IMU sample of 0 ms: while it reads it, the GPS driver
