@@ -22,9 +22,7 @@ and the safe positions written at a start on the ground would cut the throttle i
 
 from __future__ import annotations
 
-import ctypes
 import math
-import struct
 import time
 from collections.abc import Mapping
 from pathlib import Path
@@ -34,6 +32,7 @@ from companion.actuators import minissc
 from companion.actuators.airframe import Airframe, load_airframe
 from companion.actuators.flying_trim import FlyingTrim
 from companion.messages import ActuatorCommand, ServoOutput
+from companion.messages.base import packed_layout
 from companion.params.atomic import atomic_write_text
 from companion.plugin import FLIGHT_NICE, NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
 from companion.sensors.serial_port import ReopeningSerial, open_problem
@@ -49,18 +48,16 @@ HELD_MARK_MAX_S = 60.0
 
 
 # A command read in one call, 50 times a second (a ctypes field read makes an object, the
-# ``aux`` array one more each time): ActuatorCommand's native layout, t_us, aileron,
-# elevator, rudder, throttle, aux[4], armed.
-_COMMAND = struct.Struct("=q8dB")
-_ARMED = 9
+# ``aux`` array one more each time), in the registry's layout.
+_COMMAND, _COMMAND_AT = packed_layout(ActuatorCommand)
+_ARMED = _COMMAND_AT["armed"]
 # Where each driven surface's command is in it: ``flaps`` is aux[0], ``brakes`` aux[1];
 # other extras are not driven.
-SURFACE_AT = {"aileron": 1, "elevator": 2, "rudder": 3, "throttle": 4, "flaps": 5, "brakes": 6}
-# ServoOutput made in one call from its packed fields (native layout: t_us, pulse_us[8],
-# position[8], command_t_us, bytes_out) instead of a dozen ctypes field and item writes.
-_OUTPUT = struct.Struct("=q8H8BqQ")
-assert _COMMAND.size <= ctypes.sizeof(ActuatorCommand)
-assert _OUTPUT.size == ctypes.sizeof(ServoOutput)
+SURFACE_AT = {name: _COMMAND_AT[name] for name in ("aileron", "elevator", "rudder", "throttle")}
+SURFACE_AT |= {"flaps": _COMMAND_AT["aux"], "brakes": _COMMAND_AT["aux"] + 1}
+# ServoOutput made in one call from its packed fields instead of a dozen ctypes field and
+# item writes.
+_OUTPUT, _ = packed_layout(ServoOutput)
 
 
 def surface_value(cmd: ActuatorCommand, surface: str) -> float:
