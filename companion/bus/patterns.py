@@ -72,7 +72,12 @@ class IdleTally:
         return self
 
     def __exit__(self, *exc: object) -> None:
-        self.seconds += time.perf_counter() - self._since
+        self.add_since(self._since)
+
+    def add_since(self, started: float) -> None:
+        """Count the time since ``started`` (``time.perf_counter()``) as idle: a hot wait's
+        one call instead of the context manager's two."""
+        self.seconds += time.perf_counter() - started
 
 
 class Writer(Generic[M]):
