@@ -21,6 +21,7 @@ from pathlib import Path
 import pytest
 from pyulog import ULog
 
+from companion.bus.namespace import cleanup_namespace
 from companion.control.mission.items import MissionItem
 from companion.control.mission.plan import checked_plan
 from ground.campaign.landing_score import landing_score_for_plan, read_truth
@@ -50,14 +51,28 @@ def _upload(gcs: GroundStation, items: list[MissionItem]) -> None:
 
 
 def _command_until_accepted(gcs: GroundStation, command: int, *params: float) -> None:
-    end = time.monotonic() + 60.0
+    """Send until accepted, as a person clicks again; on giving up, say what the vehicle
+    answered and why (its ``PreArm:`` STATUSTEXTs)."""
+    end, answers, said = time.monotonic() + 60.0, [], set()
     while time.monotonic() < end:  # arming waits for the first GPS fix
         gcs.heartbeat()
         gcs.command(command, *params)
-        if gcs.ack(command, 10).result == d.MAV_RESULT_ACCEPTED:
-            return
+        until = time.monotonic() + 10.0
+        while time.monotonic() < until:
+            msg = gcs.conn.recv_match(
+                type=["COMMAND_ACK", "STATUSTEXT"], blocking=True, timeout=0.2
+            )
+            if msg is None or msg.get_srcSystem() != 1:
+                continue
+            if msg.get_type() == "STATUSTEXT":
+                said.add(msg.text)
+            elif msg.command == command:
+                if msg.result == d.MAV_RESULT_ACCEPTED:
+                    return
+                answers.append(msg.result)
+                break
         time.sleep(0.5)
-    raise AssertionError(f"command {command} never accepted")
+    raise AssertionError(f"command {command} never accepted: answers {answers}, said {said}")
 
 
 def _wait_for_the_hold(proc: SimRun) -> None:
@@ -117,9 +132,16 @@ def test_the_c172_lands_its_qgc_landing_pattern_in_a_crosswind_and_disarms(tmp_p
         _command_until_accepted(gcs, d.MAV_CMD_COMPONENT_ARM_DISARM, 1.0)
         _command_until_accepted(gcs, d.MAV_CMD_MISSION_START, 0.0)
         completed, disarmed, states = _fly(gcs)
+    except BaseException:
+        # The flight never began or broke off: end the run now rather than wait out its
+        # hang guard, and fail with what went wrong (the run's output is in the log file).
+        proc.kill()
+        proc.wait()
+        cleanup_namespace(namespace)
+        raise
     finally:
         gcs.close()
-        out = finish(proc, namespace, WALL_LIMIT_S)
+    out = finish(proc, namespace, WALL_LIMIT_S)
     assert completed and disarmed, out[-3000:]
     # What QGroundControl's Fly view goes by (Land Abort only while LANDING): the take-off
     # from the roll to its height, the flight, the landing to the stop, on the ground.
