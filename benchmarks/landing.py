@@ -15,11 +15,12 @@ heartbeat said it was disarmed. ``est x`` is where the vehicle's own navigation 
 (its flight log) put it across the line at that moment: the controller's error, the rest
 of ``across`` being the navigation's (the emulated GPS wanders 1 m per axis, 60 s
 correlated, the same sequence for a seed whatever is flown). ``--seeds N`` flies each
-row with the simulator's seeds 1 to N (the GPS's wander, the sensors' noise) and ends with
-how many passed. The light turbulence is JSBSim's own sequence in simulated time, the same
-for every seed: ``--start-at S`` (repeatable; default 10) starts the mission at
-another second, so the approach meets other gusts (a ground station arms on its own clock:
-tests/sitl/test_landing.py armed at second 4.8 in one run).
+row with the simulator's seeds 1 to N (the GPS's wander, the sensors' noise and the
+turbulence's gusts) and ends with how many passed. Seed 1 flies JSBSim's own gust
+sequence, the one every run flew before the seed picked the gusts. ``--start-at S``
+(repeatable; default 10) starts the mission at another second, so the approach meets
+another part of the sequence (a ground station arms on its own clock: tests/sitl/
+test_landing.py holds the simulation for its arming).
 Criteria (issue 24, along and across from issue 42 item 8): |along| ≤ 15 m,
 |across| ≤ 2 m, sink ≤ 1.5 m/s, bounce ≤ 1 m, |bank| ≤ 10°, stopped on the runway,
 disarmed. benchmarks/plans/circuit_*.plan are circuits without QGroundControl's pattern

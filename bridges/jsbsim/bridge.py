@@ -85,7 +85,7 @@ def _flight(opts: BridgeOptions, airframe: SimAirframe) -> Flight:
         opts.airborne_bank_deg,
     )
     flight.set_wind(*opts.wind_ned)
-    flight.set_turbulence(opts.turbulence)
+    flight.set_turbulence(opts.turbulence, opts.seed)  # one seed: the same flight
     for servo in airframe.servos.values():
         if servo.surface == "brakes":  # held at their safe setting until commanded
             flight.set_controls({"brakes": servo.command(servo.trim)})

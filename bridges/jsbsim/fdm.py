@@ -121,10 +121,13 @@ class Flight:
         self.fdm["atmosphere/wind-east-fps"] = east / FT
         self.fdm["atmosphere/wind-down-fps"] = down / FT
 
-    def set_turbulence(self, level: str) -> None:
-        """MIL-F-8785C turbulence: none, light, moderate or severe."""
+    def set_turbulence(self, level: str, seed: int | None = None) -> None:
+        """MIL-F-8785C turbulence: none, light, moderate or severe; ``seed`` picks the gust
+        sequence (JSBSim's own, which seeds 0 and 1 also give, when None)."""
         severity, wind_kt = TURBULENCE[level]
         self.turbulence = severity > 0
+        if seed is not None:
+            self.fdm["atmosphere/randomseed"] = seed
         if severity == 0:
             self.fdm["atmosphere/turb-type"] = 0
             return

@@ -61,7 +61,10 @@ def hil(
         list[str] | None, typer.Option(help="START:SECONDS of no GPS fix, repeatable")
     ] = None,
     duration: Annotated[float | None, typer.Option(help="seconds to fly, then stop")] = None,
-    seed: Annotated[int, typer.Option(help="sensor noise seed")] = 1,
+    seed: Annotated[
+        int,
+        typer.Option(help="sensor noise and turbulence seed (0 and 1: JSBSim's own gusts)"),
+    ] = 1,
     noise: Annotated[float, typer.Option(help="sensor noise scale (0: perfect)")] = 1.0,
     gps_wander: Annotated[
         float | None, typer.Option(min=0, max=100, help="the GPS's wandering error, m")

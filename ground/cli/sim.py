@@ -101,7 +101,10 @@ def sim(
         list[str] | None, typer.Option(help="START:SECONDS of no GPS fix, repeatable")
     ] = None,
     duration: Annotated[float | None, typer.Option(help="simulated seconds, then stop")] = None,
-    seed: Annotated[int, typer.Option(help="sensor noise seed")] = 1,
+    seed: Annotated[
+        int,
+        typer.Option(help="sensor noise and turbulence seed (0 and 1: JSBSim's own gusts)"),
+    ] = 1,
     exact: Annotated[
         bool,
         typer.Option(

@@ -96,7 +96,7 @@ def plan_slots(req: FleetRequest) -> list[VehicleSlot]:
                 state_dir=req.state_dir / f"v{i}",
                 home=offset_home(req.opts.home, (i - 1) * req.spacing_m),
                 links=links,
-                seed=req.opts.seed + i - 1,  # independent sensor noise per aircraft
+                seed=req.opts.seed + i - 1,  # its own sensor noise and gusts
                 truth=vehicle_truth(truth, i),
             )
         )
