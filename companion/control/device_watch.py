@@ -47,20 +47,22 @@ class DeviceWatch:
         self.kinds = {kind for kind, settings in plugins.items() if "device" in settings}
         self.history: dict[str, deque[_Counts]] = {}
         self.kind_of: dict[str, str] = {}  # plug-in name -> kind
-        self._last_t_us: int | None = None
+        self._last_table = b""
 
     def update(self, health: SystemHealth | None) -> None:
         """Take a health table (the same one again is ignored)."""
-        if health is None or health.t_us == self._last_t_us:
+        # Not by its time: a held simulation's tables all carry the held time.
+        if health is None or (table := bytes(health)) == self._last_table:
             return
-        self._last_t_us = health.t_us
+        self._last_table = table
         for row in health.rows():
             if row.kind.decode() not in self.kinds or row.group.decode() != "core":
                 continue
             running = row.state == PluginState.RUNNING
             # Judged on the plug-in's own time of its counters: the table's time may run
             # ahead of counters not yet reported again (a busy or fast-simulating machine).
-            t_us = row.counted_us or health.t_us
+            # 0 is a time too (a simulation's first instant), not "the table's".
+            t_us = row.counted_us
             now = _Counts(t_us, row.pid if running else 0, row.bytes_in,
                           row.frames_ok, row.frames_bad)  # fmt: skip
             name = row.name.decode()
@@ -68,8 +70,13 @@ class DeviceWatch:
             history = self.history.setdefault(name, deque())
             if history and history[-1].pid != now.pid:
                 history.clear()  # a new process counts from zero: judge it afresh
-            elif history and history[-1].t_us >= t_us:
-                continue  # the same report again: nothing new was counted
+            elif history and history[-1].t_us > t_us:
+                continue  # an older report than the one kept
+            elif history and history[-1].t_us == t_us:
+                # The same report again, or newer counters at a clock that stood still
+                # (a simulation held for the arming): the newest counts stand for then.
+                history[-1] = now
+                continue
             history.append(now)
             # Keep the newest table at least a window old, and every one since.
             while len(history) > 1 and now.t_us - history[1].t_us >= WINDOW_US:

@@ -106,3 +106,20 @@ def test_the_same_table_twice_counts_once_and_the_reason_reaches_prearm():
         Readiness(now_us=0, devices=silent), {"ARMING_GPS_EPH": 5.0, "ARMING_STALE_S": 1.0}
     )
     assert "compass: no data from its device" in reasons
+
+
+def test_a_held_simulation_clock_still_takes_newer_counters():
+    """``companion sim --hold-at``: the vehicle time stops while a ground station arms, and
+    every table after that carries the same time. The counters in them are newer: a table
+    made before the plug-ins' first reports must not refuse arming for ever (a CI run's
+    vehicle, held at 10 s, never armed)."""
+    watch = DeviceWatch(PLUGINS)
+    watch.update(table(0, {}))  # the plug-ins just started: nothing heard yet
+    watch.update(table(10, {"gps": (400, 1, 0)}, counted_s={"gps": 10, "compass": 0}))
+    assert watch.failures() == ["compass: waiting for data from its device"]
+    for _ in range(3):  # held at 10 s: the compass's report comes in a later table
+        watch.update(table(10, {"gps": (400, 1, 0), "compass": (600, 20, 0)}))
+    assert watch.failures() == []
+    # An older report than the one held is not taken over it.
+    watch.update(table(10, {"gps": (400, 1, 0)}, counted_s={"gps": 9, "compass": 9}))
+    assert watch.failures() == []
