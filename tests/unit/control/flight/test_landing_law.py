@@ -127,6 +127,23 @@ def test_the_rangefinder_moves_the_glide_path_onto_the_runway_the_navigator_misp
     assert other.ground_alt == 103.0
 
 
+def test_the_climb_feed_forward_carries_the_glide_path_down_with_the_corrected_runway():
+    """While the rangefinder brings the runway down the 3 m the navigator misplaced, the
+    glide path comes down with it: the energy controller is told the path sinks that much
+    faster, not only at its slope's rate (it flew 0.4-0.65 m above a path moving so, and
+    began the flare in a dive). Once the runway is found, the slope's rate alone."""
+    land = Landing(START, 150.0, TOUCHDOWN, 103.0)  # the runway really at 100 m
+    over_ground = replace(_state(-100.0, 12.0), range_height=12.0)
+    moving = land.step(over_ground, V, 0.02)
+    for _ in range(500):
+        settled = land.step(over_ground, V, 0.02)
+    assert land.ground_alt == pytest.approx(100.0, abs=0.05)
+    # GROUND_TAU_S 1.5 s: the first step moves the runway 3 m / 1.5 s = 2 m/s.
+    assert moving.climb_ff == pytest.approx(settled.climb_ff - 2.0, abs=0.2)
+    known = Landing(START, 150.0, TOUCHDOWN, 100.0).step(over_ground, V, 0.02)
+    assert settled.climb_ff == pytest.approx(known.climb_ff, abs=0.01) and known.climb_ff < 0.0
+
+
 def test_a_flare_begun_as_a_gust_slows_the_sink_is_no_slower_than_the_glides():
     """A gust that has just slowed the sink when the flare begins does not make the flare
     slower than the glide's (it floated, and a C172 touched down 47 m long): its sink demand

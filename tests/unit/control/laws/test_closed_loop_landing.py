@@ -97,6 +97,21 @@ def test_a_home_altitude_misread_at_arming_is_corrected_by_the_rangefinder(airfr
     assert abs(off.along_m) > abs(score.along_m) + 50.0, (off, score)
 
 
+def test_a_runway_a_metre_off_in_the_navigators_height_lands_where_the_true_one_does():
+    """The simulated vehicle's navigator reads about 0.9 m low on the approach: the
+    rangefinder moves the runway, and the glide path with it, in the last seconds before
+    the flare. The controller follows the path's move as well as its slope, so the C172
+    lands where it lands on the true height (1.8 m short); following the slope alone it
+    ran above the moving path into the flare and landed 5.3-5.8 m short."""
+    items = checked_plan(PLAN)[0]
+    along = []
+    for error_m in (0.0, 0.9, -0.9):
+        loop = ClosedLoop("c172p", items, home_alt_error_m=error_m, range_max_m=12.0)
+        assert loop.fly_until_disarmed(600.0)
+        along.append(landing_score_for_plan(loop.truth(), items).along_m)
+    assert abs(along[1] - along[0]) < 1.0 and abs(along[2] - along[0]) < 1.0, along
+
+
 def test_a_go_around_on_the_approach_climbs_away_and_the_second_approach_lands():
     items = checked_plan(PLAN)[0]
     loop = ClosedLoop("c172p", items)
