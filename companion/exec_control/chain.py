@@ -68,35 +68,39 @@ class ChainLink:
             self._reader_host, self._reader = host, host.bus.reader_of(self.trigger)
         return self._reader
 
-    def run_after(self, producer: PluginHost) -> float | None:
-        """On the producer's thread, after its step: this plug-in's step, if a sample of
-        its trigger waits for it (its wait would then return at once: a step run without
-        one would sleep on the producer's thread) and it is not busy on its own thread.
-        The thread's CPU time when it ended (None: it did not run)."""
+    def run_after(self, payer: PluginHost) -> tuple[float | None, float]:
+        """On ``payer``'s thread (the plug-in whose thread it is), after the producer's step:
+        this plug-in's step, if a sample of its trigger waits for it (its wait would then
+        return at once: a step run without one would sleep on the producer's thread) and it
+        is not busy on its own thread. The thread's CPU time when it ended (None: it did not
+        run) and the CPU time it and its own followers took."""
         host = self.host
         if host is None:
-            return None
+            return None, 0.0
         reader = self._reader if self._reader_host is host else self._trigger_reader(host)
         if reader is None or not reader.has_samples():
-            return None
+            return None, 0.0
         self._last_run = time.monotonic()  # the producer delivers: no step of its own
         if not self._lock.acquire(blocking=False):
-            return None  # busy in its own step: its own wait takes the sample
-        # The CPU of this step and of its own followers' is moved from the producer's row to
-        # this one; each follower moves its own share on from here, so every plug-in's row
-        # holds its own steps, however deep in the chain they ran. A last follower's reading
-        # at its end is this one's end too (a clock read is a system call).
-        cpu_before, cpu_after = time.thread_time(), None
+            return None, 0.0  # busy in its own step: its own wait takes the sample
+        # The CPU of this step is moved from the thread's own plug-in's row to this one, and
+        # each follower moves its own share from that same row: every row holds its own
+        # steps at every moment (moved through the producer, a producer's row read between
+        # its follower's move and its own showed minus the follower's step, then plus it:
+        # 43 % for a relay a second after a long one). A last follower's reading at its end
+        # is this one's end too (a clock read is a system call).
+        cpu_before, cpu_after, followers = time.thread_time(), None, 0.0
         try:
             if self._step_locked(host):
-                cpu_after = host.after_step()  # its own followers
+                cpu_after, followers = host.after_step(payer)  # its own followers
         finally:
             if cpu_after is None:
                 cpu_after = time.thread_time()
             took = cpu_after - cpu_before
-            host.cpu_moved_s += took
-            producer.cpu_moved_s -= took
-        return cpu_after
+            own = took - followers
+            host.cpu_moved_s += own
+            payer.cpu_moved_s -= own
+        return cpu_after, took
 
     def _step_locked(self, host: PluginHost) -> bool:
         """One step under the lock ``run_after`` took; whether it ran and succeeded.
@@ -149,13 +153,18 @@ class ChainLink:
         return not self.failed
 
 
-def run_followers(followers: Sequence[ChainLink], producer: PluginHost) -> float | None:
-    """Run each follower that has a sample of its trigger waiting, after ``producer``'s step;
-    the thread's CPU time when the last one ended (None: the last did not run)."""
-    cpu_after = None
+def run_followers(
+    followers: Sequence[ChainLink], producer: PluginHost, payer: PluginHost | None = None
+) -> tuple[float | None, float]:
+    """Run each follower that has a sample of its trigger waiting, after ``producer``'s step,
+    on ``payer``'s thread (the producer's own when None); the thread's CPU time when the
+    last one ended (None: the last did not run) and the CPU time they took."""
+    payer = producer if payer is None else payer
+    cpu_after, took = None, 0.0
     for link in followers:
-        cpu_after = link.run_after(producer)
-    return cpu_after
+        cpu_after, link_took = link.run_after(payer)
+        took += link_took
+    return cpu_after, took
 
 
 def chain_links(members: Sequence[dict[str, Any]]) -> dict[str, tuple[str, ChainLink]]:

@@ -85,8 +85,8 @@ class StepTimer:
         return tuple(ordered[min(last, int(q * len(ordered)))] for q in qs)
 
 
-def _nothing() -> float | None:
-    return None
+def _nothing(payer: object = None) -> tuple[float | None, float]:
+    return None, 0.0
 
 
 def _signal_pipe() -> int:
@@ -126,9 +126,10 @@ class PluginHost:
         self._cpu_clock = time.pthread_getcpuclockid(threading.get_ident())
         self.cpu_moved_s = 0.0
         self._cpu_mark = (self._cpu_s(), time.monotonic())
-        # Run after each step on this plug-in's thread (the composed host's chain); it gives
-        # the thread's CPU time when it ended if it read it last (None: it did not).
-        self.after_step: Callable[[], float | None] = _nothing
+        # Run after each step on this plug-in's thread (the composed host's chain), given the
+        # host whose thread it is when that is another's; it gives the thread's CPU time when
+        # it ended if it read it last (None: it did not) and the CPU its followers took.
+        self.after_step: Callable[..., tuple[float | None, float]] = _nothing
         self.bus = BusNode(spec["namespace"], spec["name"], node)
         self.timer = StepTimer()
         # A composed plug-in's host gives a writer that outlives this instance: the counters
