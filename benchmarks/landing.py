@@ -1,7 +1,7 @@
 """Automatic landings of both airframes, scored from the simulator's truth.
 
 Usage: uv run python benchmarks/landing.py [--aircraft c172p] [--plan land_east.plan]
-       [--calm-only] [--seeds N] [--start-at S ...]
+       [--calm-only] [--seeds N] [--start-at S ...] [--keep DIR]
 (aircraft and plan repeatable; default: c172p and J3Cub, benchmarks/plans/land_east.plan)
 
 Each airframe, plan and condition (calm; 5 m/s crosswind from the south with light
@@ -61,6 +61,9 @@ def main() -> None:
     ap.add_argument("--calm-only", action="store_true")
     ap.add_argument("--seeds", type=int, default=1, help="fly seeds 1..N of each row")
     ap.add_argument("--start-at", type=float, action="append", help="simulated second(s)")
+    ap.add_argument(
+        "--keep", type=Path, help="keep each flight's folder (truth, flight log, sim log) here"
+    )
     args = ap.parse_args()
     conditions = {"calm": CONDITIONS["calm"]} if args.calm_only else CONDITIONS
     plans = [_plan(p) for p in (args.plan or ["land_east.plan"])]
@@ -79,18 +82,20 @@ def main() -> None:
                 for start, seed in product(args.start_at or [START_AT_S], seeds):
                     flight = Flight(str(plan), name, wind, turbulence, (), seed,
                                     str(SIM_CONFIG), False, 900.0, start)  # fmt: skip
-                    text, ok = fly_whole_vehicle(flight, plan)
+                    text, ok = fly_whole_vehicle(flight, plan, args.keep)
                     row = f"{name:8} {plan.stem:10} {cond:18} {start:5g} {seed:4d} {text}"
                     print(row, flush=True)
                     passed, flown = passed + ok, flown + 1
     print(f"passed {passed} of {flown}")
 
 
-def fly_whole_vehicle(flight: Flight, plan: Path) -> tuple[str, bool]:
-    """Fly ``flight`` with ``companion sim``; its scored row and whether it passed."""
+def fly_whole_vehicle(flight: Flight, plan: Path, keep: Path | None = None) -> tuple[str, bool]:
+    """Fly ``flight`` with ``companion sim``; its scored row and whether it passed. With
+    ``keep``, the flight's folder stays there (named by its flight id)."""
     with tempfile.TemporaryDirectory() as tmp:
-        row = fly_flight(FlightJob(flight, tmp, timeout_s=900.0))
-        truth = Path(tmp) / flight.flight_id / "truth.csv"
+        out = keep or Path(tmp)
+        row = fly_flight(FlightJob(flight, str(out), timeout_s=900.0))
+        truth = out / flight.flight_id / "truth.csv"
         score = _score(truth, plan)
         est = navigation_across(truth, plan, score)
     return _row(score, est, row)
