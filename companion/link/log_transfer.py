@@ -57,7 +57,9 @@ class _Range:
     eof_marker: bool  # a count-0 LOG_DATA at ``end`` once the data is out
 
     def overlaps(self, other: _Range) -> bool:
-        return self.ofs <= other.end and other.ofs <= self.end
+        # Ranges that only touch do not: a station asking for each lost packet on its own
+        # had every second request drop the one before it.
+        return self.ofs < other.end and other.ofs < self.end
 
 
 @dataclass
@@ -244,7 +246,11 @@ class LogTransferService:
         r = t.now
         if r.ofs >= r.end:
             out = []
-            if r.eof_marker:
+            if r.eof_marker and t.queued:
+                # MAVProxy ends its download at a count-0 packet, holes or not: the holes it
+                # asked for meanwhile go first (a log of whole packets saved with a gap).
+                t.queued.append(_Range(r.end, r.end, eof_marker=True))
+            elif r.eof_marker:
                 msg = self.mav.log_data_encode(t.log_id, r.end, 0, bytes(CHUNK))
                 out.append(Outgoing(msg, t.peer))
                 self.tokens -= FRAME_BYTES

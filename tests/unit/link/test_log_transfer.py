@@ -125,6 +125,23 @@ def test_mavproxy_holes_all_filled_and_qgc_restart_replaces(tmp_path):
     assert assemble(got, 9000)[8100:] == path.read_bytes()[8100:]
 
 
+def test_holes_asked_for_during_the_download_come_before_its_count_zero_end(tmp_path):
+    """MAVProxy takes a count-0 packet as the end, whatever it still lacks: on a busy link it
+    asks for the holes while the download is still under way, and a log of whole packets
+    must not be told it ended before they come."""
+    (path,) = make_logs(tmp_path / "logs", 9000)  # whole packets: it ends with a count 0
+    st = Station(tmp_path / "logs", rate_bytes_s=2000)
+    got = st.send("LOG_REQUEST_DATA", 0, 0, 0xFFFFFFFF) + st.run(2.0)
+    lost = {900, 990}  # two packets the radio lost, asked for again one by one
+    got = [m for m in got if m.ofs not in lost]
+    for ofs in sorted(lost):
+        got += st.send("LOG_REQUEST_DATA", 0, ofs, 90)
+    got += st.run(12.0)
+    counts = [m.count for m in got]
+    assert counts.count(0) == 1 and counts[-1] == 0, counts[-5:]
+    assert assemble(got, 9000) == path.read_bytes()
+
+
 def test_hostile_requests_are_refused_and_counted(tmp_path):
     make_logs(tmp_path / "logs", 1000)
     st = Station(tmp_path / "logs")
