@@ -6,12 +6,13 @@ plug-in's ``sim`` fixture instead."""
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 from pathlib import Path
 
-from companion.bus.namespace import cleanup_namespace, leftover_files
-from companion.testing.processes import LoggedProcess
+from companion.bus.namespace import leftover_files
+from companion.testing.processes import LoggedProcess, stop_tree
 from tests.support.vehicle import REPO, companion_env, unique_namespace
 
 
@@ -39,9 +40,7 @@ def finish(proc: SimRun, namespace: str, timeout_s: float) -> str:
     try:
         proc.wait(timeout=timeout_s)
     except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait()
-        cleanup_namespace(namespace)
+        stop_tree(proc, namespace, signal.SIGKILL)  # the whole tree, not only its top
         out = proc.output()
         raise AssertionError(f"companion sim did not finish in {timeout_s} s:\n{out}") from None
     out = proc.output()

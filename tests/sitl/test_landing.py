@@ -21,9 +21,9 @@ from pathlib import Path
 import pytest
 from pyulog import ULog
 
-from companion.bus.namespace import cleanup_namespace
 from companion.control.mission.items import MissionItem
 from companion.control.mission.plan import checked_plan
+from companion.testing.processes import stop_tree
 from ground.campaign.landing_score import landing_score_for_plan, read_truth
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import GroundStation, free_udp_port
@@ -135,9 +135,7 @@ def test_the_c172_lands_its_qgc_landing_pattern_in_a_crosswind_and_disarms(tmp_p
     except BaseException:
         # The flight never began or broke off: end the run now rather than wait out its
         # hang guard, and fail with what went wrong (the run's output is in the log file).
-        proc.kill()
-        proc.wait()
-        cleanup_namespace(namespace)
+        stop_tree(proc, namespace)
         raise
     finally:
         gcs.close()
