@@ -47,14 +47,15 @@ class DeviceWatch:
         self.kinds = {kind for kind, settings in plugins.items() if "device" in settings}
         self.history: dict[str, deque[_Counts]] = {}
         self.kind_of: dict[str, str] = {}  # plug-in name -> kind
-        self._last_table = b""
+        self._last_table: SystemHealth | None = None
 
     def update(self, health: SystemHealth | None) -> None:
         """Take a health table (the same one again is ignored)."""
-        # Not by its time: a held simulation's tables all carry the held time.
-        if health is None or (table := bytes(health)) == self._last_table:
+        # Not by its time: a held simulation's tables all carry the held time. A reader's
+        # ``get()`` gives the same object until a new table comes.
+        if health is None or health is self._last_table:
             return
-        self._last_table = table
+        self._last_table = health
         for row in health.rows():
             if row.kind.decode() not in self.kinds or row.group.decode() != "core":
                 continue
