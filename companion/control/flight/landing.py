@@ -181,7 +181,6 @@ class Landing:
         self._touchdown_pitch = 0.0
         self._tau = 1.0
         self._glide_sink = 0.0  # m/s: the glide path's sink rate at the last approach step
-        self._ground_rate = 0.0  # m/s: how fast the rangefinder moved ground_alt last step
         self.flare_alt = math.nan  # where the flare is planned to begin (flare_distance)
         self._decel = DecelEstimate()
 
@@ -263,10 +262,11 @@ class Landing:
 
     def step(self, s: AircraftState, v: Mapping[str, float], dt: float) -> LandingDemand:
         """The demand for this step; ``v`` holds the parameters by name."""
+        ground_rate = 0.0  # m/s: how fast the rangefinder moves the runway's altitude
         if self.phase == LandPhase.APPROACH:
             ground_before = self.ground_alt
             self._correct_ground(s, dt)
-            self._ground_rate = (self.ground_alt - ground_before) / dt if dt > 0 else 0.0
+            ground_rate = (self.ground_alt - ground_before) / dt if dt > 0 else 0.0
             self._smooth_trim(s, dt)
         height = s.range_height if math.isfinite(s.range_height) else s.alt_msl - self.ground_alt
         ground_speed = math.hypot(*s.vel)
@@ -303,7 +303,7 @@ class Landing:
         self._glide_sink = max(speed_along, 0.0) * slope
         # The path moves with the runway's height as the rangefinder corrects it, and the
         # energy controller follows the path's rate, not only its slope's.
-        ff = self._ground_rate - self._glide_sink if on_slope else 0.0
+        ff = ground_rate - self._glide_sink if on_slope else 0.0
         return LandingDemand(
             self.phase, line, alt, v["TECS_LAND_ARSPD"], flaps=landing_flaps(v), climb_ff=ff
         )
