@@ -88,12 +88,14 @@ def fly(config: Path, cpu_s: float, kill_core: bool) -> dict[str, float]:
         v.vehicle_up()
         v.wait_sim(ARM_AT_S + FLYING_AFTER_S)
         pids, relay_pids = v.labelled(), tree(relay.pid)
-        before = sum(cpu_seconds(p) for p in pids.values())
+        each = {label: cpu_seconds(p) for label, p in pids.items()}
         relay_before = sum(cpu_seconds(p) for p in relay_pids)
         wall0, sim0 = time.monotonic(), v.sim_s()
         time.sleep(cpu_s)
         wall = time.monotonic() - wall0
-        res["cpu_pct"] = 100 * (sum(cpu_seconds(p) for p in pids.values()) - before) / wall
+        for label, p in pids.items():
+            res[f"cpu_pct:{label}"] = 100 * (cpu_seconds(p) - each[label]) / wall
+        res["cpu_pct"] = sum(res[f"cpu_pct:{label}"] for label in pids)
         res["relay_cpu_pct"] = 100 * (sum(cpu_seconds(p) for p in relay_pids) - relay_before) / wall
         res["sim_rate"] = (v.sim_s() - sim0) / wall
         res["pss_mb"] = sum(pss_kib(p) for p in v.labelled().values()) / 1024
@@ -175,11 +177,14 @@ def main() -> None:
     print(f"{'layout':<15}{'procs':>6}{'CPU':>9}{'relay CPU':>11}{'ratio':>7}"
           f"{'PSS':>10}{'relay PSS':>11}{'sim/real':>9}")  # fmt: skip
     for name, rs in runs.items():
-        med = {k: statistics.median(r[k] for r in rs) for k in rs[0]}
+        med = {k: statistics.median(r[k] for r in rs if k in r) for k in rs[0]}
         ratio = statistics.median(r["cpu_pct"] / r["relay_cpu_pct"] for r in rs)
         print(f"{name:<15}{med['processes']:6.0f}{med['cpu_pct']:8.2f}%{med['relay_cpu_pct']:10.2f}%"
               f"{ratio:6.2f}x{med['pss_mb']:7.1f} MB{med['relay_pss_mb']:8.1f} MB"
               f"{med['sim_rate']:9.3f}")  # fmt: skip
+        shares = sorted(((k.split(":", 1)[1], v) for k, v in med.items() if ":" in k),
+                        key=lambda kv: -kv[1])  # fmt: skip
+        print("  by process: " + ", ".join(f"{k} {v:.2f}%" for k, v in shares))
         if "core_up_s" in med:
             print(f"  kill -9 of the composed process hosting the IMU: started again "
                   f"{med['core_started_s'] * 1000:.0f} ms, its first counters "

@@ -39,6 +39,7 @@ from companion.exec_control.plugin_host import (
     set_name,
 )
 from companion.exec_control.priority import apply_nice
+from companion.exec_control.profiling import run_profiled
 from companion.exec_control.registry import load
 from companion.fd_wait import drain, wait_readable
 from companion.messages import PluginStats
@@ -103,7 +104,9 @@ class Member:
         backoff_s = 0.0
         while not self.stopping:
             started = time.monotonic()
-            code = self.run_once(stats)
+            # COMPANION_PROFILE: one profile per thread, a chained plug-in's steps in its
+            # producer's (cProfile follows only the thread that enabled it).
+            code = run_profiled(self.name, lambda: self.run_once(stats), per_thread=True)
             if self.stopping:
                 break
             if time.monotonic() - started >= STABLE_AFTER_S:

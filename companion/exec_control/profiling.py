@@ -2,9 +2,12 @@
 
 ``COMPANION_PROFILE=DIR`` makes every plug-in process run its plug-in (init, steps, close)
 under cProfile and write ``DIR/<name>.<pid>.prof`` when it stops; ``COMPANION_PROFILE_ONLY``
-(comma-separated plug-in names) limits it to those. Times are the process's CPU time
-(``time.process_time``: a function asleep in a wait costs nothing, the kernel's work in its
-system calls counts) unless ``COMPANION_PROFILE_CLOCK=wall``. The variables reach the
+(comma-separated plug-in names) limits it to those. A composed process writes one file per
+plug-in thread, named after the plug-in; a chained plug-in's steps (run on its producer's
+thread) are in its producer's file. Times are the process's CPU time
+(``time.process_time``; a composed process's threads each their own, ``time.thread_time``:
+a function asleep in a wait costs nothing, the kernel's work in its system calls counts)
+unless ``COMPANION_PROFILE_CLOCK=wall``. The variables reach the
 plug-ins through the supervisor's and the fork server's environment, so
 
     COMPANION_PROFILE=/tmp/prof companion sim --plan qgc_plans/square.plan
@@ -59,13 +62,15 @@ def exec_wrapper(name: str) -> list[str]:
     return shlex.split(os.environ.get(ENV_WRAP, ""))
 
 
-def run_profiled(name: str, run: Callable[[], T]) -> T:
-    """``run()``, under cProfile when the environment asks for plug-in ``name``."""
+def run_profiled(name: str, run: Callable[[], T], per_thread: bool = False) -> T:
+    """``run()``, under cProfile when the environment asks for plug-in ``name``; timed by
+    the calling thread's CPU clock when ``per_thread`` (a thread of a composed process)."""
     path = profile_path(name)
     if path is None:
         return run()
     wall = os.environ.get(ENV_CLOCK, "cpu") == "wall"
-    profiler = cProfile.Profile(time.perf_counter if wall else time.process_time)
+    cpu = time.thread_time if per_thread else time.process_time
+    profiler = cProfile.Profile(time.perf_counter if wall else cpu)
     try:
         return profiler.runcall(run)
     finally:
