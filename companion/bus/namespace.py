@@ -106,16 +106,32 @@ def cleanup_namespace(namespace: str) -> int:
     management segment iceoryx2 keeps, and any orphaned segment) are deleted too, so
     nothing is left in /dev/shm.
     """
-    import iceoryx2 as iox2
-
-    cfg = make_config(namespace)
-    try:
-        iox2.Node.try_cleanup_dead_nodes(iox2.ServiceType.Ipc, cfg)
-    except Exception as exc:  # a half-written node of a process killed mid-start
-        log.debug("iceoryx2 dead-node cleanup: %s", exc)
+    cleanup_dead_nodes(namespace)
     if alive_nodes(namespace):
         return 0
     return _remove_prefixed_files(prefix_of(namespace))
+
+
+def cleanup_dead_nodes(namespace: str) -> int:
+    """Remove the ports and files of this namespace's dead iceoryx2 nodes (processes killed
+    with SIGKILL) from every service they were in; how many nodes were removed."""
+    import iceoryx2 as iox2
+
+    removed = 0
+    try:
+        states = iox2.Node.list(iox2.ServiceType.Ipc, make_config(namespace))
+    except Exception as exc:  # a namespace being removed by another process meanwhile
+        log.debug("iceoryx2 node list: %s", exc)
+        return 0
+    for state in states:
+        if not isinstance(state, iox2.NodeState.Dead):
+            continue
+        try:
+            state[0].try_remove_stale_resources()
+            removed += 1
+        except Exception as exc:  # a half-written node of a process killed mid-start
+            log.debug("iceoryx2 dead-node cleanup: %s", exc)
+    return removed
 
 
 def _matching(base: Path, prefix: str) -> list[Path]:

@@ -270,3 +270,38 @@ def test_before_gives_the_newest_value_older_than_a_time_whatever_came_since(nam
     assert without is not None and with_it is not None and later is not None
     assert (without.t_us, with_it.t_us, with_it.distance_m) == (20, 20, 2.0)
     assert later.t_us == 30
+
+
+def test_a_killed_processs_node_is_cleaned_while_others_of_its_bus_live_on(namespace):
+    """A plug-in process killed outright leaves a dead node among living ones (the
+    supervisor's, the other plug-ins'): the cleanup removes that node alone, and the
+    living node's channel still carries samples to a reader that joins afterwards."""
+    import iceoryx2 as iox2
+
+    from companion.bus.namespace import cleanup_dead_nodes, make_config
+
+    code = (
+        "import sys, time\nfrom companion.bus.node import BusNode\n"
+        "bus = BusNode(sys.argv[1], 'doomed'); r = bus.latest_reader('nav/state')\n"
+        "print('up', flush=True); time.sleep(60)\n"
+    )
+    with BusNode(namespace, "alive") as bus:
+        nav = bus.writer("nav/state")
+        proc = subprocess.Popen(
+            [sys.executable, "-c", code, namespace], cwd=REPO, stdout=subprocess.PIPE, text=True
+        )
+        assert proc.stdout is not None and proc.stdout.readline() == "up\n"
+        proc.kill()
+        proc.wait()
+
+        def states() -> list[type]:
+            return [type(s) for s in iox2.Node.list(iox2.ServiceType.Ipc, make_config(namespace))]
+
+        assert iox2.NodeState.Dead in states()
+        assert cleanup_dead_nodes(namespace) == 1
+        assert iox2.NodeState.Dead not in states()
+        assert states().count(iox2.NodeState.Alive) == 1
+        reader = bus.latest_reader("nav/state")
+        nav.publish(NavState(t_us=7))
+        got = wait_for(reader.get, 5.0, "the sample after the cleanup")
+        assert got is not None and got.t_us == 7
