@@ -130,6 +130,9 @@ class PluginHost:
         # host whose thread it is when that is another's; it gives the thread's CPU time when
         # it ended if it read it last (None: it did not) and the CPU its followers took.
         self.after_step: Callable[..., tuple[float | None, float]] = _nothing
+        # Set once ``init`` has returned or raised (a composed process starts the rest of
+        # its plug-ins after its flight path's).
+        self.initialised = threading.Event()
         self.bus = BusNode(spec["namespace"], spec["name"], node)
         self.timer = StepTimer()
         # A composed plug-in's host gives a writer that outlives this instance: the counters
@@ -192,6 +195,8 @@ class PluginHost:
             if self.composed:  # its row says BACKOFF; a process of its own just dies
                 self.publish_stats()
             return False
+        finally:
+            self.initialised.set()
         # Up: the health table has the new process's own counters before its first step,
         # which waits for its device (a silent one: the read timeout, a second).
         self.publish_stats()

@@ -130,3 +130,29 @@ def test_a_sample_published_without_waking_goes_with_the_next_one(vehicle_factor
     )
     imu, relay = (steps[n][-1] - steps[n][0] for n in ("imu", "relay"))
     assert 0.4 * imu <= relay <= 0.6 * imu, (imu, relay)
+
+
+def test_the_flight_path_of_a_composed_process_is_up_before_its_other_plugins(
+    vehicle_factory,
+):
+    """A composed process (started, or restarted after a kill in the air) inits its flight
+    path first: a plug-in whose init holds the interpreter's lock for 1.5 s, listed first,
+    does not hold up the IMU's and the chained relay's inits, whose first counters come
+    before its own, and the samples then flow through the chain."""
+    vehicle = vehicle_factory(
+        in_one_process(
+            plugin("slow", "tests.support.chained_plugins:SlowInit", hold_s=1.5),
+            plugin("imu", TICKER, rate_hz=100.0),
+            plugin("relay", CHAINED),
+        )
+    )
+    stats = vehicle.bus.queue_reader("system/plugin_stats")
+    first: list[bytes] = []
+
+    def all_up() -> bool:
+        first.extend(s.name for s in stats.drain() if s.name not in first)
+        return len(first) == 3
+
+    wait_for(all_up, 30, "the three plug-ins' first counters")
+    assert first[-1] == b"slow", first
+    states(vehicle.bus.latest_reader("nav/state", keep=64), 20)

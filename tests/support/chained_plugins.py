@@ -3,6 +3,7 @@ wake-up of the plug-in that publishes their input), named as module:Class in con
 
 from __future__ import annotations
 
+import ctypes
 import threading
 import time
 
@@ -82,3 +83,20 @@ class ChainedBurner(Plugin):
             while time.thread_time() < end:
                 pass
             self.out.publish(ActuatorCommand(t_us=state.t_us))
+
+
+class SlowInit(Plugin):
+    """A plug-in whose init holds the interpreter's lock for ``hold_s`` (a C call that does
+    not let it go, as a slow import or a driver's blocking call can): every other thread
+    of its process stands still meanwhile."""
+
+    settings = {"hold_s": Setting(float, 1.5, "seconds init holds the lock", min=0.0)}
+
+    def init(self, ctx: PluginContext) -> None:
+        super().init(ctx)
+        # PyDLL calls keep the lock, unlike ctypes.CDLL's.
+        ctypes.PyDLL(None).usleep(int(ctx.settings["hold_s"] * 1e6))
+
+    def step(self) -> None:
+        with self.ctx.bus.idle:
+            time.sleep(0.1)
