@@ -1,7 +1,7 @@
 """A small busy board: the vehicle flying a plan in real time inside a CPU quota.
 
 Usage: uv run python benchmarks/cpu_quota.py [--plan square.plan]
-       [--quotas exact,none,25,15,10,7.5,5] [--quick]
+       [--quotas exact,none,25,15,10,7.5,5] [--quick] [--composed]
 
 Each row flies the plan through hardware in the loop on this machine (tests/support/hil.py:
 ``companion hil --ptys`` and ``companion run`` with the shipped HIL config, started apart,
@@ -10,7 +10,8 @@ vehicle (``companion run`` and every process it starts) is confined by a cgroup 
 quota, a share of one core (tests/support/cpu_quota.py; needs root); the simulator, the
 ground station and the watcher stay outside it. ``none`` flies unconfined; ``exact`` flies
 the same plan in exact lockstep (``companion sim --exact``) as the reference. ``--quick``
-flies short_leg.plan at 15 % only.
+flies short_leg.plan at 15 % only; ``--composed`` puts every plug-in in one process
+(``process = "vehicle"``, as ``companion/configs/aircraft.toml`` offers a small board).
 
 Per row: completed or not; cross-track RMS / p95, height RMS from the simulator's truth
 (the campaign's score); IMU first byte -> Mini SSC frame written, p50 / p99 (as
@@ -60,23 +61,32 @@ class QuotaHilRun(HilRun):
     """HIL on this machine with the vehicle in ``quota`` and a second ground endpoint for
     the watcher (both processes inherit this one's niceness)."""
 
-    def __init__(self, tmp: Path, quota: CpuQuota, watch_port: int, *hil_args: str) -> None:
-        self.quota, self.watch_port = quota, watch_port
+    def __init__(
+        self, tmp: Path, quota: CpuQuota, watch_port: int, *hil_args: str, composed: bool = False
+    ) -> None:
+        self.quota, self.watch_port, self.composed = quota, watch_port, composed
         super().__init__(tmp, *hil_args)
 
-    def _start(self, name: str, env: dict[str, str], *args: str) -> subprocess.Popen[str]:
+    def _start(
+        self, name: str, env: dict[str, str], *args: str, new_session: bool = False
+    ) -> subprocess.Popen[str]:
         vehicle = name.startswith("vehicle")
         if vehicle:  # the watcher listens as a second ground station (MAVSDK has the first)
             ours = f'"udpout://127.0.0.1:{self.port}"'
             theirs = f'{ours}, "udpout://127.0.0.1:{self.watch_port}"'
-            self.config.write_text(self.config.read_text().replace(ours, theirs))
+            text = self.config.read_text().replace(ours, theirs)
+            if self.composed and 'process = "vehicle"' not in text:
+                # Every plug-in in one process, as aircraft.toml offers for a small board.
+                text = text.replace("[vehicle]\n", '[vehicle]\nprocess = "vehicle"\n', 1)
+            self.config.write_text(text)
 
         # The vehicle joins before it starts its plug-ins: they are all confined with it.
         before_exec = self.quota.join if vehicle else None
         with (self.tmp / f"{name}.log").open("w") as out:
             cmd = [sys.executable, "-m", "companion", *args]
             return subprocess.Popen(cmd, cwd=REPO, env=env, text=True, stdout=out, stderr=out,
-                                    preexec_fn=before_exec)  # fmt: skip
+                                    preexec_fn=before_exec,
+                                    start_new_session=new_session)  # fmt: skip
 
 
 def _line_drops(report: str) -> dict[str, int]:
@@ -84,13 +94,19 @@ def _line_drops(report: str) -> dict[str, int]:
     return {k: int(n) for k, n in re.findall(r"(\w+) \d+B \((\d+) dropped\)", report)}
 
 
-def fly_quota(percent: float | None, plan: Path, deadline_s: float, renice: dict) -> dict:
-    """One real-time HIL flight with the vehicle in ``percent`` of a core (None: no limit)."""
+LAYOUTS = {False: "one process per plug-in", True: "composed"}
+
+
+def fly_quota(
+    percent: float | None, plan: Path, deadline_s: float, renice: dict, composed: bool = False
+) -> dict:
+    """One real-time HIL flight with the vehicle in ``percent`` of a core (None: no limit);
+    ``composed``: its plug-ins in one process."""
     load0 = os.getloadavg()[0]
     with tempfile.TemporaryDirectory() as tmp, CpuQuota(percent, shares=SHARES) as quota:
         watch = Watch(renice)
         hil_args = ("--duration", str(deadline_s + 120))
-        run = QuotaHilRun(Path(tmp), quota, watch.port, *hil_args)
+        run = QuotaHilRun(Path(tmp), quota, watch.port, *hil_args, composed=composed)
         watch.start_on(run.namespace)
         started, used0 = time.monotonic(), quota.used_s()
         seen: dict = {"finished": False}
@@ -196,6 +212,9 @@ def main() -> None:
     )
     ap.add_argument("--health", action="store_true", help="print each plug-in's counters too")
     ap.add_argument("--renice", default="", help="NAME=NICE,... plug-ins reniced once up")
+    ap.add_argument(
+        "--composed", action="store_true", help="every plug-in in one process (aircraft.toml's)"
+    )
     args = ap.parse_args()
     # The simulator, the vehicle, MAVSDK and the exact row's processes inherit it.
     os.nice(args.nice)
@@ -208,7 +227,8 @@ def main() -> None:
     if reason and any(q != "exact" for q in quotas):
         sys.exit(f"cpu_quota: {reason}")
     print(
-        f"c172p {plan.name}, calm; quota = % of one core; {os.cpu_count()} cores "
+        f"c172p {plan.name}, calm, {LAYOUTS[args.composed]}; quota = % of one core; "
+        f"{os.cpu_count()} cores "
         f"shared with other jobs (load = 1-min load average during the row); simulator and "
         f"watcher at nice {args.nice}, the vehicle's cgroup at cpu.shares {SHARES}",
         flush=True,
@@ -218,7 +238,8 @@ def main() -> None:
         if q == "exact":
             row = fly_exact(plan)
         else:
-            row = fly_quota(None if q == "none" else float(q), plan, args.deadline, renice)
+            limit = None if q == "none" else float(q)
+            row = fly_quota(limit, plan, args.deadline, renice, args.composed)
         print(format_row(q, row), flush=True)
         if args.health:
             for name, h in row.get("health", {}).items():
