@@ -21,6 +21,8 @@ from companion.bus.node import BusNode
 
 
 def main() -> None:
+    if len(sys.argv) != 3 or sys.argv[1] in ("-h", "--help"):
+        sys.exit(__doc__)
     namespace, seconds = sys.argv[1], float(sys.argv[2])
     latencies_us: list[int] = []
     with BusNode(namespace, "servo_latency_probe") as bus:
