@@ -75,6 +75,11 @@ class Member:
         self.followers = followers
         self.name: str = spec["name"]
         self._stop_r, self._stop_w = os.pipe()
+        # Non-blocking, as a process's own signal pipe is: a device read that finds it
+        # readable drains it (``fd_wait.drain`` reads until empty), and on a blocking pipe
+        # that read waited for ever: every serial sensor's thread hung at a stop, and the
+        # process ended a second later with their ports never closed.
+        os.set_blocking(self._stop_r, False)
         self.stopping = False
         self.restarts = 0
         self.host: PluginHost | None = None
