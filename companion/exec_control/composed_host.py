@@ -94,8 +94,9 @@ class Member:
         return member
 
     def stop(self) -> None:
-        """Ask the plug-in to stop after its current step (its stop descriptor turns
-        readable and stays so)."""
+        """Ask the plug-in to stop after its current step: its stop descriptor turns
+        readable, ending any wait on it, until a device read drains it; the stop itself
+        is the flag its host looks at after each step."""
         self.stopping = True
         if self.host is not None:
             self.host.stopping = True
