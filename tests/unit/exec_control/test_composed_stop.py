@@ -8,6 +8,7 @@ import threading
 from companion.exec_control.composed_host import Member
 from companion.sensors.serial_port import ReopeningSerial
 from tests.support.pty import StreamingPty
+from tests.support.vehicle import wait_for
 
 
 def test_a_composed_sensor_reading_a_live_device_stops_at_once(tmp_path):
@@ -27,8 +28,7 @@ def test_a_composed_sensor_reading_a_live_device_stops_at_once(tmp_path):
     device.start()
     try:
         thread.start()
-        while not any(reads):
-            thread.join(0.05)
+        wait_for(lambda: any(reads), 10.0, "the device's first bytes")
         member.stop()
         thread.join(2.0)
         assert not thread.is_alive(), "the sensor's read never returned after the stop"
