@@ -16,7 +16,7 @@ import os
 import re
 import shutil
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import iceoryx2 as iox2
@@ -101,16 +101,20 @@ def alive_nodes(namespace: str) -> int:
 def cleanup_namespace(namespace: str) -> int:
     """Remove what dead processes of this namespace left behind; return files removed.
 
-    Dead nodes (a plug-in killed with SIGKILL) are cleaned through iceoryx2 itself. When
-    no node of the namespace is alive any more, the remaining prefixed files (the global
-    management segment iceoryx2 keeps, and any orphaned segment) are deleted too, so
-    nothing is left in /dev/shm.
+    While other nodes live, the dead ones (a plug-in killed with SIGKILL) are cleaned
+    through iceoryx2 itself, read from one listing of the namespace's nodes. When none is
+    alive any more, the namespace's prefixed files (the dead nodes', the global management
+    segment iceoryx2 keeps, any orphaned segment) are deleted, so nothing is left in
+    /dev/shm.
     """
-    if alive_nodes(namespace):
+    import iceoryx2 as iox2
+
+    states = iox2.Node.list(iox2.ServiceType.Ipc, make_config(namespace))
+    if any(isinstance(state, iox2.NodeState.Alive) for state in states):
         # Others still use the bus: only the dead nodes go, each through iceoryx2. With
         # none alive the files are simply removed, which is quicker (the 13 nodes of a
         # vehicle killed whole: 92 ms through iceoryx2 on an idle machine).
-        cleanup_dead_nodes(namespace)
+        _remove_dead(states)
         return 0
     return _remove_prefixed_files(prefix_of(namespace))
 
@@ -120,12 +124,20 @@ def cleanup_dead_nodes(namespace: str) -> int:
     with SIGKILL) from every service they were in; how many nodes were removed."""
     import iceoryx2 as iox2
 
-    removed = 0
     try:
         states = iox2.Node.list(iox2.ServiceType.Ipc, make_config(namespace))
     except Exception as exc:  # a namespace being removed by another process meanwhile
         log.debug("iceoryx2 node list: %s", exc)
         return 0
+    return _remove_dead(states)
+
+
+def _remove_dead(states: list[Any]) -> int:
+    """Remove the stale resources of the dead nodes among ``states`` (``Node.list``'s);
+    how many were removed."""
+    import iceoryx2 as iox2
+
+    removed = 0
     for state in states:
         if not isinstance(state, iox2.NodeState.Dead):
             continue
