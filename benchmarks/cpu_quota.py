@@ -64,8 +64,8 @@ class QuotaHilRun(HilRun):
     def __init__(
         self, tmp: Path, quota: CpuQuota, watch_port: int, *hil_args: str, composed: bool = False
     ) -> None:
-        self.quota, self.watch_port, self.composed = quota, watch_port, composed
-        super().__init__(tmp, *hil_args)
+        self.quota, self.watch_port = quota, watch_port
+        super().__init__(tmp, *hil_args, composed=composed)
 
     def _start(
         self, name: str, env: dict[str, str], *args: str, new_session: bool = False
@@ -74,11 +74,7 @@ class QuotaHilRun(HilRun):
         if vehicle:  # the watcher listens as a second ground station (MAVSDK has the first)
             ours = f'"udpout://127.0.0.1:{self.port}"'
             theirs = f'{ours}, "udpout://127.0.0.1:{self.watch_port}"'
-            text = self.config.read_text().replace(ours, theirs)
-            if self.composed and 'process = "vehicle"' not in text:
-                # Every plug-in in one process, as aircraft.toml offers for a small board.
-                text = text.replace("[vehicle]\n", '[vehicle]\nprocess = "vehicle"\n', 1)
-            self.config.write_text(text)
+            self.config.write_text(self.config.read_text().replace(ours, theirs))
 
         # The vehicle joins before it starts its plug-ins: they are all confined with it.
         before_exec = self.quota.join if vehicle else None

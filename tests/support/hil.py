@@ -18,14 +18,20 @@ from tests.support.vehicle import REPO, companion_env, unique_namespace
 SHIPPED = REPO / "companion" / "configs" / "hil.toml"
 
 
-def hil_vehicle_config(tmp: Path, lines: Path, port: int, namespace: str) -> Path:
-    """The shipped HIL config, on these lines, state, bus and ground-station port."""
+def hil_vehicle_config(
+    tmp: Path, lines: Path, port: int, namespace: str, composed: bool = False
+) -> Path:
+    """The shipped HIL config, on these lines, state, bus and ground-station port;
+    ``composed``: every plug-in in one process (``process = "vehicle"``, as
+    ``companion/configs/aircraft.toml`` offers a small board)."""
     text = SHIPPED.read_text().replace("/tmp/companion-hil", str(lines))
     text = text.replace(
         '"udpout://127.0.0.1:14550", "udpout://127.0.0.1:14540"', f'"udpout://127.0.0.1:{port}"'
     )
+    process = 'process = "vehicle"\n' if composed else ""
     text = text.replace(
-        "[vehicle]\n", f'[vehicle]\nnamespace = "{namespace}"\nstate_dir = "{tmp / "state"}"\n'
+        "[vehicle]\n",
+        f'[vehicle]\nnamespace = "{namespace}"\nstate_dir = "{tmp / "state"}"\n{process}',
     )
     config = tmp / "hil_vehicle.toml"
     config.write_text(text)
@@ -35,11 +41,11 @@ def hil_vehicle_config(tmp: Path, lines: Path, port: int, namespace: str) -> Pat
 class HilRun:
     """The simulator and the vehicle, started apart; MAVLink from the vehicle on ``port``."""
 
-    def __init__(self, tmp: Path, *hil_args: str) -> None:
+    def __init__(self, tmp: Path, *hil_args: str, composed: bool = False) -> None:
         self.tmp, self.namespace, self.port = tmp, unique_namespace("hil"), free_udp_port()
         self.lines, self.truth = tmp / "lines", tmp / "truth.csv"
         self.started = time.monotonic()  # about when the simulation's time began
-        self.config = hil_vehicle_config(tmp, self.lines, self.port, self.namespace)
+        self.config = hil_vehicle_config(tmp, self.lines, self.port, self.namespace, composed)
         self.env = companion_env(self.namespace)
         self.sim = self._start("hil", self.env, "hil", "--ptys", str(self.lines),
                                "--truth", str(self.truth), *hil_args)  # fmt: skip
