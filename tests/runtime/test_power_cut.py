@@ -147,6 +147,11 @@ def imu_stamps(path: Path) -> list[int]:
     return [int(t) for t in ulog.get_dataset("sensors_imu").data["timestamp"]]
 
 
+def wait_new_log(logs: Path, sealed: dict[Path, str]) -> None:
+    """Until a log of the running vehicle's (none of ``sealed``) is in view."""
+    wait_for(lambda: any(p not in sealed for p in logs.glob("*.ulg")), 30, "a new log")
+
+
 def check_stored(gcs: GroundStation, written: Written) -> None:
     """The restarted vehicle serves the last acknowledged content or the one in flight."""
     assert read_param(gcs) in written.allowed(PARAM)
@@ -165,7 +170,7 @@ def test_a_power_cut_mid_write_leaves_every_store_and_log_readable(vehicle_facto
     for cut_no in range(1, CUTS + 1):
         imu = vehicle.bus.queue_reader("sensors/imu")  # a full queue keeps its newest
         # The log of this run is on disk and growing before the writes begin.
-        wait_for(lambda: any(p not in sealed for p in logs.glob("*.ulg")), 30, "a new log")
+        wait_new_log(logs, sealed)
         cut = threading.Event()
         newest_us = [0]
 
@@ -207,5 +212,5 @@ def test_a_power_cut_mid_write_leaves_every_store_and_log_readable(vehicle_facto
     gcs.close()
     assert all(written.acked[t] for t in TYPES), "each kind of list was stored"
     # The last run's log is in view once its header is on disk, whenever its logger started.
-    wait_for(lambda: any(p not in sealed for p in logs.glob("*.ulg")), 30, "the last log")
+    wait_new_log(logs, sealed)
     assert not list(state.rglob(".*.part")), "no log left hidden"
