@@ -70,9 +70,26 @@ def threads(pids: dict[str, int]) -> dict[tuple[str, int], Row]:
     return out
 
 
-def plugin_steps(v: Vehicle) -> dict[str, tuple[int, int]]:
-    """Each plug-in's last counters on the bus: (steps, t_us)."""
-    return {s.name.decode(): (s.steps, s.t_us) for s in v.stats.drain()}
+def plugin_steps(
+    v: Vehicle, cpu: dict[str, list[float]] | None = None
+) -> dict[str, tuple[int, int]]:
+    """Each plug-in's last counters on the bus: (steps, t_us); each one's CPU shares
+    (``cpu_pct``, its own steps: a chained plug-in's are its own, not its producer's) are
+    appended to ``cpu``."""
+    out = {}
+    for s in v.stats.drain():
+        out[s.name.decode()] = (s.steps, s.t_us)
+        if cpu is not None:
+            cpu.setdefault(s.name.decode(), []).append(s.cpu_pct)
+    return out
+
+
+def sleep_reading_cpu(v: Vehicle, seconds: float, cpu: dict[str, list[float]]) -> None:
+    """Sleep ``seconds``, reading the plug-ins' counters (once a second each) as they come."""
+    end = time.monotonic() + seconds
+    while (left := end - time.monotonic()) > 0:
+        time.sleep(min(0.5, left))
+        plugin_steps(v, cpu)
 
 
 def fly(seconds: float, config: Path, relay_on: bool) -> dict[str, Any]:
@@ -96,7 +113,8 @@ def fly(seconds: float, config: Path, relay_on: bool) -> dict[str, Any]:
         time.sleep(1.2)  # counters come once a second: a fresh set to start from
         steps0 = plugin_steps(v)
         before, wall0, sim0 = threads(pids), time.monotonic(), v.sim_s()
-        time.sleep(seconds)
+        shares: dict[str, list[float]] = {}
+        sleep_reading_cpu(v, seconds, shares)
         after, wall, sim = threads(pids), time.monotonic() - wall0, v.sim_s() - sim0
         time.sleep(1.2)
         steps1 = plugin_steps(v)
@@ -115,7 +133,8 @@ def fly(seconds: float, config: Path, relay_on: bool) -> dict[str, Any]:
     for name, (n1, t1) in steps1.items():
         if name in steps0 and t1 > steps0[name][1]:
             steps[name] = (n1 - steps0[name][0]) / ((t1 - steps0[name][1]) / 1e6)
-    return {"rows": rows, "steps": steps, "wall": wall, "sim_rate": sim / wall}
+    plugin_cpu = {name: sum(c) / len(c) for name, c in shares.items() if c}
+    return {"rows": rows, "steps": steps, "cpu": plugin_cpu, "wall": wall, "sim_rate": sim / wall}
 
 
 def main() -> None:
@@ -145,6 +164,9 @@ def main() -> None:
               f"{t[3]:8.1f}{t[4]:8.1f}")  # fmt: skip
     print("plug-in steps a second: "
           + ", ".join(f"{n} {s:.1f}" for n, s in sorted(res["steps"].items())))  # fmt: skip
+    by_share = sorted(res["cpu"].items(), key=lambda x: -x[1])
+    print("plug-in CPU % (its own steps, also those run on its producer's thread): "
+          + ", ".join(f"{n} {c:.2f}" for n, c in by_share))  # fmt: skip
 
 
 if __name__ == "__main__":
