@@ -35,10 +35,14 @@ SHM_DIR = Path("/dev/shm")
 # (``iox_dir``), removed whole with its shared memory, so nothing of a vehicle stays in
 # /dev/shm once it has stopped (a reboot clears them anyway).
 # Per reader, room for publishers gone (a plug-in restarted) while their samples were still
-# unread. iceoryx2's default of 128 costs every reader ~0.5 MB of its process's own memory,
-# a quarter of the vehicle's; a reader reads at least once a second, and 16 restarts
-# between two of its reads would be a crash loop the supervisor's back-off rules out.
-EXPIRED_CONNECTIONS = 16
+# unread. Each place costs every reader 3.5 KB of its process's own memory: iceoryx2's
+# default of 128 took ~0.5 MB a reader, a quarter of the vehicle's, and 16 took 98 KB
+# where 8 take 70 (3 MB over a vehicle's hundred readers). A reader reads at least once
+# a second, and the supervisor's back-off restarts a process at most four times in one;
+# a composed process that died twice between two reads would leave its three writers of
+# link/commands six places, and only a crash loop fills eight, whose unread samples
+# lost are the oldest of a dead publisher's.
+EXPIRED_CONNECTIONS = 8
 
 _log_level_set = False
 
