@@ -14,15 +14,17 @@ flies short_leg.plan at 15 % only; ``--composed`` puts every plug-in in one proc
 (``process = "vehicle"``, as ``companion/configs/aircraft.toml`` offers a small board).
 
 Per row: completed or not; cross-track RMS / p95, height RMS from the simulator's truth
-(the campaign's score); IMU first byte -> Mini SSC frame written, p50 / p99 (as
-benchmarks/latency.py: the IMU driver's stamp against a bus subscriber's clock); the
-navigator's state rate and the telemetry rates a ground station gets (ATTITUDE,
-GLOBAL_POSITION_INT, on a UDP endpoint of its own), from arming to the mission's end; the
-vehicle's own dropped and bad-frame counters (its health table, as ``companion status``)
-and the bytes the simulator's IMU line could not hand over; the CPU the quota's cgroup
-used and the share of its periods throttled; the load average of the machine (other jobs
-share its cores) and the first thing that went wrong (a warning the vehicle sent, a
-plug-in restarted, an arm refusal, a timeout).
+(the campaign's score); for a plan that ends in a landing, on a line of its own, the
+touchdown along and across the landing point and its sink (``benchmarks/landing.py``'s
+score: ``--plan benchmarks/plans/land_east.plan``); IMU first byte -> Mini SSC frame
+written, p50 / p99 (as benchmarks/latency.py: the IMU driver's stamp against a bus
+subscriber's clock); the navigator's state rate and the telemetry rates a ground station
+gets (ATTITUDE, GLOBAL_POSITION_INT, on a UDP endpoint of its own), from arming to the
+mission's end; the vehicle's own dropped and bad-frame counters (its health table, as
+``companion status``) and the bytes the simulator's IMU line could not hand over; the CPU
+the quota's cgroup used and the share of its periods throttled; the load average of the
+machine (other jobs share its cores) and the first thing that went wrong (a warning the
+vehicle sent, a plug-in restarted, an arm refusal, a timeout).
 """
 
 from __future__ import annotations
@@ -43,10 +45,17 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from benchmarks.quota_watch import Watch, fly_watched  # noqa: E402
+from companion.control.mission.plan import checked_plan  # noqa: E402
 from companion.navigation.estimate_csv import read_estimate  # noqa: E402
 from ground.campaign.flight_run import FlightJob, fly_flight  # noqa: E402
+from ground.campaign.landing_score import (  # noqa: E402
+    LandingScore,
+    landing_score_for_plan,
+    read_truth,
+)
 from ground.campaign.scoring import score_track  # noqa: E402
 from ground.campaign.spec import PLANS, SIM_CONFIG, Flight  # noqa: E402
+from mavlink_dialect import companion as d  # noqa: E402
 from tests.support.cpu_quota import CpuQuota, unusable_reason  # noqa: E402
 from tests.support.hil import HilRun  # noqa: E402
 
@@ -107,7 +116,8 @@ def fly_quota(
         started, used0 = time.monotonic(), quota.used_s()
         seen: dict = {"finished": False}
         try:
-            seen = asyncio.run(fly_watched(run.port, str(plan), deadline_s, watch))
+            lands = _landing_plan(plan)
+            seen = asyncio.run(fly_watched(run.port, str(plan), deadline_s, watch, lands))
         except Exception as exc:  # a refusal or a timeout is this row's result, not the end
             seen["error"] = f"{type(exc).__name__}: {exc}"[:120]
             watch.event(seen["error"])
@@ -139,7 +149,35 @@ def _score(truth: Path, plan: Path, seen: dict) -> dict:
     except (OSError, ValueError, KeyError) as exc:
         seen.setdefault("error", f"no truth to score: {exc}")
         score = {"xtrack_rms_m": np.nan, "xtrack_p95_m": np.nan, "alt_rms_m": np.nan}
-    return {"completed": bool(seen.get("finished")), **score}
+    return {"completed": bool(seen.get("finished")), **score, **_landing(truth, plan)}
+
+
+def _landing_plan(plan: Path) -> bool:
+    return any(it.command == d.MAV_CMD_NAV_LAND for it in checked_plan(plan)[0])
+
+
+def _landing(truth: Path, plan: Path) -> dict:
+    """A plan that ends in a landing: its touchdown, scored as benchmarks/landing.py
+    scores it (``landing``: None when the plan has no NAV_LAND)."""
+    try:
+        items = checked_plan(plan)[0]
+        return {"landing": landing_score_for_plan(read_truth(truth), items)}
+    except ValueError:  # no NAV_LAND in the plan
+        return {"landing": None}
+    except (OSError, KeyError) as exc:
+        return {"landing": LandingScore(False), "landing_error": str(exc)[:80]}
+
+
+def format_landing(s: LandingScore | None) -> str | None:
+    """The row's landing, one line (None: the plan has none)."""
+    if s is None:
+        return None
+    if not s.landed:
+        return "       landing: none"
+    verdict = "on target" if s.passed() else "MISSED"
+    return (f"       landing: {s.along_m:+.1f} m along, {s.across_m:+.2f} m across, "
+            f"sink {s.sink_m_s:.2f} m/s, bounce {s.bounce_m:.2f} m, stopped {s.stopped}: "
+            f"{verdict}")  # fmt: skip
 
 
 def _last_error(log_text: str) -> str:
@@ -237,6 +275,8 @@ def main() -> None:
             limit = None if q == "none" else float(q)
             row = fly_quota(limit, plan, args.deadline, renice, args.composed)
         print(format_row(q, row), flush=True)
+        if (landed := format_landing(row.get("landing"))) is not None:
+            print(landed, flush=True)
         if args.health:
             for name, h in row.get("health", {}).items():
                 print(

@@ -23,9 +23,10 @@ from mavsdk.plugins.action import ActionError
 from companion.bus.node import BusNode
 from companion.messages.channels import KEEP
 from mavlink_dialect import companion as m
-from tests.support.mavsdk_flight import mission_finished, plan_uploaded
+from tests.support.mavsdk_flight import mission_finished, plan_uploaded, until
 
 ARM_TRIES_S = 120.0  # pre-arm checks may take longer on a slow board: keep asking
+ROLLOUT_S = 90.0  # a landing's mission ends at touchdown: the roll-out and disarming follow
 
 
 class Watch:
@@ -143,8 +144,11 @@ class Watch:
         return row
 
 
-async def fly_watched(port: int, plan: str, deadline_s: float, watch: Watch) -> dict:
-    """Upload ``plan``, arm (asking again while refused), start, wait for its end."""
+async def fly_watched(
+    port: int, plan: str, deadline_s: float, watch: Watch, lands: bool = False
+) -> dict:
+    """Upload ``plan``, arm (asking again while refused), start, wait for its end (and, for
+    a plan that ``lands``, for the vehicle to disarm itself once it has stopped)."""
     seen: dict = {}
     async with plan_uploaded(port, plan, connect_s=120.0) as flight:
         give_up = time.monotonic() + ARM_TRIES_S
@@ -166,4 +170,11 @@ async def fly_watched(port: int, plan: str, deadline_s: float, watch: Watch) -> 
         watch.ended_at = time.monotonic()
         if not seen["finished"]:
             watch.event(f"mission not finished in {deadline_s:.0f} s")
+        elif lands:
+            try:
+                armed = flight.telemetry.subscribe_armed()
+                await until(armed, lambda a: not a, "disarmed", ROLLOUT_S)
+                seen["disarmed"] = True
+            except AssertionError as exc:
+                watch.event(str(exc))
     return seen

@@ -165,6 +165,8 @@ def main() -> None:
     print("plug-in steps a second: "
           + ", ".join(f"{n} {s:.1f}" for n, s in sorted(res["steps"].items())))  # fmt: skip
     by_share = sorted(res["cpu"].items(), key=lambda x: -x[1])
+    if not any(c for _, c in by_share):
+        return  # a plug-in of its own process says its share in the table above
     print("plug-in CPU % (its own steps, also those run on its producer's thread): "
           + ", ".join(f"{n} {c:.2f}" for n, c in by_share))  # fmt: skip
 
