@@ -16,15 +16,16 @@ flies short_leg.plan at 15 % only; ``--composed`` puts every plug-in in one proc
 Per row: completed or not; cross-track RMS / p95, height RMS from the simulator's truth
 (the campaign's score); for a plan that ends in a landing, on a line of its own, the
 touchdown along and across the landing point and its sink (``benchmarks/landing.py``'s
-score: ``--plan benchmarks/plans/land_east.plan``); IMU first byte -> Mini SSC frame
-written, p50 / p99 (as benchmarks/latency.py: the IMU driver's stamp against a bus
-subscriber's clock); the navigator's state rate and the telemetry rates a ground station
-gets (ATTITUDE, GLOBAL_POSITION_INT, on a UDP endpoint of its own), from arming to the
-mission's end; the vehicle's own dropped and bad-frame counters (its health table, as
-``companion status``) and the bytes the simulator's IMU line could not hand over; the CPU
-the quota's cgroup used and the share of its periods throttled; the load average of the
-machine (other jobs share its cores) and the first thing that went wrong (a warning the
-vehicle sent, a plug-in restarted, an arm refusal, a timeout).
+score: ``--plan benchmarks/plans/circuit_east.plan``; MAVSDK's plan import refuses
+QGroundControl's landing pattern); IMU first byte -> Mini SSC frame written, p50 / p99 (as
+benchmarks/latency.py: the IMU driver's stamp against a bus subscriber's clock); the
+navigator's state rate and the telemetry rates a ground station gets (ATTITUDE,
+GLOBAL_POSITION_INT, on a UDP endpoint of its own), from arming to the mission's end; the
+vehicle's own dropped and bad-frame counters (its health table, as ``companion status``)
+and the bytes the simulator's IMU line could not hand over; the CPU the quota's cgroup
+used and the share of its periods throttled; the load average of the machine (other jobs
+share its cores) and the first thing that went wrong (a warning the vehicle sent, a
+plug-in restarted, an arm refusal, a timeout).
 """
 
 from __future__ import annotations
