@@ -48,7 +48,7 @@ sys.path.insert(0, str(REPO))
 from benchmarks.quota_watch import Watch, fly_watched  # noqa: E402
 from companion.control.mission.plan import checked_plan  # noqa: E402
 from companion.navigation.estimate_csv import read_estimate  # noqa: E402
-from ground.campaign.flight_run import FlightJob, fly_flight  # noqa: E402
+from ground.campaign.flight_run import FlightJob, fly_flight, plan_lands  # noqa: E402
 from ground.campaign.landing_score import (  # noqa: E402
     LandingScore,
     landing_score_for_plan,
@@ -56,7 +56,6 @@ from ground.campaign.landing_score import (  # noqa: E402
 )
 from ground.campaign.scoring import score_track  # noqa: E402
 from ground.campaign.spec import PLANS, SIM_CONFIG, Flight  # noqa: E402
-from mavlink_dialect import companion as d  # noqa: E402
 from tests.support.cpu_quota import CpuQuota, unusable_reason  # noqa: E402
 from tests.support.hil import HilRun  # noqa: E402
 
@@ -116,8 +115,8 @@ def fly_quota(
         watch.start_on(run.namespace)
         started, used0 = time.monotonic(), quota.used_s()
         seen: dict = {"finished": False}
+        lands = plan_lands(str(plan))
         try:
-            lands = _landing_plan(plan)
             seen = asyncio.run(fly_watched(run.port, str(plan), deadline_s, watch, lands))
         except Exception as exc:  # a refusal or a timeout is this row's result, not the end
             seen["error"] = f"{type(exc).__name__}: {exc}"[:120]
@@ -132,6 +131,8 @@ def fly_quota(
             except Exception as exc:  # it is ended either way; the row says so
                 watch.event(f"stopping: {exc!r}")
         row = _score(run.truth, plan, seen)
+        if lands:
+            row.update(_landing(run.truth, plan))
         reports = [ln for ln in run.log("hil").splitlines() if " out: " in ln]
         drops = _line_drops(reports[-1]) if reports else {}
         vehicle_log = run.log("vehicle")
@@ -150,22 +151,16 @@ def _score(truth: Path, plan: Path, seen: dict) -> dict:
     except (OSError, ValueError, KeyError) as exc:
         seen.setdefault("error", f"no truth to score: {exc}")
         score = {"xtrack_rms_m": np.nan, "xtrack_p95_m": np.nan, "alt_rms_m": np.nan}
-    return {"completed": bool(seen.get("finished")), **score, **_landing(truth, plan)}
-
-
-def _landing_plan(plan: Path) -> bool:
-    return any(it.command == d.MAV_CMD_NAV_LAND for it in checked_plan(plan)[0])
+    return {"completed": bool(seen.get("finished")), **score}
 
 
 def _landing(truth: Path, plan: Path) -> dict:
-    """A plan that ends in a landing: its touchdown, scored as benchmarks/landing.py
-    scores it (``landing``: None when the plan has no NAV_LAND)."""
+    """The touchdown of a plan that ends in a landing, scored as benchmarks/landing.py
+    scores it."""
     try:
         items = checked_plan(plan)[0]
         return {"landing": landing_score_for_plan(read_truth(truth), items)}
-    except ValueError:  # no NAV_LAND in the plan
-        return {"landing": None}
-    except (OSError, KeyError) as exc:
+    except (OSError, KeyError, ValueError) as exc:  # no truth, or a truth cut short
         return {"landing": LandingScore(False), "landing_error": str(exc)[:80]}
 
 

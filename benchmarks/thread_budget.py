@@ -78,9 +78,10 @@ def plugin_steps(
     appended to ``cpu``."""
     out = {}
     for s in v.stats.drain():
-        out[s.name.decode()] = (s.steps, s.t_us)
+        name = s.name.decode()
+        out[name] = (s.steps, s.t_us)
         if cpu is not None:
-            cpu.setdefault(s.name.decode(), []).append(s.cpu_pct)
+            cpu.setdefault(name, []).append(s.cpu_pct)
     return out
 
 

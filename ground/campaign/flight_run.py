@@ -172,7 +172,7 @@ def _fly(job: FlightJob, folder: Path, tl: Timeline) -> None:
         try:
             pilot = _Pilot(gcs, proc, time.monotonic() + job.timeout_s, tl, job.silent_s)
             pilot.endless_seq = endless_final_item(flight.plan)
-            pilot.fly(flight.start_at_s, _lands(flight.plan))
+            pilot.fly(flight.start_at_s, plan_lands(flight.plan))
         finally:
             _end(proc)
             gcs.close()
@@ -211,7 +211,7 @@ def endless_final_item(plan: str | Path) -> int | None:
     return None
 
 
-def _lands(plan: str) -> bool:
+def plan_lands(plan: str) -> bool:
     """Whether the plan ends in a landing (then the flight ends disarmed)."""
     try:
         return any(it.command == d.MAV_CMD_NAV_LAND for it in load_plan(plan).get(0, []))
