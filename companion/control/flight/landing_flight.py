@@ -223,7 +223,9 @@ class LandingFlight:
             self.return_lands = True
         if entered or plan.executor is None or plan.executor.current < first:
             assert plan.frame is not None
-            ex = MissionExecutor(plan.items, plan.frame, plan.home_alt, config.executor)
+            ex = MissionExecutor(
+                plan.items, plan.frame, plan.home_alt, config.executor, said=self.said
+            )
             ex.start(first, pos, nav.alt_msl_m)
             plan.executor = ex
         return fly_mission(plan.executor)
@@ -250,7 +252,7 @@ class LandingFlight:
             items = self._home_landing(pos, nav.yaw_rad, plan.frame, config, turn_radius)
             if items is None:
                 return None
-            ex = MissionExecutor(items, plan.frame, plan.home_alt, config.executor)
+            ex = MissionExecutor(items, plan.frame, plan.home_alt, config.executor, said=self.said)
             ex.start(0, pos, nav.alt_msl_m)
             plan.executor, self.landing_home, self.landing = ex, True, None
         sp = plan.executor.step(pos, nav.alt_msl_m, t_s, turn_radius)

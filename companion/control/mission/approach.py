@@ -37,3 +37,15 @@ def final_height(alt: float, start: Point, land: Point, land_alt: float, steepes
     if steepest <= 0.0:
         return alt
     return min(alt, land_alt + distance(start, land) * math.tan(steepest))
+
+
+def circle_note(planned: tuple[float, float], flown: tuple[float, float]) -> str | None:
+    """What to tell the operator of a landing circle flown wider (the aircraft's turn) or
+    left lower (``LAND_SLOPE_MAX``) than the plan says; (radius, height above home) each.
+    None when it is flown as planned. A ground station shows the plan's circle and height,
+    and its operator would otherwise read the difference as a fault."""
+    (radius, height), (flown_radius, flown_height) = planned, flown
+    if flown_radius - radius < 1.0 and height - flown_height < 1.0:
+        return None
+    return (f"Land circle: {flown_radius:.0f} m at {flown_height:.0f} m"
+            f" (plan: {radius:.0f} m at {height:.0f} m)")  # fmt: skip

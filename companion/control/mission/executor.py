@@ -18,8 +18,13 @@ import math
 from dataclasses import dataclass, field
 
 from companion.control.laws.fillet import MIN_TURN_RAD, corner_arc
-from companion.control.mission.approach import circle_down, final_height
-from companion.control.mission.items import CAMERA_STOPS, MissionItem
+from companion.control.mission.approach import circle_down, circle_note, final_height
+from companion.control.mission.items import (
+    MAX_JUMPS_PER_STEP,
+    SKIPPED,
+    MissionItem,
+    next_flown,
+)
 from companion.control.mission.leg_geometry import CircleProgress, past_point, tangent_angle
 from companion.control.mission.leg_geometry import distance as _distance
 from companion.geodesy import LocalFrame, wrap_pi
@@ -28,10 +33,6 @@ from mavlink_dialect import companion as d
 RELATIVE_FRAMES = (d.MAV_FRAME_GLOBAL_RELATIVE_ALT, d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT)
 ON_CIRCLE = 0.25  # within this fraction of the radius the aircraft counts as circling
 TAKEOFF_MARGIN_M = 5.0
-MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
-
-# Markers and camera stops: nothing to fly (DO_LAND_START only marks where a landing begins).
-SKIPPED = CAMERA_STOPS | {d.MAV_CMD_DO_LAND_START}
 LOITER_ALT_MARGIN_M = 5.0  # LOITER_TO_ALT: this close to its height counts as there
 TANGENT_WINDOW = math.radians(30.0)  # leave a LOITER_TO_ALT this soon past the tangent point
 ESTABLISHED = math.radians(90.0)  # and once it has flown this far round it
@@ -86,6 +87,7 @@ class MissionExecutor:
     speed: float = math.nan
     finished: bool = False
     reached: list[int] = field(default_factory=list)  # items reached since the last drain
+    said: list[tuple[int, str]] = field(default_factory=list)  # (MAV_SEVERITY, text)
 
     def __post_init__(self) -> None:
         self.jumps_done: dict[int, int] = {}  # how often each DO_JUMP (by seq) jumped
@@ -95,6 +97,7 @@ class MissionExecutor:
         self._prev_alt = self.home_alt_msl
         self._hold: Setpoint | None = None
         self._turn_radius = 0.0
+        self._told: set[int] = set()  # LOITER_TO_ALT items whose circle was said
         # An implicit take-off's height (take_off_first); the waypoint the climb flew past.
         self.climb_to, self._flown_back = math.nan, False
 
@@ -285,22 +288,8 @@ class MissionExecutor:
         return nxt is not None and nxt.command == d.MAV_CMD_NAV_LAND
 
     def _next_nav(self) -> MissionItem | None:
-        """The item flown after the current one (speed changes, markers and jumps
-        followed as they will be), or None."""
-        seq, jumps = self.current + 1, dict(self.jumps_done)
-        for _ in range(MAX_JUMPS_PER_STEP):
-            if seq >= len(self.items):
-                return None
-            item = self.items[seq]
-            if item.command == d.MAV_CMD_DO_JUMP:
-                done, repeats = jumps.get(item.seq, 0), round(item.param2)
-                jumps[item.seq] = done + 1
-                seq = round(item.param1) if repeats < 0 or done < repeats else seq + 1
-            elif item.command in SKIPPED or item.command == d.MAV_CMD_DO_CHANGE_SPEED:
-                seq += 1
-            else:
-                return item
-        return None
+        """The item flown after the current one, or None."""
+        return next_flown(self.items, self.current + 1, self.jumps_done)
 
     def _return(self, item: MissionItem, pos: Point, alt: float) -> Setpoint:
         home = (0.0, 0.0)
@@ -347,6 +336,11 @@ class MissionExecutor:
             start = (centre[0] + nominal * out[0], centre[1] + nominal * out[1])
             centre = (start[0] - radius * out[0], start[1] - radius * out[1])
             target_alt = self._final_from(start, target_alt)
+        if item.seq not in self._told and self._turn_radius > 0.0:  # once, on the circle
+            self._told.add(item.seq)
+            home, planned_alt = self.home_alt_msl, self.alt_of(item)
+            note = circle_note((nominal, planned_alt - home), (radius, target_alt - home))
+            self.said += [(d.MAV_SEVERITY_NOTICE, note)] if note else []
         circle = Setpoint(Kind.CIRCLE, centre, centre, target_alt, radius, clockwise, self.speed)
         on_circle = abs(_distance(pos, centre) - radius) <= radius * ON_CIRCLE
         way = 1.0 if clockwise else -1.0

@@ -9,6 +9,7 @@ approach are accepted and do nothing: there is no camera on board to stop.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -31,6 +32,9 @@ NAV_COMMANDS = frozenset(
 CAMERA_STOPS = frozenset(
     {d.MAV_CMD_IMAGE_STOP_CAPTURE, d.MAV_CMD_DO_SET_CAM_TRIGG_DIST, d.MAV_CMD_VIDEO_STOP_CAPTURE}
 )
+# Markers and camera stops: nothing to fly (DO_LAND_START only marks where a landing begins).
+SKIPPED = CAMERA_STOPS | {d.MAV_CMD_DO_LAND_START}
+MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
 DO_COMMANDS = (
     frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_JUMP, d.MAV_CMD_DO_LAND_START})
     | CAMERA_STOPS
@@ -172,3 +176,24 @@ def check_mission(items: list[MissionItem]) -> int:
         if result != d.MAV_MISSION_ACCEPTED:
             return result
     return d.MAV_MISSION_ACCEPTED
+
+
+def next_flown(
+    items: Sequence[MissionItem], seq: int, jumps_done: Mapping[int, int]
+) -> MissionItem | None:
+    """The item flown from ``seq`` on (speed changes, markers and jumps followed as they
+    will be, given the jumps done so far), or None."""
+    jumps = dict(jumps_done)
+    for _ in range(MAX_JUMPS_PER_STEP):
+        if seq >= len(items):
+            return None
+        item = items[seq]
+        if item.command == d.MAV_CMD_DO_JUMP:
+            done, repeats = jumps.get(item.seq, 0), round(item.param2)
+            jumps[item.seq] = done + 1
+            seq = round(item.param1) if repeats < 0 or done < repeats else seq + 1
+        elif item.command in SKIPPED or item.command == d.MAV_CMD_DO_CHANGE_SPEED:
+            seq += 1
+        else:
+            return item
+    return None

@@ -174,6 +174,25 @@ def test_a_landing_circle_descends_below_its_height_for_a_final_no_steeper_than_
     assert sp.kind == Kind.LAND and sp.from_alt == pytest.approx(low, abs=0.1)
 
 
+def test_a_landing_circle_flown_wider_or_lower_than_planned_is_said_once():
+    """QGroundControl draws the plan's circle and height: the operator is told, once, what
+    is flown instead (QGroundControl 5 showed a 75 m circle at 40 m; the C172 flew 230 m
+    at 33 m for a final no steeper than 5°), and nothing for a circle flown as planned."""
+    items = [
+        item(0, d.MAV_CMD_NAV_LOITER_TO_ALT, (-75.0, -380.0), z=40.0, p1=1.0, p2=75.0),
+        item(1, d.MAV_CMD_NAV_LAND, (0.0, 0.0), z=0.0),
+    ]
+    ex = executor(items, pos=(-75.0, -900.0), alt=HOME_ALT + 40.0)
+    ex.config.final_slope_max = math.radians(5.0)
+    for _ in range(3):
+        ex.step((-75.0, -900.0), HOME_ALT + 40.0, 0.0, turn_radius=230.0)
+    assert ex.said == [(d.MAV_SEVERITY_NOTICE, "Land circle: 230 m at 33 m (plan: 75 m at 40 m)")]
+    assert all(len(text) <= 50 for _, text in ex.said)  # one STATUSTEXT
+    as_planned = executor(items, pos=(-75.0, -900.0), alt=HOME_ALT + 40.0)
+    as_planned.step((-75.0, -900.0), HOME_ALT + 40.0, 0.0, turn_radius=60.0)
+    assert as_planned.said == []
+
+
 def test_a_landing_circle_met_at_its_exit_point_is_flown_round_before_the_final():
     """Down at the circle's height on the way there, the aircraft meets the circle at its
     exit point flying across it (south, the final runs east): it turns final only once it
