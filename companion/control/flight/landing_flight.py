@@ -288,8 +288,9 @@ class LandingFlight:
             self.refused = True
             self.said.append((d.MAV_SEVERITY_CRITICAL, "Land: no pattern fits the fence, circling"))
             return None
+        # Said with or without a fence: the ground station shows no pattern it did not plan.
+        self.said.append((d.MAV_SEVERITY_NOTICE, pattern.described()))
         if fence is not None and not fence.empty:
-            self.said.append((d.MAV_SEVERITY_NOTICE, pattern.described()))
             if not pattern.leg_kept:
                 self.said.append(
                     (d.MAV_SEVERITY_WARNING, "Land: the way to the loiter crosses the fence")

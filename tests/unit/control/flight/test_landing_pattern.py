@@ -125,9 +125,12 @@ def test_land_refused_by_the_fence_says_so_and_circles_where_it_is():
     assert controller.lander.landing_home
 
 
-def test_the_chosen_pattern_is_said_when_a_fence_is_kept():
+@pytest.mark.parametrize("fenced", [True, False])
+def test_the_chosen_pattern_is_said_with_or_without_a_fence(fenced):
+    """QGroundControl draws no pattern for Land (5 showed none): the operator reads where
+    the aircraft goes, fence or not."""
     controller = _controller(checked_plan(REPO / "qgc_plans" / "square.plan")[0])
-    controller.lander.fence = _fence([CircleZone((0.0, 0.0), 5000.0)])
+    controller.lander.fence = _fence([CircleZone((0.0, 0.0), 5000.0)]) if fenced else None
     controller.step(_in_the_air(0.0), _status(FlightMode.LAND), 0.0)
     assert controller.lander.said == [
         (d.MAV_SEVERITY_NOTICE, "Land: course 180, 800 m final, loiter right")
