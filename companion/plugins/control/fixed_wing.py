@@ -181,15 +181,9 @@ class FixedWingPlugin(Plugin):
 
     def _say(self, now_us: int) -> None:
         """What the landing told the operator (the pattern it chose, or why none)."""
-        said = self.controller.lander.said
-        executor = self.controller.executor  # the stored mission's (its landing circle)
-        if executor is not None and executor.said:
-            said += executor.said
-            executor.said.clear()
-        for severity, text in said:
+        for severity, text in self.controller.lander.take_said(self.controller.executor):
             self.ctx.log.info("%s", text)
             self.texts.publish(StatusText.of(now_us, severity, text))
-        said.clear()
 
     def _count(self, refused: bool, t_us: int) -> None:
         """Count the step; an unusable solution or status is said once per stretch of them."""

@@ -132,9 +132,12 @@ def test_the_chosen_pattern_is_said_with_or_without_a_fence(fenced):
     controller = _controller(checked_plan(REPO / "qgc_plans" / "square.plan")[0])
     controller.lander.fence = _fence([CircleZone((0.0, 0.0), 5000.0)]) if fenced else None
     controller.step(_in_the_air(0.0), _status(FlightMode.LAND), 0.0)
-    assert controller.lander.said == [
+    # What the plug-in tells the ground station: Land's executor is the controller's now,
+    # and says into the same list (read twice and cleared, it once said nothing at all).
+    assert controller.lander.take_said(controller.executor) == [
         (d.MAV_SEVERITY_NOTICE, "Land: course 180, 800 m final, loiter right")
     ]
+    assert controller.lander.take_said(controller.executor) == []
 
 
 GO_AROUND_M = go_around_run({"TECS_CLMB_MAX": 3.0, "AIRSPEED_CRUISE": 30.0})  # 500 m
