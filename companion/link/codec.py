@@ -30,10 +30,12 @@ CRC_LEN = 2
 SIGNED_PART = -6  # a signature covers the frame up to its own 6 bytes (timestamp included)
 ONE_MINUTE = 6_000_000  # in signing units (10 µs): how far behind ours a timestamp may be
 _START = re.compile(b"[\xfd\xfe]")
-# A header must name a message we know and a payload no longer than that message's:
-# msgid → (CRC extra, longest payload). An unknown id cannot be checksummed (its CRC extra
-# is unknown), so it cannot be told from garbage; the C library (PX4, ArduPilot) drops
-# those too, as failing their checksum.
+# A header must name a message we know, and in MAVLink 1 a payload no longer than that
+# message's: msgid → (CRC extra, longest payload). An unknown id cannot be checksummed (its
+# CRC extra is unknown), so it cannot be told from garbage; the C library (PX4, ArduPilot)
+# drops those too, as failing their checksum. A MAVLink 2 payload may be longer: a sender
+# with a newer definition adds extension fields (QGroundControl's SERIAL_CONTROL carries
+# its target in two), which the CRC extra does not cover and an older reader ignores.
 _KNOWN = {i: (cls.crc_extra, cls.unpacker.size) for i, cls in dialect.mavlink_map.items()}
 
 
@@ -214,7 +216,7 @@ def _frame_size(buf: bytearray, pos: int, n: int) -> tuple[int | None, bool]:
         msgid = buf[pos + 5]
         size = header + length + CRC_LEN
     known = _KNOWN.get(msgid)
-    return size, known is not None and length <= known[1]
+    return size, known is not None and (length <= known[1] or buf[pos] == V2)
 
 
 def _checksum_ok(frame: bytearray) -> bool:
