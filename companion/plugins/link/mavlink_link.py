@@ -37,6 +37,7 @@ from companion.link.mode_messages import current_mode
 from companion.link.params_service import ParamsService
 from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
+from companion.link.shell_service import ShellService
 from companion.link.signing import configured_secret, key_file_problem, key_from
 from companion.link.snapshot import SNAPSHOT_CHANNELS, Snapshot
 from companion.link.statustext import StatusTexts
@@ -237,6 +238,7 @@ class MavlinkLink(Plugin):
         self._params_service = service
         self.metadata = MetadataService(self.mav, self.store.decls.values(), sysid, service.compid)
         self.router.add_service(self.metadata)
+        self.router.add_service(ShellService(self.mav, self.readers["health"].get, self.store))
 
     def _param_changed(self, name: str, value: float) -> None:
         """Tell the parameter's owner (it follows params/changes) and apply our own."""
