@@ -14,6 +14,8 @@ from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
 
 Point = tuple[float, float]
+NOTE_WIDER = 1.1  # a landing circle flown this much wider than planned is said
+NOTE_LOWER_M = 2.0  # and one left this much lower
 
 
 def circle_down(
@@ -42,10 +44,11 @@ def final_height(alt: float, start: Point, land: Point, land_alt: float, steepes
 def circle_note(planned: tuple[float, float], flown: tuple[float, float]) -> str | None:
     """What to tell the operator of a landing circle flown wider (the aircraft's turn) or
     left lower (``LAND_SLOPE_MAX``) than the plan says; (radius, height above home) each.
-    None when it is flown as planned. A ground station shows the plan's circle and height,
+    None when it is flown as planned, or near enough that the map would not show it (a
+    250 m circle flown 253 m wide). A ground station shows the plan's circle and height,
     and its operator would otherwise read the difference as a fault."""
     (radius, height), (flown_radius, flown_height) = planned, flown
-    if flown_radius - radius < 1.0 and height - flown_height < 1.0:
+    if flown_radius <= radius * NOTE_WIDER and height - flown_height <= NOTE_LOWER_M:
         return None
     return (f"Land circle: {flown_radius:.0f} m at {flown_height:.0f} m"
             f" (plan: {radius:.0f} m at {height:.0f} m)")  # fmt: skip

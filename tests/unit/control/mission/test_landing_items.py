@@ -191,6 +191,12 @@ def test_a_landing_circle_flown_wider_or_lower_than_planned_is_said_once():
     as_planned = executor(items, pos=(-75.0, -900.0), alt=HOME_ALT + 40.0)
     as_planned.step((-75.0, -900.0), HOME_ALT + 40.0, 0.0, turn_radius=60.0)
     assert as_planned.said == []
+    # Nor for a few metres: a 250 m circle flown 253 m wide (the c172p's turn on land_east).
+    near = executor([item(0, d.MAV_CMD_NAV_LOITER_TO_ALT, CENTRE, z=50.0, p1=1.0, p2=RADIUS),
+                     item(1, d.MAV_CMD_NAV_LAND, LAND, z=0.0)], pos=(-250.0, -900.0),
+                    alt=HOME_ALT + 50.0)  # fmt: skip
+    near.step((-250.0, -900.0), HOME_ALT + 50.0, 0.0, turn_radius=253.0)
+    assert near.said == []
 
 
 def test_a_landing_circle_met_at_its_exit_point_is_flown_round_before_the_final():
