@@ -7,6 +7,7 @@ import contextlib
 import itertools
 import logging
 import os
+import random
 import signal
 import socket
 import subprocess
@@ -27,11 +28,30 @@ def unique_namespace(tag: str = "t") -> str:
     return f"{tag}{os.getpid()}_{next(_counter)}"
 
 
+# Ports are handed out below the kernel's ephemeral range (32768-60999 on Linux): a port the
+# kernel picked could go, the moment its finder let it go, to any socket bound to port 0 (a
+# ground station's, another test's), and the vehicle then started on it found it taken (a
+# link's "Address already in use" in CI, 2026-12-05). Each pytest-xdist worker draws from
+# its own slice, so two workers never race for one either.
+PORT_RANGE = (20000, 32000)
+
+
 def free_udp_port() -> int:
-    """A UDP port nobody on this machine holds now (the kernel's choice)."""
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
+    """A loopback UDP port nobody on this machine holds now, outside the ports the kernel
+    gives sockets bound to port 0, from this test worker's own slice of them."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")[2:]
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1") or 1)
+    span = (PORT_RANGE[1] - PORT_RANGE[0]) // max(workers, 1)
+    low = PORT_RANGE[0] + (int(worker) % max(workers, 1) if worker.isdigit() else 0) * span
+    for _ in range(1000):
+        port = random.randrange(low, low + span)
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+            try:
+                sock.bind(("127.0.0.1", port))
+            except OSError:
+                continue  # held: draw again
+            return port
+    raise OSError(f"no free UDP port in {low}..{low + span - 1}")
 
 
 def companion_env(namespace: str, pythonpath: Sequence[Path] = ()) -> dict[str, str]:

@@ -17,7 +17,6 @@ import logging
 import math
 import os
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -29,6 +28,7 @@ import psutil
 
 from companion.bus.namespace import cleanup_namespace, leftover_files
 from companion.control.mission.plan import PlanError, load_plan
+from companion.testing.processes import free_udp_port
 from ground.campaign.scoring import TrackScore, score_track
 from ground.campaign.spec import REPO, Flight
 
@@ -384,10 +384,3 @@ def _signal_group(pgid: int, sig: int) -> None:
         os.killpg(pgid, sig)
     except (ProcessLookupError, PermissionError):
         pass
-
-
-def free_udp_port() -> int:
-    """A loopback UDP port nothing is bound to now (for a flight's ground-station link)."""
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
