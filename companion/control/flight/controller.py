@@ -175,8 +175,7 @@ class FlightController:
 
         Dead-reckoned positions drift, so following waypoints with them would steer by a
         growing error; a straight course at a known height is the safe thing until GPS
-        returns (then the commander has the aircraft loiter).
-        """
+        returns (then the commander has the aircraft loiter)."""
         if not nav.flags & NAV_DEAD_RECKONING or self.landed:
             self._hold_course = None
             return setpoint
@@ -262,7 +261,9 @@ class FlightController:
         ex, resumed = self.executor, None
         if ex is None or (entered and ex.finished):
             assert self.frame is not None
-            ex = MissionExecutor(self.items, self.frame, self.home_alt, self.config.executor)
+            ex = MissionExecutor(  # what it says goes out with the landing's texts
+                self.items, self.frame, self.home_alt, self.config.executor, said=self.lander.said
+            )
             # In the air (a restarted controller, say) the leg is taken up as it was flown.
             radius = None if self.landed else self._turn_radius()
             resumed = start_mission(ex, status.mission_first, pos, nav.alt_msl_m, radius)
@@ -379,8 +380,7 @@ class FlightController:
         ground speed of the turn (cruise airspeed with the wind behind).
 
         From the planned speed and the slowly changing wind estimate, not the measured
-        speed: a circle whose radius followed every gust would never be flown round.
-        """
+        speed: a circle whose radius followed every gust would never be flown round."""
         wind = min(math.hypot(*self.wind.wind_ne), MAX_TURN_WIND)
         v = self.config["AIRSPEED_CRUISE"] + wind
         return v * v / (G * math.tan(self.config.roll_limit * TURN_BANK_FRACTION))

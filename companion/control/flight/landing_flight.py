@@ -301,17 +301,6 @@ class LandingFlight:
                 )
         return pattern.items(frame)
 
-    def take_said(self, executor: MissionExecutor | None) -> list[tuple[int, str]]:
-        """What the landing and the controller's ``executor`` (the stored mission's landing
-        circle) have said since the last call, each once: an executor of Land's own says
-        into this list already."""
-        out = list(self.said)
-        self.said.clear()
-        if executor is not None and executor.said is not self.said:
-            out += executor.said
-            executor.said.clear()
-        return out
-
     def leave_home_landing(self, mode: FlightMode) -> bool:
         """Another mode: True when the controller is to drop the executor (the stored
         mission's is made afresh when it is flown)."""

@@ -87,7 +87,8 @@ class MissionExecutor:
     speed: float = math.nan
     finished: bool = False
     reached: list[int] = field(default_factory=list)  # items reached since the last drain
-    said: list[tuple[int, str]] = field(default_factory=list)  # (MAV_SEVERITY, text)
+    # (MAV_SEVERITY, text) for the operator; a controller's executors share its landing's.
+    said: list[tuple[int, str]] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.jumps_done: dict[int, int] = {}  # how often each DO_JUMP (by seq) jumped

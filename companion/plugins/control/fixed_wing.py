@@ -181,9 +181,11 @@ class FixedWingPlugin(Plugin):
 
     def _say(self, now_us: int) -> None:
         """What the landing told the operator (the pattern it chose, or why none)."""
-        for severity, text in self.controller.lander.take_said(self.controller.executor):
+        said = self.controller.lander.said  # every executor's too (a landing circle)
+        for severity, text in said:
             self.ctx.log.info("%s", text)
             self.texts.publish(StatusText.of(now_us, severity, text))
+        said.clear()
 
     def _count(self, refused: bool, t_us: int) -> None:
         """Count the step; an unusable solution or status is said once per stretch of them."""

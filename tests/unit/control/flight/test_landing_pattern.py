@@ -29,6 +29,7 @@ from mavlink_dialect import companion as d
 from tests.support.vehicle import REPO
 from tests.unit.control.flight.test_ground_safety import HOME, _controller, _status
 from tests.unit.control.flight.test_land_mode import _in_the_air
+from tests.unit.control.mission.executor_flying import item
 
 FRAME = LocalFrame(HOME[0], HOME[1])
 EAST = math.pi / 2
@@ -132,12 +133,25 @@ def test_the_chosen_pattern_is_said_with_or_without_a_fence(fenced):
     controller = _controller(checked_plan(REPO / "qgc_plans" / "square.plan")[0])
     controller.lander.fence = _fence([CircleZone((0.0, 0.0), 5000.0)]) if fenced else None
     controller.step(_in_the_air(0.0), _status(FlightMode.LAND), 0.0)
-    # What the plug-in tells the ground station: Land's executor is the controller's now,
-    # and says into the same list (read twice and cleared, it once said nothing at all).
-    assert controller.lander.take_said(controller.executor) == [
+    # What the plug-in tells the ground station, once (read twice and cleared by an
+    # earlier draining of Land's executor as well, it said nothing at all).
+    assert controller.lander.said == [
         (d.MAV_SEVERITY_NOTICE, "Land: course 180, 800 m final, loiter right")
     ]
-    assert controller.lander.take_said(controller.executor) == []
+
+
+def test_the_stored_missions_landing_circle_is_said_with_the_landings_texts():
+    """QGroundControl's default 75 m landing circle, flown by the c172p at its own turn
+    radius: the stored mission's executor says so where the plug-in reads the landing's."""
+    items = [
+        item(0, d.MAV_CMD_NAV_LOITER_TO_ALT, (700.0, 0.0), z=100.0, p1=1.0, p2=75.0),
+        item(1, d.MAV_CMD_NAV_LAND, (700.0, 2000.0), z=0.0),
+    ]
+    controller = _controller(items)
+    controller.step(_in_the_air(0.0), _status(FlightMode.MISSION), 0.0)
+    ((severity, text),) = controller.lander.said
+    assert severity == d.MAV_SEVERITY_NOTICE
+    assert text.startswith("Land circle: ") and text.endswith("(plan: 75 m at 100 m)"), text
 
 
 GO_AROUND_M = go_around_run({"TECS_CLMB_MAX": 3.0, "AIRSPEED_CRUISE": 30.0})  # 500 m
