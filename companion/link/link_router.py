@@ -10,6 +10,7 @@ from __future__ import annotations
 import logging
 import math
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -59,7 +60,8 @@ class LinkRouter:
     ) -> None:
         self.mav = mav
         self.endpoints = endpoints
-        self.services = list(services)
+        self.services: list[Service] = []
+        self._timers: list[Callable[[], float]] = []  # the services' next_due
         self.parsers: dict[tuple[int, Remote], StreamParser] = {}
         self.routes: dict[int, set[int]] = {}  # sysid → endpoint indexes it was heard on
         self.schedules = [StreamSchedule() for _ in endpoints]
@@ -69,7 +71,7 @@ class LinkRouter:
         self.signing = shared_state(signing_key) if signing_key else None
         self.packers = [self._packer(i, e, signing_key) for i, e in enumerate(endpoints)]
         self.by_type: dict[str, list[Service]] = {}
-        for service in self.services:
+        for service in services:
             self.add_service(service)
 
     def _packer(self, index: int, endpoint: Endpoint, key: bytes | None) -> Any:
@@ -83,6 +85,8 @@ class LinkRouter:
     def add_service(self, service: Service) -> None:
         if service not in self.services:
             self.services.append(service)
+            if (timer := getattr(service, "next_due", None)) is not None:
+                self._timers.append(timer)
         for name in service.handles:
             self.by_type.setdefault(name, []).append(service)
 
@@ -193,8 +197,7 @@ class LinkRouter:
 
     def next_due(self, nav_known: bool = True) -> float:
         times = [s.next_time(nav_known) for s in self._streaming()]
-        nexts = [getattr(s, "next_due", lambda: float("inf"))() for s in self.services]
-        return min([*times, *nexts, float("inf")])
+        return min([*times, *(timer() for timer in self._timers), math.inf])
 
     def _streaming(self) -> list[StreamSchedule]:
         """The schedules of the endpoints that have someone to send to. One nobody has

@@ -61,6 +61,11 @@ class StreamSchedule:
         self.period_s = {mid: _default_period(mid) for mid in STREAMS}
         self.next_due = dict.fromkeys(STREAMS, 0.0)
         self.last_sent = dict.fromkeys(STREAMS, 0.0)
+        # next_time's and nav_due's answers, kept until a rate or a due time changes: the
+        # link asks them on every wake-up (and twice on some), and each went over every
+        # stream for an answer that changes only when one is sent or a rate is set.
+        self._times: dict[bool, float] = {}
+        self._nav_due: float | None = None
 
     def set_interval(self, msg_id: int, interval_us: float) -> bool:
         """MAV_CMD_SET_MESSAGE_INTERVAL semantics: -1 off, 0 default, else µs (at most
@@ -74,7 +79,12 @@ class StreamSchedule:
         else:
             self.period_s[msg_id] = max(interval_us / 1e6, 1.0 / MAX_RATE_HZ)
         self.next_due[msg_id] = 0.0
+        self._changed()
         return True
+
+    def _changed(self) -> None:
+        self._times.clear()
+        self._nav_due = None
 
     def interval_us(self, msg_id: int) -> int:
         """The current interval (MESSAGE_INTERVAL): -1 when off, 0 when unknown."""
@@ -107,6 +117,8 @@ class StreamSchedule:
                 continue
             out.append(mid)
             self.next_due[mid] = max(due_s + period, now_s - period)
+        if out:
+            self._changed()
         return sorted(out, key=lambda mid: self._turn(mid, now_s))
 
     def _turn(self, msg_id: int, now_s: float) -> tuple[bool, bool, float]:
@@ -121,16 +133,21 @@ class StreamSchedule:
     def nav_due(self) -> float:
         """When the first stream that follows the navigator falls due (it then goes out
         on the next navigation state); inf when none is on."""
-        times = [self.next_due[m] for m in FOLLOWS_NAV if self.period_s[m] > 0]
-        return min(times, default=float("inf"))
+        if self._nav_due is None:
+            times = [self.next_due[m] for m in FOLLOWS_NAV if self.period_s[m] > 0]
+            self._nav_due = min(times, default=float("inf"))
+        return self._nav_due
 
     def next_time(self, nav_known: bool = True) -> float:
         """When a stream falls due without a navigation state (the wake-up for timers).
         Before the first state (``nav_known`` false) the streams that carry one have
         nothing to send: they wake nobody."""
-        times = [
-            self.next_due[m] + (_hold(p) if m in FOLLOWS_NAV else 0.0)
-            for m, p in self.period_s.items()
-            if p > 0 and (nav_known or m not in FOLLOWS_NAV)
-        ]
-        return min(times) if times else float("inf")
+        known = self._times.get(nav_known)
+        if known is None:
+            times = [
+                self.next_due[m] + (_hold(p) if m in FOLLOWS_NAV else 0.0)
+                for m, p in self.period_s.items()
+                if p > 0 and (nav_known or m not in FOLLOWS_NAV)
+            ]
+            known = self._times[nav_known] = min(times) if times else float("inf")
+        return known

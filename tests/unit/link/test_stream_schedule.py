@@ -81,3 +81,22 @@ def test_the_state_goes_first_and_a_skipped_stream_before_it():
     schedule.next_due = dict.fromkeys(schedule.next_due, 2.0)
     due = schedule.due(2.0, nav_at_s=2.0)
     assert due.index(SYS_STATUS) < due.index(ATTITUDE)
+
+
+def test_the_next_wake_follows_every_send_and_every_rate_asked():
+    """The link sleeps until ``next_time``/``nav_due``: each answer must move with a sent
+    stream and a new rate, or the link would oversleep a stream (or wake for nothing)."""
+    schedule = StreamSchedule()
+    for msg_id in schedule.period_s:
+        schedule.set_interval(msg_id, -1)  # all off ...
+    assert schedule.next_time() == float("inf") and schedule.nav_due() == float("inf")
+    schedule.set_interval(SYS_STATUS, 1_000_000)  # ... but SYS_STATUS at 1 Hz
+    assert schedule.next_time() == 0.0
+    assert schedule.due(0.0) == [SYS_STATUS]
+    assert schedule.next_time() == 1.0  # sent: the next is a period on
+    schedule.set_interval(ATTITUDE, 100_000)  # ATTITUDE asked for: due at once
+    assert schedule.nav_due() == 0.0 and schedule.next_time() == NAV_HOLD_S
+    assert schedule.due(0.01, nav_at_s=0.01) == [ATTITUDE]
+    assert schedule.nav_due() == 0.1 and schedule.next_time() == 0.1 + NAV_HOLD_S
+    schedule.set_interval(ATTITUDE, -1)  # turned off again
+    assert schedule.nav_due() == float("inf") and schedule.next_time() == 1.0
