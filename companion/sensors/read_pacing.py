@@ -37,5 +37,9 @@ class ReadPacer:
         (0: read at once), at the pace vehicle time ran at between the last two reads."""
         if self.batch_us <= 0 or self._last is None:
             return 0.0
-        left_us = self._last[0] + self.batch_us - vehicle_us
-        return max(0.0, left_us * self._wall_per_us)
+        return self.wall_s_until(self._last[0] + self.batch_us, vehicle_us)
+
+    def wall_s_until(self, deadline_us: int, vehicle_us: int) -> float:
+        """Wall seconds until vehicle time reaches ``deadline_us`` from ``vehicle_us`` (0 when
+        past), at the pace vehicle time ran at between the last two reads."""
+        return max(0.0, (deadline_us - vehicle_us) * self._wall_per_us)

@@ -9,6 +9,7 @@ import threading
 import time
 
 import numpy as np
+import pynmea2
 import pytest
 
 from companion.messages import FlightMode, VehicleStatus
@@ -107,3 +108,64 @@ def test_disarmed_the_rangefinder_and_receiver_batch_their_reads_and_lose_no_fra
         assert np.median(gaps) == pytest.approx(1e6 / RATE_HZ, rel=0.05), name
         # 100 frames a second, read in batches of 0.1 s: about 10 reads a second.
         assert woke[name] < 40, f"{name} woke {woke[name]:.0f} times a second for 100 frames"
+
+
+def _pcbat(voltage_mv: int, current_ma: int) -> bytes:
+    body = f"PCBAT,{voltage_mv},{current_ma}"
+    return f"${body}*{pynmea2.NMEASentence.checksum(body):02X}\r\n".encode()
+
+
+@pytest.mark.timeout(240)
+def test_the_battery_monitor_batches_its_reads_and_counts_every_readings_charge(
+    vehicle_factory, tmp_path
+):
+    """Nothing acts on one reading of the pack, armed or not: it is read twice a second, and
+    the charge used still adds up every reading's current, each stamped a period apart."""
+    rate_hz, frames, amps = 50.0, 150, 36.0  # 3 s of readings
+    pty = Pty(tmp_path / "ttyBattery")
+    vehicle = vehicle_factory(
+        vehicle_config(
+            "batched_battery",
+            plugin("battery", "sensors.battery", device=pty.link, rate_hz=rate_hz),
+        )
+    )
+    status = vehicle.bus.writer("vehicle/status")
+    done = threading.Event()
+
+    def commander() -> None:  # armed in Mission: the battery is batched even so
+        while not done.wait(0.25):
+            status.publish(VehicleStatus(t_us=0, mode=int(FlightMode.MISSION), armed=1))
+
+    threading.Thread(target=commander, daemon=True).start()
+    packs = vehicle.bus.latest_reader("sensors/battery", keep=64)
+    pid = vehicle.wait_running("battery")
+
+    def heard() -> bool:
+        os.write(pty.master, _pcbat(12000, 0))
+        time.sleep(0.05)
+        return packs.get() is not None
+
+    wait_for(heard, 60, "first reading")
+    time.sleep(1.0)
+    packs.drain()
+    before, started = voluntary_switches(pid), time.monotonic()
+    writer = _write_every(
+        pty.master, [_pcbat(12000 - i, round(amps * 1000)) for i in range(frames)], 1 / rate_hz
+    )
+    got = []
+    while len(got) < frames:
+        assert time.monotonic() - started < 60, f"{len(got)} of {frames}"
+        got += packs.drain()
+        time.sleep(0.05)
+    writer.join()
+    woke = (voluntary_switches(pid) - before) / (time.monotonic() - started)
+    done.set()
+
+    gaps = np.diff([b.t_us for b in got])
+    assert (gaps > 0).all(), "readings stamped alike or out of order"
+    assert np.median(gaps) == pytest.approx(1e6 / rate_hz, rel=0.05)
+    # 36 A for the 149 periods between the first and last reading of the run: 29.8 mAh.
+    used = got[-1].consumed_mah - got[0].consumed_mah
+    assert used == pytest.approx(amps * 1000 * (frames - 1) / rate_hz / 3600, rel=0.02)
+    # 50 readings a second, read in batches of 0.5 s: a few reads a second.
+    assert woke < 15, f"the battery monitor woke {woke:.0f} times a second for 50 readings"

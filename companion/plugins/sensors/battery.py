@@ -12,9 +12,11 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from companion.messages import VehicleStatus
 from companion.params import ParamDecl
 from companion.params.live import LiveParams
 from companion.plugin import PluginContext
+from companion.plugins.sensors.read_batching import batch_setting
 from companion.plugins.sensors.serial_sensor import SerialSensor, serial_settings
 from companion.sensors.battery_monitor import (
     BatteryGauge,
@@ -42,8 +44,17 @@ BATTERY_PARAMS = (
 class BatteryMonitor(SerialSensor[MonitorReading]):
     """Publishes the gauge's view of the pack on sensors/battery."""
 
-    settings = serial_settings("serial:///dev/ttyAMA1:57600", 57600, 10.0)
+    # Nothing acts on one reading of the pack: its failsafes wait BATT_LOW_TIMER (10 s)
+    # and the ground station shows it once a second. So the frames are read in batches,
+    # each still published with its own stamp, a device period apart, and the gauge
+    # integrates every one of them.
+    periodic_frames = True
+    settings = {
+        **serial_settings("serial:///dev/ttyAMA1:57600", 57600, 10.0),
+        "batch_s": batch_setting("Always (its failsafes wait BATT_LOW_TIMER)", 0.5),
+    }
     params = BATTERY_PARAMS
+    optional_inputs = ("params/changes", "vehicle/status")
     outputs = ("sensors/battery",)
 
     def init(self, ctx: PluginContext) -> None:
@@ -66,6 +77,9 @@ class BatteryMonitor(SerialSensor[MonitorReading]):
             cell_full_v=v["BATT_CELL_FULL"],
             cell_empty_v=v["BATT_CELL_EMPTY"],
         )
+
+    def per_frame(self, status: VehicleStatus) -> bool:
+        return False
 
     def make_decoder(self, settings: Mapping[str, Any]) -> BatteryMonitorDecoder:
         return BatteryMonitorDecoder()

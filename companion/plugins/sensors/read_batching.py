@@ -19,11 +19,11 @@ from companion.sensors.read_pacing import ReadPacer
 from companion.sensors.serial_port import ReopeningSerial
 
 
-def batch_setting(what: str) -> Setting:
+def batch_setting(what: str, default_s: float = 0.1) -> Setting:
     """The ``batch_s`` setting of a driver that batches ``what``."""
     return Setting(
         float,
-        0.1,
+        default_s,
         f"{what}, read the frames that piled up every batch_s of vehicle time"
         " (0: each frame as it comes)",
         min=0.0,

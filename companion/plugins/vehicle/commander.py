@@ -12,6 +12,7 @@ operator should read on ``vehicle/statustext``.
 from __future__ import annotations
 
 import math
+import time
 from pathlib import Path
 from typing import Any
 
@@ -43,9 +44,12 @@ from companion.messages import (
 )
 from companion.params.live import LiveParams
 from companion.plugin import Plugin, PluginContext
+from companion.sensors.read_pacing import ReadPacer
 from mavlink_dialect import companion as d
 
-WAIT_S = 0.05  # armed: navigation, sticks and failsafes looked at 20 times a wall second
+# Resuming a flight after a restart in the air: the navigator's first solution is looked
+# for 20 times a wall second.
+WAIT_S = 0.05
 # Disarmed no failsafe acts: waking as often as the status goes out is enough on the bench
 # (an arming wakes it at once: the supervisor's health table says so as it arms).
 DISARMED_WAIT_S = 1.0
@@ -109,7 +113,7 @@ class CommanderPlugin(Plugin):
         self.rc_switch = bus.queue_reader("sensors/rc_switch")
         self.joystick = bus.latest_reader("link/manual_control")
         # Commands and the mode switch wake it at once; the rest (navigation at 100 Hz and
-        # more, the sticks at 50 Hz) is read when it wakes on its own (``WAIT_S``): waking
+        # more, the sticks at 50 Hz) is read when it wakes on its own (``_pause``): waking
         # for every navigation sample cost a lockstep simulation a tenth of its speed.
         # The health table too: the supervisor publishes it as it arms or disarms, and a
         # disarmed commander otherwise sleeps a whole second.
@@ -125,13 +129,20 @@ class CommanderPlugin(Plugin):
         self.nav_good: Any = None  # the last usable one
         self.arms = 0  # times armed, for the ground notice
         self.told: tuple[int, int] = (-1, -1)  # (mode changes, arms) last told about
+        # Armed, it wakes when its next failsafe judgement or status falls due in vehicle
+        # time (commands and the mode switch wake it at once): waking 20 times a wall second
+        # judged nothing more often, and in a simulation running faster than real time it
+        # judged the failsafes less often than their period.
+        self.pace = ReadPacer(0.0)
+        self.pause_s = WAIT_S
 
     def step(self) -> None:
         c = self.commander
         # A flight to resume is judged as often as an armed one: a restart in the air waits
         # for the navigator's first solution, not for the next second.
-        self.waiter.sleep(WAIT_S if c.armed or self.saved is not None else DISARMED_WAIT_S)
+        self.waiter.sleep(self.pause_s)
         now = self.ctx.clock.now_us()
+        self.pace.read_at(now, time.monotonic())
         nav = self._nav()
         health = self.health.get()
         if self.saved is not None and not self._resume(now, nav, health):
@@ -166,6 +177,16 @@ class CommanderPlugin(Plugin):
         for ack in acks:
             self.acks.publish(ack)
         self._keep_flight_state(now)
+        self.pause_s = self._pause(now)
+
+    def _pause(self, now: int) -> float:
+        """How long to sleep unless woken: until the next judgement or status when armed."""
+        if self.saved is not None:
+            return WAIT_S
+        if not self.commander.armed:
+            return DISARMED_WAIT_S
+        due = min(self.next_failsafe_us, self.next_status_us)
+        return min(self.pace.wall_s_until(due, now), FAILSAFE_PERIOD_US / 1e6)
 
     def _read_flight_state(self, state_dir: Path) -> None:
         self.state_dir = state_dir

@@ -59,3 +59,12 @@ def test_the_rangefinder_is_read_frame_by_frame_armed_with_the_ground_in_view():
     sensor.ground_in_view = True  # take-off roll, approach, flare
     assert sensor.per_frame(armed)
     assert not sensor.per_frame(disarmed)  # on the bench
+
+
+def test_a_deadline_in_vehicle_time_is_waited_for_at_the_pace_the_simulation_runs():
+    pacer = ReadPacer(0.0)  # the commander's: no batch, its own deadlines
+    assert pacer.wall_s_until(100_000, 0) == pytest.approx(0.1)  # no pace yet: real time
+    pacer.read_at(0, 10.0)
+    pacer.read_at(400_000, 10.1)  # four times faster than real time
+    assert pacer.wall_s_until(500_000, 400_000) == pytest.approx(0.025)
+    assert pacer.wall_s_until(300_000, 400_000) == 0.0  # already past
