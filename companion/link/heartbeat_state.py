@@ -16,7 +16,7 @@ from companion.link.identity import VehicleState
 from companion.link.mode_messages import heartbeat_mode
 from companion.messages import FlightMode, SystemHealth, VehicleStatus
 
-COMMANDER_WAIT_S = 5.0  # its status comes at 4 Hz armed, 1 Hz on the ground
+COMMANDER_WAIT_S = 5.0  # its status comes at 3 Hz armed, 1 Hz on the ground
 
 
 class HeartbeatFollower:

@@ -53,7 +53,10 @@ WAIT_S = 0.05
 # Disarmed no failsafe acts: waking as often as the status goes out is enough on the bench
 # (an arming wakes it at once: the supervisor's health table says so as it arms).
 DISARMED_WAIT_S = 1.0
-STATUS_PERIOD_US = 250_000  # 4 Hz: the link and the controller follow it
+# Armed, the status goes out on every third failsafe judgement (one wake-up serves both;
+# a change goes out at once): the link and the controller follow it, and an armed status
+# wakes them.
+STATUS_PERIOD_US = 300_000
 # Disarmed, a status that has not changed goes out once a second, and wakes no reader; a
 # change (an ack, the mode switch, a failsafe) is sent at once, and wakes them.
 DISARMED_STATUS_PERIOD_US = 1_000_000
@@ -180,13 +183,14 @@ class CommanderPlugin(Plugin):
         self.pause_s = self._pause(now)
 
     def _pause(self, now: int) -> float:
-        """How long to sleep unless woken: until the next judgement or status when armed."""
+        """How long to sleep unless woken: armed, until the next failsafe judgement (the
+        status, due every third one, goes out on the same wake-up)."""
         if self.saved is not None:
             return WAIT_S
         if not self.commander.armed:
             return DISARMED_WAIT_S
-        due = min(self.next_failsafe_us, self.next_status_us)
-        return min(self.pace.wall_s_until(due, now), FAILSAFE_PERIOD_US / 1e6)
+        wait_s = self.pace.wall_s_until(self.next_failsafe_us, now)
+        return min(wait_s, FAILSAFE_PERIOD_US / 1e6)
 
     def _read_flight_state(self, state_dir: Path) -> None:
         self.state_dir = state_dir
