@@ -26,7 +26,6 @@ import argparse
 import os
 import shutil
 import signal
-import socket
 import statistics
 import subprocess
 import sys
@@ -46,15 +45,10 @@ from benchmarks.footprint import (  # noqa: E402
     use_bytecode,
 )
 from benchmarks.process_probes import cpu_seconds, pss_kib  # noqa: E402
+from companion.testing.processes import free_udp_port  # noqa: E402
 
 CONFIGS = REPO / "companion" / "configs"
 LAYOUTS = (("own processes", CONFIGS / "sim.toml"), ("composed", CONFIGS / "sim_composed.toml"))
-
-
-def free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def start_relay(master: int, out: int) -> subprocess.Popen[bytes]:
@@ -76,7 +70,7 @@ def tree(pid: int) -> list[int]:
 def fly(config: Path, cpu_s: float, kill_core: bool) -> dict[str, float]:
     tmp = Path(tempfile.mkdtemp(prefix="compose_fp"))
     namespace = f"cfp{os.getpid()}_{int(time.time() * 1000) % 100000}"
-    master, out = free_port(), free_port()
+    master, out = free_udp_port(), free_udp_port()
     relay = start_relay(master, out)
     cmd = [sys.executable, "-m", "companion", "sim", "--config", str(config),
            "--plan", "qgc_plans/square.plan", "--airborne", "--start-at", str(ARM_AT_S),

@@ -33,18 +33,13 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from companion.testing.processes import free_udp_port  # noqa: E402
 from mavlink_dialect import companion as m  # noqa: E402
 from tests.support.hostile import HostileStream  # noqa: E402
 
 WINDOW = 16  # commands in flight on UDP before the sender waits for answers
 SERIAL_BYTES_PER_S = 57600 / 10
 STALL_S = 1.0
-
-
-def free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def raw_pty() -> tuple[int, str]:
@@ -197,7 +192,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="fuzz_link"))
-    namespace, udp_port = f"fz{os.getpid()}", free_port()
+    namespace, udp_port = f"fz{os.getpid()}", free_udp_port()
     master, tty = raw_pty()
     sim = start_sim(tmp, namespace, udp_port, tty)
     try:

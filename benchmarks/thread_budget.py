@@ -28,8 +28,9 @@ from typing import Any
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from benchmarks.compose_footprint import free_port, start_relay, stop_relay  # noqa: E402
+from benchmarks.compose_footprint import start_relay, stop_relay  # noqa: E402
 from benchmarks.footprint import ARM_AT_S, FLYING_AFTER_S, Vehicle, use_bytecode  # noqa: E402
+from companion.testing.processes import free_udp_port  # noqa: E402
 
 TICK_S = 1.0 / os.sysconf("SC_CLK_TCK")
 COMPOSED = REPO / "companion" / "configs" / "sim_composed.toml"
@@ -96,8 +97,8 @@ def sleep_reading_cpu(v: Vehicle, seconds: float, cpu: dict[str, list[float]]) -
 def fly(seconds: float, config: Path, relay_on: bool) -> dict[str, Any]:
     tmp = Path(tempfile.mkdtemp(prefix="thread_budget"))
     namespace = f"tb{os.getpid()}_{int(time.time() * 1000) % 100000}"
-    master = free_port()
-    relay = start_relay(master, free_port()) if relay_on else None
+    master = free_udp_port()
+    relay = start_relay(master, free_udp_port()) if relay_on else None
     link = f"udpout://127.0.0.1:{master}" if relay_on else "udpout://127.0.0.1:9"
     cmd = [sys.executable, "-m", "companion", "sim", "--config", str(config),
            "--plan", "qgc_plans/square.plan", "--airborne", "--start-at", str(ARM_AT_S),
