@@ -132,8 +132,8 @@ class CommanderPlugin(Plugin):
         self.nav_good: Any = None  # the last usable one
         self.arms = 0  # times armed, for the ground notice
         self.told: tuple[int, int] = (-1, -1)  # (mode changes, arms) last told about
-        # Armed, it wakes when its next failsafe judgement or status falls due in vehicle
-        # time (commands and the mode switch wake it at once): waking 20 times a wall second
+        # Armed, it wakes when its next failsafe judgement falls due in vehicle time
+        # (commands and the mode switch wake it at once): waking 20 times a wall second
         # judged nothing more often, and in a simulation running faster than real time it
         # judged the failsafes less often than their period.
         self.pace = ReadPacer(0.0)
