@@ -82,13 +82,16 @@ def test_a_chained_plugin_acts_on_its_own_timeouts_when_its_producer_falls_silen
 
 
 def test_each_plugin_of_a_chain_is_charged_its_own_cpu(vehicle_factory):
-    # imu -> relay -> burner, all on the IMU's thread: the burner's 1 ms a state at 100 Hz
-    # (a tenth of a core) shows in its own row, not in the IMU's or the relay's.
+    # imu -> relay -> burner, all on the IMU's thread: the burner's 3 ms a state at 100 Hz
+    # (a third of a core; less on a busy machine, where fewer states come) shows in its own
+    # row, not in the IMU's or the relay's, whose own work (a tick, a relay step, the
+    # chain's calls) is about 1 % of a core idle and grows on a busy machine (5.5 % beside
+    # two CPU-bound jobs: over the 5 % this test allowed them against a 1 ms burn).
     vehicle = vehicle_factory(
         in_one_process(
             plugin("imu", TICKER, rate_hz=100.0),
             plugin("relay", CHAINED),
-            plugin("burner", BURNER, burn_ms=1.0),
+            plugin("burner", BURNER, burn_ms=3.0),
         )
     )
     nav = vehicle.bus.latest_reader("nav/state", keep=64)
@@ -99,11 +102,13 @@ def test_each_plugin_of_a_chain_is_charged_its_own_cpu(vehicle_factory):
         return {n: r.cpu_pct for n, r in rows.items() if r is not None}
 
     # The backlog of states the burner found at its start is burnt at a whole core first.
-    wait_for(lambda: 6.0 < cpu().get("burner", 0.0) < 15.0, 30, "the burner at its rate")
+    wait_for(lambda: 10.0 < cpu().get("burner", 0.0) < 45.0, 30, "the burner at its rate")
+    time.sleep(1.1)  # the rows of the second that ended it also hold the plug-ins' init
     for _ in range(3):  # each second's rows, once a second
         share = cpu()
-        assert 6.0 < share["burner"] < 15.0, share
-        assert share["imu"] < 5.0 and 0.0 <= share["relay"] < 5.0, share
+        assert 10.0 < share["burner"] < 45.0, share
+        assert 0.0 <= share["imu"] < share["burner"] / 4, share
+        assert 0.0 <= share["relay"] < share["burner"] / 4, share
         time.sleep(1.0)
 
 
