@@ -10,12 +10,13 @@ PX4 publish for their fixed-wing landings, written here from their descriptions:
   instead of floating past it.
 - **Flare**: below ``LAND_FLARE_ALT`` above the runway, or when the ground is less than
   ``LAND_FLARE_SEC`` away at the present sink rate, the throttle is cut (power comes back
-  only against a sink that would land short of the point, ``LAND_FLARE_PWR``) and pitch flies
-  an exponential flare: a sink-rate demand that falls with height towards ``TECS_LAND_SINK``
-  at the ground, from the sink rate at its start (the glide path's, when a gust has just
-  slowed the sink below it) and from the glide's pitch and sink averaged over its last
-  seconds (not a gust's moment). Bank is limited to ``LEVEL_ROLL_LIMIT``; the crab is kept, so a
-  crosswind does not drift the aircraft off the centreline in the flare.
+  only against a sink that would land short of the point, ``LAND_FLARE_PWR`` up to
+  ``LAND_FLARE_THR``) and pitch flies an exponential flare: a sink-rate demand that falls
+  with height towards ``TECS_LAND_SINK`` at the ground, from the sink rate at its start
+  (the glide path's, when a gust has just slowed the sink below it) and from the glide's
+  pitch and sink averaged over its last seconds (not a gust's moment). Bank is limited to
+  ``LEVEL_ROLL_LIMIT``; the crab is kept, so a crosswind does not drift the aircraft off
+  the centreline in the flare.
 - **Rollout**: on the wheels the rudder (and the steered wheel) holds the centreline,
   the wings are held level, the throttle is idle (the brakes come on with it).
 - **Stopped**: slower than a walking pace for ``LAND_DISARMDELAY`` seconds: disarm.
@@ -82,7 +83,9 @@ LANDING_PARAMS = (
               "the modelled flare's distance before the point (lower it if the airframe lands "
               "short: its flare then begins nearer the point)"),
     ParamDecl("LAND_FLARE_PWR", 4.0, 0.0, 10.0, "1/(m/s)", "landing: flare throttle per m/s "
-              "sunk beyond what reaches the point, at most TRIM_THROTTLE (0: idle all flare)"),
+              "sunk beyond what reaches the point, at most LAND_FLARE_THR (0: idle all flare)"),
+    ParamDecl("LAND_FLARE_THR", 0.0, 0.0, 1.0, "", "landing: most flare throttle against a "
+              "sink that lands short, as a gust's lull gives (0: TRIM_THROTTLE)"),
     ParamDecl("LAND_PITCH_CD", 0.0, -500.0, 1500.0, "cdeg", "landing: least pitch in the flare"),
     ParamDecl("LAND_DISARMDELAY", 3.0, 0.0, 127.0, "s", "landing: disarm this long after stop"),
     ParamDecl("TECS_LAND_ARSPD", 28.0, 5.0, 100.0, "m/s", "landing: approach airspeed"),
@@ -336,9 +339,12 @@ class Landing:
         # The pitch lags the demand, and at idle with flaps a C172 sinks 4-5 m/s: a flare
         # begun in a gust's dive stayed above its sink demand all the way and touched down
         # 26 m short. Power holds it up, but only against a sink that lands short of the
-        # point: one begun late and high floats past it as it is.
+        # point: one begun late and high floats past it as it is. As much as a pilot would
+        # give in gusts (LAND_FLARE_THR): at TRIM_THROTTLE a C172 whose flare met a lull
+        # still sank 15 m short of the point.
         short = -s.climb_rate - max(aim, sink_dem)
-        throttle = clamp(v["LAND_FLARE_PWR"] * short, 0.0, v["TRIM_THROTTLE"])
+        most = v["LAND_FLARE_THR"] or v["TRIM_THROTTLE"]
+        throttle = clamp(v["LAND_FLARE_PWR"] * short, 0.0, most)
         self._flare_integ = clamp(self._flare_integ + SINK_I * error * dt, -0.1, 0.25)
         pitch_min = math.radians(v["LAND_PITCH_CD"] / 100.0)
         pitch_max = math.radians(v["TECS_LAND_PMAX"])
