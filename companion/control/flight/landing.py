@@ -74,6 +74,7 @@ SINK_I = 0.05  # rad per (m/s·s)
 # The flare starts from the glide's pitch and sink averaged over this long, not from the
 # moment's: a gust that had just pitched the nose down or changed the sink is not the trim.
 GLIDE_TRIM_TAU_S = 2.0
+FLARE_THR_SHARE = 0.5  # LAND_FLARE_THR below this share of the flare's planned height
 
 
 LANDING_PARAMS = (
@@ -84,8 +85,8 @@ LANDING_PARAMS = (
               "short: its flare then begins nearer the point)"),
     ParamDecl("LAND_FLARE_PWR", 4.0, 0.0, 10.0, "1/(m/s)", "landing: flare throttle per m/s "
               "sunk beyond what reaches the point, at most LAND_FLARE_THR (0: idle all flare)"),
-    ParamDecl("LAND_FLARE_THR", 0.0, 0.0, 1.0, "", "landing: most flare throttle against a "
-              "sink that lands short, as a gust's lull gives (0: TRIM_THROTTLE)"),
+    ParamDecl("LAND_FLARE_THR", 0.0, 0.0, 1.0, "", "landing: most throttle in the flare's "
+              "lower half against a sink that lands short, as a lull gives (0: TRIM_THROTTLE)"),
     ParamDecl("LAND_PITCH_CD", 0.0, -500.0, 1500.0, "cdeg", "landing: least pitch in the flare"),
     ParamDecl("LAND_DISARMDELAY", 3.0, 0.0, 127.0, "s", "landing: disarm this long after stop"),
     ParamDecl("TECS_LAND_ARSPD", 28.0, 5.0, 100.0, "m/s", "landing: approach airspeed"),
@@ -339,11 +340,12 @@ class Landing:
         # The pitch lags the demand, and at idle with flaps a C172 sinks 4-5 m/s: a flare
         # begun in a gust's dive stayed above its sink demand all the way and touched down
         # 26 m short. Power holds it up, but only against a sink that lands short of the
-        # point: one begun late and high floats past it as it is. As much as a pilot would
-        # give in gusts (LAND_FLARE_THR): at TRIM_THROTTLE a C172 whose flare met a lull
-        # still sank 15 m short of the point.
+        # point: one begun late and high floats past it as it is. Below half the flare's
+        # height, its pitch up, as much as a pilot gives in gusts (LAND_FLARE_THR): at
+        # TRIM_THROTTLE a lull there sank a C172 15 m short; higher, more only sped it up.
         short = -s.climb_rate - max(aim, sink_dem)
-        most = v["LAND_FLARE_THR"] or v["TRIM_THROTTLE"]
+        low = height < FLARE_THR_SHARE * self.flare_alt
+        most = (v["LAND_FLARE_THR"] if low else 0.0) or v["TRIM_THROTTLE"]
         throttle = clamp(v["LAND_FLARE_PWR"] * short, 0.0, most)
         self._flare_integ = clamp(self._flare_integ + SINK_I * error * dt, -0.1, 0.25)
         pitch_min = math.radians(v["LAND_PITCH_CD"] / 100.0)

@@ -78,17 +78,22 @@ def test_the_flare_adds_power_only_against_a_sink_that_lands_short_of_the_point(
     assert late.phase == LandPhase.FLARE and late.throttle == 0.0
 
 
-def test_the_flare_may_open_the_throttle_beyond_trim_up_to_land_flare_thr():
-    # 100 m out at 2.5 m, sinking 4 m/s (a lull at idle): far short of the point.
-    def throttle(e: float, sink: float, thr_max: float) -> float:
+def test_low_in_the_flare_a_sink_short_of_the_point_may_open_the_throttle_to_land_flare_thr():
+    # 100 m out, sinking 3 m/s (a lull): far short of the point, after an approach whose
+    # flare was planned from about 3.7 m.
+    def throttle(height: float, thr_max: float, e: float = 200.0, sink: float = 3.0) -> float:
         land = Landing(START, 150.0, TOUCHDOWN, 100.0)
-        return land.step(_state(e, 2.5, sink), V | {"LAND_FLARE_THR": thr_max}, 0.02).throttle
+        v = V | {"LAND_FLARE_THR": thr_max}
+        land.step(_state(0.0, 40.0), v, 0.02)
+        return land.step(_state(e, height, sink), v, 0.02).throttle
 
-    assert throttle(200.0, 4.0, 0.0) == V["TRIM_THROTTLE"]  # 0: at most TRIM_THROTTLE
-    assert throttle(200.0, 4.0, 1.0) == 1.0
-    assert throttle(200.0, 4.0, 0.3) == 0.3
-    # A flare that reaches the point gets no more power than before: none.
-    assert throttle(260.0, 2.5, 1.0) == 0.0
+    assert throttle(1.0, 0.0) == V["TRIM_THROTTLE"]  # 0: at most TRIM_THROTTLE
+    assert throttle(1.0, 1.0) == 1.0
+    assert throttle(1.0, 0.3) == 0.3
+    # In the flare's upper half, its pitch still coming up, no more than TRIM_THROTTLE.
+    assert throttle(2.5, 1.0) == V["TRIM_THROTTLE"]
+    # A flare that reaches the point gets no power at all.
+    assert throttle(1.0, 1.0, e=290.0, sink=1.0) == 0.0
 
 
 def test_a_go_around_climbs_away_along_the_runway_and_cannot_start_on_the_ground():
