@@ -84,7 +84,7 @@ LANDING_PARAMS = (
               "the modelled flare's distance before the point (lower it if the airframe lands "
               "short: its flare then begins nearer the point)"),
     ParamDecl("LAND_FLARE_PWR", 4.0, 0.0, 10.0, "1/(m/s)", "landing: flare throttle per m/s "
-              "sunk beyond what reaches the point, at most LAND_FLARE_THR (0: idle all flare)"),
+              "sunk beyond what reaches the point, at most TRIM_THROTTLE (0: idle all flare)"),
     ParamDecl("LAND_FLARE_THR", 0.0, 0.0, 1.0, "", "landing: most throttle in the flare's "
               "lower half against a sink that lands short, as a lull gives (0: TRIM_THROTTLE)"),
     ParamDecl("LAND_PITCH_CD", 0.0, -500.0, 1500.0, "cdeg", "landing: least pitch in the flare"),
