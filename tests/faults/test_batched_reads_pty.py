@@ -9,7 +9,6 @@ import threading
 import time
 
 import numpy as np
-import pynmea2
 import pytest
 
 from companion.messages import FlightMode, VehicleStatus
@@ -18,6 +17,7 @@ from tests.support import sbus, tfmini
 from tests.support.configs import plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
+from tests.unit.sensors.test_battery_monitor import sentence
 
 FRAMES = 300  # 3 s at 100 Hz
 RATE_HZ = 100.0
@@ -110,11 +110,6 @@ def test_disarmed_the_rangefinder_and_receiver_batch_their_reads_and_lose_no_fra
         assert woke[name] < 40, f"{name} woke {woke[name]:.0f} times a second for 100 frames"
 
 
-def _pcbat(voltage_mv: int, current_ma: int) -> bytes:
-    body = f"PCBAT,{voltage_mv},{current_ma}"
-    return f"${body}*{pynmea2.NMEASentence.checksum(body):02X}\r\n".encode()
-
-
 @pytest.mark.timeout(240)
 def test_the_battery_monitor_batches_its_reads_and_counts_every_readings_charge(
     vehicle_factory, tmp_path
@@ -141,7 +136,7 @@ def test_the_battery_monitor_batches_its_reads_and_counts_every_readings_charge(
     pid = vehicle.wait_running("battery")
 
     def heard() -> bool:
-        os.write(pty.master, _pcbat(12000, 0))
+        os.write(pty.master, sentence("PCBAT,12000,0"))
         time.sleep(0.05)
         return packs.get() is not None
 
@@ -149,9 +144,8 @@ def test_the_battery_monitor_batches_its_reads_and_counts_every_readings_charge(
     time.sleep(1.0)
     packs.drain()
     before, started = voluntary_switches(pid), time.monotonic()
-    writer = _write_every(
-        pty.master, [_pcbat(12000 - i, round(amps * 1000)) for i in range(frames)], 1 / rate_hz
-    )
+    readings = [sentence(f"PCBAT,{12000 - i},{round(amps * 1000)}") for i in range(frames)]
+    writer = _write_every(pty.master, readings, 1 / rate_hz)
     got = []
     while len(got) < frames:
         assert time.monotonic() - started < 60, f"{len(got)} of {frames}"
