@@ -295,6 +295,8 @@ def test_on_a_quiet_bench_the_logger_sleeps_until_a_sample_comes(vehicle_factory
     wait_for(lambda: vehicle.row("logger").step_p50_us > 0, 30, "the logger stepping")
     time.sleep(2.0)  # its reads have measured the trickle
     before, start = voluntary_switches(pid), time.monotonic()
-    time.sleep(6.0)
+    time.sleep(8.0)
     per_s = (voluntary_switches(pid) - before) / (time.monotonic() - start)
-    assert per_s < 3.2, f"the logger woke {per_s:.1f} times a second for 2 samples a second"
+    # Two samples and its counters once a second are 3 wake-ups; on a timer it woke 4-5.
+    # A busy machine adds the odd sleep on a lock or a page (3.33 at load 15).
+    assert per_s < 3.6, f"the logger woke {per_s:.1f} times a second for 2 samples a second"
