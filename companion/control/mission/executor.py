@@ -378,9 +378,9 @@ class MissionExecutor:
         circle = Setpoint(Kind.CIRCLE, centre, centre, target_alt, radius, clockwise, self.speed)
         if item.command == d.MAV_CMD_NAV_LOITER_UNLIM:
             return circle
-        dist = _distance(pos, centre)
+        flown = max(radius, self._turn_radius)  # the controller's circle: never tighter
         state = self._loiter
-        if abs(dist - radius) > radius * ON_CIRCLE and state.started_s is None:
+        if abs(_distance(pos, centre) - flown) > flown * ON_CIRCLE and state.started_s is None:
             return circle  # still getting onto the circle: nothing counts yet
         if state.started_s is None:
             state.started_s = t_s

@@ -80,6 +80,26 @@ def test_loiter_turns_completes_after_720_degrees(direction: int):
     assert sp.a == pytest.approx(centre, abs=0.05)  # the next leg starts at its centre
 
 
+@pytest.mark.parametrize("command", [d.MAV_CMD_NAV_LOITER_TIME, d.MAV_CMD_NAV_LOITER_TURNS])
+@pytest.mark.parametrize("p3", [0.0, 75.0, -75.0])
+def test_a_loiter_tighter_than_the_aircraft_turns_ends_on_the_circle_it_flies(
+    command: int, p3: float
+):
+    """The controller flies a circle tighter than its turn at its turn radius (a C172 at
+    cruise: 216 m); the loiter counts its time and turns on that circle. Judged on the
+    plan's 75 m (or the 80 m default) it never began: the mission circled there forever."""
+    centre, flown = (1_000.0, 0.0), 216.0
+    items = [item(0, command, centre, z=100.0, p1=1.0, p3=p3), wp(1, (3_000.0, 0.0))]
+    ex = executor(items)
+    way = -1.0 if p3 < 0 else 1.0
+    for k in range(400):  # two degrees a second round the circle it flies
+        sp = ex.step(on_circle(centre, flown, 180.0 + way * 2.0 * k), 180.0, float(k), flown)
+        if ex.drain_reached() == [0]:
+            break
+    assert sp.kind == Kind.LINE and sp.b == pytest.approx((3_000.0, 0.0), abs=0.05), k
+    assert k <= 181  # one turn, or a second on it
+
+
 @pytest.mark.parametrize(
     "command",
     [d.MAV_CMD_NAV_LOITER_UNLIM, d.MAV_CMD_NAV_LOITER_TIME, d.MAV_CMD_NAV_LOITER_TURNS],

@@ -1,0 +1,129 @@
+"""How benchmarks/jump_landings.py flies a plan besides ``companion sim``: a watcher that
+kills the control plug-in on the loop's second lap, and the control laws alone.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import threading
+import time
+from pathlib import Path
+
+import psutil
+
+from companion.bus.namespace import cleanup_namespace
+from companion.bus.node import BusNode
+from companion.control.mission.plan import checked_plan
+from ground.campaign.landing_score import landing_score_for_plan
+from mavlink_dialect import companion as d
+from tests.support.closed_loop import ClosedLoop
+
+
+def _second_lap(plan: Path) -> int:
+    """How many items are reached when the loop's second lap has begun (its first item)."""
+    from benchmarks.jump_landings import planned_order
+
+    order = planned_order(plan)
+    items = checked_plan(plan)[0]
+    jump = next(it for it in items if it.command == d.MAV_CMD_DO_JUMP)
+    target = next(s for s in order if s >= round(jump.param1))
+    return [k for k, s in enumerate(order) if s == target][1] + 1
+
+
+class ControlKiller:
+    """Kills this process's flight's ``control`` plug-in once (SIGKILL), on the loop's
+    second lap, as a crash would; the execution control starts it again."""
+
+    def __init__(self, plan: Path) -> None:
+        self.after = _second_lap(plan)
+        self.stop = threading.Event()
+        self.killed_at: int | None = None  # the item flown to when it was killed
+        self.namespace: str | None = None
+
+    def run(self) -> None:
+        while not self.stop.wait(0.5) and self.namespace is None:
+            self.namespace = self._find()
+        if self.namespace is None:
+            return
+        bus = BusNode(self.namespace, "killer")
+        control = bus.latest_reader("control/status")
+        try:
+            while not self.stop.wait(0.02):
+                status = control.get()
+                if status is not None and status.reached_count >= self.after:
+                    pid = self._pid("control")
+                    if pid is not None:
+                        os.kill(pid, signal.SIGKILL)
+                        self.killed_at = status.mission_seq
+                        return
+        finally:
+            bus.close()
+            cleanup_namespace(self.namespace)
+
+    def _find(self) -> str | None:
+        token = f"camp{os.getpid()}p"
+        for proc in psutil.process_iter(["cmdline"]):
+            cmd = proc.info["cmdline"] or []
+            for k, arg in enumerate(cmd[:-1]):
+                if arg == "--namespace" and cmd[k + 1].startswith(token):
+                    return cmd[k + 1]
+        return None
+
+    def _pid(self, name: str) -> int | None:
+        token = f"--namespace {self.namespace} "
+        for proc in psutil.process_iter(["name", "cmdline"]):
+            if proc.info["name"] == name and token in " ".join(proc.info["cmdline"] or []) + " ":
+                return proc.pid
+        time.sleep(0.01)
+        return None
+
+
+def fly_closed_loop(plan: Path, airframe: str, weather: tuple, seed: int) -> tuple[bool, str]:
+    """The control laws alone against JSBSim on the true state; judged as the whole
+    vehicle's flights are, the ground station hearing the last item of a step's reached."""
+    from benchmarks.jump_landings import (
+        SAFE_SHARE,
+        _landing_first,
+        back_to_zero,
+        least_planned,
+        planned_order,
+    )
+
+    items = checked_plan(plan)[0]
+    wind, turbulence = weather
+    loop = ClosedLoop(airframe, items, wind_ned=wind, turbulence=turbulence, range_max_m=12.0)
+    loop.flight.fdm["atmosphere/randomseed"] = seed + 2
+    disarmed = loop.fly_until_disarmed(2000.0)
+    order = planned_order(plan)
+    heard = [s.out.reached[-1] for s in loop.samples if s.out.reached]
+    seqs = [s.out.mission_seq for s in loop.samples]
+    score = landing_score_for_plan(loop.truth(), items)
+    faults = []
+    if loop.reached != order:
+        faults.append(f"reached {loop.reached} != {order}")
+    elif heard != order:
+        faults.append(f"heard {heard}")
+    if back_to_zero(seqs, order):
+        faults.append("MISSION_CURRENT back to 0")
+    low = _lowest(loop, items, order, seqs, _landing_first(items, order))
+    if not low >= SAFE_SHARE * least_planned(items, order):
+        faults.append(f"down to {low:.0f} m before the landing")
+    if not score.passed():
+        faults.append("landing off target")
+    if not disarmed:
+        faults.append("not disarmed")
+    text = (f"{score.along_m:+7.1f} / {score.across_m:+5.2f} m sink {score.sink_m_s:4.2f} "
+            f"low {low:4.0f} m")  # fmt: skip
+    return not faults, text + ("  " + "; ".join(faults) if faults else "")
+
+
+def _lowest(loop: ClosedLoop, items: list, order: list, seqs: list, landing: int) -> float:
+    if order[1] not in seqs or landing not in seqs:
+        return math.nan
+    climbed = seqs.index(order[1]) + 50 * 20  # 20 s after the take-off item
+    began = len(seqs) - 1 - seqs[::-1].index(landing)
+    began = next(k for k in range(began, -1, -1) if seqs[k] != landing) + 1
+    heights = [s.alt_agl for s in loop.samples[climbed:began]]
+    return min(heights) if heights else math.nan
