@@ -104,14 +104,15 @@ def jump_plan(k: int) -> tuple[dict, float, str]:
     what.insert(0, f"jump to {target_name} x{repeats} {place}")
     _landing(r, kind, frame, unit, items, jump if place == "inside landing" else None)
     mission = {"items": items, "plannedHomePosition": list(HOME), "version": 2,
-               "firmwareType": 12, "vehicleType": 1, "cruiseSpeed": 30, "hoverSpeed": 5}  # fmt: skip
+               "firmwareType": 12, "vehicleType": 1, "cruiseSpeed": 30,
+               "hoverSpeed": 5}  # fmt: skip
     doc = {"fileType": "Plan", "version": 1, "groundStation": "QGroundControl",
            "mission": mission, "geoFence": {"version": 2, "polygons": [], "circles": []},
            "rallyPoints": {"version": 2, "points": []}}  # fmt: skip
     return doc, heading, f"runway {heading:5.1f} {kind:8} " + ", ".join(what)
 
 
-def _landing(r, kind, frame, unit, items, between) -> None:  # noqa: ANN001
+def _landing(r, kind, frame, unit, items, between) -> None:
     """The landing's items: a waypoint on the runway's line (``between`` adds the jump
     after it) and NAV_LAND, or QGroundControl's landing pattern."""
     land_along = r.uniform(-100.0, 300.0)

@@ -59,6 +59,8 @@ class Timeline:
     complete_ms: int | None = None
     last_ms: int = 0
     seqs: list[int] = field(default_factory=list)
+    seq_ms: list[int] = field(default_factory=list)  # vehicle time each of ``seqs`` was seen
+    reached: list[int] = field(default_factory=list)  # MISSION_ITEM_REACHED, as heard
     texts: list[str] = field(default_factory=list)
     armed: bool | None = None  # as the vehicle's last heartbeat said
 
@@ -266,6 +268,7 @@ class _Pilot:
             return False
         if not self.tl.seqs or self.tl.seqs[-1] != msg.seq:
             self.tl.seqs.append(msg.seq)
+            self.tl.seq_ms.append(self.tl.last_ms)
         # A plan that ends in an unlimited loiter is never COMPLETE: it is done once that
         # loiter is the current item, with nothing left to fly.
         if msg.mission_state == d.MISSION_STATE_COMPLETE or msg.seq == self.endless_seq:
@@ -322,6 +325,8 @@ class _Pilot:
             self.tl.last_ms = max(self.tl.last_ms, int(ms))
         if msg.get_type() == "STATUSTEXT":
             self.tl.texts.append(msg.text)
+        elif msg.get_type() == "MISSION_ITEM_REACHED" and msg.get_srcSystem() == 1:
+            self.tl.reached.append(msg.seq)
         elif msg.get_type() == "HEARTBEAT" and msg.get_srcSystem() == 1:
             self.tl.armed = bool(msg.base_mode & d.MAV_MODE_FLAG_SAFETY_ARMED)
 
