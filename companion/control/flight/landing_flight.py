@@ -139,9 +139,14 @@ class LandingFlight:
         return self._fly_attitude(dem, (pos, vel, nav, airspeed, dt), out, config, lateral)
 
     def _come_round(self, ex: MissionExecutor | None, pos: tuple[float, float], alt: float) -> None:
-        """Climbed out after a go-around: fly the landing's approach again."""
+        """Climbed out after a go-around: fly the landing's approach again. The DO_JUMPs
+        keep their counts: a jump on the way from the approach's start (NAV_LAND straight
+        after a loop's DO_JUMP) has done its repeats, and sent the aircraft round the whole
+        loop again when counted afresh."""
         if ex is not None:
+            done = dict(ex.jumps_done)
             ex.start(approach_start(ex.items, ex.current), pos, alt)
+            ex.jumps_done.update(done)
         self.landing = None
 
     def _fly_attitude(
