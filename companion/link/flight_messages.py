@@ -20,6 +20,18 @@ def _finite(x: float) -> float:
     return x if math.isfinite(x) else 0.0
 
 
+def mission_items_reached(mav: Any, c: ControlStatus, told: int) -> list[Any]:
+    """MISSION_ITEM_REACHED for each item reached since ``told`` items were (-1: none told
+    yet, the link just started: the last one only, as before it began). A controller
+    restarted counts from 0 again: all it has reached."""
+    count, kept = c.reached_count, ControlStatus.REACHED_KEPT
+    if c.last_reached < 0 or count == told:
+        return []
+    first = count - 1 if told < 0 else (told if told < count else 0)
+    seqs = [c.recent_reached[n % kept] for n in range(max(first, count - kept), count)]
+    return [mav.mission_item_reached_encode(seq) for seq in seqs if seq >= 0]
+
+
 def nav_controller_output(mav: Any, c: ControlStatus | None) -> Any:
     """Guidance demands and errors (bearings in whole degrees, as the message has them)."""
     if c is None:

@@ -121,9 +121,9 @@ class MissionState(enum.IntEnum):
 class ControlStatus(Message):
     """What the flight controller is doing. Producer: control.fixed_wing. Consumer: link.
 
-    Feeds NAV_CONTROLLER_OUTPUT, MISSION_CURRENT, MISSION_ITEM_REACHED (sent when
-    ``reached_count`` grows) and EXTENDED_SYS_STATE's landed state (from ``landed``,
-    ``takeoff_phase`` and ``land_phase``).
+    Feeds NAV_CONTROLLER_OUTPUT, MISSION_CURRENT, MISSION_ITEM_REACHED (one for each item
+    ``reached_count`` grew by, from ``recent_reached``) and EXTENDED_SYS_STATE's landed
+    state (from ``landed``, ``takeoff_phase`` and ``land_phase``).
     """
 
     _fields_ = [
@@ -146,9 +146,13 @@ class ControlStatus(Message):
         ("takeoff_phase", ctypes.c_uint8),  # take-off Phase from the roll to the height, else 0
         ("reached_count", ctypes.c_uint32),
         ("last_reached", ctypes.c_int32),
+        # The last REACHED_KEPT items reached, the n-th (from 0) at [n % REACHED_KEPT]: two
+        # in one step (a loiter, then the take-off a DO_JUMP returns to) are both told.
+        ("recent_reached", ctypes.c_int32 * 8),
     ]
 
     STALE_US = 2_000_000  # no newer status for this long: the controller has stopped
+    REACHED_KEPT = 8
 
     def fresh(self, now_us: int) -> bool:
         """Whether the controller is still running (it publishes ten times a second)."""

@@ -128,6 +128,7 @@ class FixedWingPlugin(Plugin):
         self.refusing = False  # the last step's inputs were not usable
         self.reached_count = 0
         self.last_reached = -1
+        self.recent_reached = [-1] * ControlStatus.REACHED_KEPT
         self.next_status_us = 0
         self.default_status = VehicleStatus(mode=int(FlightMode.LOITER), armed=1)
 
@@ -172,9 +173,10 @@ class FixedWingPlugin(Plugin):
         self.surfaces.publish(ActuatorCommand.from_buffer_copy(packed))
         if out.disarm and not self.disarm_sent:
             self._disarm(now_us, out, status)
-        if out.reached:
-            self.reached_count += len(out.reached)
-            self.last_reached = out.reached[-1]
+        for seq in out.reached:  # each told, however many in one step
+            self.recent_reached[self.reached_count % ControlStatus.REACHED_KEPT] = seq
+            self.reached_count += 1
+            self.last_reached = seq
         if out.reached or now_us >= self.next_status_us:
             self.status_out.publish(self._status(now_us, out, status))
             self.next_status_us = now_us + STATUS_PERIOD_US
@@ -243,4 +245,5 @@ class FixedWingPlugin(Plugin):
         msg.landed = int(out.landed)
         msg.land_phase, msg.takeoff_phase = out.land_phase, out.takeoff_phase
         msg.reached_count, msg.last_reached = self.reached_count, self.last_reached
+        msg.recent_reached[:] = self.recent_reached
         return msg

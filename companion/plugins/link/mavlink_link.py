@@ -24,6 +24,7 @@ from companion.link.codec import dialect as d
 from companion.link.command_service import CommandService
 from companion.link.commands import register_commands
 from companion.link.endpoints import endpoint_problems, open_endpoints, serial_endpoints
+from companion.link.flight_messages import mission_items_reached
 from companion.link.gcs_watch import GcsWatch
 from companion.link.heartbeat_state import HeartbeatFollower
 from companion.link.identity import IdentityService
@@ -151,7 +152,7 @@ class MavlinkLink(Plugin):
         self.link_status = bus.writer("link/status")
         self.texts = bus.queue_reader("vehicle/statustext")
         self.next_prearm_s = 0.0
-        self.reached_count = 0
+        self.reached_count = -1  # items the controller said it reached (-1: not heard yet)
         self.timesync = TimesyncService(
             self.mav, lambda: ctx.clock.now_us() * 1000, sysid, ctx.settings["compid"]
         )
@@ -292,9 +293,8 @@ class MavlinkLink(Plugin):
         """The controller's status while it runs; MISSION_ITEM_REACHED when it grows."""
         if control is None or not control.fresh(self.ctx.clock.now_us()):
             return None
-        if control.reached_count != self.reached_count and control.last_reached >= 0:
-            msg = self.mav.mission_item_reached_encode(control.last_reached)
-            self.router.send([Outgoing(msg, None)], time.monotonic())
+        reached = mission_items_reached(self.mav, control, self.reached_count)
+        self.router.send([Outgoing(msg, None) for msg in reached], time.monotonic())
         self.reached_count = control.reached_count
         self.missions.follow(control.mission_state, control.mission_seq)
         return control
