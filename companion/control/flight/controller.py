@@ -288,16 +288,14 @@ class FlightController:
         return setpoint
 
     def _fly_takeoff(
-        self,
-        setpoint: Setpoint,
-        pos: tuple[float, float],
-        nav: NavState,
-        airspeed: float,
-        dt: float,
-        out: ControlOutput,
-    ) -> ControlOutput:
+        self, setpoint: Setpoint, pos: tuple[float, float], nav: NavState, airspeed: float,
+        dt: float, out: ControlOutput,
+    ) -> ControlOutput:  # fmt: skip
         if self.takeoff is None:
-            self.takeoff = self.lander.runway = RunwayTakeoff(pos, nav.yaw_rad, self.home_alt)
+            self.takeoff = RunwayTakeoff(pos, nav.yaw_rad, self.home_alt)
+            # A take-off item flown in the air (a DO_JUMP back to it) climbs on its heading:
+            # no runway there for Land to come back to.
+            self.lander.runway = self.takeoff if self.landed else self.lander.runway
             self.attitude.reset()
         to = self.takeoff
         cfg = self.config.values
