@@ -239,6 +239,8 @@ class MissionExecutor:
         if self._descending is not None:
             return self._loiter_to_alt(self._descending, pos, alt)
         radius = item.acceptance_m(self.config.wp_radius)
+        if _distance(self._prev, b) <= radius:  # a leg from itself (a loiter there, a jump
+            self._prev = pos  # back to it) has no finish line: it starts here (ArduPlane)
         if not self._flown_back:
             radius = max(radius, self._turn_lead(self._prev, b))
         if _distance(pos, b) <= radius or past_point(self._prev, b, pos):

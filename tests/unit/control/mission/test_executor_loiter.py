@@ -18,6 +18,7 @@ from tests.unit.control.mission.executor_flying import (
     executor,
     fly_lines,
     item,
+    jump,
     on_circle,
     wp,
 )
@@ -98,6 +99,29 @@ def test_a_loiter_tighter_than_the_aircraft_turns_ends_on_the_circle_it_flies(
             break
     assert sp.kind == Kind.LINE and sp.b == pytest.approx((3_000.0, 0.0), abs=0.05), k
     assert k <= 181  # one turn, or a second on it
+
+
+def test_a_waypoint_where_the_loiter_before_it_circled_is_flown_to_and_passed():
+    """A loiter at a waypoint's place, then a DO_JUMP back to that waypoint (or the
+    waypoint after the loiter): the leg to it began at the loiter's centre, the waypoint
+    itself, and a leg from a point to itself has no finish line. The aircraft, still on its
+    216 m circle, never came within 30 m of the point: a whole vehicle circled there until
+    its battery ran low. The leg now starts where the aircraft is; circling on, the
+    waypoint is passed once the aircraft is beyond it."""
+    p, flown = (1_000.0, 0.0), 216.0
+    items = [wp(0, p), wp(1, (0.0, 1_500.0)),
+             item(2, d.MAV_CMD_NAV_LOITER_TIME, p, z=100.0, p1=10.0),
+             jump(3, 0, 1), wp(4, (-1_500.0, 0.0))]  # fmt: skip
+    ex = executor(items)
+    reached, setpoints, _ = fly_lines(ex, turn_radius=flown)
+    assert reached == [0, 1] and setpoints[-1].kind == Kind.CIRCLE
+    for k in range(360):  # on round the circle it flies, two degrees a second
+        sp = ex.step(on_circle(p, flown, 90.0 + 2.0 * k), 180.0, 100.0 + k, flown)
+        reached += ex.drain_reached()
+        if reached[2:] == [2, 0]:
+            break
+    assert reached == [0, 1, 2, 0], reached  # the loiter, then the waypoint it circled
+    assert sp.kind == Kind.LINE and sp.b == pytest.approx((0.0, 1_500.0), abs=0.05)
 
 
 @pytest.mark.parametrize(
