@@ -20,9 +20,10 @@ heard against the plan's (the loop flown exactly its repeat count more times, th
 landing), MISSION_CURRENT never back to 0 after the take-off item, no descent under
 ``SAFE_SHARE`` of the lowest planned height between the climb and the landing's first
 item, the touchdown (15 m along, 2 m across, sink 1.5 m/s: ground/campaign/landing_score.py)
-and the disarm. ``--restart`` kills the control plug-in (SIGKILL) once on the loop's
-second lap: the execution control starts it again, and the reached sequence must still be
-the plan's.
+and the disarm; ``own`` is the touchdown across by the vehicle's own navigation solution
+(the rest of the truth's is the emulated GPS's wander). ``--restart`` kills the control
+plug-in (SIGKILL) once on the loop's second lap: the execution control starts it again,
+and the reached sequence must still be the plan's.
 """
 
 from __future__ import annotations
@@ -43,7 +44,12 @@ from benchmarks.varied_landings import HOME, _crosswind
 from companion.control.mission.plan import checked_plan
 from companion.geodesy import LocalFrame
 from ground.campaign.flight_run import FlightJob, fly_flight
-from ground.campaign.landing_score import LandingScore, landing_score_for_plan, read_truth
+from ground.campaign.landing_score import (
+    LandingScore,
+    landing_score_for_plan,
+    navigation_across,
+    read_truth,
+)
 from ground.campaign.spec import SIM_CONFIG, Flight
 from mavlink_dialect import companion as d
 
@@ -193,8 +199,9 @@ def judge(plan: Path, folder: Path, row: dict) -> tuple[bool, str]:
         faults.append("not disarmed")
     if row["status"] != "ok":
         faults.append(row["error"])
-    text = (f"{score.along_m:+7.1f} / {score.across_m:+5.2f} m sink {score.sink_m_s:4.2f} "
-            f"low {low:4.0f} m")  # fmt: skip
+    est = navigation_across(folder / "truth.csv", plan, score) if truth is not None else math.nan
+    text = (f"{score.along_m:+7.1f} / {score.across_m:+5.2f} m (own {est:+5.2f}) "
+            f"sink {score.sink_m_s:4.2f} low {low:4.0f} m")  # fmt: skip
     return not faults, text + ("  " + "; ".join(faults) if faults else "")
 
 
