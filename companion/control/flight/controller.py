@@ -328,18 +328,10 @@ class FlightController:
         return out
 
     def _fly(
-        self,
-        sp: Setpoint,
-        pos: tuple[float, float],
-        vel: tuple[float, float],
-        nav: NavState,
-        airspeed: float,
-        dt: float,
-        out: ControlOutput,
-        least_speed: float = math.inf,
-        climb_ff: float = 0.0,
-        roll_dem: float = math.nan,
-    ) -> ControlOutput:
+        self, sp: Setpoint, pos: tuple[float, float], vel: tuple[float, float], nav: NavState,
+        airspeed: float, dt: float, out: ControlOutput, least_speed: float = math.inf,
+        climb_ff: float = 0.0, roll_dem: float = math.nan,
+    ) -> ControlOutput:  # fmt: skip
         """Fly ``sp`` by the energy controller and the line guidance (or at ``roll_dem``)."""
         cfg = self.config
         speed_dem = sp.speed if math.isfinite(sp.speed) else cfg["AIRSPEED_CRUISE"]
@@ -352,8 +344,12 @@ class FlightController:
         lateral = self._lateral(sp, pos, vel, dt)
         if not math.isfinite(roll_dem):
             roll_dem = bank_for(lateral.lat_acc, cfg.bank_limit(speed_dem))
+        # No stall in a turn, but for the take-off's climb and the landing, which fly their own.
+        own = sp.approach or self.takeoff is not None or self.lander.landing is not None
+        least = 0.0 if own else cfg.least_speed_in_turn(speed_min, roll_dem)
+        alt, speed_dem = nav.alt_msl_m, max(speed_dem, least)
         energy = self.tecs.step(
-            nav.alt_msl_m, -nav.vd_m_s, airspeed, sp.alt_msl, speed_dem, dt, climb_ff
+            alt, -nav.vd_m_s, airspeed, sp.alt_msl, speed_dem, dt, climb_ff, least
         )
         surfaces = self.attitude.step(
             roll_dem,

@@ -5,6 +5,12 @@ between potential and kinetic energy is what pitch changes. Height and speed err
 become demanded rates through time constants; throttle closes the total-rate error and
 pitch the balance-rate error, each with feed-forward, damping and a bounded integrator.
 ``speed_weight`` (0..2) says whether pitch looks after height (0), speed (2) or both (1).
+
+Underspeed protection (Lambregts' TECS has it, and ArduPilot's and PX4's): below 90 % of
+the least airspeed the caller gives, with the throttle already at its most, pitch looks
+after speed alone until the least airspeed is back, giving up height before the wing stalls
+(a C172 slowed to its least airspeed in a gusty turn, the throttle open and the nose held
+up for the height, lost 100 m).
 """
 
 from __future__ import annotations
@@ -52,6 +58,8 @@ class Tecs:
         self.pitch_integ = 0.0
         self._speed: float | None = None
         self.speed_rate = 0.0
+        self.underspeed = False
+        self._throttle_out = 0.0
 
     def reset(self, pitch: float = 0.0) -> None:
         """Start again (after takeoff or a mode that flew pitch directly)."""
@@ -59,6 +67,7 @@ class Tecs:
         self.pitch_integ = pitch
         self._speed = None
         self.speed_rate = 0.0
+        self.underspeed = False
 
     def _track_speed(self, speed: float, dt: float) -> None:
         if self._speed is not None and dt > 0:
@@ -75,11 +84,13 @@ class Tecs:
         speed_dem: float,
         dt: float,
         climb_ff: float = 0.0,
+        least_speed: float = 0.0,
     ) -> EnergyDemand:
         """Pitch and throttle for the demanded height (m) and airspeed (m/s).
 
         ``climb_ff`` (m/s) is how fast the demanded height itself moves (a glide path):
         without it the height would trail a moving demand by a constant error.
+        ``least_speed`` (m/s): the airspeed the underspeed protection keeps (0: none).
         """
         g = self.gains
         self._track_speed(speed, dt)
@@ -90,12 +101,21 @@ class Tecs:
         # Specific (per unit weight) energy rates, m/s.
         ste_rate_dem = climb_dem + v * accel_dem / G
         ste_rate = climb_rate + v * self.speed_rate / G
-        w = clamp(g.speed_weight, 0.0, 2.0)
+        w = 2.0 if self._check_underspeed(speed, least_speed) else clamp(g.speed_weight, 0.0, 2.0)
         seb_rate_dem = climb_dem * (2.0 - w) - v * accel_dem / G * w
         seb_rate = climb_rate * (2.0 - w) - v * self.speed_rate / G * w
         throttle = self._throttle(ste_rate_dem, ste_rate, dt)
         pitch = self._pitch(seb_rate_dem, seb_rate, v, dt)
+        self._throttle_out = throttle = g.throttle_max if self.underspeed else throttle
         return EnergyDemand(pitch, throttle)
+
+    def _check_underspeed(self, speed: float, least_speed: float) -> bool:
+        """Whether the aircraft is under 90 % of ``least_speed`` with the throttle at its
+        most (or has been, and is not back to ``least_speed`` yet)."""
+        slow = speed < (least_speed if self.underspeed else 0.9 * least_speed)
+        full = self.underspeed or self._throttle_out >= 0.95 * self.gains.throttle_max
+        self.underspeed = least_speed > 0.0 and slow and full
+        return self.underspeed
 
     def _throttle(self, ste_rate_dem: float, ste_rate: float, dt: float) -> float:
         g = self.gains
