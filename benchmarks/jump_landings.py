@@ -31,7 +31,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import random
 import sys
 import tempfile
 import threading
@@ -40,9 +39,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.jump_flights import ControlKiller, fly_closed_loop
-from benchmarks.varied_landings import HOME, _crosswind
+from benchmarks.varied_landings import HOME, _crosswind, random_runway
 from companion.control.mission.plan import checked_plan
-from companion.geodesy import LocalFrame
 from ground.campaign.flight_run import FlightJob, fly_flight
 from ground.campaign.landing_score import (
     LandingScore,
@@ -60,10 +58,7 @@ MAX_SIM_S = 2000.0
 
 def jump_plan(k: int) -> tuple[dict, float, str]:
     """Plan ``k`` as a .plan document, its runway's heading (deg) and a description."""
-    r = random.Random(k)
-    frame = LocalFrame(HOME[0], HOME[1])
-    heading = r.uniform(0.0, 360.0)
-    unit = (math.cos(math.radians(heading)), math.sin(math.radians(heading)))
+    r, frame, heading, unit = random_runway(k)
     items: list[dict] = []
 
     def add(command: int, ne: tuple[float, float] | None, alt: float, *params: float) -> int:

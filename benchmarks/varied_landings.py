@@ -40,12 +40,18 @@ HOME = (-37.9105, 145.134, 80.0)  # the simulator's home (bridges/jsbsim/fdm.py)
 CROSSWIND_M_S = 5.0
 
 
-def varied_plan(k: int) -> tuple[dict, float, str]:
-    """Plan ``k`` as a .plan document, its runway heading (deg) and a one-line description."""
+def random_runway(k: int) -> tuple[random.Random, LocalFrame, float, tuple[float, float]]:
+    """Plan ``k``'s random draws, the frame at home, its runway's heading (deg, the first
+    draw) and the runway's unit vector (north, east)."""
     r = random.Random(k)
-    frame = LocalFrame(HOME[0], HOME[1])
     heading = r.uniform(0.0, 360.0)
     unit = (math.cos(math.radians(heading)), math.sin(math.radians(heading)))
+    return r, LocalFrame(HOME[0], HOME[1]), heading, unit
+
+
+def varied_plan(k: int) -> tuple[dict, float, str]:
+    """Plan ``k`` as a .plan document, its runway heading (deg) and a one-line description."""
+    r, frame, heading, unit = random_runway(k)
 
     def at(along: float, side: float = 0.0) -> list[float]:
         lat, lon = frame.latlon(along * unit[0] - side * unit[1], along * unit[1] + side * unit[0])
