@@ -39,7 +39,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.jump_flights import ControlKiller, fly_closed_loop
-from benchmarks.varied_landings import HOME, _crosswind, random_runway
+from benchmarks.varied_landings import HOME, _crosswind, landing_pattern, random_runway
 from companion.control.mission.plan import checked_plan
 from ground.campaign.flight_run import FlightJob, fly_flight
 from ground.campaign.landing_score import (
@@ -132,13 +132,7 @@ def _landing(r, kind, frame, unit, items, between) -> None:
             if between is not None and command == 16:
                 between()
         return
-    items.append({
-        "type": "ComplexItem", "complexItemType": "fwLandingPattern", "version": 2,
-        "altitudesAreRelative": True, "landCoordinate": [*land, 0],
-        "landingApproachCoordinate": [*approach, alt], "useLoiterToAlt": True,
-        "loiterClockwise": r.choice([True, False]), "loiterRadius": r.choice([75, 150, 250]),
-        "stopTakingPhotos": True, "stopTakingVideo": True, "valueSetIsDistance": True,
-    })  # fmt: skip
+    items.append(landing_pattern(r, land, approach, alt))
 
 
 def planned_order(plan: Path) -> list[int]:

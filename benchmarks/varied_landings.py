@@ -49,6 +49,18 @@ def random_runway(k: int) -> tuple[random.Random, LocalFrame, float, tuple[float
     return r, LocalFrame(HOME[0], HOME[1]), heading, unit
 
 
+def landing_pattern(r: random.Random, land: list[float], approach: list[float], alt: float) -> dict:
+    """QGroundControl's fixed-wing landing pattern onto ``land`` from ``approach`` at
+    ``alt`` (m above home), its loiter's direction and radius drawn from ``r``."""
+    return {
+        "type": "ComplexItem", "complexItemType": "fwLandingPattern", "version": 2,
+        "altitudesAreRelative": True, "landCoordinate": [*land, 0],
+        "landingApproachCoordinate": [*approach, alt], "useLoiterToAlt": True,
+        "loiterClockwise": r.choice([True, False]), "loiterRadius": r.choice([75, 150, 250]),
+        "stopTakingPhotos": True, "stopTakingVideo": True, "valueSetIsDistance": True,
+    }  # fmt: skip
+
+
 def varied_plan(k: int) -> tuple[dict, float, str]:
     """Plan ``k`` as a .plan document, its runway heading (deg) and a one-line description."""
     r, frame, heading, unit = random_runway(k)
@@ -73,13 +85,7 @@ def varied_plan(k: int) -> tuple[dict, float, str]:
     if kind == "waypoint":
         items += [simple(16, approach, alt), simple(21, land, 0.0)]
     else:
-        items.append({
-            "type": "ComplexItem", "complexItemType": "fwLandingPattern", "version": 2,
-            "altitudesAreRelative": True, "landCoordinate": [*land, 0],
-            "landingApproachCoordinate": [*approach, alt], "useLoiterToAlt": True,
-            "loiterClockwise": r.choice([True, False]), "loiterRadius": r.choice([75, 150, 250]),
-            "stopTakingPhotos": True, "stopTakingVideo": True, "valueSetIsDistance": True,
-        })  # fmt: skip
+        items.append(landing_pattern(r, land, approach, alt))
     mission = {"items": items, "plannedHomePosition": list(HOME), "version": 2,
                "firmwareType": 12, "vehicleType": 1}  # fmt: skip
     doc = {"fileType": "Plan", "version": 1, "groundStation": "QGroundControl", "mission": mission}
