@@ -36,6 +36,7 @@ from companion.messages import (
     CommandAck,
     CommandId,
     FlightMode,
+    MissionState,
     NavFlags,
     PluginState,
     StatusText,
@@ -247,7 +248,10 @@ class CommanderPlugin(Plugin):
         c = self.commander
         control = self.control.get()
         flying_mission = c.armed and c.mode == FlightMode.MISSION
-        if flying_mission and control is not None and control.fresh(now):
+        # A controller with no mission running (restarted, its first steps refused) says
+        # item 0: the item to resume from is still the one saved.
+        running = control is not None and control.mission_state != MissionState.NOT_STARTED
+        if flying_mission and running and control is not None and control.fresh(now):
             c.mission_first = max(0, int(control.mission_seq))
         state = c.snapshot()
         # The same state as last step (nearly every step): the same verdict, without the

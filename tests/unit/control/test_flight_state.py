@@ -13,7 +13,8 @@ from companion.control.flight_state import (
     load_flight_state,
     save_flight_state,
 )
-from companion.messages import FlightMode, NavFlags
+from companion.messages import ControlStatus, FlightMode, MissionState, NavFlags
+from companion.plugins.vehicle.commander import CommanderPlugin
 
 HOME = (-37.9105, 145.134, 50.0)
 
@@ -69,3 +70,25 @@ def test_a_restored_commander_says_what_it_said_before_its_restart():
     old, new = before.status(5), after.status(5)
     assert bytes(old) == bytes(new)
     assert after.armed and after.mode == FlightMode.MISSION and after.mission_first == 2
+
+
+def test_the_item_to_resume_from_is_not_a_restarted_controllers_item_0(tmp_path):
+    """The commander keeps the mission's item from the controller's status, to resume from
+    after a restart. A controller restarted in the air whose first steps are refused (no
+    navigation yet) has no mission running and says item 0: taken, a second restart would
+    fly the mission again from the take-off."""
+    commander = Commander(lambda: 6)
+    commander.home, commander.armed, commander.mode = HOME, True, FlightMode.MISSION
+    status = ControlStatus(t_us=1_000_000, mission_seq=4, mission_state=MissionState.ACTIVE)
+    plugin = SimpleNamespace(
+        commander=commander, control=SimpleNamespace(get=lambda: status), judged=None,
+        written="", written_armed=False, state_dir=tmp_path,
+    )  # fmt: skip
+    CommanderPlugin._keep_flight_state(plugin, 1_100_000)  # type: ignore[arg-type]
+    assert commander.mission_first == 4 and load_flight_state(tmp_path).mission_seq == 4
+    status = ControlStatus(t_us=2_000_000, mission_seq=0, mission_state=MissionState.NOT_STARTED)
+    CommanderPlugin._keep_flight_state(plugin, 2_100_000)  # type: ignore[arg-type]
+    assert commander.mission_first == 4 and load_flight_state(tmp_path).mission_seq == 4
+    status = ControlStatus(t_us=3_000_000, mission_seq=5, mission_state=MissionState.ACTIVE)
+    CommanderPlugin._keep_flight_state(plugin, 3_100_000)  # type: ignore[arg-type]
+    assert commander.mission_first == 5 and load_flight_state(tmp_path).mission_seq == 5
