@@ -126,6 +126,8 @@ class ControlStatus(Message):
     state (from ``landed``, ``takeoff_phase`` and ``land_phase``).
     """
 
+    REACHED_KEPT = 8  # items reached kept in ``recent_reached``
+
     _fields_ = [
         ("t_us", ctypes.c_int64),
         ("nav_roll_rad", ctypes.c_double),
@@ -148,11 +150,10 @@ class ControlStatus(Message):
         ("last_reached", ctypes.c_int32),
         # The last REACHED_KEPT items reached, the n-th (from 0) at [n % REACHED_KEPT]: two
         # in one step (a loiter, then the take-off a DO_JUMP returns to) are both told.
-        ("recent_reached", ctypes.c_int32 * 8),
+        ("recent_reached", ctypes.c_int32 * REACHED_KEPT),
     ]
 
     STALE_US = 2_000_000  # no newer status for this long: the controller has stopped
-    REACHED_KEPT = 8
 
     def fresh(self, now_us: int) -> bool:
         """Whether the controller is still running (it publishes ten times a second)."""

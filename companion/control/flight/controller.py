@@ -347,9 +347,9 @@ class FlightController:
         # No stall in a turn, but for the take-off's climb and the landing, which fly their own.
         own = sp.approach or self.takeoff is not None or self.lander.landing is not None
         least = 0.0 if own else cfg.least_speed_in_turn(speed_min, roll_dem)
-        alt, speed_dem = nav.alt_msl_m, max(speed_dem, least)
+        speed_dem = max(speed_dem, least)
         energy = self.tecs.step(
-            alt, -nav.vd_m_s, airspeed, sp.alt_msl, speed_dem, dt, climb_ff, least
+            nav.alt_msl_m, -nav.vd_m_s, airspeed, sp.alt_msl, speed_dem, dt, climb_ff, least
         )
         surfaces = self.attitude.step(
             roll_dem,

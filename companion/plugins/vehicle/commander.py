@@ -250,8 +250,12 @@ class CommanderPlugin(Plugin):
         flying_mission = c.armed and c.mode == FlightMode.MISSION
         # A controller with no mission running (restarted, its first steps refused) says
         # item 0: the item to resume from is still the one saved.
-        running = control is not None and control.mission_state != MissionState.NOT_STARTED
-        if flying_mission and running and control is not None and control.fresh(now):
+        if (
+            flying_mission
+            and control is not None
+            and control.fresh(now)
+            and control.mission_state != MissionState.NOT_STARTED
+        ):
             c.mission_first = max(0, int(control.mission_seq))
         state = c.snapshot()
         # The same state as last step (nearly every step): the same verdict, without the
