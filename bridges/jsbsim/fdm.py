@@ -9,6 +9,7 @@ from dataclasses import replace
 import jsbsim
 
 from bridges.jsbsim.conditions import TURBULENCE, Home
+from bridges.jsbsim.ground_wind import body_from_ned, wind_share
 from bridges.sensor_models.true_state import TrueState
 
 __all__ = ["TURBULENCE", "Flight", "Home"]
@@ -55,6 +56,8 @@ class Flight:
         self.turbulence = False
         self.brake_channel = False  # until a brakes servo is heard, idle means brakes
         self.rest_agl_m = 0.0  # the reference point's height on the wheels (0: not known)
+        self.wind_ned = (0.0, 0.0, 0.0)  # m/s, the direction it blows towards
+        self.wind_share = 1.0  # of it the model feels now (ground_wind)
         self._initial_conditions(model, airborne_agl_m, speed_m_s)
         if airborne_agl_m and bank_deg:
             self._bank(bank_deg)
@@ -117,9 +120,33 @@ class Flight:
 
     def set_wind(self, north: float, east: float, down: float) -> None:
         """Steady wind, m/s, the direction it blows towards."""
+        self.wind_ned = (north, east, down)
+        self._feel_wind(1.0)
+
+    def _feel_wind(self, share: float) -> None:
+        """Give the model ``share`` of the wind (``ground_wind``: its aerodynamics fail in
+        an airflow from the side or behind, which only a slow aircraft on its wheels meets)."""
+        self.wind_share = share
+        north, east, down = (share * w for w in self.wind_ned)
         self.fdm["atmosphere/wind-north-fps"] = north / FT
         self.fdm["atmosphere/wind-east-fps"] = east / FT
         self.fdm["atmosphere/wind-down-fps"] = down / FT
+
+    def _ground_wind(self) -> None:
+        share = 1.0
+        if self.weight_on_wheels():
+            f = self.fdm
+            angles = (f["attitude/phi-rad"], f["attitude/theta-rad"], f["attitude/psi-rad"])
+            ground = (
+                f["velocities/v-north-fps"] * FT,
+                f["velocities/v-east-fps"] * FT,
+                f["velocities/v-down-fps"] * FT,
+            )
+            share = wind_share(
+                body_from_ned(ground, *angles), body_from_ned(self.wind_ned, *angles)
+            )
+        if share != self.wind_share:
+            self._feel_wind(share)
 
     def set_turbulence(self, level: str, seed: int | None = None) -> None:
         """MIL-F-8785C turbulence: none, light, moderate or severe; ``seed`` picks the gust
@@ -189,6 +216,8 @@ class Flight:
             # JSBSim's MIL-F-8785C scale lengths shrink with height; on the runway they
             # give gusts that throw a parked Cub into the air and the model into NaNs.
             self.fdm["atmosphere/turb-type"] = MILSPEC if self._above_ground() else 0
+        if any(self.wind_ned):
+            self._ground_wind()
         self.fdm.run()
         s = self._model_state()
         if _physical(s):
