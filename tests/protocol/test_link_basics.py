@@ -197,7 +197,10 @@ def test_plugin_health_and_nav_status(link):
 
 def test_reboot_is_acknowledged_and_every_plug_in_comes_back(link):
     vehicle, gcs, _ = link
-    before = {row.name.decode(): row.restarts for row in vehicle.health().rows()}
+    # The vehicle answered the station, but on a busy machine this test's reader may not yet
+    # hold the supervisor's first health table.
+    table = wait_for(vehicle.health, 30, "the supervisor's health table")
+    before = {row.name.decode(): row.restarts for row in table.rows()}
     gcs.command(m.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN, 1)
     assert gcs.ack(m.MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN).result == m.MAV_RESULT_ACCEPTED
 
