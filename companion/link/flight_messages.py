@@ -10,6 +10,7 @@ from companion.link.codec import dialect as d
 from companion.messages import ControlStatus, MissionState
 
 LANDING_PHASES = (1, 2, 3)  # the controller's LandPhase APPROACH, FLARE and ROLLOUT
+TAKEOFF_PHASES = (1, 2, 3)  # its take-off Phase GROUND_ROLL, ROTATE, CLIMB_OUT (not ABORTED)
 
 
 def _deg(rad: float) -> float:
@@ -81,7 +82,7 @@ def landed_state(c: ControlStatus | None) -> int | None:
     """
     if c is None:
         return None
-    if c.takeoff_phase:
+    if c.takeoff_phase in TAKEOFF_PHASES:
         return d.MAV_LANDED_STATE_TAKEOFF
     if c.land_phase in LANDING_PHASES:
         return d.MAV_LANDED_STATE_LANDING

@@ -299,8 +299,12 @@ class FlightController:
             self.attitude.reset()
         to = self.takeoff
         cfg = self.config.values
-        demand = to.step(pos, nav.alt_msl_m, nav.yaw_rad, nav.yaw_rate_rad_s, airspeed, cfg)
+        speed = math.hypot(nav.vn_m_s, nav.ve_m_s)
+        demand = to.step(pos, nav.alt_msl_m, nav.yaw_rad, nav.yaw_rate_rad_s, airspeed, cfg,
+                         speed, dt)  # fmt: skip
         out.takeoff_phase = int(demand.phase)
+        if demand.phase == Phase.ABORTED:
+            return to.abort(out, speed, cfg, self.lander.said)
         if demand.phase == Phase.CLIMB_OUT:
             # Climb straight out along the runway with normal energy control.
             far = to.centreline_point(1e5)

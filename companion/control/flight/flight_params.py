@@ -80,6 +80,15 @@ CONTROL_PARAMS = (
     _p("TKOFF_PITCH_DEG", 8.0, 0.0, 25.0, "deg", "take-off: pitch held after rotating"),
     _p("TKOFF_GND_PITCH", 0.0, -10.0, 20.0, "deg", "take-off: pitch held on the ground roll"),
     _p("TKOFF_STEER_P", 1.0, 0.0, 5.0, "", "take-off: rudder per radian of heading error"),
+    _p(
+        "TKOFF_TIMEOUT",
+        0.0,
+        0.0,
+        120.0,
+        "s",
+        "take-off: abort (idle, brakes, disarm) when "
+        "the roll is not at 4 m/s ground speed after this long (0: never)",
+    ),
     _p("WP_RADIUS", 30.0, 1.0, 500.0, "m", "waypoint acceptance radius"),
     _p("WP_LOITER_RAD", 80.0, 10.0, 2000.0, "m", "loiter radius when an item gives none"),
     _p("RTL_ALT_M", 100.0, 10.0, 1000.0, "m", "return altitude above home"),

@@ -4,6 +4,10 @@ The centreline is the line from where the roll started along the heading the air
 had then. On the ground the rudder (and the nose wheel or tail wheel it moves) steers
 back onto it; after rotation the wings are held level on the same line until the
 aircraft is high enough for normal guidance.
+
+A roll that does not reach ``ROLLING_M_S`` of ground speed within ``TKOFF_TIMEOUT``
+seconds (brakes dragging, a wheel in soft ground, a throttle that does nothing) is
+aborted: idle, brakes, disarm, as ArduPlane's parameter of that name does. 0: no limit.
 """
 
 from __future__ import annotations
@@ -13,10 +17,13 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from companion.control.flight.output import ControlOutput
 from companion.geodesy import wrap_pi
+from mavlink_dialect import companion as d
 
 CLIMB_OUT_AGL_M = 15.0  # below this the aircraft flies the runway line with wings level
 STEER_LOOKAHEAD_M = 30.0
+ROLLING_M_S = 4.0  # the ground speed a take-off roll must reach within TKOFF_TIMEOUT
 
 
 class Phase(enum.IntEnum):
@@ -25,6 +32,7 @@ class Phase(enum.IntEnum):
     GROUND_ROLL = 1
     ROTATE = 2
     CLIMB_OUT = 3  # high enough for normal guidance
+    ABORTED = 4  # too slow to roll within TKOFF_TIMEOUT: idle, brakes, disarm
 
 
 @dataclass(frozen=True)
@@ -46,6 +54,9 @@ class RunwayTakeoff:
         self.heading = heading
         self.ground_msl = ground_msl
         self.phase = Phase.GROUND_ROLL
+        self.rolling_s = 0.0  # seconds of ground roll before ROLLING_M_S was reached
+        self.rolled = False  # ROLLING_M_S reached (or the take-off began in the air)
+        self.abort_said = False
 
     def centreline_point(self, distance: float) -> tuple[float, float]:
         """The point ``distance`` metres down the runway from the start."""
@@ -67,8 +78,15 @@ class RunwayTakeoff:
         yaw_rate: float,
         airspeed: float,
         v: Mapping[str, float],
+        ground_speed: float = math.inf,
+        dt: float = 0.0,
     ) -> TakeoffDemand:
-        """What to do now; ``v`` holds the control parameters by name."""
+        """What to do now (``dt`` seconds after the last step, at ``ground_speed``); ``v``
+        holds the control parameters by name."""
+        if self._too_slow(ground_speed, dt, v["TKOFF_TIMEOUT"]):
+            self.phase = Phase.ABORTED
+        if self.phase == Phase.ABORTED:
+            return TakeoffDemand(self.phase, 0.0, 0.0, 0.0, 0.0)
         agl = alt_msl - self.ground_msl
         if self.phase == Phase.GROUND_ROLL and airspeed >= v["TKOFF_ROTATE_SPD"]:
             self.phase = Phase.ROTATE
@@ -86,3 +104,22 @@ class RunwayTakeoff:
             return TakeoffDemand(self.phase, 0.0, pitch, throttle, rudder)
         pitch = math.radians(v["TKOFF_PITCH_DEG"])
         return TakeoffDemand(self.phase, 0.0, pitch, throttle, rudder)
+
+    def _too_slow(self, ground_speed: float, dt: float, timeout_s: float) -> bool:
+        """Whether the roll has gone on ``timeout_s`` without reaching ``ROLLING_M_S``."""
+        if self.rolled or self.phase != Phase.GROUND_ROLL:
+            return False
+        self.rolled = ground_speed >= ROLLING_M_S
+        self.rolling_s += dt
+        return not self.rolled and timeout_s > 0.0 and self.rolling_s > timeout_s
+
+    def abort(
+        self, out: ControlOutput, speed: float, v: Mapping[str, float], said: list[tuple[int, str]]
+    ) -> ControlOutput:
+        """The aborted roll's output: idle, brakes, disarm; the operator told once."""
+        if not self.abort_said:
+            text = f"Takeoff aborted: {speed:.1f} m/s after {v['TKOFF_TIMEOUT']:.0f} s"
+            said.append((d.MAV_SEVERITY_CRITICAL, text))
+            self.abort_said = True
+        out.throttle, out.brakes, out.disarm = 0.0, max(v["LAND_BRAKE"], 0.5), True
+        return out

@@ -24,6 +24,7 @@ from companion.actuators.airframe import AirframeError, load_airframe
 from companion.control.flight.attitude_modes import pilot_sticks
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.flight_params import control_params, flight_config
+from companion.control.flight.takeoff import Phase as TakeoffPhase
 from companion.control.mission.fence import Fence
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
@@ -203,10 +204,13 @@ class FixedWingPlugin(Plugin):
     def _disarm(self, now_us: int, out: ControlOutput, status: VehicleStatus) -> None:
         # The ground station hears the mission complete before the controller stops.
         self.status_out.publish(self._status(now_us, out, status))
-        self.ctx.log.info(
-            "landed and stopped: disarming (%d landing steps on the rangefinder's height)",
-            self.controller.lander.range_steps,
-        )
+        if out.takeoff_phase == TakeoffPhase.ABORTED:
+            self.ctx.log.warning("take-off aborted: disarming")
+        else:
+            self.ctx.log.info(
+                "landed and stopped: disarming (%d landing steps on the rangefinder's height)",
+                self.controller.lander.range_steps,
+            )
         self.commands.publish(VehicleCommand(t_us=now_us, command=int(CommandId.STOP)))
         self.disarm_sent = True
 

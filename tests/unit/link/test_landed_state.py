@@ -19,10 +19,16 @@ def test_no_controller_no_landed_state():
     assert landed_state(None) is None
 
 
-@pytest.mark.parametrize("phase", list(Phase))
+@pytest.mark.parametrize("phase", [Phase.GROUND_ROLL, Phase.ROTATE, Phase.CLIMB_OUT])
 def test_the_whole_take_off_is_takeoff(phase):
     on_the_roll = ControlStatus(landed=int(phase == Phase.GROUND_ROLL), takeoff_phase=phase)
     assert landed_state(on_the_roll) == m.MAV_LANDED_STATE_TAKEOFF
+
+
+def test_an_aborted_take_off_is_on_the_ground():
+    """TKOFF_TIMEOUT: the roll never got going; QGroundControl must not count it flying."""
+    aborted = ControlStatus(landed=1, takeoff_phase=Phase.ABORTED)
+    assert landed_state(aborted) == m.MAV_LANDED_STATE_ON_GROUND
 
 
 @pytest.mark.parametrize(

@@ -47,3 +47,36 @@ def test_the_cub_takes_off_with_a_quartering_tailwind(towards_deg: int) -> None:
     assert worst < 15.0, f"the nose swung {worst:.0f}° off the runway heading on the ground"
     top = max(s.alt_agl for s in loop.samples)
     assert top > CLIMBED_AGL_M, f"climbed to {top:.1f} m above the runway in 60 s"
+
+
+def _brakes_stuck(loop: ClosedLoop) -> None:
+    """Wheel brakes held on whatever the controller commands (a dragging brake)."""
+    set_controls = loop.flight.set_controls
+
+    def held(controls: dict[str, float]) -> None:
+        set_controls(controls)
+        loop.flight.fdm["fcs/left-brake-cmd-norm"] = 1.0
+        loop.flight.fdm["fcs/right-brake-cmd-norm"] = 1.0
+
+    loop.flight.set_controls = held  # type: ignore[method-assign]
+
+
+def test_a_roll_that_never_gets_going_is_aborted_at_tkoff_timeout() -> None:
+    """ArduPlane's TKOFF_TIMEOUT: not at 4 m/s after that long, idle, brakes, disarm, said."""
+    loop = ClosedLoop("c172p", [_takeoff_item()], overrides={"TKOFF_TIMEOUT": 8.0})
+    _brakes_stuck(loop)
+    assert loop.fly_until_disarmed(30.0)
+    aborted = [s for s in loop.samples if s.out.takeoff_phase == Phase.ABORTED]
+    assert 8.0 < aborted[0].t_s < 8.2  # the first step past the limit
+    assert all(s.out.throttle == 0.0 and s.out.disarm for s in aborted)
+    assert max(s.out.throttle for s in loop.samples) == 1.0  # it had tried at full power
+    said = loop.controller.lander.said
+    assert said and said[0][1].startswith("Takeoff aborted: 0.") and len(said) == 1
+
+
+def test_a_roll_that_gets_going_is_not_aborted() -> None:
+    """The same limit on a free roll: past 4 m/s in time, the climb goes on after it."""
+    loop = ClosedLoop("c172p", [_takeoff_item()], overrides={"TKOFF_TIMEOUT": 8.0})
+    loop.run(40.0)
+    assert not any(s.out.takeoff_phase == Phase.ABORTED or s.out.disarm for s in loop.samples)
+    assert max(s.alt_agl for s in loop.samples) > CLIMBED_AGL_M
