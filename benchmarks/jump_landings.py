@@ -1,7 +1,7 @@
 """Take-off, a DO_JUMP loop, then a landing: random plans as a QGroundControl user makes them.
 
 Usage: uv run python benchmarks/jump_landings.py [--plans 12] [--first 0] [--airframe c172p]
-       [--calm-only] [--closed-loop] [--restart] [--keep DIR]
+       [--calm-only | --crosswind-only] [--closed-loop] [--restart] [--keep DIR]
 
 Plan ``k`` is drawn from a generator seeded with ``k``: NAV_TAKEOFF, a loop of two or
 three waypoints 700-1500 m from home at 80-130 m (perhaps a DO_CHANGE_SPEED, perhaps a
@@ -237,6 +237,7 @@ def main() -> None:
     ap.add_argument("--first", type=int, default=0)
     ap.add_argument("--airframe", action="append", help="c172p, J3Cub (default: both)")
     ap.add_argument("--calm-only", action="store_true")
+    ap.add_argument("--crosswind-only", action="store_true")
     ap.add_argument("--closed-loop", action="store_true", help="the control laws alone")
     ap.add_argument("--restart", action="store_true", help="kill the controller mid-loop")
     ap.add_argument("--keep", type=Path, help="keep each flight's folder here")
@@ -252,7 +253,9 @@ def main() -> None:
                     "crosswind": (_crosswind(heading), "light")}  # fmt: skip
         for airframe in args.airframe or ["c172p", "J3Cub"]:
             for name, weather in weathers.items():
-                if args.calm_only and name != "calm":
+                if (args.calm_only and name != "calm") or (
+                    args.crosswind_only and name != "crosswind"
+                ):
                     continue
                 if args.closed_loop:
                     ok, text = fly_closed_loop(path, airframe, weather, k)
