@@ -9,7 +9,8 @@ from dataclasses import replace
 import jsbsim
 
 from bridges.jsbsim.conditions import TURBULENCE, Home
-from bridges.jsbsim.ground_wind import body_from_ned, wind_share
+from bridges.jsbsim.ground_wind import wind_share
+from bridges.sensor_models.sensor_errors import body_from_ned
 from bridges.sensor_models.true_state import TrueState
 
 __all__ = ["TURBULENCE", "Flight", "Home"]
@@ -136,15 +137,15 @@ class Flight:
         share = 1.0
         if self.weight_on_wheels():
             f = self.fdm
-            angles = (f["attitude/phi-rad"], f["attitude/theta-rad"], f["attitude/psi-rad"])
+            rotation = body_from_ned(
+                f["attitude/phi-rad"], f["attitude/theta-rad"], f["attitude/psi-rad"]
+            )
             ground = (
                 f["velocities/v-north-fps"] * FT,
                 f["velocities/v-east-fps"] * FT,
                 f["velocities/v-down-fps"] * FT,
             )
-            share = wind_share(
-                body_from_ned(ground, *angles), body_from_ned(self.wind_ned, *angles)
-            )
+            share = wind_share(rotation @ ground, rotation @ self.wind_ned)
         if share != self.wind_share:
             self._feel_wind(share)
 

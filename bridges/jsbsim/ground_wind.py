@@ -22,42 +22,29 @@ wind feels all of it; on a take-off roll the crosswind grows in with the speed (
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 
 U_FLOOR_M_S = 0.5
 BETA_MAX_RAD = math.radians(30.0)
 ALPHA_MAX_RAD = math.radians(30.0)
-
-Vector = tuple[float, float, float]
-
-
-def body_from_ned(v: Vector, roll: float, pitch: float, yaw: float) -> Vector:
-    """A north-east-down vector in the body axes of an aircraft at these Euler angles."""
-    n, e, d = v
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cr, sr = math.cos(roll), math.sin(roll)
-    x_h, y_h = cy * n + sy * e, -sy * n + cy * e  # heading axes
-    x = cp * x_h - sp * d
-    z_p = sp * x_h + cp * d
-    return (x, cr * y_h + sr * z_p, -sr * y_h + cr * z_p)
+_TAN_B, _TAN_A = math.tan(BETA_MAX_RAD), math.tan(ALPHA_MAX_RAD)
 
 
-def wind_share(ground_body: Vector, wind_body: Vector) -> float:
+def wind_share(ground_body: Iterable[float], wind_body: Iterable[float]) -> float:
     """The largest ``k`` in [0, 1] for which the air meets the aircraft from ahead (see the
-    module's text), given its velocity over the ground and the wind, both in body axes;
-    0 when no share does."""
+    module's text), given its velocity over the ground and the wind, both in body axes
+    (turned by ``sensor_errors.body_from_ned``); 0 when no share does."""
     u_g, v_g, w_g = ground_body
     w_u, w_v, w_w = wind_body
     # Air-relative velocity: (u_g - k w_u, v_g - k w_v, w_g - k w_w). Every condition is
     # linear in k, so the shares that meet them all form one interval.
     low, high = 0.0, 1.0
-    tan_b, tan_a = math.tan(BETA_MAX_RAD), math.tan(ALPHA_MAX_RAD)
     conditions = (
         (u_g - U_FLOOR_M_S, -w_u),  # u - floor >= 0
-        (tan_b * u_g - v_g, -tan_b * w_u + w_v),  # tan(b) u - v >= 0
-        (tan_b * u_g + v_g, -tan_b * w_u - w_v),  # tan(b) u + v >= 0
-        (tan_a * u_g - w_g, -tan_a * w_u + w_w),
-        (tan_a * u_g + w_g, -tan_a * w_u - w_w),
+        (_TAN_B * u_g - v_g, -_TAN_B * w_u + w_v),  # tan(b) u - v >= 0
+        (_TAN_B * u_g + v_g, -_TAN_B * w_u - w_v),  # tan(b) u + v >= 0
+        (_TAN_A * u_g - w_g, -_TAN_A * w_u + w_w),
+        (_TAN_A * u_g + w_g, -_TAN_A * w_u - w_w),
     )
     for constant, slope in conditions:  # constant + slope * k >= 0
         if slope > 0.0:

@@ -10,7 +10,8 @@ import math
 import pytest
 
 from bridges.jsbsim.fdm import Flight, Home
-from bridges.jsbsim.ground_wind import body_from_ned, wind_share
+from bridges.jsbsim.ground_wind import wind_share
+from bridges.sensor_models.sensor_errors import body_from_ned
 
 RATE_HZ = 100.0
 EAST = math.pi / 2
@@ -19,14 +20,14 @@ CUB_PITCH = math.radians(12.0)  # resting on its tail wheel
 
 def _share(ground_east_m_s: float, wind_ned: tuple[float, float, float]) -> float:
     """The share an aircraft facing east at the Cub's resting pitch feels."""
-    ground = body_from_ned((0.0, ground_east_m_s, 0.0), 0.0, CUB_PITCH, EAST)
-    return wind_share(ground, body_from_ned(wind_ned, 0.0, CUB_PITCH, EAST))
+    rotation = body_from_ned(0.0, CUB_PITCH, EAST)
+    return wind_share(rotation @ (0.0, ground_east_m_s, 0.0), rotation @ wind_ned)
 
 
 def test_body_axes_of_an_aircraft_facing_east():
-    x, y, z = body_from_ned((0.0, 5.0, 0.0), 0.0, 0.0, EAST)
+    x, y, z = body_from_ned(0.0, 0.0, EAST) @ (0.0, 5.0, 0.0)
     assert (x, y, z) == pytest.approx((5.0, 0.0, 0.0))
-    x, y, z = body_from_ned((5.0, 0.0, 0.0), 0.0, 0.0, EAST)  # north is its left
+    x, y, z = body_from_ned(0.0, 0.0, EAST) @ (5.0, 0.0, 0.0)  # north is its left
     assert (x, y, z) == pytest.approx((0.0, -5.0, 0.0))
 
 
@@ -45,7 +46,7 @@ def test_a_crosswind_grows_in_with_the_ground_speed():
     assert 0.0 < shares[0] < 0.5 and shares[-2:] == [1.0, 1.0]
     # The air felt meets it 30 degrees off the nose while the share is cut.
     for gs, k in zip((1.0, 3.0, 6.0), shares, strict=False):
-        u, v, _w = body_from_ned((-5.0 * k, gs, 0.0), 0.0, CUB_PITCH, EAST)
+        u, v, _w = body_from_ned(0.0, CUB_PITCH, EAST) @ (-5.0 * k, gs, 0.0)
         assert math.degrees(math.atan2(abs(v), u)) == pytest.approx(30.0)
 
 
