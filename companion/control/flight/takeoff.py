@@ -78,8 +78,8 @@ class RunwayTakeoff:
         yaw_rate: float,
         airspeed: float,
         v: Mapping[str, float],
-        ground_speed: float = math.inf,
-        dt: float = 0.0,
+        ground_speed: float,
+        dt: float,
     ) -> TakeoffDemand:
         """What to do now (``dt`` seconds after the last step, at ``ground_speed``); ``v``
         holds the control parameters by name."""
