@@ -15,16 +15,29 @@ The time to the point counts the flare's loss of speed: with the throttle cut an
 nose coming up the aircraft slows (a C172 with flaps by 2-3 m/s in a 5 s flare, which
 made it touch down 20-40 m short of where the constant-speed flare aimed), so the
 deceleration is measured while flaring and the distance d is flown in the T that solves
-d = v·T - a·T²/2. Pure: numbers in, numbers out.
+d = v·T - a·T²/2.
+
+A flare flown faster than the approach speed has lift to spare: at a given angle of attack
+the wing lifts in proportion to V², so the attitude that lets the aircraft sink is lower
+by the share ``1 - (V_a/V)²`` of the wing's angle of attack above zero lift at the
+approach speed V_a (``LAND_FLARE_AOA``), and ``fast_pitch_drop`` takes that off the
+flare's least pitch. A Cub 6 m/s fast after gusts at idle, held at its least pitch, rose
+off its glide as the flare began and floated 48 m past the point at 0.1-1 m/s of sink.
+Pure: numbers in, numbers out.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+
+from companion.control.laws.limits import clamp
 
 MAX_DECEL = 3.0  # m/s²: more than any glider-like flare loses; a gust's spike is not speed lost
 DECEL_TAU_S = 1.0  # the measured deceleration's smoothing
 _ITERATIONS = 40
+# Lift counted at most this many times the approach's: a faster reading is a gust's spike.
+FAST_LIFT_MAX = 2.0
 
 
 def time_to_point(distance: float, speed: float, decel: float) -> float:
@@ -62,6 +75,27 @@ def aimed_sink(height: float, t_go: float, touchdown_sink: float) -> float:
         else:
             hi = mid
     return s * (1.0 + math.sqrt(lo * hi))
+
+
+def fast_pitch_drop(airspeed: float, approach_speed: float, aoa_deg: float) -> float:
+    """How much lower (rad) the flare's least pitch may be at ``airspeed`` (m/s; NaN:
+    unknown) than at ``approach_speed``, for a wing ``aoa_deg`` above its zero lift there:
+    the share ``1 - (V_a/V)²`` of it that the extra speed's lift makes up (0 when slower,
+    unknown or ``aoa_deg`` is 0)."""
+    if aoa_deg <= 0.0 or not math.isfinite(airspeed) or airspeed <= approach_speed:
+        return 0.0
+    lift = min((airspeed / max(approach_speed, 1.0)) ** 2, FAST_LIFT_MAX)
+    return math.radians(aoa_deg) * (1.0 - 1.0 / lift)
+
+
+def flare_pitch(pitch: float, airspeed: float, v: Mapping[str, float]) -> float:
+    """``pitch`` (rad) within the flare's limits at ``airspeed``: ``TECS_LAND_PMAX`` above,
+    ``LAND_PITCH_CD`` below, less ``fast_pitch_drop`` when faster than ``TECS_LAND_ARSPD``
+    (a floor set for the approach speed held a Cub 6 m/s fast at its least pitch, its nose
+    above its glide's, and it floated 48 m long)."""
+    drop = fast_pitch_drop(airspeed, v["TECS_LAND_ARSPD"], v["LAND_FLARE_AOA"])
+    least = math.radians(v["LAND_PITCH_CD"] / 100.0) - drop
+    return clamp(pitch, least, math.radians(v["TECS_LAND_PMAX"]))
 
 
 class DecelEstimate:

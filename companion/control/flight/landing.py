@@ -40,7 +40,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from companion.control.flight.flare_aim import DecelEstimate, aimed_sink, time_to_point
+from companion.control.flight.flare_aim import DecelEstimate, aimed_sink, flare_pitch, time_to_point
 from companion.control.laws.limits import clamp
 from companion.geodesy import wrap_pi
 from companion.params import ParamDecl
@@ -76,7 +76,6 @@ SINK_I = 0.05  # rad per (m/s·s)
 GLIDE_TRIM_TAU_S = 2.0
 FLARE_THR_SHARE = 0.5  # LAND_FLARE_THR below this share of the flare's planned height
 
-
 LANDING_PARAMS = (
     ParamDecl("LAND_FLARE_ALT", 3.0, 0.5, 20.0, "m", "landing: flare below this height"),
     ParamDecl("LAND_FLARE_SEC", 2.0, 0.5, 10.0, "s", "landing: flare this long before ground"),
@@ -88,6 +87,8 @@ LANDING_PARAMS = (
     ParamDecl("LAND_FLARE_THR", 0.0, 0.0, 1.0, "", "landing: most throttle in the flare's "
               "lower half against a sink that lands short, as a lull gives (0: TRIM_THROTTLE)"),
     ParamDecl("LAND_PITCH_CD", 0.0, -500.0, 1500.0, "cdeg", "landing: least pitch in the flare"),
+    ParamDecl("LAND_FLARE_AOA", 0.0, 0.0, 15.0, "deg", "landing: wing's angle of attack over zero "
+              "lift at TECS_LAND_ARSPD; faster, the flare's least pitch is lower (0: off)"),
     ParamDecl("LAND_DISARMDELAY", 3.0, 0.0, 127.0, "s", "landing: disarm this long after stop"),
     ParamDecl("TECS_LAND_ARSPD", 28.0, 5.0, 100.0, "m/s", "landing: approach airspeed"),
     ParamDecl("TECS_LAND_SINK", 0.4, 0.05, 2.0, "m/s", "landing: sink rate at touchdown"),
@@ -161,6 +162,7 @@ class AircraftState:
     yaw: float
     yaw_rate: float
     range_height: float = math.nan  # m above the ground by the rangefinder; NaN: none usable
+    airspeed: float = math.nan  # m/s; NaN: unknown
 
 
 class Landing:
@@ -348,8 +350,6 @@ class Landing:
         most = (v["LAND_FLARE_THR"] if low else 0.0) or v["TRIM_THROTTLE"]
         throttle = clamp(v["LAND_FLARE_PWR"] * short, 0.0, most)
         self._flare_integ = clamp(self._flare_integ + SINK_I * error * dt, -0.1, 0.25)
-        pitch_min = math.radians(v["LAND_PITCH_CD"] / 100.0)
-        pitch_max = math.radians(v["TECS_LAND_PMAX"])
         # The flight path the sink demand asks for, on top of the glide's pitch: the change
         # of path angle is the pitch change to first order (the feedback does the rest).
         speed = max(math.hypot(*s.vel), 5.0)
@@ -360,7 +360,7 @@ class Landing:
             (self.start, self.point(1e4)),
             self.land_alt,
             v["TECS_LAND_ARSPD"],
-            pitch=clamp(pitch, pitch_min, pitch_max),
+            pitch=flare_pitch(pitch, s.airspeed, v),  # faster, a lower floor (flare_aim.py)
             throttle=throttle,
             roll_limit=math.radians(v["LEVEL_ROLL_LIMIT"]),
             flaps=landing_flaps(v),

@@ -118,7 +118,7 @@ class LandingFlight:
                            config["RNGFND_LANDING"])  # fmt: skip
         self.range_steps += math.isfinite(agl)
         state = AircraftState(pos, vel, nav.alt_msl_m, -nav.vd_m_s, nav.pitch_rad, nav.yaw_rad,
-                              nav.yaw_rate_rad_s, agl)  # fmt: skip
+                              nav.yaw_rate_rad_s, agl, airspeed)  # fmt: skip
         dem = land.step(state, config.values, dt)
         out.land_phase = int(dem.phase)
         out.flaps, out.brakes = dem.flaps, dem.brakes

@@ -1,6 +1,6 @@
 """The flare's aim (companion/control/flight/flare_aim.py): the sink demand whose
-exponential flare touches down on the point, and the time to the point as the aircraft
-slows."""
+exponential flare touches down on the point, the time to the point as the aircraft
+slows, and the least pitch of a flare flown faster than the approach."""
 
 from __future__ import annotations
 
@@ -8,7 +8,13 @@ import math
 
 import pytest
 
-from companion.control.flight.flare_aim import DecelEstimate, aimed_sink, time_to_point
+from companion.control.flight.flare_aim import (
+    DecelEstimate,
+    aimed_sink,
+    fast_pitch_drop,
+    flare_pitch,
+    time_to_point,
+)
 
 SINK = 0.4  # TECS_LAND_SINK
 
@@ -57,3 +63,20 @@ def test_the_deceleration_is_measured_smoothed_and_a_gust_spike_bounded():
     assert est.decel == pytest.approx(2.0, abs=0.05)
     est.update(speed + 50.0, 0.02)  # a jump no aircraft flies: clipped before smoothing
     assert est.decel > 1.8 - 0.02 * 5.0 / 1.0
+
+
+def test_a_faster_flare_may_pitch_lower_by_the_angle_of_attack_its_extra_lift_makes_up():
+    # Lift goes as V²·(α - α0): at 28 m/s a wing 6° above zero lift at 22 m/s holds the
+    # same lift 6°·(1 - (22/28)²) = 2.3° lower.
+    assert fast_pitch_drop(28.0, 22.0, 6.0) == pytest.approx(math.radians(2.3), abs=1e-3)
+    assert fast_pitch_drop(22.0, 22.0, 6.0) == 0.0  # at the approach speed, and slower
+    assert fast_pitch_drop(18.0, 22.0, 6.0) == 0.0
+    assert fast_pitch_drop(28.0, 22.0, 0.0) == 0.0  # LAND_FLARE_AOA 0: off
+    assert fast_pitch_drop(math.nan, 22.0, 6.0) == 0.0  # no airspeed known
+    assert fast_pitch_drop(80.0, 22.0, 6.0) == pytest.approx(math.radians(3.0))  # a spike: half
+    v = {"LAND_PITCH_CD": -400.0, "TECS_LAND_PMAX": 10.0, "TECS_LAND_ARSPD": 22.0,
+         "LAND_FLARE_AOA": 6.0}  # fmt: skip
+    assert flare_pitch(-1.0, 28.0, v) == pytest.approx(math.radians(-6.3), abs=1e-3)
+    assert flare_pitch(-1.0, 22.0, v) == pytest.approx(math.radians(-4.0))
+    assert flare_pitch(-0.05, 28.0, v) == -0.05
+    assert flare_pitch(1.0, 28.0, v) == pytest.approx(math.radians(10.0))

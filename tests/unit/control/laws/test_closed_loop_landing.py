@@ -99,6 +99,26 @@ def test_full_power_in_the_flare_holds_the_c172_up_through_a_lull():
     assert full.passed() and full.along_m > trim.along_m + 5.0, full
 
 
+def test_a_cub_fast_after_gusts_at_idle_flares_lower_and_lands_on_the_point():
+    """In JSBSim's gust sequence 35 on circuit_east the Cub's final is flown 5-6 m/s fast at
+    idle (rising air: its pitch holds the path). As the flare began its pitch went up to
+    LAND_PITCH_CD, above the glide's, and at 28-30 m/s the wing lifted it off the path and
+    held it there: it floated at 0.2-0.5 m/s of sink and touched down 48 m long. With the
+    least pitch lowered by what the extra speed's lift makes up (LAND_FLARE_AOA) it lands
+    on target."""
+    items = checked_plan(PLAN.with_name("circuit_east.plan"))[0]
+    scores = []
+    for overrides in ({"LAND_FLARE_AOA": 0.0}, {}):
+        loop = ClosedLoop("J3Cub", items, wind_ned=CROSSWIND, turbulence="light",
+                          range_max_m=12.0, overrides=overrides)  # fmt: skip
+        loop.flight.fdm["atmosphere/randomseed"] = 35
+        loop.fly_until_disarmed(600.0)
+        scores.append(landing_score_for_plan(loop.truth(), items))
+    floor, lowered = scores
+    assert floor.along_m > 40.0, floor
+    assert lowered.passed(), lowered
+
+
 @pytest.mark.parametrize(("airframe", "error_m"), [("J3Cub", -3.2), ("c172p", 3.2)])
 def test_a_home_altitude_misread_at_arming_is_corrected_by_the_rangefinder(airframe, error_m):  # type: ignore[no-untyped-def]
     """The navigator's GPS-aided height read 3.2 m off when home was taken (as in a
