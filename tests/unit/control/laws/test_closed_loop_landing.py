@@ -18,7 +18,7 @@ import pytest
 from companion.control.flight.landing import LandPhase
 from companion.control.mission.plan import checked_plan
 from companion.messages import FlightMode
-from ground.campaign.landing_score import landing_score_for_plan
+from ground.campaign.landing_score import LandingScore, landing_score_for_plan
 from tests.support.closed_loop import ClosedLoop
 
 PLAN = Path(__file__).resolve().parents[4] / "benchmarks" / "plans" / "land_east.plan"
@@ -62,20 +62,28 @@ def test_a_steep_final_with_a_tailwind_is_flown_down_its_path_onto_the_target():
     assert held.along_m > 20.0, held
 
 
+def _gusty_landings(
+    airframe: str, plan: Path, seed: int, without: dict[str, float]
+) -> tuple[LandingScore, LandingScore]:
+    """The plan flown in the crosswind and JSBSim's gust sequence ``seed``, once with the
+    parameters ``without`` and once as the airframe ships: the two landings' scores."""
+    items = checked_plan(plan)[0]
+    scores = []
+    for overrides in (without, {}):
+        loop = ClosedLoop(airframe, items, wind_ned=CROSSWIND, turbulence="light",
+                          range_max_m=12.0, overrides=overrides)  # fmt: skip
+        loop.flight.fdm["atmosphere/randomseed"] = seed
+        loop.fly_until_disarmed(600.0)
+        scores.append(landing_score_for_plan(loop.truth(), items))
+    return scores[0], scores[1]
+
+
 def test_power_in_the_flare_holds_up_a_flare_begun_in_a_gusts_dive():
     """In JSBSim's own gust sequence (its seed 1, the one the simulated vehicle meets) the
     C172's flare on land_east begins in a gust's dive, nose 4° down and sinking 2 m/s, and
     its pitch lags the demand all the way down: at idle it touched down 26 m short. Power
     against the sink that would land short of the point puts it on target."""
-    items = checked_plan(PLAN)[0]
-    scores = []
-    for overrides in ({"LAND_FLARE_PWR": 0.0}, {}):
-        loop = ClosedLoop("c172p", items, wind_ned=CROSSWIND, turbulence="light",
-                          range_max_m=12.0, overrides=overrides)  # fmt: skip
-        loop.flight.fdm["atmosphere/randomseed"] = 1
-        loop.fly_until_disarmed(600.0)
-        scores.append(landing_score_for_plan(loop.truth(), items))
-    idle, powered = scores
+    idle, powered = _gusty_landings("c172p", PLAN, 1, {"LAND_FLARE_PWR": 0.0})
     assert idle.along_m < -20.0, idle
     assert powered.passed(), powered
 
@@ -106,15 +114,8 @@ def test_a_cub_fast_after_gusts_at_idle_flares_lower_and_lands_on_the_point():
     held it there: it floated at 0.2-0.5 m/s of sink and touched down 48 m long. With the
     least pitch lowered by what the extra speed's lift makes up (LAND_FLARE_AOA) it lands
     on target."""
-    items = checked_plan(PLAN.with_name("circuit_east.plan"))[0]
-    scores = []
-    for overrides in ({"LAND_FLARE_AOA": 0.0}, {}):
-        loop = ClosedLoop("J3Cub", items, wind_ned=CROSSWIND, turbulence="light",
-                          range_max_m=12.0, overrides=overrides)  # fmt: skip
-        loop.flight.fdm["atmosphere/randomseed"] = 35
-        loop.fly_until_disarmed(600.0)
-        scores.append(landing_score_for_plan(loop.truth(), items))
-    floor, lowered = scores
+    circuit = PLAN.with_name("circuit_east.plan")
+    floor, lowered = _gusty_landings("J3Cub", circuit, 35, {"LAND_FLARE_AOA": 0.0})
     assert floor.along_m > 40.0, floor
     assert lowered.passed(), lowered
 
