@@ -43,7 +43,6 @@ from dataclasses import dataclass
 from companion.control.flight.flare_aim import DecelEstimate, aimed_sink, flare_pitch, time_to_point
 from companion.control.laws.limits import clamp
 from companion.geodesy import wrap_pi
-from companion.params import ParamDecl
 
 Point = tuple[float, float]
 
@@ -75,44 +74,6 @@ SINK_I = 0.05  # rad per (m/s·s)
 # moment's: a gust that had just pitched the nose down or changed the sink is not the trim.
 GLIDE_TRIM_TAU_S = 2.0
 FLARE_THR_SHARE = 0.5  # LAND_FLARE_THR below this share of the flare's planned height
-
-LANDING_PARAMS = (
-    ParamDecl("LAND_FLARE_ALT", 3.0, 0.5, 20.0, "m", "landing: flare below this height"),
-    ParamDecl("LAND_FLARE_SEC", 2.0, 0.5, 10.0, "s", "landing: flare this long before ground"),
-    ParamDecl("LAND_FLARE_AIM", 90.0, 50.0, 150.0, "%", "landing: the glide ends this share of "
-              "the modelled flare's distance before the point (lower it if the airframe lands "
-              "short: its flare then begins nearer the point)"),
-    ParamDecl("LAND_FLARE_PWR", 4.0, 0.0, 10.0, "1/(m/s)", "landing: flare throttle per m/s "
-              "sunk beyond what reaches the point, at most TRIM_THROTTLE (0: idle all flare)"),
-    ParamDecl("LAND_FLARE_THR", 0.0, 0.0, 1.0, "", "landing: most throttle in the flare's "
-              "lower half against a sink that lands short, as a lull gives (0: TRIM_THROTTLE)"),
-    ParamDecl("LAND_PITCH_CD", 0.0, -500.0, 1500.0, "cdeg", "landing: least pitch in the flare"),
-    ParamDecl("LAND_FLARE_AOA", 0.0, 0.0, 15.0, "deg", "landing: wing's angle of attack over zero "
-              "lift at TECS_LAND_ARSPD; faster, the flare's least pitch is lower (0: off)"),
-    ParamDecl("LAND_DISARMDELAY", 3.0, 0.0, 127.0, "s", "landing: disarm this long after stop"),
-    ParamDecl("TECS_LAND_ARSPD", 28.0, 5.0, 100.0, "m/s", "landing: approach airspeed"),
-    ParamDecl("TECS_LAND_SINK", 0.4, 0.05, 2.0, "m/s", "landing: sink rate at touchdown"),
-    ParamDecl("TECS_LAND_PMAX", 10.0, 0.0, 30.0, "deg", "landing: most pitch in the flare"),
-    ParamDecl("LEVEL_ROLL_LIMIT", 5.0, 0.0, 45.0, "deg", "landing: most bank in the flare"),
-    ParamDecl("LAND_SLOPE_MIN", 3.0, 1.0, 10.0, "deg", "landing: the least slope of the glide "
-              "path; from a lower approach the height is held until the path is met"),
-    ParamDecl("LAND_SLOPE_MAX", 0.0, 0.0, 20.0, "deg", "landing: a landing circle (LOITER_TO_ALT) "
-              "descends below its height until the final is no steeper (0: off)"),
-    ParamDecl("TECS_APPR_SMAX", 0.0, 0.0, 20.0, "m/s", "landing: most sink on the approach, "
-              "for a steep final or a tailwind (0: TECS_SINK_MAX)"),
-    ParamDecl("TECS_LAND_SPDWGT", 0.0, 0.0, 2.0, "", "landing: TECS speed weight on the approach "
-              "(0: pitch holds the glide path)"),
-    ParamDecl("LAND_BRAKE", 0.5, 0.0, 1.0, "", "rollout: wheel brakes (fraction of full)"),
-    ParamDecl("LAND_BRAKE_SPD", 50.0, 0.0, 50.0, "m/s", "rollout: brake below this ground speed"),
-    ParamDecl("LAND_ROLL_ELEV", 0.0, 0.0, 1.0, "", "rollout: elevator held back once too slow "
-              "to fly (a tail dragger pins its tail wheel); 0: the touchdown pitch is held"),
-    ParamDecl("LAND_STEER_P", 8.0, 0.0, 10.0, "", "rollout: rudder per radian of heading error"),
-    ParamDecl("LAND_FLAP_PERCNT", 0.0, 0.0, 100.0, "%", "landing: flaps on the approach"),
-    ParamDecl("RTL_AUTOLAND", 0.0, 0.0, 2.0, "", "Return lands at DO_LAND_START: 1 after "
-              "reaching home, 2 at once"),
-    ParamDecl("RNGFND_LANDING", 1.0, 0.0, 1.0, "", "landing: flare on the rangefinder's "
-              "height when it has a fresh valid reading (no effect without one)"),
-)  # fmt: skip
 
 
 class LandPhase(enum.IntEnum):
