@@ -31,6 +31,7 @@ from companion.messages import (
     CommandId,
     CommandResult,
     FlightMode,
+    LandPhase,
     NavFlags,
     NavState,
     VehicleCommand,
@@ -77,7 +78,7 @@ _AIRBORNE_COMMANDS = {
     CommandId.ORBIT: FlightMode.LOITER,
 }
 NO_POINT = (math.nan, math.nan, math.nan)
-LANDING_PHASES = (1, 2)  # LandPhase APPROACH and FLARE: a go-around can still be flown
+LANDING_PHASES = (LandPhase.APPROACH, LandPhase.FLARE)  # a go-around can still be flown
 
 
 class Commander:

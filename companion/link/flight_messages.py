@@ -7,10 +7,11 @@ import math
 from typing import Any
 
 from companion.link.codec import dialect as d
-from companion.messages import ControlStatus, MissionState
+from companion.messages import ControlStatus, LandPhase, MissionState, TakeoffPhase
 
-LANDING_PHASES = (1, 2, 3)  # the controller's LandPhase APPROACH, FLARE and ROLLOUT
-TAKEOFF_PHASES = (1, 2, 3)  # its take-off Phase GROUND_ROLL, ROTATE, CLIMB_OUT (not ABORTED)
+LANDING_PHASES = (LandPhase.APPROACH, LandPhase.FLARE, LandPhase.ROLLOUT)
+# Not ABORTED: a take-off given up is on the ground.
+TAKEOFF_PHASES = (TakeoffPhase.GROUND_ROLL, TakeoffPhase.ROTATE, TakeoffPhase.CLIMB_OUT)
 
 
 def _deg(rad: float) -> float:

@@ -12,6 +12,26 @@ from companion.messages.base import NAME_LEN, Message
 REASON_LEN = 200
 
 
+class LandPhase(enum.IntEnum):
+    """Where in the landing the aircraft is (``ControlStatus.land_phase``; 0: not landing)."""
+
+    APPROACH = 1
+    FLARE = 2
+    ROLLOUT = 3
+    STOPPED = 4
+    GO_AROUND = 5
+
+
+class TakeoffPhase(enum.IntEnum):
+    """Where in the take-off the aircraft is (``ControlStatus.takeoff_phase``; 0: not
+    taking off)."""
+
+    GROUND_ROLL = 1
+    ROTATE = 2
+    CLIMB_OUT = 3  # high enough for normal guidance
+    ABORTED = 4  # too slow to roll within TKOFF_TIMEOUT: idle, brakes, disarm
+
+
 class CommandId(enum.IntEnum):
     """Vehicle commands carried on ``link/commands``.
 
@@ -145,7 +165,7 @@ class ControlStatus(Message):
         ("mission_state", ctypes.c_uint8),  # MissionState
         ("landed", ctypes.c_uint8),
         ("land_phase", ctypes.c_uint8),  # LandPhase while landing, 0 otherwise
-        ("takeoff_phase", ctypes.c_uint8),  # take-off Phase from the roll to the height, else 0
+        ("takeoff_phase", ctypes.c_uint8),  # TakeoffPhase from the roll to the height, else 0
         ("reached_count", ctypes.c_uint32),
         ("last_reached", ctypes.c_int32),
         # The last REACHED_KEPT items reached, the n-th (from 0) at [n % REACHED_KEPT]: two

@@ -18,7 +18,7 @@ from companion.control.flight.landing_flight import LandingFlight, MissionRef, M
 from companion.control.flight.mode_targets import arrive, mode_target
 from companion.control.flight.output import ControlOutput
 from companion.control.flight.pilot_flight import PilotFlight
-from companion.control.flight.takeoff import Phase, RunwayTakeoff
+from companion.control.flight.takeoff import RunwayTakeoff
 from companion.control.inputs import nav_usable, rates_or_zero, status_usable, sticks_usable
 from companion.control.laws.attitude import AttitudeController
 from companion.control.laws.l1_guidance import L1Guidance, LateralDemand, bank_for
@@ -31,7 +31,7 @@ from companion.control.mission.resume import start_mission
 from companion.control.modes import PILOT_MODES
 from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import LocalFrame
-from companion.messages import FlightMode, NavState, VehicleStatus
+from companion.messages import FlightMode, NavState, TakeoffPhase, VehicleStatus
 from companion.messages.navigation import NAV_DEAD_RECKONING
 
 AIRBORNE_AGL_M = 10.0
@@ -201,7 +201,7 @@ class FlightController:
         return max(ground, airspeed if math.isfinite(airspeed) else 0.0) >= LANDED_SPEED
 
     def _taking_off(self, nav: NavState) -> bool:
-        return self.takeoff is not None and self.takeoff.phase != Phase.CLIMB_OUT
+        return self.takeoff is not None and self.takeoff.phase != TakeoffPhase.CLIMB_OUT
 
     def _setpoint(
         self,
@@ -303,14 +303,14 @@ class FlightController:
         demand = to.step(pos, nav.alt_msl_m, nav.yaw_rad, nav.yaw_rate_rad_s, airspeed, cfg,
                          speed, dt)  # fmt: skip
         out.takeoff_phase = int(demand.phase)
-        if demand.phase == Phase.ABORTED:
+        if demand.phase == TakeoffPhase.ABORTED:
             return to.abort(out, speed, cfg, self.lander.said)
-        if demand.phase == Phase.CLIMB_OUT:
+        if demand.phase == TakeoffPhase.CLIMB_OUT:
             # Climb straight out along the runway with normal energy control.
             far = to.centreline_point(1e5)
             line = Setpoint(Kind.LINE, to.start, far, setpoint.alt_msl, speed=setpoint.speed)
             return self._fly(line, pos, (nav.vn_m_s, nav.ve_m_s), nav, airspeed, dt, out)
-        ground = demand.phase == Phase.GROUND_ROLL
+        ground = demand.phase == TakeoffPhase.GROUND_ROLL
         surfaces = self.attitude.step(
             demand.roll,
             demand.pitch,

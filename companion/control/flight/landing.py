@@ -35,7 +35,6 @@ the glide path 3 m too high, and the Cub touched down 40 m long.
 
 from __future__ import annotations
 
-import enum
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -43,6 +42,7 @@ from dataclasses import dataclass
 from companion.control.flight.flare_aim import DecelEstimate, aimed_sink, flare_pitch, time_to_point
 from companion.control.laws.limits import clamp
 from companion.geodesy import wrap_pi
+from companion.messages.control import LandPhase
 
 Point = tuple[float, float]
 
@@ -74,16 +74,6 @@ SINK_I = 0.05  # rad per (m/s·s)
 # moment's: a gust that had just pitched the nose down or changed the sink is not the trim.
 GLIDE_TRIM_TAU_S = 2.0
 FLARE_THR_SHARE = 0.5  # LAND_FLARE_THR below this share of the flare's planned height
-
-
-class LandPhase(enum.IntEnum):
-    """Where in the landing the aircraft is."""
-
-    APPROACH = 1
-    FLARE = 2
-    ROLLOUT = 3
-    STOPPED = 4
-    GO_AROUND = 5
 
 
 @dataclass(frozen=True)

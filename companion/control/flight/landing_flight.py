@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
-from companion.control.flight.landing import AircraftState, Landing, LandingDemand, LandPhase
+from companion.control.flight.landing import AircraftState, Landing, LandingDemand
 from companion.control.flight.landing_pattern import (
     HOME_TOUCHDOWN_M,
     Approach,
@@ -26,7 +26,7 @@ from companion.control.flight.range_height import range_height
 from companion.control.laws.l1_guidance import bank_for
 from companion.control.mission.executor import Kind, MissionExecutor, Setpoint
 from companion.control.mission.items import MissionItem
-from companion.messages import FlightMode, NavState, RangeReading
+from companion.messages import FlightMode, LandPhase, NavState, RangeReading
 from mavlink_dialect import companion as d
 
 if TYPE_CHECKING:

@@ -27,6 +27,6 @@ class ControlOutput:
     landed: bool = True
     disarm: bool = False  # landed and stopped: the flight is over
     land_phase: int = 0  # LandPhase while landing, else 0
-    takeoff_phase: int = 0  # take-off Phase from the roll until the take-off height, else 0
+    takeoff_phase: int = 0  # TakeoffPhase from the roll until the take-off height, else 0
     flaps: float = 0.0  # 0 up .. 1 fully down
     brakes: float = 1.0  # 0 off .. 1 full: held while parked

@@ -12,13 +12,13 @@ aborted: idle, brakes, disarm, as ArduPlane's parameter of that name does. 0: no
 
 from __future__ import annotations
 
-import enum
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 from companion.control.flight.output import ControlOutput
 from companion.geodesy import wrap_pi
+from companion.messages.control import TakeoffPhase
 from mavlink_dialect import companion as d
 
 CLIMB_OUT_AGL_M = 15.0  # below this the aircraft flies the runway line with wings level
@@ -26,20 +26,11 @@ STEER_LOOKAHEAD_M = 30.0
 ROLLING_M_S = 4.0  # the ground speed a take-off roll must reach within TKOFF_TIMEOUT
 
 
-class Phase(enum.IntEnum):
-    """Where in the take-off the aircraft is."""
-
-    GROUND_ROLL = 1
-    ROTATE = 2
-    CLIMB_OUT = 3  # high enough for normal guidance
-    ABORTED = 4  # too slow to roll within TKOFF_TIMEOUT: idle, brakes, disarm
-
-
 @dataclass(frozen=True)
 class TakeoffDemand:
     """Attitude, throttle and (on the ground) rudder for this step."""
 
-    phase: Phase
+    phase: TakeoffPhase
     roll: float
     pitch: float
     throttle: float
@@ -53,7 +44,7 @@ class RunwayTakeoff:
         self.start = start
         self.heading = heading
         self.ground_msl = ground_msl
-        self.phase = Phase.GROUND_ROLL
+        self.phase = TakeoffPhase.GROUND_ROLL
         self.rolling_s = 0.0  # seconds of ground roll before ROLLING_M_S was reached
         self.rolled = False  # ROLLING_M_S reached (or the take-off began in the air)
         self.abort_said = False
@@ -84,14 +75,14 @@ class RunwayTakeoff:
         """What to do now (``dt`` seconds after the last step, at ``ground_speed``); ``v``
         holds the control parameters by name."""
         if self._too_slow(ground_speed, dt, v["TKOFF_TIMEOUT"]):
-            self.phase = Phase.ABORTED
-        if self.phase == Phase.ABORTED:
+            self.phase = TakeoffPhase.ABORTED
+        if self.phase == TakeoffPhase.ABORTED:
             return TakeoffDemand(self.phase, 0.0, 0.0, 0.0, 0.0)
         agl = alt_msl - self.ground_msl
-        if self.phase == Phase.GROUND_ROLL and airspeed >= v["TKOFF_ROTATE_SPD"]:
-            self.phase = Phase.ROTATE
-        if self.phase == Phase.ROTATE and agl >= CLIMB_OUT_AGL_M:
-            self.phase = Phase.CLIMB_OUT
+        if self.phase == TakeoffPhase.GROUND_ROLL and airspeed >= v["TKOFF_ROTATE_SPD"]:
+            self.phase = TakeoffPhase.ROTATE
+        if self.phase == TakeoffPhase.ROTATE and agl >= CLIMB_OUT_AGL_M:
+            self.phase = TakeoffPhase.CLIMB_OUT
         throttle = v["THR_MAX"]
         # The rudder holds the runway heading until the aircraft is high enough for normal
         # guidance: on the wheels it steers, just after rotation (slow, wings level) it
@@ -99,7 +90,7 @@ class RunwayTakeoff:
         heading_dem = self.heading - math.atan2(self.xtrack(pos), STEER_LOOKAHEAD_M)
         rudder = v["TKOFF_STEER_P"] * wrap_pi(heading_dem - yaw) - 0.3 * yaw_rate
         rudder = max(-1.0, min(1.0, rudder))
-        if self.phase == Phase.GROUND_ROLL:
+        if self.phase == TakeoffPhase.GROUND_ROLL:
             pitch = math.radians(v["TKOFF_GND_PITCH"])
             return TakeoffDemand(self.phase, 0.0, pitch, throttle, rudder)
         pitch = math.radians(v["TKOFF_PITCH_DEG"])
@@ -107,7 +98,7 @@ class RunwayTakeoff:
 
     def _too_slow(self, ground_speed: float, dt: float, timeout_s: float) -> bool:
         """Whether the roll has gone on ``timeout_s`` without reaching ``ROLLING_M_S``."""
-        if self.rolled or self.phase != Phase.GROUND_ROLL:
+        if self.rolled or self.phase != TakeoffPhase.GROUND_ROLL:
             return False
         self.rolled = ground_speed >= ROLLING_M_S
         self.rolling_s += dt

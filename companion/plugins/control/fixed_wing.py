@@ -24,7 +24,6 @@ from companion.actuators.airframe import AirframeError, load_airframe
 from companion.control.flight.attitude_modes import pilot_sticks
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.flight_params import control_params, flight_config
-from companion.control.flight.takeoff import Phase as TakeoffPhase
 from companion.control.mission.fence import Fence
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
@@ -35,6 +34,7 @@ from companion.messages import (
     FlightMode,
     MissionState,
     StatusText,
+    TakeoffPhase,
     VehicleCommand,
     VehicleStatus,
 )

@@ -9,25 +9,25 @@ from __future__ import annotations
 import pytest
 from pymavlink.dialects.v20 import common as m
 
-from companion.control.flight.landing import LandPhase
-from companion.control.flight.takeoff import Phase
 from companion.link.flight_messages import landed_state
-from companion.messages import ControlStatus
+from companion.messages import ControlStatus, LandPhase, TakeoffPhase
 
 
 def test_no_controller_no_landed_state():
     assert landed_state(None) is None
 
 
-@pytest.mark.parametrize("phase", [Phase.GROUND_ROLL, Phase.ROTATE, Phase.CLIMB_OUT])
+@pytest.mark.parametrize(
+    "phase", [TakeoffPhase.GROUND_ROLL, TakeoffPhase.ROTATE, TakeoffPhase.CLIMB_OUT]
+)
 def test_the_whole_take_off_is_takeoff(phase):
-    on_the_roll = ControlStatus(landed=int(phase == Phase.GROUND_ROLL), takeoff_phase=phase)
+    on_the_roll = ControlStatus(landed=int(phase == TakeoffPhase.GROUND_ROLL), takeoff_phase=phase)
     assert landed_state(on_the_roll) == m.MAV_LANDED_STATE_TAKEOFF
 
 
 def test_an_aborted_take_off_is_on_the_ground():
     """TKOFF_TIMEOUT: the roll never got going; QGroundControl must not count it flying."""
-    aborted = ControlStatus(landed=1, takeoff_phase=Phase.ABORTED)
+    aborted = ControlStatus(landed=1, takeoff_phase=TakeoffPhase.ABORTED)
     assert landed_state(aborted) == m.MAV_LANDED_STATE_ON_GROUND
 
 

@@ -14,7 +14,8 @@ from dataclasses import replace
 import pytest
 
 from companion.control.flight.flight_params import CONTROL_PARAMS
-from companion.control.flight.landing import AircraftState, Landing, LandPhase
+from companion.control.flight.landing import AircraftState, Landing
+from companion.messages import LandPhase
 
 V = {p.name: p.default for p in CONTROL_PARAMS}
 START, TOUCHDOWN = (0.0, -500.0), (0.0, 300.0)  # an approach eastwards, 800 m long

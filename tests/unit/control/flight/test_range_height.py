@@ -8,9 +8,9 @@ import math
 import pytest
 
 from companion.control.flight.flight_params import CONTROL_PARAMS
-from companion.control.flight.landing import AircraftState, Landing, LandPhase
+from companion.control.flight.landing import AircraftState, Landing
 from companion.control.flight.range_height import range_height
-from companion.messages import RangeReading
+from companion.messages import LandPhase, RangeReading
 
 V = {p.name: p.default for p in CONTROL_PARAMS}
 NAV_T = 50_000_000

@@ -16,10 +16,10 @@ from pathlib import Path
 import pytest
 
 from bridges.jsbsim.fdm import Home
-from companion.control.flight.landing import LandPhase
 from companion.control.mission.items import MissionItem
 from companion.control.mission.plan import checked_plan
 from companion.geodesy import LocalFrame
+from companion.messages import LandPhase
 from ground.campaign.landing_score import landing_score_for_plan
 from mavlink_dialect import companion as d
 from tests.support.closed_loop import ClosedLoop

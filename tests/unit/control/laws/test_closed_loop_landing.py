@@ -15,9 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from companion.control.flight.landing import LandPhase
 from companion.control.mission.plan import checked_plan
-from companion.messages import FlightMode
+from companion.messages import FlightMode, LandPhase
 from ground.campaign.landing_score import LandingScore, landing_score_for_plan
 from tests.support.closed_loop import ClosedLoop
 

@@ -13,9 +13,9 @@ import math
 import pytest
 
 from bridges.jsbsim.fdm import Home
-from companion.control.flight.takeoff import Phase
 from companion.control.mission.items import MissionItem
 from companion.geodesy import LocalFrame
+from companion.messages import TakeoffPhase
 from mavlink_dialect import companion as d
 from tests.support.closed_loop import ClosedLoop
 
@@ -40,7 +40,7 @@ def test_the_cub_takes_off_with_a_quartering_tailwind(towards_deg: int) -> None:
     loop = ClosedLoop("J3Cub", [_takeoff_item()], wind_ned=wind, turbulence="light")
     loop.flight.fdm["atmosphere/randomseed"] = 3
     loop.run(60.0)
-    rolling = [s for s in loop.samples if s.out.takeoff_phase == Phase.GROUND_ROLL]
+    rolling = [s for s in loop.samples if s.out.takeoff_phase == TakeoffPhase.GROUND_ROLL]
     assert rolling, "no ground roll"
     # On the wheels the heading stays near the runway's (east): a ground loop swung it ±30°.
     worst = max(abs(math.degrees(s.yaw) - 90.0) for s in rolling)
@@ -66,7 +66,7 @@ def test_a_roll_that_never_gets_going_is_aborted_at_tkoff_timeout() -> None:
     loop = ClosedLoop("c172p", [_takeoff_item()], overrides={"TKOFF_TIMEOUT": 8.0})
     _brakes_stuck(loop)
     assert loop.fly_until_disarmed(30.0)
-    aborted = [s for s in loop.samples if s.out.takeoff_phase == Phase.ABORTED]
+    aborted = [s for s in loop.samples if s.out.takeoff_phase == TakeoffPhase.ABORTED]
     assert 8.0 < aborted[0].t_s < 8.2  # the first step past the limit
     assert all(s.out.throttle == 0.0 and s.out.disarm for s in aborted)
     assert max(s.out.throttle for s in loop.samples) == 1.0  # it had tried at full power
@@ -78,5 +78,6 @@ def test_a_roll_that_gets_going_is_not_aborted() -> None:
     """The same limit on a free roll: past 4 m/s in time, the climb goes on after it."""
     loop = ClosedLoop("c172p", [_takeoff_item()], overrides={"TKOFF_TIMEOUT": 8.0})
     loop.run(40.0)
-    assert not any(s.out.takeoff_phase == Phase.ABORTED or s.out.disarm for s in loop.samples)
+    aborted = TakeoffPhase.ABORTED
+    assert not any(s.out.takeoff_phase == aborted or s.out.disarm for s in loop.samples)
     assert max(s.alt_agl for s in loop.samples) > CLIMBED_AGL_M
