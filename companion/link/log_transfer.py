@@ -4,13 +4,15 @@ As QGroundControl's Log Download page and MAVProxy's ``log`` module use it:
 LOG_REQUEST_LIST (a range of ids) → one LOG_ENTRY per log (id, size, time), ids from 0 in
 the order the logs were started (``num_logs`` 0 when there is none); LOG_REQUEST_DATA
 (id, offset, count) → LOG_DATA of 90 bytes each from that offset, the last one shorter.
-A request that reaches past the end of a log ending on a 90-byte boundary, or asks from
-the end (up to the next boundary), gets a final LOG_DATA with ``count`` 0 (MAVProxy waits
-for one). A request overlapping the range under
+A request from the end (up to the next 90-byte boundary) gets a LOG_DATA with ``count`` 0:
+MAVProxy asks there once it holds every packet and, on a log of whole packets, waits for
+that answer. Nothing else gets one: MAVProxy ends its download at a count-0 packet
+whatever it still lacks, so a packet lost on the way (a full receive buffer on a busy
+machine) would be saved as 90 zero bytes. Without it, MAVProxy finds the hole after 0.7 s
+of silence, asks for it, and then asks from the end. A request overlapping the range under
 way replaces it (QGroundControl, after a silence, asks again from its first hole); one
 beside it waits its turn (MAVProxy asks for up to twenty holes at once); LOG_REQUEST_END
-stops. LOG_ERASE removes every log but the one being written, and is
-refused while armed.
+stops. LOG_ERASE removes every log but the one being written, and is refused while armed.
 
 The data goes out at a share of the link's byte budget, paced here, so telemetry and
 command answers keep the rest. Requests that cannot be served (unknown id, offset past
@@ -169,8 +171,8 @@ class LogTransferService:
         if ofs > -(-size // CHUNK) * CHUNK:
             stream.close()
             return self._refuse(f"LOG_REQUEST_DATA for log {log_id}: offset {ofs} > size {size}")
-        # Past the end (MAVProxy asks there after the short last packet): just the marker.
-        eof_marker = ofs + count > size and (ofs >= size or (size - ofs) % CHUNK == 0)
+        # From the end (MAVProxy asks there once it has every packet): just the marker.
+        eof_marker = ofs >= size
         end = max(ofs, min(size, ofs + count))
         self._add(_Range(ofs, end, eof_marker), log_id, peer, stream)
         return self.tick(now_s)

@@ -13,9 +13,18 @@ from companion.flight_log import being_written
 from companion.messages import CommandId, VehicleCommand
 from mavlink_dialect import companion as m
 from tests.protocol.log_client import QgcDownload, list_logs, mavproxy_download
+from tests.protocol.lossy_hop import LossyHop
 from tests.protocol.mav_client import GroundStation, free_udp_port
 from tests.protocol.test_mavproxy import MavProxy
-from tests.support.configs import FAKE_NAV, TICKER, WAITING, link, plugin, vehicle_config
+from tests.support.configs import (
+    FAKE_NAV,
+    TICKER,
+    WAITING,
+    link,
+    link_vehicle,
+    plugin,
+    vehicle_config,
+)
 from tests.support.vehicle import Vehicle, wait_for
 
 MIN_LOG_BYTES = 120_000  # more than two of QGroundControl's 46080-byte chunks
@@ -154,4 +163,37 @@ def test_mavproxy_log_list_and_download(vehicle_factory, tmp_path):
     mavproxy = MavProxy(port, tmp_path)
     size = on_board.stat().st_size
     data = mavproxy_download(mavproxy, tmp_path, lambda: mavproxy.connected(vehicle), size, 120)
+    assert data == on_board.read_bytes()
+
+
+@pytest.mark.timeout(240)
+def test_mavproxy_downloads_a_log_of_whole_packets_whole_through_a_lost_packet(
+    vehicle_factory, tmp_path
+):
+    """MAVProxy ends a download at a count-0 packet whatever it still lacks: a log whose
+    size is a multiple of 90 bytes, one packet of it lost on the way, comes down whole
+    (MAVProxy asks for the hole in the silence after the stream, then for the end)."""
+    port = free_udp_port()
+    state = tmp_path / "state"
+    (state / "logs").mkdir(parents=True)
+    on_board = state / "logs" / "0001_armed.ulg"
+    on_board.write_bytes(bytes(range(256)) * 450)  # 115200 bytes: 1280 whole packets
+    vehicle = vehicle_factory(link_vehicle(f"udpin://127.0.0.1:{port}", state))
+    vehicle.wait_running("link")
+    lost: set[int] = set()
+
+    def drop(msg) -> bool:
+        if msg.get_type() == "LOG_DATA" and msg.ofs == 23040 and msg.ofs not in lost:
+            lost.add(msg.ofs)
+            return True
+        return False
+
+    hop = LossyHop(port, drop)
+    try:
+        mavproxy = MavProxy(hop.port, tmp_path)
+        size = on_board.stat().st_size
+        data = mavproxy_download(mavproxy, tmp_path, lambda: mavproxy.connected(vehicle), size, 120)
+    finally:
+        hop.close()
+    assert lost == {23040}
     assert data == on_board.read_bytes()

@@ -92,12 +92,12 @@ def test_no_logs_is_one_entry_saying_so(tmp_path):
 
 
 @pytest.mark.parametrize("size", [900, 905])
-def test_to_the_end_of_the_log_and_a_count_zero_packet_on_a_boundary(tmp_path, size):
+def test_to_the_end_of_the_log_and_a_count_zero_packet_only_when_asked_from_the_end(tmp_path, size):
     (path,) = make_logs(tmp_path / "logs", size)
     st = Station(tmp_path / "logs")
     frames = st.send("LOG_REQUEST_DATA", 0, 0, 0xFFFFFFFF) + st.run(0.5)
     assert assemble(frames, size) == path.read_bytes()
-    assert [m.count for m in frames][-2:] == ([90, 0] if size % 90 == 0 else [90, 5])
+    assert [m.count for m in frames][-2:] == ([90, 90] if size % 90 == 0 else [90, 5])
     # QGroundControl asks for whole bins: no count-0 packet after the last one.
     frames = st.send("LOG_REQUEST_DATA", 0, 0, -(-size // 90) * 90) + st.run(0.5)
     assert frames[-1].count == (size % 90 or 90)
@@ -125,11 +125,30 @@ def test_mavproxy_holes_all_filled_and_qgc_restart_replaces(tmp_path):
     assert assemble(got, 9000)[8100:] == path.read_bytes()[8100:]
 
 
+def test_a_packet_lost_unnoticed_is_asked_for_again_before_the_end_is_said(tmp_path):
+    """MAVProxy takes a count-0 packet as the end of the log, whatever it still lacks. So
+    the stream never ends with one: a packet the radio (or a full receive buffer) lost is
+    found in the silence after the stream and asked for, then MAVProxy asks from the end
+    and only that request is told the end."""
+    (path,) = make_logs(tmp_path / "logs", 9000)  # whole packets: no short last one
+    st = Station(tmp_path / "logs", rate_bytes_s=2000)
+    got = st.send("LOG_REQUEST_DATA", 0, 0, 0xFFFFFFFF) + st.run(12.0)
+    assert [m.count for m in got].count(0) == 0  # a gap here would have ended the download
+    lost = {900, 990, 4500}
+    got = [m for m in got if m.ofs not in lost]
+    for ofs in (900, 4500):  # MAVProxy's requests for its holes (runs of lost packets)
+        got += st.send("LOG_REQUEST_DATA", 0, ofs, 180 if ofs == 900 else 90)
+    got += st.run(2.0)
+    assert [m.count for m in got].count(0) == 0
+    assert assemble(got, 9000) == path.read_bytes()
+    (end,) = st.send("LOG_REQUEST_DATA", 0, 9000, 0xFFFFFFFF)
+    assert (end.ofs, end.count) == (9000, 0)
+
+
 def test_holes_asked_for_during_the_download_come_before_its_count_zero_end(tmp_path):
-    """MAVProxy takes a count-0 packet as the end, whatever it still lacks: on a busy link it
-    asks for the holes while the download is still under way, and a log of whole packets
-    must not be told it ended before they come."""
-    (path,) = make_logs(tmp_path / "logs", 9000)  # whole packets: it ends with a count 0
+    """On a busy link MAVProxy may ask for holes and from the end while the download is
+    still under way: the holes come first, and the end last."""
+    (path,) = make_logs(tmp_path / "logs", 9000)
     st = Station(tmp_path / "logs", rate_bytes_s=2000)
     got = st.send("LOG_REQUEST_DATA", 0, 0, 0xFFFFFFFF) + st.run(2.0)
     lost = {900, 990}  # two packets the radio lost, asked for again one by one
@@ -137,6 +156,7 @@ def test_holes_asked_for_during_the_download_come_before_its_count_zero_end(tmp_
     for ofs in sorted(lost):
         got += st.send("LOG_REQUEST_DATA", 0, ofs, 90)
     got += st.run(12.0)
+    got += st.send("LOG_REQUEST_DATA", 0, 9000, 0xFFFFFFFF) + st.run(1.0)
     counts = [m.count for m in got]
     assert counts.count(0) == 1 and counts[-1] == 0, counts[-5:]
     assert assemble(got, 9000) == path.read_bytes()
