@@ -9,8 +9,12 @@ notes when each stage's message appears: (a) nav/state, (b) control/actuators, (
 servo output the Mini SSC plug-in publishes once the frame's bytes are written, (d)
 ATTITUDE on UDP (matched to the navigation state whose attitude it carries). Each
 latency is the arrival time minus the IMU sample's stamp; the subscriber's own wake-up
-(~0.1 ms) is included (it sleeps on the bus and the UDP socket together). Prints p50, p99
-and max per stage, the control period's jitter and the stalls over 20 ms.
+(~0.1 ms) is included (it sleeps on the bus and the UDP socket together). Where the system
+allows it the subscriber runs under SCHED_FIFO above the vehicle's flight chain, so that on
+a busy machine its own wait for a CPU is not counted as the vehicle's; the servo stage is
+also given as the servo output stamped it (its ``t_us``, taken once the frame is written),
+which no subscriber delays. Prints p50, p99 and max per stage, the control period's jitter
+and the stalls over 20 ms.
 """
 
 from __future__ import annotations
@@ -36,6 +40,7 @@ from mavlink_dialect import companion as m  # noqa: E402
 
 WARM_UP_S = 15.0
 STALL_US = 20_000
+OBSERVER_FIFO = 20  # above the flight chain's realtime_priority (10 by default)
 
 
 SIM_CONFIG = REPO / "companion" / "configs" / "sim.toml"
@@ -70,9 +75,11 @@ class Stages:
     """Arrival minus IMU stamp, in µs, per stage."""
 
     def __init__(self) -> None:
-        self.lat: dict[str, list[int]] = {k: [] for k in ("nav", "actuators", "servos", "att")}
+        stages = ("nav", "actuators", "servos", "servos_stamped", "att")
+        self.lat: dict[str, list[int]] = {k: [] for k in stages}
         self.by_attitude: dict[tuple[float, float], int] = {}
         self.control_arrivals: list[int] = []
+        self.observer = ""
 
     def note(self, stage: str, now_us: int, t_us: int) -> None:
         if t_us > 0:
@@ -86,8 +93,19 @@ def listen(port: int) -> socket.socket:
     return sock
 
 
+def observe_first() -> str:
+    """This thread under SCHED_FIFO above the vehicle when the system allows it."""
+    try:
+        policy = os.SCHED_FIFO | os.SCHED_RESET_ON_FORK
+        os.sched_setscheduler(0, policy, os.sched_param(OBSERVER_FIFO))
+    except OSError:
+        return "normal scheduling (SCHED_FIFO refused)"
+    return f"SCHED_FIFO {OBSERVER_FIFO}"
+
+
 def measure(namespace: str, sock: socket.socket, seconds: float) -> Stages:
     stages, parser = Stages(), m.MAVLink(None)
+    stages.observer = observe_first()
     with BusNode(namespace, "latency") as bus:
         nav = bus.latest_reader("nav/state")
         act = bus.queue_reader("control/actuators")
@@ -111,6 +129,7 @@ def measure(namespace: str, sock: socket.socket, seconds: float) -> Stages:
             for msg in servos.drain():
                 if counting:
                     stages.note("servos", now, msg.command_t_us)
+                    stages.note("servos_stamped", msg.t_us, msg.command_t_us)
             read_udp(sock, parser, stages, now, counting)
     return stages
 
@@ -152,11 +171,13 @@ def main() -> None:
         sim.wait(timeout=30)
         cleanup_namespace(namespace)
     print(
-        f"companion sim in real time, mission flying, {args.seconds:.0f} s after {WARM_UP_S:.0f} s"
+        f"companion sim in real time, mission flying, {args.seconds:.0f} s after {WARM_UP_S:.0f} s;"
+        f" the subscriber at {stages.observer}"
     )
     print(summary("IMU first byte -> nav/state", stages.lat["nav"]))
     print(summary("IMU first byte -> control/actuators", stages.lat["actuators"]))
     print(summary("IMU first byte -> Mini SSC frame written", stages.lat["servos"]))
+    print(summary("  the same, as the servo output stamped it", stages.lat["servos_stamped"]))
     print(summary("IMU first byte -> ATTITUDE on UDP", stages.lat["att"]))
     periods = np.diff(stages.control_arrivals) / 1000.0
     if len(periods):
