@@ -38,7 +38,7 @@ from companion.exec_control.plugin_host import (
     _signal_pipe,
     set_name,
 )
-from companion.exec_control.priority import apply_nice
+from companion.exec_control.priority import apply_priority
 from companion.exec_control.profiling import run_profiled
 from companion.exec_control.registry import load
 from companion.fd_wait import drain, wait_readable
@@ -104,7 +104,7 @@ class Member:
 
     def run(self) -> None:
         """The thread: run the plug-in, and again after each failure, until stopped."""
-        apply_nice(self.name, self.spec.get("nice", 0))  # this thread's own
+        apply_priority(self.name, self.spec.get("nice", 0), self.spec["vehicle"])  # its own
         set_name(self.name)  # its thread's, as top -H shows it
         with BusNode(self.spec["namespace"], f"{self.name}_stats", self.node) as node:
             self.loop(node.writer("system/plugin_stats"))

@@ -70,6 +70,15 @@ _VEHICLE_KEYS: dict[str, Setting] = {
         "the OS process every plug-in without a `process` of its own shares (a small board's"
         " choice: one interpreter, the flight path on one wake-up); empty: one per plug-in",
     ),
+    "realtime_priority": Setting(
+        int,
+        10,
+        "SCHED_FIFO priority of the flight chain (the plug-ins at a negative nice) on the"
+        " monotonic clock, where the system allows it (CAP_SYS_NICE): woken, it runs before"
+        " any normal process; below the kernel's interrupt threads (50). 0: nice values only",
+        min=0,
+        max=49,
+    ),
     "state_dir": Setting(
         str,
         "",

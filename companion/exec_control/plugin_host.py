@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
 from companion.bus.node import BusNode
 from companion.bus.patterns import Writer
-from companion.exec_control.priority import apply_nice
+from companion.exec_control.priority import apply_priority
 from companion.exec_control.profiling import run_profiled
 from companion.exec_control.registry import load
 from companion.messages import NAME_LEN, PluginState, PluginStats
@@ -252,7 +252,7 @@ def main(spec: dict[str, Any]) -> int:
         format=f"%(asctime)s {spec['name']}[%(process)d] %(levelname)s %(message)s",
     )
     die_with_parent()
-    apply_nice(spec["name"], spec.get("nice", 0))
+    apply_priority(spec["name"], spec.get("nice", 0), spec["vehicle"])
     host = PluginHost(spec)
     signal.signal(signal.SIGTERM, host.request_stop)
     signal.signal(signal.SIGINT, host.request_stop)

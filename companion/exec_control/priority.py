@@ -5,6 +5,12 @@ weight: each nice step is about 25 % of weight. The flight chain asks for
 ``companion.plugin.FLIGHT_NICE`` so that the link, the flight log and the slower sensors
 give way to it first, as a flight stack's scheduler runs its rate loop before telemetry.
 Nice is a thread's on Linux, so plug-ins composed into one process keep their own.
+
+On the hardware time base (a real aircraft, hardware in the loop) the flight chain also
+runs under ``SCHED_FIFO`` at the vehicle's ``realtime_priority``, as a flight stack's rate
+loop runs on Linux: woken, it runs before any normal process, however busy the board, so
+its latency does not depend on the other work there. A simulation's clock leaves it at its
+nice value: exact lockstep keeps a thread busy for as long as the simulator feeds it.
 """
 
 from __future__ import annotations
@@ -12,8 +18,8 @@ from __future__ import annotations
 import logging
 import os
 import resource
-from collections.abc import Iterable
-from typing import Protocol
+from collections.abc import Iterable, Mapping
+from typing import Any, Protocol
 
 NICE_MIN, NICE_MAX = -20, 19
 _CAP_SYS_NICE = 23  # the capability's bit in /proc/PID/status CapEff
@@ -67,3 +73,29 @@ def apply_nice(name: str, nice: int) -> int:
     except PermissionError:
         log.debug("%s: nice %+d refused", name, nice)
         return os.nice(0)
+
+
+def realtime_priority(nice: int, vehicle: Mapping[str, Any]) -> int:
+    """The ``SCHED_FIFO`` priority a plug-in asks for: the vehicle's ``realtime_priority``
+    for the flight chain (a negative nice) on the hardware time base, 0 (none) otherwise."""
+    if nice >= 0 or vehicle.get("clock", "monotonic") != "monotonic":
+        return 0
+    return int(vehicle.get("realtime_priority", 0))
+
+
+def apply_priority(name: str, nice: int, vehicle: Mapping[str, Any]) -> str:
+    """The calling thread's scheduling: its nice value, then ``SCHED_FIFO`` when it asks
+    for it (``realtime_priority``) and the system allows it. Says which ("nice -5",
+    "fifo 10"). A refusal (no CAP_SYS_NICE, a cgroup given no real-time time) is said once
+    and leaves the nice value; threads and processes it starts later get normal scheduling
+    (``SCHED_RESET_ON_FORK`` for processes; its own threads are the plug-in's to mind)."""
+    at = apply_nice(name, nice)
+    rt = realtime_priority(nice, vehicle)
+    if rt <= 0:
+        return f"nice {at}"
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO | os.SCHED_RESET_ON_FORK, os.sched_param(rt))
+    except OSError as exc:  # EPERM: no capability, or a cgroup with no real-time runtime
+        log.info("%s: SCHED_FIFO %d refused (%s); it runs at nice %d", name, rt, exc, at)
+        return f"nice {at}"
+    return f"fifo {rt}"

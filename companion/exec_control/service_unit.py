@@ -64,7 +64,8 @@ StartLimitIntervalSec=0
 Type=exec
 User={spec.user}
 SupplementaryGroups=dialout
-# The flight chain's plug-ins raise their priority (companion.exec_control.priority).
+# The flight chain's plug-ins raise their priority and run SCHED_FIFO
+# (companion.exec_control.priority).
 AmbientCapabilities=CAP_SYS_NICE
 ExecStart={shlex.join(run)}
 KillMode=mixed

@@ -7,6 +7,7 @@ fast as the process can publish. The wait between samples stands in for a device
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 from collections.abc import Iterator, Mapping
@@ -46,6 +47,10 @@ class ReplaySensors(Plugin):
         self.path = Path(ctx.settings["file"]).expanduser()
         self.writers = {kind: ctx.bus.writer(name) for kind, name in CHANNEL_OF.items()}
         self._pace = threading.Event()
+        if ctx.settings["speed"] != 1.0 and os.sched_getscheduler(0) != os.SCHED_OTHER:
+            # Faster than real time is not real-time work: as a SCHED_FIFO thread a replay
+            # as fast as it can go would hold a core (it keeps its nice value).
+            os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
         self._restart()
 
     def _restart(self) -> None:
