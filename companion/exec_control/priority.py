@@ -86,9 +86,10 @@ def realtime_priority(nice: int, vehicle: Mapping[str, Any]) -> int:
 def apply_priority(name: str, nice: int, vehicle: Mapping[str, Any]) -> str:
     """The calling thread's scheduling: its nice value, then ``SCHED_FIFO`` when it asks
     for it (``realtime_priority``) and the system allows it. Says which ("nice -5",
-    "fifo 10"). A refusal (no CAP_SYS_NICE, a cgroup given no real-time time) is said once
-    and leaves the nice value; threads and processes it starts later get normal scheduling
-    (``SCHED_RESET_ON_FORK`` for processes; its own threads are the plug-in's to mind)."""
+    "fifo 10"). A refusal leaves the nice value; it is said here only when the raise of the
+    nice value went through (a cgroup given no real-time time): without CAP_SYS_NICE the
+    supervisor has said so once for the whole vehicle (``note_refused_raises``). Processes
+    it starts get normal scheduling (``SCHED_RESET_ON_FORK``); threads inherit it."""
     at = apply_nice(name, nice)
     rt = realtime_priority(nice, vehicle)
     if rt <= 0:
@@ -96,6 +97,7 @@ def apply_priority(name: str, nice: int, vehicle: Mapping[str, Any]) -> str:
     try:
         os.sched_setscheduler(0, os.SCHED_FIFO | os.SCHED_RESET_ON_FORK, os.sched_param(rt))
     except OSError as exc:  # EPERM: no capability, or a cgroup with no real-time runtime
-        log.info("%s: SCHED_FIFO %d refused (%s); it runs at nice %d", name, rt, exc, at)
+        said = log.info if at == nice else log.debug
+        said("%s: SCHED_FIFO %d refused (%s); it runs at nice %d", name, rt, exc, at)
         return f"nice {at}"
     return f"fifo {rt}"
