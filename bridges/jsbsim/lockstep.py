@@ -8,6 +8,8 @@ import time
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any, Protocol
 
+from companion.time_grid import early_us
+
 if TYPE_CHECKING:
     from companion.bus.node import Waiter
     from companion.bus.patterns import LatestReader, Reader
@@ -162,6 +164,7 @@ class FlightSync(_BusWait):
     ) -> None:
         super().__init__(waiter)
         self.period_us = period_us
+        self.early_us = early_us(period_us)
         self.answers = answers
         self.lag_us = lag_periods * period_us
         self.stamp, self.always = stamp, always
@@ -185,11 +188,14 @@ class FlightSync(_BusWait):
         elif not self.flying:
             return
         grid = (t_us - self.lag_us) // self.period_us * self.period_us
-        if self._answered(grid) or self.lagging:
+        # A navigator with its samples near the ticks answers a tick with the sample just
+        # before it (companion.time_grid); a simulation's samples are never there.
+        due = grid - self.early_us + 1 if grid > 0 else grid
+        if self._answered(due) or self.lagging:
             return
         started = self.synced or (self.always and self.answered_us >= 0)
         limit = STALL_FLIGHT_S if started else START_FLIGHT_S
-        if not self._until(lambda: self._answered(grid), limit):
+        if not self._until(lambda: self._answered(due), limit):
             log.warning(
                 "lockstep: no answer to the state at %.2f s for %.0f s (newest"
                 " answer: %.2f s); not waiting for it",
