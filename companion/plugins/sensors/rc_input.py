@@ -69,8 +69,13 @@ class RcInput(Plugin):
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
         framing = SBUS_FRAMING
+        # The pilot's sticks go to the servos: the driver hands each frame over at once.
         self.port = ReopeningSerial(
-            ctx.settings["device"], ctx.settings["baud"], framing=framing, stop_fd=ctx.stop_fd
+            ctx.settings["device"],
+            ctx.settings["baud"],
+            framing=framing,
+            stop_fd=ctx.stop_fd,
+            low_latency=True,
         )
         self.decoder = SbusDecoder()
         self.live = LiveParams(ctx.bus, self.params, Path(ctx.vehicle.get("state_dir", ".")))

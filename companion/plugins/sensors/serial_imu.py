@@ -35,6 +35,7 @@ class SerialImu(SerialSensor[VectorNavReading]):
     pressure (as height above the first reading) on sensors/baro."""
 
     periodic_frames = True
+    low_latency = True
 
     nice = FLIGHT_NICE
 

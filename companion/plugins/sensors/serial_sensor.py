@@ -44,11 +44,17 @@ class SerialSensor(Plugin, Generic[ReadingT]):
     # One frame per sample, sent every 1/rate_hz (an IMU, not a GPS's several sentences a
     # fix): frames a late read finds together are stamped a period apart, not alike.
     periodic_frames: ClassVar[bool] = False
+    # Its bytes start the flight path (the IMU's): the port's driver is asked to hand them
+    # over at once (``serial_port.set_low_latency``), not in a USB adapter's lumps.
+    low_latency: ClassVar[bool] = False
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
         self.port = ReopeningSerial(
-            ctx.settings["device"], ctx.settings["baud"], stop_fd=ctx.stop_fd
+            ctx.settings["device"],
+            ctx.settings["baud"],
+            stop_fd=ctx.stop_fd,
+            low_latency=self.low_latency,
         )
         self.framer = self.make_framer()
         self.decoder = self.make_decoder(ctx.settings)
