@@ -52,6 +52,13 @@ class SerialLine:
         self.port = serial.serial_for_url(
             url, baudrate=baud, parity=parity, stopbits=stopbits, timeout=0, write_timeout=0
         )
+        # The servo card's line brings the board's commands back: on a USB adapter they
+        # would come in lumps at its 16 ms latency timer, a late control loop in the loop.
+        # (The vehicle asks the same of its IMU's port; a pty refuses, which changes nothing.)
+        try:
+            self.port.set_low_latency_mode(True)
+        except (AttributeError, ValueError, OSError, NotImplementedError):
+            pass
         self.bytes_out = 0
         self.dropped = 0
 
