@@ -34,25 +34,33 @@ def test_samples_straddling_the_ticks_still_give_a_state_every_period():
     assert np.all(np.abs(periods - 20.0) < 1.0), sorted(set(np.round(periods)))
 
 
+def _first_at_or_past_each_tick(stamps: list[int], period_us: int) -> list[int]:
+    """The grid's choice before it stayed with the samples (what exact lockstep mirrors)."""
+    taken, next_us = [], 0
+    for t in stamps:
+        if t >= next_us:
+            taken.append(t)
+            next_us = (t // period_us + 1) * period_us
+    return taken
+
+
 def test_an_imu_clock_drifting_through_the_ticks_costs_a_period_or_two_per_crossing():
-    # 100 ppm fast: the samples' phase walks 1 ms in 10 s and through a tick twice in 60 s.
-    stamps = _imu(60.0, phase_us=-4_000.0, jitter_us=300.0, drift_ppm=-100.0)
+    # An IMU clock 250 ppm slow (five times a cheap crystal's error, to cross within a
+    # minute): its samples' phase walks 15 ms in 60 s, through the ticks twice.
+    stamps = _imu(60.0, phase_us=3_000.0, jitter_us=300.0, drift_ppm=-250.0)
     periods = _periods_ms(stamps)
     odd = int(np.sum(np.abs(periods - 20.0) >= 1.0))
     assert 1 <= odd <= 4, odd
     assert np.all((periods > 9.0) & (periods < 31.0))
+    before = np.diff(_first_at_or_past_each_tick(stamps, 20_000)) / 1000.0
+    assert np.sum(np.abs(before - 20.0) >= 1.0) >= 20  # 10/30 ms while they straddled
 
 
 def test_a_simulations_exact_stamps_give_the_first_sample_at_or_past_each_tick():
     # Frames of 10 ms: what the simulator's exact lockstep waits for at each tick.
+    stamps = list(range(10_000, 2_000_000, 10_000))
     for rate_hz in (50.0, 25.0, 10.0, 100.0):
-        period = round(1e6 / rate_hz)
-        stamps = list(range(10_000, 2_000_000, 10_000))
-        expected, next_us = [], 0
-        for t in stamps:
-            if t >= next_us:
-                expected.append(t)
-                next_us = (t // period + 1) * period
+        expected = _first_at_or_past_each_tick(stamps, round(1e6 / rate_hz))
         assert _taken(stamps, rate_hz) == expected
 
 
