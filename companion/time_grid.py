@@ -10,7 +10,7 @@ millisecond either way, and the IMU's clock drifts against the board's: every fe
 its samples come for a while right at a tick, some just before it and some just after. The
 first sample at or past each tick was then one period late or early at random: a 50 Hz
 navigator published at 10, 20 and 30 ms intervals and the controller ran at them (30 % of
-its periods in one of three 60 s runs of ``benchmarks/latency.py`` on the hardware time
+its periods in one of four 60 s runs of ``benchmarks/latency.py`` on the hardware time
 base). So a grid that took a sample within ``early_us(period)`` of its tick takes the
 sample that comes up to that much before the next tick as well: it stays with the
 samples near its ticks until they drift further off. A simulation's samples come on a
