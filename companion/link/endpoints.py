@@ -2,7 +2,8 @@
 
 ``udpout://HOST:PORT`` sends to a ground station (and hears its replies on the same
 socket), ``udpin://HOST:PORT`` listens and answers whoever speaks, ``tcpin://HOST:PORT``
-accepts TCP clients, ``serial:///dev/ttyUSB0:57600`` is a radio modem. Endpoints move
+accepts TCP clients, ``serial:///dev/ttyUSB0:57600`` is a radio modem (MAVProxy's and
+MAVSDK's spellings of these are taken too: ``endpoint_urls``). Endpoints move
 bytes only; framing is companion.link.codec's (one parser per remote), CRC and signing pymavlink's.
 """
 
@@ -13,11 +14,17 @@ import logging
 import socket
 import time
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
-from urllib.parse import parse_qs, urlparse
+from urllib.parse import urlparse
 
 import serial
 
+from companion.link.endpoint_urls import (
+    SCHEME_NAMES,
+    EndpointError,
+    EndpointOptions,
+    parse_serial_url,
+    split_options,
+)
 from companion.sensors.serial_port import FIRST_RETRY_S, MAX_RETRY_S, SerialPort, open_port
 
 log = logging.getLogger(__name__)
@@ -26,10 +33,6 @@ _PORT_ERRORS = (serial.SerialException, OSError, ValueError, TypeError)
 
 Remote = tuple[str, int] | str  # a UDP/TCP peer address, or the serial device
 MAX_DATAGRAM = 65535
-
-
-class EndpointError(ValueError):
-    """An endpoint URL that cannot be used."""
 
 
 class Endpoint(ABC):
@@ -292,56 +295,12 @@ class SerialEndpoint(Endpoint):
                 port.close()
 
 
-def parse_serial_url(url: str) -> tuple[str, int]:
-    """``serial:///dev/ttyUSB0:57600`` → ("/dev/ttyUSB0", 57600)."""
-    rest = url.removeprefix("serial://")
-    path, sep, baud = rest.rpartition(":")
-    if not sep or not baud.isdigit() or not path:
-        raise EndpointError(f"{url!r}: expected serial:///dev/DEVICE:BAUD")
-    return path, int(baud)
-
-
 DEFAULT_NETWORK_BYTES_S = 1_000_000.0
 SERIAL_SHARE = 0.8
 KINDS: dict[str, type[Endpoint]] = dict(
     udpout=UdpOut, udpin=UdpIn, tcpin=TcpIn, serial=SerialEndpoint
 )
-SCHEMES = frozenset(KINDS)
-
-
-@dataclass(frozen=True)
-class EndpointOptions:
-    """Per-endpoint options, given as a URL query: ``udpin://0.0.0.0:14550?budget=20000``.
-
-    budget: bytes per second for this endpoint (serial default: baud / 10);
-    tlog: path of a .tlog recording of this endpoint's traffic;
-    signing: off, optional or required (see companion.link.signing).
-    """
-
-    budget_bytes_s: float | None = None
-    tlog: str | None = None
-    signing: str = "off"
-
-
-def split_options(url: str) -> tuple[str, EndpointOptions]:
-    """The URL without its query, and the options the query sets."""
-    base, _, query = url.partition("?")
-    known = {"budget", "tlog", "signing"}
-    fields = parse_qs(query, keep_blank_values=True) if query else {}
-    unknown = set(fields) - known
-    if unknown:
-        raise EndpointError(f"{url!r}: unknown option(s) {sorted(unknown)}; known: {sorted(known)}")
-    budget = None
-    if "budget" in fields:
-        try:
-            budget = float(fields["budget"][-1])
-        except ValueError:
-            raise EndpointError(f"{url!r}: budget must be bytes per second") from None
-    tlog = fields["tlog"][-1] if "tlog" in fields else None
-    signing = fields["signing"][-1] if "signing" in fields else "off"
-    if signing not in ("off", "optional", "required"):
-        raise EndpointError(f"{url!r}: signing must be off, optional or required")
-    return base, EndpointOptions(budget, tlog, signing)
+assert sorted(KINDS) == sorted(SCHEME_NAMES)
 
 
 def endpoint_problems(urls: list[str], signing_key: str) -> list[str]:
@@ -350,9 +309,7 @@ def endpoint_problems(urls: list[str], signing_key: str) -> list[str]:
     problems = []
     for url in urls:
         try:
-            base, options = split_options(str(url))
-            if base.split("://", 1)[0] not in SCHEMES:
-                problems.append(f"endpoint {url!r}: scheme must be one of {sorted(SCHEMES)}")
+            _, options = split_options(str(url))
             if options.signing != "off" and not signing_key:
                 problems.append(f"endpoint {url!r} asks for signing but signing_key is empty")
         except EndpointError as exc:
@@ -363,10 +320,7 @@ def endpoint_problems(urls: list[str], signing_key: str) -> list[str]:
 def open_endpoint(url: str) -> Endpoint:
     """Open the endpoint a URL names; EndpointError for an unknown scheme or option."""
     base, options = split_options(url)
-    scheme = base.split("://", 1)[0] if "://" in base else ""
-    if scheme not in KINDS:
-        raise EndpointError(f"{url!r}: scheme must be one of {sorted(SCHEMES)}")
-    endpoint = KINDS[scheme](base)
+    endpoint = KINDS[base.split("://", 1)[0]](base)
     endpoint.options = options
     return endpoint
 

@@ -48,6 +48,15 @@ def _single_links(link: list[str] | None, api_port_base: int | None) -> list[str
     return links
 
 
+def _check_links(links: list[str]) -> None:
+    """Refuse a --link the link could not open, before anything flies without it."""
+    from companion.link.endpoint_urls import url_problem
+
+    for url in links:
+        if (problem := url_problem(url)) is not None:
+            raise typer.BadParameter(problem, param_hint="--link")
+
+
 def _fleet_settings(config: Path, namespace: str) -> tuple[dict, dict]:
     from rich.markup import escape
 
@@ -188,6 +197,7 @@ def sim(
     from ground.sitl.requests import GCS_LINK, FleetRequest, SimRequest
 
     setup_logging(log_level)
+    _check_links(link or [])
     lists = plan_or_exit(plan) if plan is not None else None
     vehicle, fleet = _fleet_settings(config, namespace or default_namespace())
     try:
