@@ -216,10 +216,12 @@ class TcpIn(Endpoint):
 class SerialEndpoint(Endpoint):
     """A radio modem or cable: ``serial:///dev/ttyUSB0:57600``.
 
-    The first open happens here (a device missing at start-up is the config's fault). A
-    device lost later (a USB adapter pulled out: a read that fails, or readable with nothing
-    to read) is closed, ``reopens`` counts it, and ``filenos`` opens it again when it is
-    back, retrying after 0.1 s doubling to 2 s: the link's other endpoints fly on meanwhile.
+    A device lost (a USB adapter pulled out: a read that fails, or readable with nothing to
+    read) is closed, ``reopens`` counts it, and ``filenos`` opens it again when it is back,
+    retrying after 0.1 s doubling to 2 s: the link's other endpoints fly on meanwhile. A
+    device missing at start-up is waited for the same way (a radio unplugged, or one the
+    kernel names a moment after the service started, must not take the UDP link down with
+    it); ``companion check`` is where a wrong path shows.
     """
 
     def __init__(self, url: str) -> None:
@@ -228,7 +230,12 @@ class SerialEndpoint(Endpoint):
         self.reopens = 0
         self._retry_s = FIRST_RETRY_S
         self._next_try = 0.0
-        self.port: SerialPort | None = self._open()
+        self.port: SerialPort | None = None
+        try:
+            self.port = self._open()
+        except _PORT_ERRORS as exc:
+            log.warning("%s: cannot open (%s); waiting for it", url, exc)
+            self._next_try = time.monotonic() + self._retry_s
 
     def _open(self) -> SerialPort:
         # open_port: a radio at a custom rate reopens after a restart (pyserial issue #805).

@@ -63,3 +63,21 @@ def test_a_radio_pulled_out_and_plugged_back_in_is_reopened(tmp_path):
         radio.close()
     finally:
         pty.vanish()
+
+
+def test_a_radio_missing_at_start_is_waited_for_and_taken_when_it_comes(tmp_path):
+    link = tmp_path / "ttyUSB1"
+    radio = SerialEndpoint(f"serial://{link}:57600")  # no device there yet: no error
+    assert radio.filenos() == [] and radio.send(b"early") == 0 and radio.write_errors == 1
+    pty = Pty(link)  # the adapter enumerates after the link started
+    try:
+        deadline = time.monotonic() + 5.0
+        while not radio.filenos() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert radio.filenos(), "opened within the 2 s back-off"
+        os.write(pty.master, b"ground")
+        assert read_when_ready(radio) == b"ground" and radio.reopens == 0
+        assert radio.send(b"air") == 3 and os.read(pty.master, 64) == b"air"
+        radio.close()
+    finally:
+        pty.vanish()
