@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import logging
 import sys
+from pathlib import Path
 
 from companion.exec_control.handover import received
 
@@ -53,7 +54,20 @@ def run_vehicle(config: str, namespace: str | None, log_level: str) -> int:
     except ConfigError as exc:
         return config_refused(exc)
     log.info("config read")
+    _make_state_dir(cfg.vehicle.get("state_dir"), log)
     return Supervisor(cfg, log_level).run()
+
+
+def _make_state_dir(state_dir: str | None, log: logging.Logger) -> None:
+    """The state directory, made once here rather than by each plug-in that writes to it
+    (a fresh machine, or --state-dir naming a new one); one that cannot be made is said
+    here, and the vehicle flies on without what it would have kept there."""
+    if not state_dir:
+        return
+    try:
+        Path(state_dir).expanduser().mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        log.error("state directory %s cannot be made (%s): nothing will be kept", state_dir, exc)
 
 
 if __name__ == "__main__":

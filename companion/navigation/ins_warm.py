@@ -98,6 +98,7 @@ class WarmFile:
         self.next_us = 0
         self._fd: int | None = None
         self._size = 0  # the longest text written: a shorter one is padded over it
+        self.failures = 0  # writes that failed (a full or read-only disk)
 
     def read(self) -> WarmState | None:
         """The last solution written, or None (none, or damaged: a cold start)."""
@@ -124,10 +125,14 @@ class WarmFile:
         self._size = max(self._size, len(text))
         try:
             if self._fd is None:  # this process's first write: an older file goes
+                self.path.parent.mkdir(parents=True, exist_ok=True)
                 self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
             os.pwrite(self._fd, text.ljust(self._size), 0)
         except OSError as exc:  # a full or read-only disk must not stop the navigator
-            log.warning("warm start file not written: %s", exc)
+            # Said once: five times a second it buried every other line of the log.
+            self.failures += 1
+            level = logging.WARNING if self.failures == 1 else logging.DEBUG
+            log.log(level, "warm start file not written (failure %d): %s", self.failures, exc)
 
     def close(self) -> None:
         """Let the file go (a plug-in restarted in its process opens it again)."""

@@ -136,3 +136,18 @@ def _level_imu(t_us: int) -> Message:
     from companion.messages import Imu
 
     return Imu(t_us=t_us, az_m_s2=-9.81, temp_c=np.nan)
+
+
+def test_a_new_state_directory_is_made_and_a_failing_disk_is_said_once(tmp_path, caplog):
+    state = _killed_in_the_turn()
+    fresh = WarmFile(tmp_path / "new" / "state")  # --state-dir naming one not made yet
+    fresh.write(state)
+    assert fresh.read() is not None and fresh.failures == 0
+    fresh.close()
+    (tmp_path / "file").write_text("")
+    broken = WarmFile(tmp_path / "file" / "state")  # its parent is a file: never writable
+    with caplog.at_level("DEBUG", logger="companion.navigation.ins_warm"):
+        for i in range(10):
+            broken.write(WarmState(**{**vars(state), "t_us": state.t_us + i * 200_000}))
+    warnings = [r for r in caplog.records if r.levelname == "WARNING"]
+    assert broken.failures == 10 and len(warnings) == 1
