@@ -14,7 +14,6 @@ cannot slip in through a new remote address.
 from __future__ import annotations
 
 import hashlib
-import re
 import time
 from pathlib import Path
 from typing import Any
@@ -51,10 +50,9 @@ PROTECTED = frozenset(
 
 
 def key_from(secret: str) -> bytes:
-    """A 32-byte key: 64 hex digits as given, anything else is a passphrase (SHA-256),
-    as MAVProxy's ``signing setup PASSPHRASE`` derives it."""
-    if re.fullmatch(r"[0-9a-fA-F]{64}", secret):
-        return bytes.fromhex(secret)
+    """The 32-byte key of a secret text: its SHA-256, whatever the text (64 hex digits
+    included), as QGroundControl (MAVLinkSigning.cc) and MAVProxy (``signing key``) make
+    theirs of what their user types; the same text in both ends gives the same key."""
     return hashlib.sha256(secret.encode()).digest()
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import secrets
 import time
 
 import pytest
@@ -87,5 +88,29 @@ def test_required_signing_without_a_key_is_a_config_error(tmp_path):
     with pytest.raises(ConfigError, match="asks for signing but signing_key is empty"):
         load_config(path)
     path.write_text(signed_vehicle(14999, PASSPHRASE, scheme="udpp"))
-    with pytest.raises(ConfigError, match="scheme must be one of"):
+    with pytest.raises(ConfigError, match="expected udpout://HOST:PORT"):
         load_config(path)
+
+
+def test_a_key_file_made_as_the_hardware_guide_says_matches_mavproxy_typed_the_same_text(
+    vehicle_factory, tmp_path
+):
+    from MAVProxy.modules.mavproxy_signing import SigningModule
+
+    text = secrets.token_hex(32)  # `openssl rand -hex 32 > /etc/companion/signing.key`
+    key_file = tmp_path / "signing.key"
+    key_file.write_text(text + "\n")
+    port = free_udp_port()
+    endpoint = f"udpin://127.0.0.1:{port}?signing=required"
+    vehicle_factory(
+        vehicle_config(
+            "signed", link(endpoint, signing_key_file=str(key_file)), plugin("nav", FAKE_NAV)
+        )
+    )
+    gcs = GroundStation(port)
+    # What MAVProxy's `signing key TEXT` makes of the text (QGroundControl hashes it alike).
+    gcs.conn.setup_signing(SigningModule.passphrase_to_key(None, text), sign_outgoing=True)
+    gcs.connect()
+    gcs.command(m.MAV_CMD_REQUEST_MESSAGE, m.MAVLINK_MSG_ID_AUTOPILOT_VERSION)
+    assert gcs.ack(m.MAV_CMD_REQUEST_MESSAGE).result == m.MAV_RESULT_ACCEPTED
+    gcs.close()

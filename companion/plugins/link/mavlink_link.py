@@ -83,7 +83,7 @@ class MavlinkLink(Plugin):
         # PX4: the QGroundControl plug-in that offers every guided action for a fixed wing
         # (companion.control.modes says why); generic: no guided action in QGroundControl.
         "autopilot": Setting(str, "px4", "MAV_AUTOPILOT reported", choices=tuple(AUTOPILOTS)),
-        "signing_key": Setting(str, "", "signing key: 64 hex digits or a passphrase (SHA-256)"),
+        "signing_key": Setting(str, "", "signing key: the ground station's text (SHA-256)"),
         # Kept out of the config (which is shown and copied), readable by the vehicle only.
         "signing_key_file": Setting(str, "", "file holding the signing key (as signing_key)"),
     }
