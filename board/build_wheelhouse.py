@@ -1,6 +1,6 @@
 """Build the wheelhouse an ARM board installs the on-board program from, with no compiler.
 
-    python3 -m uv run python board/build_wheelhouse.py [--out /work/arm64/wheelhouse]
+    python3 -m uv run python board/build_wheelhouse.py [--out ~/wheelhouse]
 
 Everything the on-board install needs (the project without its ``ground`` extra, pinned by
 uv.lock) as wheels for aarch64, CPython 3.11, manylinux_2_28 or older (Debian bookworm and
@@ -197,9 +197,11 @@ def report(out: Path, times: dict[str, float]) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", type=Path, default=Path("/work/arm64/wheelhouse"))
-    ap.add_argument("--work", type=Path, default=Path("/work/arm64/build"),
-                    help="the throwaway venv, sdists and the Rust build")  # fmt: skip
+    ap.add_argument("--out", type=Path, default=Path.home() / "wheelhouse",
+                    help="where the wheels go (default ~/wheelhouse)")  # fmt: skip
+    ap.add_argument("--work", type=Path, default=Path.home() / ".cache" / "companion-arm64",
+                    help="the throwaway venv, sdists and the Rust build "
+                         "(default ~/.cache/companion-arm64)")  # fmt: skip
     ap.add_argument("--report-only", action="store_true", help="print an existing wheelhouse")
     args = ap.parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")

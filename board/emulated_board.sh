@@ -9,14 +9,14 @@
 #   board/emulated_board.sh stop      # stop what run started
 #   board/emulated_board.sh teardown  # stop, unmount everything this script mounted
 #
-# ARM64_ROOT (default /work/arm64/root) and WHEELHOUSE (/work/arm64/wheelhouse, made by
+# ARM64_ROOT (default /work/arm64/root) and WHEELHOUSE ($HOME/wheelhouse, made by
 # board/build_wheelhouse.py) say where. The vehicle is installed at /opt/companion in the
 # root; its output goes to $ARM64_ROOT/var/log/companion.log. A config's device paths and
 # state_dir are paths inside the root; the host reaches them under $ARM64_ROOT.
 set -euo pipefail
 
 ROOT=${ARM64_ROOT:-/work/arm64/root}
-WHEELHOUSE=${WHEELHOUSE:-/work/arm64/wheelhouse}
+WHEELHOUSE=${WHEELHOUSE:-$HOME/wheelhouse}
 MIRROR=${DEBIAN_MIRROR:-http://deb.debian.org/debian}
 STATE=${ROOT}.state # outside the root: pid, and what this script mounted
 VENV=/opt/companion
