@@ -159,7 +159,9 @@ def summary(name: str, values: list[int]) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seconds", type=float, default=60.0)
-    ap.add_argument("--config", type=Path, default=SIM_CONFIG, help="the vehicle (sim_composed)")
+    ap.add_argument(
+        "--config", type=Path, default=SIM_CONFIG, help="vehicle config (default sim.toml)"
+    )
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="latency"))
     namespace, sock = f"lat{os.getpid()}", listen(0)

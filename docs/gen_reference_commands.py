@@ -119,4 +119,5 @@ def option_row(param: Any) -> tuple[str, str, str]:
         default = ""
     # A default under this checkout (the shipped config) is shown as the repository path.
     shown = str(default).replace(f"{REPO}/", "")
-    return names, shown, getattr(param, "help", "") or ""
+    # A help text escapes a bracket for the terminal's markup ("\\[vehicle]"); not here.
+    return names, shown, (getattr(param, "help", "") or "").replace("\\[", "[")

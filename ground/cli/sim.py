@@ -91,7 +91,7 @@ def sim(
     aircraft: Annotated[
         str | None,
         typer.Option(
-            help="airframe: c172p, J3Cub, or a TOML path (default: the config's [vehicle] airframe)"
+            help="airframe: c172p, J3Cub, or a TOML path (default: the \\[vehicle] airframe)"
         ),
     ] = None,
     plan: Annotated[Path | None, typer.Option(help="QGroundControl .plan to preload")] = None,
@@ -176,7 +176,7 @@ def sim(
         int | None, typer.Option(min=1, max=255, help="MAVLink system id (default: config)")
     ] = None,
     count: Annotated[
-        int | None, typer.Option(min=1, max=254, help="vehicles to fly (default: [fleet] or 1)")
+        int | None, typer.Option(min=1, max=254, help="vehicles to fly (default: \\[fleet] or 1)")
     ] = None,
     spacing: Annotated[
         float | None, typer.Option(min=0, help="metres east between vehicles (default 50)")
