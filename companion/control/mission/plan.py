@@ -3,8 +3,9 @@
 A plan is JSON: ``mission.items`` (SimpleItems with command, frame, params[7],
 autoContinue; of the ComplexItems the fixed-wing landing pattern is expanded to the items
 QGroundControl uploads for it, the others are refused by name), ``geoFence`` (polygons
-with inclusion flags, circles) and ``rallyPoints.points``. Exported plans always carry
-``geoFence`` and ``rallyPoints`` objects, which MAVSDK's importer requires.
+with inclusion flags, circles, the breach return point) and ``rallyPoints.points``.
+Exported plans always carry ``geoFence`` and ``rallyPoints`` objects, which MAVSDK's
+importer requires.
 """
 
 from __future__ import annotations
@@ -129,6 +130,10 @@ def _fence_items(plan: dict[str, Any]) -> list[MissionItem]:
         )
         lat, lon = circle["circle"]["center"]
         items.append(_fence_item(len(items), cmd, circle["circle"]["radius"], lat, lon, 1))
+    if "breachReturn" in fence:  # [lat, lon, alt]: uploaded by QGroundControl after the zones
+        lat, lon, alt = fence["breachReturn"]
+        point = _fence_item(len(items), d.MAV_CMD_NAV_FENCE_RETURN_POINT, 0.0, lat, lon, 1)
+        items.append(replace(point, frame=d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, z=float(alt)))
     return items
 
 
@@ -177,7 +182,10 @@ def load_plan(path: str | Path) -> dict[int, list[MissionItem]]:
         )
         for i, p in enumerate(plan.get("rallyPoints", {}).get("points", []))
     ]
-    fence = _fence_items(plan)
+    try:
+        fence = _fence_items(plan)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise PlanError(f"{path}: geoFence: {exc!r}") from None
     mission = _mission_items(plan, path)
     return {0: mission, 1: fence, 2: rally}
 
