@@ -92,10 +92,7 @@ def mission_load(
     lists = plan_or_exit(plan)
     for mission_type, items in lists.items():
         store.replace(mission_type, items)
-    counts = ", ".join(
-        f"{len(v)} {k}" for k, v in zip(("mission", "fence", "rally"), lists.values(), strict=False)
-    )
-    out.print(f"stored {counts} items from {plan}")
+    out.print(f"stored {_counts({t: len(items) for t, items in lists.items()})} items from {plan}")
 
 
 @mission_app.command("save")
@@ -103,9 +100,15 @@ def mission_save(
     plan: Annotated[Path, typer.Argument(help=".plan file to write")],
     config: Annotated[Path, CONFIG_OPT],
 ) -> None:
-    """Write the vehicle's stored mission and rally points as a .plan file."""
+    """Write the vehicle's stored mission, fence and rally points as a .plan file."""
     from companion.control.mission.plan import save_plan
 
     store = _mission_store(config)
-    save_plan(plan, store.items)
-    out.print(f"{len(store.items[0])} mission items written to {plan}")
+    written = save_plan(plan, store.items)
+    out.print(f"wrote {_counts(written)} items to {plan}")
+
+
+def _counts(by_type: dict[int, int]) -> str:
+    """``6 mission, 4 fence, 1 rally`` (by mission type 0, 1, 2)."""
+    names = {0: "mission", 1: "fence", 2: "rally"}
+    return ", ".join(f"{by_type.get(t, 0)} {name}" for t, name in names.items())

@@ -3,9 +3,11 @@
 A plan is JSON: ``mission.items`` (SimpleItems with command, frame, params[7],
 autoContinue; of the ComplexItems the fixed-wing landing pattern is expanded to the items
 QGroundControl uploads for it, the others are refused by name), ``geoFence`` (polygons
-with inclusion flags, circles, the breach return point) and ``rallyPoints.points``.
-Exported plans always carry ``geoFence`` and ``rallyPoints`` objects, which MAVSDK's
-importer requires.
+and circles with inclusion flags, the breach return point) and ``rallyPoints.points``.
+Exported plans hold all three as QGroundControl 4.4 writes them (it refuses a polygon
+without its ``version`` and ``inclusion``, a circle without ``inclusion``), so loading an
+exported plan stores the same items again; ``geoFence`` and ``rallyPoints`` are always
+there, which MAVSDK's importer requires.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+from companion.control.mission.fence import CIRCLES, POLYGONS
 from companion.control.mission.items import MissionItem, check_mission
 from mavlink_dialect import companion as d
 
@@ -191,7 +194,7 @@ def load_plan(path: str | Path) -> dict[int, list[MissionItem]]:
 
 
 def plan_json(items: dict[int, list[MissionItem]]) -> dict[str, Any]:
-    """A QGroundControl plan holding these items (fences and rally as items lists)."""
+    """A QGroundControl plan holding these items: mission, geofence and rally points."""
     mission = [
         {
             "type": "SimpleItem",
@@ -219,7 +222,7 @@ def plan_json(items: dict[int, list[MissionItem]]) -> dict[str, Any]:
             "plannedHomePosition": home,
             "items": mission,
         },
-        "geoFence": {"version": 2, "polygons": [], "circles": []},
+        "geoFence": _fence_json(items.get(1, [])),
         "rallyPoints": {"version": 2, "points": rally},
     }
 
@@ -230,9 +233,44 @@ def _export_params(it: MissionItem) -> list[float | None]:
     return [None if isinstance(v, float) and math.isnan(v) else v for v in values]
 
 
-def save_plan(path: str | Path, items: dict[int, list[MissionItem]]) -> None:
-    """Write a .plan file (fence items are not exported yet: only mission and rally)."""
-    Path(path).write_text(json.dumps(plan_json(items), indent=2))
+def _fence_json(items: list[MissionItem]) -> dict[str, Any]:
+    """``geoFence`` as QGroundControl 4.4 writes it; polygon vertices are grouped as the
+    vehicle's fence reads them (companion.control.mission.fence: the count in param1)."""
+    polygons: list[dict[str, Any]] = []
+    circles: list[dict[str, Any]] = []
+    fence: dict[str, Any] = {"version": 2, "polygons": polygons, "circles": circles}
+    i = 0
+    while i < len(items):
+        item = items[i]
+        if item.command in POLYGONS:
+            vertices = items[i : i + max(3, round(item.param1))]
+            points = [[v.x / 1e7, v.y / 1e7] for v in vertices]
+            polygons.append({"inclusion": POLYGONS[item.command], "version": 1, "polygon": points})
+            i += len(vertices)
+            continue
+        if item.command in CIRCLES:
+            circle = {"center": [item.x / 1e7, item.y / 1e7], "radius": item.param1}
+            circles.append({"inclusion": CIRCLES[item.command], "version": 1, "circle": circle})
+        elif item.command == d.MAV_CMD_NAV_FENCE_RETURN_POINT:
+            fence["breachReturn"] = [item.x / 1e7, item.y / 1e7, item.z]
+        i += 1
+    return fence
+
+
+def plan_counts(plan: dict[str, Any]) -> dict[int, int]:
+    """How many items of each mission type a plan written by ``plan_json`` holds."""
+    fence = plan["geoFence"]
+    vertices = sum(len(p["polygon"]) for p in fence["polygons"])
+    fenced = vertices + len(fence["circles"]) + ("breachReturn" in fence)
+    return {0: len(plan["mission"]["items"]), 1: fenced, 2: len(plan["rallyPoints"]["points"])}
+
+
+def save_plan(path: str | Path, items: dict[int, list[MissionItem]]) -> dict[int, int]:
+    """Write a .plan file with the mission, geofence and rally points; the count of each
+    written (by mission type)."""
+    plan = plan_json(items)
+    Path(path).write_text(json.dumps(plan, indent=2))
+    return plan_counts(plan)
 
 
 def checked_plan(path: str | Path) -> dict[int, list[MissionItem]]:

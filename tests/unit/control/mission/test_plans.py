@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from companion.control.mission.items import check_mission
+from companion.control.mission.items import MissionItem, check_mission
 from companion.control.mission.plan import PlanError, load_plan, save_plan
 from mavlink_dialect import companion as d
 from tests.support.configs import vehicle_config
@@ -83,3 +83,32 @@ def test_cli_load_and_save(tmp_path):
     )
     assert done.returncode == 0 and len(load_plan(saved)[0]) == len(load_plan(PLANS[0])[0])
     assert Path(tmp_path / "state" / "missions" / "mission.json").exists()
+
+
+def test_a_fence_uploaded_over_mavlink_is_saved_polygon_by_polygon(tmp_path):
+    """A ground station uploads fence items in its own order and frame: the saved plan
+    groups the vertices by the count each carries, as the vehicle's fence reads them."""
+    incl, excl = d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION, d.MAV_CMD_NAV_FENCE_CIRCLE_EXCLUSION
+    square = [(-379000000, 1451000000), (-378900000, 1451000000), (-378900000, 1451100000)]
+    triangle = [(-379500000, 1452000000), (-379400000, 1452000000), (-379400000, 1452100000)]
+    points = [*square, (-379100000, 1451500000), *triangle]
+    commands = [incl] * 3 + [excl] + [d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_EXCLUSION] * 3
+    fence = [
+        MissionItem(
+            s, d.MAV_FRAME_GLOBAL, cmd, 0, 1, 75.0 if cmd == excl else 3.0, 0, 0, 0, x, y, 0
+        )
+        for s, (cmd, (x, y)) in enumerate(zip(commands, points, strict=True))
+    ]
+    assert save_plan(tmp_path / "f.plan", {0: [], 1: fence, 2: []}) == {0: 0, 1: 7, 2: 0}
+    saved = json.loads((tmp_path / "f.plan").read_text())["geoFence"]
+    assert [(p["inclusion"], len(p["polygon"])) for p in saved["polygons"]] == [
+        (True, 3),
+        (False, 3),
+    ]
+    assert saved["circles"] == [
+        {"inclusion": False, "version": 1, "circle": {"center": [-37.91, 145.15], "radius": 75.0}}
+    ]
+    again = load_plan(tmp_path / "f.plan")[1]
+    assert sorted((i.command, i.x, i.y, i.param1) for i in again) == sorted(
+        (i.command, i.x, i.y, i.param1) for i in fence
+    )
