@@ -153,9 +153,12 @@ class ParamStore:
     def index_of(self, name: str) -> int:
         return self.names.index(name)
 
-    def plan(self, name: str, value: float) -> dict[str, float]:
+    def plan(
+        self, name: str, value: float, values: Mapping[str, float] | None = None
+    ) -> dict[str, float]:
         """The stored values a set would change (an alias's: its owners'); ParamError when
-        unknown, out of range or not something the owners can honour."""
+        unknown, out of range or not something the owners can honour. ``values``: the
+        stored values to plan against (a file's, before any is applied), else the store's."""
         decl = self.decls.get(name)
         if decl is None:
             raise ParamError(f"unknown parameter {name!r}")
@@ -164,7 +167,7 @@ class ParamStore:
         alias = self.aliases.get(name)
         if alias is None:
             return {name: float(value)}
-        updates = alias.plan(float(value), self.values)
+        updates = alias.plan(float(value), self.values if values is None else values)
         if isinstance(updates, str):
             raise ParamError(f"{name}: {updates}")
         for own, own_value in updates.items():
