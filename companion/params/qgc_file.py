@@ -1,10 +1,20 @@
-"""QGroundControl ``.params`` files: ``vehicle-id component-id name value type`` per line."""
+"""QGroundControl ``.params`` files: ``vehicle-id component-id name value type`` per line.
+
+A file lists every parameter the vehicle serves, so it lists an alias (a PX4 name such as
+RTL_RETURN_ALT, or RTL_DESCEND_ALT, which only reads RTL_ALT_M) beside the parameters it
+follows: ``save_params`` writes them all, as QGroundControl's "Save to file" and MAVProxy's
+``param save`` write every value the vehicle sent. Reading one back, the file's own
+values come first and each alias line is then read against them, not against the
+vehicle's values of the moment: a line that agrees with what it follows sets nothing
+more, one that contradicts it is refused, naming both.
+"""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
-from companion.params.store import ParamError, ParamStore
+from companion.params.store import ParamError, ParamStore, same_value
 
 MAV_PARAM_TYPE_REAL32 = 9
 
@@ -17,16 +27,16 @@ def save_params(store: ParamStore, path: Path, sysid: int = 1, compid: int = 1) 
     path.write_text("\n".join(lines) + "\n")
 
 
-def load_params(store: ParamStore, path: Path) -> int:
-    """Apply a .params file; ParamError names the line and parameter of the first bad line.
+@dataclass(frozen=True)
+class _Line:
+    lineno: int
+    name: str
+    value: float
 
-    Nothing is applied unless every line is good. A line at the parameter's default stores
-    nothing (the parameter keeps following its default), so a whole file written by
-    ``save_params`` stores only the values that differ. An alias's line sets the parameters it
-    stands for; two lines that would set one parameter to different values are an error.
-    """
-    updates: dict[str, tuple[float, str]] = {}  # stored name -> value, the line's name
-    count = 0
+
+def _lines(path: Path) -> list[_Line]:
+    """The file's parameter lines; ParamError names the first that is not one."""
+    lines = []
     for lineno, raw in enumerate(path.read_text().splitlines(), start=1):
         line = raw.strip()
         if not line or line.startswith("#"):
@@ -36,18 +46,95 @@ def load_params(store: ParamStore, path: Path) -> int:
             raise ParamError(f"{path}:{lineno}: expected 'sysid compid name value type'")
         name, text = fields[2], fields[3]
         try:
-            value = float(text)
+            lines.append(_Line(lineno, name, float(text)))
         except ValueError:
             raise ParamError(f"{path}:{lineno}: {name}: {text!r} is not a number") from None
+    return lines
+
+
+class _FilePlan:
+    """The stored values a file sets, each with the line that set it."""
+
+    def __init__(self, store: ParamStore, path: Path) -> None:
+        self.store, self.path = store, path
+        self.values = dict(store.values)  # the vehicle's, then the file's over them
+        self.set_by: dict[str, _Line] = {}
+
+    def error(self, line: _Line, text: str) -> ParamError:
+        return ParamError(f"{self.path}:{line.lineno}: {text}")
+
+    def own(self, line: _Line) -> None:
+        """A parameter of the vehicle's own: its value, checked."""
         try:
-            planned = store.plan(name, value)
+            self.store.plan(line.name, line.value)
         except ParamError as exc:
-            raise ParamError(f"{path}:{lineno}: {exc}") from None
-        for own, own_value in planned.items():
-            earlier = updates.get(own)
-            if earlier is not None and earlier[0] != own_value:
-                raise ParamError(f"{path}:{lineno}: {name} disagrees with {earlier[1]}")
-            updates[own] = (own_value, name)
-        count += 1
-    store.apply({own: own_value for own, (own_value, _) in updates.items()})
-    return count
+            raise self.error(line, str(exc)) from None
+        earlier = self.set_by.get(line.name)
+        if earlier is not None and not same_value(earlier.value, line.value):
+            raise self.error(line, f"{line.name} disagrees with line {earlier.lineno}")
+        self.values[line.name] = line.value
+        self.set_by[line.name] = line
+
+    def alias(self, line: _Line) -> bool:
+        """An alias, read against the file's values: nothing to do when it agrees (what it
+        follows was checked), its owners' values when it sets them; whether it changed any.
+        One that cannot be written is checked once the others have set what it reads."""
+        if self.agrees(line) or not self.store.aliases[line.name].writable:
+            return False
+        try:
+            planned = self.store.plan(line.name, line.value, self.values)
+        except ParamError as exc:
+            raise self.error(line, str(exc)) from None
+        for own, value in planned.items():
+            earlier = self.set_by.get(own, line)
+            if earlier is not line and not same_value(self.values[own], value):
+                raise self.contradiction(line, (own,))
+        self.values.update(planned)
+        self.set_by.update(dict.fromkeys(planned, line))
+        return bool(planned)
+
+    def agrees(self, line: _Line) -> bool:
+        """The alias of ``line`` reads its value from the file's values."""
+        return same_value(self.store.aliases[line.name].read(self.values), line.value)
+
+    def contradiction(self, line: _Line, owners: tuple[str, ...]) -> ParamError:
+        """``line``'s alias reads otherwise than the values it follows."""
+        sources = ", ".join(self.store.aliases[line.name].sources)
+        others = [o for o in owners if self.set_by.get(o, line) is not line]
+        owner = (others or [o for o in owners if o not in self.set_by] or list(owners))[0]
+        leader = self.set_by.get(owner)
+        if leader is None:
+            said = f"{owner} {self.values[owner]:g} (the vehicle's; not in the file)"
+        elif leader is line:
+            said = f"{owner} {self.values[owner]:g}"
+        else:
+            said = f"{leader.name} {leader.value:g} (line {leader.lineno})"
+        text = f"{line.name} {line.value:g} contradicts {said}: {line.name} follows {sources}"
+        return self.error(line, text)
+
+
+def load_params(store: ParamStore, path: Path) -> int:
+    """Apply a .params file; ParamError names the line and parameter of the first bad line.
+
+    Nothing is applied unless every line is good. A line at the parameter's default stores
+    nothing (the parameter keeps following its default), so a whole file written by
+    ``save_params`` stores only the values that differ. An alias's line that agrees with the
+    file's values of the parameters it follows sets nothing; one that does not sets them
+    (when the alias can be written and the file does not give them otherwise); a line that
+    contradicts another is an error naming both.
+    """
+    lines = _lines(path)
+    plan = _FilePlan(store, path)
+    for line in lines:
+        if line.name not in store.aliases:
+            plan.own(line)
+    followers = [line for line in lines if line.name in store.aliases]
+    for _ in range(len(followers) + 1):  # one alias may read what another sets
+        changed = [plan.alias(line) for line in followers]
+        if not any(changed):
+            break
+    for line in followers:
+        if not plan.agrees(line):
+            raise plan.contradiction(line, store.aliases[line.name].sources)
+    store.apply({own: plan.values[own] for own in plan.set_by})
+    return len(lines)

@@ -120,9 +120,34 @@ def test_a_params_file_sets_owners_through_aliases_and_refuses_disagreement(tmp_
     assert load_params(s, path) == 2
     assert s.get("RTL_ALT_M") == 300.0 and s.get("FS_ON") == 0.0
     path.write_text("1\t1\tRETURN_ALT\t400.0\t9\n1\t1\tRTL_ALT_M\t500.0\t9\n")
-    with pytest.raises(ParamError, match="RTL_ALT_M disagrees with RETURN_ALT"):
+    with pytest.raises(ParamError, match=r"v.params:1: RETURN_ALT 400 contradicts RTL_ALT_M 500"):
         load_params(s, path)
     assert s.get("RTL_ALT_M") == 300.0
+
+
+def test_a_params_file_is_read_against_its_own_values_not_the_vehicles(tmp_path):
+    s = store(tmp_path)
+    path = tmp_path / "v.params"
+    # Every name, as saved: the followers (SHOWN_ALT only reads RTL_ALT_M) agree with the
+    # file's values, in whatever order the lines come, and set nothing more.
+    lines = {"SHOWN_ALT": 300, "LOW_THR": 0.25, "CAP_MAH": 8000, "LOW_MAH": 2000, "RTL_ALT_M": 300}
+    path.write_text("".join(f"1\t1\t{n}\t{v}\t9\n" for n, v in lines.items()))
+    assert load_params(s, path) == 5
+    assert s.stored == {"RTL_ALT_M": 300.0, "CAP_MAH": 8000.0, "LOW_MAH": 2000.0}
+    # Aliases only: what one sets, the other reads (LOW_THR of the file's capacity).
+    path.write_text("1\t1\tLOW_THR\t0.5\t9\n1\t1\tSHOWN_ALT\t200\t9\n1\t1\tRETURN_ALT\t200\t9\n")
+    assert load_params(s, path) == 3 and s.get("RTL_ALT_M") == 200.0 and s.get("LOW_MAH") == 4000
+    path.write_text("1\t1\tRETURN_ALT\t250\t9\n1\t1\tSHOWN_ALT\t260\t9\n")
+    with pytest.raises(
+        ParamError, match=r":2: SHOWN_ALT 260 contradicts RETURN_ALT 250 \(line 1\)"
+    ):
+        load_params(s, path)
+    path.write_text("1\t1\tSHOWN_ALT\t260\t9\n")
+    with pytest.raises(
+        ParamError, match=r"SHOWN_ALT 260 contradicts RTL_ALT_M 200 \(the vehicle's"
+    ):
+        load_params(s, path)
+    assert s.get("RTL_ALT_M") == 200.0
 
 
 def test_one_owners_store_skips_the_other_owners_names_without_a_word(tmp_path, caplog):
