@@ -135,3 +135,13 @@ def client_vehicle(
         state_dir=state,
         **vehicle,
     )
+
+
+def shipped_config(name: str, directory: Path) -> Path:
+    """``companion/configs/NAME.toml`` copied into ``directory``, its state kept there
+    (``state/``): a shipped vehicle whose parameters a test may change."""
+    shipped = Path(__file__).resolve().parents[2] / "companion" / "configs" / f"{name}.toml"
+    state = f"[vehicle]\nstate_dir = {json.dumps(str(directory / 'state'))}\n"
+    config = directory / f"{name}.toml"
+    config.write_text(shipped.read_text().replace("[vehicle]\n", state, 1))
+    return config

@@ -5,7 +5,7 @@ from __future__ import annotations
 import subprocess
 import sys
 
-from tests.support.configs import FAKE_NAV, link, plugin, vehicle_config
+from tests.support.configs import FAKE_NAV, link, plugin, shipped_config, vehicle_config
 from tests.support.vehicle import REPO
 
 
@@ -61,6 +61,39 @@ def test_list_diff_set_and_reset_say_where_each_value_comes_from(tmp_path):
         "30",
         "default",
     ]
+
+
+def test_the_documented_round_trip_keeps_a_changed_return_altitude(tmp_path):
+    # docs/parameters.md: save, reset, load. The file lists RTL_DESCEND_ALT, which only
+    # reads RTL_ALT_M: loading it back was refused once RTL_RETURN_ALT had been changed.
+    config, saved = str(shipped_config("hil", tmp_path)), tmp_path / "x.params"
+    assert companion("params", "set", "RTL_RETURN_ALT", "120", "-c", config).returncode == 0
+    assert companion("params", "save", str(saved), "-c", config).returncode == 0
+    assert "RTL_DESCEND_ALT\t120.0" in saved.read_text()
+    assert companion("params", "reset", "-c", config).returncode == 0
+    loaded = companion("params", "load", str(saved), "-c", config)
+    assert loaded.returncode == 0, loaded.stderr
+    listed = rows(companion("params", "list", "-c", config).stdout)
+    assert listed["RTL_ALT_M"][:2] == ["120", "stored"]
+    assert listed["RTL_RETURN_ALT"][0] == listed["RTL_DESCEND_ALT"][0] == "120"
+
+
+def test_a_follower_contradicting_what_it_follows_is_refused_naming_both(tmp_path):
+    config, saved = str(shipped_config("hil", tmp_path)), tmp_path / "x.params"
+    companion("params", "set", "RTL_RETURN_ALT", "120", "-c", config)
+    companion("params", "save", str(saved), "-c", config)
+    companion("params", "reset", "-c", config)
+    text = saved.read_text()
+    for edited, said in (
+        ("RTL_DESCEND_ALT\t100", "RTL_DESCEND_ALT 100 contradicts RTL_ALT_M 120"),
+        ("RTL_RETURN_ALT\t90", "RTL_RETURN_ALT 90 contradicts RTL_ALT_M 120"),
+    ):
+        saved.write_text(text.replace(edited.split("\t")[0] + "\t120.0", edited))
+        refused = companion("params", "load", str(saved), "-c", config)
+        assert refused.returncode == 2 and said in refused.stderr, refused.stderr
+        assert "follows RTL_ALT_M" in refused.stderr
+    diff = companion("params", "diff", "-c", config).stdout.strip()
+    assert diff == "every parameter at its default", "nothing applied from a refused file"
 
 
 def rows(listing: str) -> dict[str, list[str]]:
