@@ -56,11 +56,14 @@ def _imu(row: dict[str, str], t_us: int) -> Imu:
 
 
 def _gps(row: dict[str, str], t_us: int) -> GpsFix:
-    lat, lon = _f(row, "lat"), _f(row, "lon")
-    if math.isnan(lat) or math.isnan(lon) or abs(lat) > 90 or abs(lon) > 180:
+    """A fix, or a receiver's sample without one (``fix`` 0 or 1: its position may be
+    empty, as a driver publishes it; the navigators skip it). A fix needs a position."""
+    lat, lon, fix = _f(row, "lat"), _f(row, "lon"), _f(row, "fix")
+    fix_type = 3 if math.isnan(fix) else max(0, min(6, round(fix)))
+    has_fix = fix_type >= 2
+    if (has_fix and (math.isnan(lat) or math.isnan(lon))) or abs(lat) > 90 or abs(lon) > 180:
         raise ValueError("gps row needs lat in [-90, 90] and lon in [-180, 180]")
     vn, ve = _f(row, "vn"), _f(row, "ve")
-    fix = _f(row, "fix")
     msg = GpsFix(t_us=t_us, lat_deg=lat, lon_deg=lon, alt_msl_m=_f(row, "alt_m"))
     msg.vn_m_s, msg.ve_m_s, msg.vd_m_s = vn, ve, _f(row, "vd")
     msg.ground_speed_m_s = math.hypot(vn, ve)
@@ -68,7 +71,7 @@ def _gps(row: dict[str, str], t_us: int) -> GpsFix:
     msg.hdop, msg.vdop = _f(row, "hdop"), math.nan
     msg.eph_m = msg.hdop * 2.5 if not math.isnan(msg.hdop) else math.nan  # UERE-style estimate
     msg.epv_m = math.nan
-    msg.fix_type = 3 if math.isnan(fix) else max(0, min(6, round(fix)))
+    msg.fix_type = fix_type
     msg.satellites = 255
     return msg
 

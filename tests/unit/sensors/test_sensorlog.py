@@ -70,3 +70,36 @@ def test_a_file_that_is_not_a_log_is_refused(tmp_path):
     path = write(tmp_path, "1,2", header="a,b")
     with pytest.raises(ValueError, match="not a sensor log"):
         list(read_sensor_log(path))
+
+
+def test_a_gps_sample_without_a_fix_is_read_as_one(tmp_path, caplog):
+    # What `companion log` writes of a receiver without a fix (a driver publishes its
+    # samples with fix 0/1 and no position): read, not refused; the navigators skip it.
+    path = write(
+        tmp_path,
+        "149.94,gps,,,,,,,,,,,,,1,,,,,,,,",
+        "149.96,gps,,,,,,,,,,,,,0,,,,,,,,",
+        "150.00,gps,,,,,,,-37.9105,145.134,120.5,10,0,,1,0.9,,,,,,,",
+    )
+    stats = LogStats()
+    fixes = list(read_sensor_log(path, stats))
+    assert stats.bad == 0 and "skipped" not in caplog.text
+    assert [f.fix_type for f in fixes] == [1, 0, 1]
+    assert math.isnan(fixes[0].lat_deg) and math.isnan(fixes[1].lon_deg)
+    assert fixes[2].lat_deg == -37.9105
+
+
+def test_a_fix_without_a_possible_position_is_still_refused(tmp_path, caplog):
+    path = write(
+        tmp_path,
+        "1.0,gps,,,,,,,,,,,,,3,0.9,,,,,,,",  # a 3-D fix with no position
+        "1.2,gps,,,,,,,-37.9,,120,,,,2,,,,,,,,",  # 2-D, no longitude
+        "1.4,gps,,,,,,,95.0,145.1,10,0,0,,3,1,,,,,,,",  # impossible latitude
+        "1.6,gps,,,,,,,-37.9,181.0,10,0,0,,1,1,,,,,,,",  # no fix says it, the value is wrong
+        "1.8,gps,,,,,,,,,,,,,,,,,,,,,",  # no fix column: a fix, as older logs meant
+        "2.0,gps,,,,,,,nan,145.1,10,0,0,,3,1,,,,,,,",
+    )
+    stats = LogStats()
+    assert list(read_sensor_log(path, stats)) == []
+    assert stats.bad == 6 and stats.rows == 6
+    assert caplog.text.count("skipped: gps row needs lat") == 6
