@@ -42,6 +42,7 @@ HEADER = [
     "heading_deg",
     "pitch_deg",
     "roll_deg",
+    "vd_std",
 ]
 
 # kind → topic, then CSV column → (ULog field, scale)
@@ -66,6 +67,7 @@ COLUMNS: dict[str, tuple[str, dict[str, tuple[str, float]]]] = {
             "vn": ("vn_m_s", 1.0),
             "ve": ("ve_m_s", 1.0),
             "vd": ("vd_m_s", 1.0),
+            "vd_std": ("vd_std_m_s", 1.0),
             "fix": ("fix_type", 1.0),
             "hdop": ("hdop", 1.0),
         },

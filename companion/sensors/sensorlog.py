@@ -1,9 +1,10 @@
 """The recorded sensor log (CSV) of the design: read it into bus messages.
 
 Header ``t,kind,ax,ay,az,gx,gy,gz,lat,lon,alt_m,vn,ve,vd,fix,hdop,mx,my,mz,baro_alt_m,
-heading_deg,pitch_deg,roll_deg``; columns are found by name and absent ones are empty
-(older files stop at ``baro_alt_m``). A row that cannot be read is counted and skipped
-with a warning naming its line; it never stops the reading.
+heading_deg,pitch_deg,roll_deg`` and optionally ``vd_std`` (which ``companion log`` adds);
+columns are found by name and absent ones are empty (older files stop at ``baro_alt_m``).
+A row that cannot be read is counted and skipped with a warning naming its line; it never
+stops the reading.
 """
 
 from __future__ import annotations
@@ -66,6 +67,8 @@ def _gps(row: dict[str, str], t_us: int) -> GpsFix:
     vn, ve = _f(row, "vn"), _f(row, "ve")
     msg = GpsFix(t_us=t_us, lat_deg=lat, lon_deg=lon, alt_msl_m=_f(row, "alt_m"))
     msg.vn_m_s, msg.ve_m_s, msg.vd_m_s = vn, ve, _f(row, "vd")
+    vd_std = _f(row, "vd_std")  # the receiver's 1-sigma of vd; empty or absent: unknown
+    msg.vd_std_m_s = vd_std if math.isfinite(vd_std) and vd_std > 0 else math.nan
     msg.ground_speed_m_s = math.hypot(vn, ve)
     msg.course_rad = math.atan2(ve, vn) % (2 * math.pi) if msg.ground_speed_m_s > 0.5 else math.nan
     msg.hdop, msg.vdop = _f(row, "hdop"), math.nan

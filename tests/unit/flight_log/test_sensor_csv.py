@@ -10,7 +10,7 @@ from pathlib import Path
 
 from companion.flight_log import ULogWriter, topic_name
 from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
-from companion.sensors.sensorlog import read_sensor_log
+from companion.sensors.sensorlog import LogStats, read_sensor_log
 from tests.support.vehicle import REPO
 
 KINDS = {
@@ -34,7 +34,10 @@ def _samples(rng: random.Random) -> list[tuple[str, object]]:
         if i % 20 == 0:
             fix = GpsFix(t_us=t, lat_deg=-37.9 + rng.uniform(-0.01, 0.01), lon_deg=145.1)
             fix.alt_msl_m, fix.vn_m_s, fix.ve_m_s, fix.vd_m_s = 100.0, 20.0, 3.0, -1.0
-            fix.hdop, fix.fix_type = 0.9, 3
+            fix.hdop, fix.fix_type, fix.vd_std_m_s = 0.9, 3, 1.5
+            if i % 60 == 40:  # a receiver without a fix, as a driver publishes it
+                fix.lat_deg = fix.lon_deg = fix.alt_msl_m = fix.hdop = math.nan
+                fix.fix_type, fix.vd_std_m_s = 1, math.nan
             out.append(("sensors/gps", fix))
     return out
 
@@ -56,7 +59,9 @@ def test_a_flight_log_converts_to_the_sensor_log_replay_reads(tmp_path: Path) ->
     )
     assert done.returncode == 0, done.stderr
     assert f"{len(samples)} sensor rows" in done.stdout
-    back = list(read_sensor_log(csv_path))
+    stats = LogStats()
+    back = list(read_sensor_log(csv_path, stats))
+    assert stats.bad == 0  # no-fix samples included
     assert [m.t_us for m in back] == sorted(m.t_us for _, m in samples)  # in time order
     # Within a time stamp the kinds come in a fixed order, so compare kind by kind.
     back.sort(key=lambda m: (type(m).__name__, m.t_us))
@@ -67,9 +72,9 @@ def test_a_flight_log_converts_to_the_sensor_log_replay_reads(tmp_path: Path) ->
             keys = ("ax_m_s2", "ay_m_s2", "az_m_s2", "gx_rad_s", "gy_rad_s", "gz_rad_s")
             assert [getattr(got, k) for k in keys] == [getattr(want, k) for k in keys]
         elif isinstance(want, GpsFix):
-            keys = ("lat_deg", "lon_deg", "alt_msl_m", "vn_m_s", "ve_m_s", "vd_m_s", "hdop")
-            assert [getattr(got, k) for k in keys] == [getattr(want, k) for k in keys]
-            assert got.fix_type == 3
+            keys = ("lat_deg", "lon_deg", "alt_msl_m", "vn_m_s", "ve_m_s", "vd_m_s", "hdop",
+                    "vd_std_m_s", "fix_type")  # fmt: skip
+            assert str([getattr(got, k) for k in keys]) == str([getattr(want, k) for k in keys])
         elif isinstance(want, Compass):
             assert math.isclose(got.heading_rad, want.heading_rad, abs_tol=1e-12)
             assert math.isclose(got.pitch_rad, 0.1) and math.isclose(got.roll_rad, -0.2)
