@@ -18,6 +18,8 @@ from typing import Any, TextIO
 
 from pyulog import ULog
 
+from companion.navigation.sample_order import FEED_ORDER
+
 HEADER = [
     "t",
     "kind",
@@ -108,9 +110,12 @@ def _rows(ulog: ULog, kind: str) -> Iterator[tuple[int, list[str]]]:
 
 
 def sensor_log_rows(path: str | Path) -> Iterator[list[str]]:
-    """The sensor rows of a ULog file, oldest first (a kind's own order kept on ties)."""
+    """The sensor rows of a ULog file, oldest first; at equal times in the order the
+    navigator reads its inputs in, as a replay of the ULog itself feeds them (a kind's own
+    order kept)."""
     ulog = ULog(str(path), [topic for topic, _ in COLUMNS.values()])
-    streams: list[Any] = [_rows(ulog, kind) for kind in COLUMNS]
+    kinds = sorted(COLUMNS, key=lambda kind: FEED_ORDER.index(f"sensors/{kind}"))
+    streams: list[Any] = [_rows(ulog, kind) for kind in kinds]
     for _t, row in heapq.merge(*streams, key=lambda item: item[0]):
         yield row
 

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from companion.flight_log import ULogWriter, topic_name
 from companion.messages import Baro, Compass, GpsFix, Imu, Magnetometer
+from companion.navigation.sample_order import FEED_ORDER
 from companion.sensors.sensorlog import LogStats, read_sensor_log
 from tests.support.vehicle import REPO
 
@@ -63,6 +64,9 @@ def test_a_flight_log_converts_to_the_sensor_log_replay_reads(tmp_path: Path) ->
     back = list(read_sensor_log(csv_path, stats))
     assert stats.bad == 0  # no-fix samples included
     assert [m.t_us for m in back] == sorted(m.t_us for _, m in samples)  # in time order
+    # At equal times in the order nav.ins_ekf feeds them (and a replay of the ULog does).
+    rank = {KINDS[c]: i for i, c in enumerate(FEED_ORDER)}
+    assert [(m.t_us, rank[type(m)]) for m in back] == sorted((m.t_us, rank[type(m)]) for m in back)
     # Within a time stamp the kinds come in a fixed order, so compare kind by kind.
     back.sort(key=lambda m: (type(m).__name__, m.t_us))
     samples.sort(key=lambda s: (type(s[1]).__name__, s[1].t_us))  # type: ignore[attr-defined]
