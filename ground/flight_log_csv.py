@@ -2,9 +2,11 @@
 
 The sensor topics (``sensors_imu``, ``sensors_gps``, ``sensors_mag``, ``sensors_baro``,
 ``sensors_compass``) become rows of their kind in time order; values are written with
-``repr`` so a float comes back to the same bits. The compass heading is written as the
-vehicle logged it (its driver may already have made it true: replay with
-``--declination 0`` then).
+``repr`` so a float comes back to the same bits. Compass headings are written magnetic, as
+the format has them: the declination the vehicle's navigator was set to (its compass
+driver made them true with it) is taken off, and ``companion replay --declination`` with
+that value puts it back (``replay_options`` says which options replay the CSV with the
+settings the vehicle flew with).
 """
 
 from __future__ import annotations
@@ -94,7 +96,7 @@ def _text(value: float) -> str:
     return "" if math.isnan(value) else repr(value)
 
 
-def _rows(ulog: ULog, kind: str) -> Iterator[tuple[int, list[str]]]:
+def _rows(ulog: ULog, kind: str, offsets: dict[str, float]) -> Iterator[tuple[int, list[str]]]:
     topic, columns = COLUMNS[kind]
     try:
         data = ulog.get_dataset(topic).data
@@ -105,17 +107,46 @@ def _rows(ulog: ULog, kind: str) -> Iterator[tuple[int, list[str]]]:
         row["t"], row["kind"] = repr(int(t_us) / 1e6), kind
         for column, (field, scale) in columns.items():
             value = float(data[field][i])
-            row[column] = str(int(value)) if column == "fix" else _text(value * scale)
+            if column == "fix":
+                row[column] = str(int(value))
+            else:
+                row[column] = _text(value * scale - offsets.get(column, 0.0))
         yield int(t_us), [row[c] for c in HEADER]
+
+
+def logged_settings(ulog: ULog) -> dict[str, str]:
+    """The navigator's settings a replay takes from the log's INFO, as logged (exact
+    decimal text): ``declination_deg`` and ``gps_delay_s`` when set (not NaN)."""
+    found = {}
+    for name in ("declination_deg", "gps_delay_s"):
+        text = str(ulog.msg_info_dict.get(f"nav.{name}", "nan"))
+        try:
+            number = float(text)
+        except ValueError:
+            continue
+        if math.isfinite(number):
+            found[name] = text
+    return found
+
+
+def replay_options(path: str | Path) -> list[str]:
+    """The options that make ``companion replay`` of the CSV run the navigator with the
+    settings the ULog's replay takes from its INFO."""
+    settings = logged_settings(ULog(str(path), []))
+    flags = {"declination_deg": "--declination", "gps_delay_s": "--gps-delay"}
+    return [item for name, text in settings.items() for item in (flags[name], text)]
 
 
 def sensor_log_rows(path: str | Path) -> Iterator[list[str]]:
     """The sensor rows of a ULog file, oldest first; at equal times in the order the
     navigator reads its inputs in, as a replay of the ULog itself feeds them (a kind's own
-    order kept)."""
+    order kept). Compass headings are written magnetic: a vehicle with a declination set
+    (INFO ``nav.declination_deg``) made them true, so that declination is taken off again."""
     ulog = ULog(str(path), [topic for topic, _ in COLUMNS.values()])
+    declination = float(logged_settings(ulog).get("declination_deg", 0.0))
+    offsets = {"heading_deg": declination} if declination else {}
     kinds = sorted(COLUMNS, key=lambda kind: FEED_ORDER.index(f"sensors/{kind}"))
-    streams: list[Any] = [_rows(ulog, kind) for kind in kinds]
+    streams: list[Any] = [_rows(ulog, kind, offsets) for kind in kinds]
     for _t, row in heapq.merge(*streams, key=lambda item: item[0]):
         yield row
 

@@ -23,7 +23,7 @@ def log(
     """Convert an on-board ULog flight log to the sensor log CSV `companion replay` reads
     (and, with --estimate, the vehicle's own navigation estimate)."""
     require_ground_extra("log", "pyulog")
-    from ground.flight_log_csv import write_sensor_log
+    from ground.flight_log_csv import replay_options, write_sensor_log
 
     if not ulog.is_file():
         err.print(f"[red]no such log: {ulog}[/red]")
@@ -31,6 +31,7 @@ def log(
     try:
         with out_path.open("w", newline="") as handle:
             rows = write_sensor_log(ulog, handle)
+        options = replay_options(ulog)
         if estimate is not None:
             from ground.replay.flight_log import write_flight_estimate
 
@@ -41,3 +42,9 @@ def log(
         err.print(f"[red]cannot convert {ulog}: {exc}[/red]")
         raise typer.Exit(EXIT_CONFIG) from None
     out.print(f"{rows} sensor rows written to {out_path}")
+    if options:  # the navigator's settings were in the log's INFO, the CSV has no place
+        out.print(
+            f"replay it with the settings flown: companion replay {out_path} {' '.join(options)}",
+            highlight=False,
+            soft_wrap=True,
+        )

@@ -28,6 +28,7 @@ def test_a_flown_ulog_replays_near_the_flight_estimate(tmp_path):
     proc, namespace, _ = start_sim(
         tmp_path, f"udpout://127.0.0.1:{port}", "--plan", str(REPO / "qgc_plans/square.plan"),
         "--duration", f"{DURATION_S:g}", "--start-at", f"{START_AT_S:g}", "--exact",
+        "--gps-outage", "20:4",  # the receiver's samples without a fix are logged too
     )  # fmt: skip
     out = finish(proc, namespace, 240)
     # --exact: one file from start-up, through the arming, to the end.
@@ -80,6 +81,46 @@ def test_a_flown_ulog_replays_near_the_flight_estimate(tmp_path):
     nav = ulog.get_dataset("nav_state").data
     valid = int((nav["flags"] & int(NavFlags.POSITION_VALID) != 0).sum())
     assert len(in_flight["t"]) == valid > 20 * (DURATION_S - 10)
+    _assert_csv_replays_as_the_ulog(sensors, estimate, result.stdout, said, tmp_path)
+
+
+def _replay_figures(said: str) -> tuple[str, str]:
+    """The rows refused and the innovation rejections a replay printed."""
+    bad = re.search(r"\((\d+) bad\)", said)
+    rejections = re.search(r"innovation rejections: GPS (\d+), heading (\d+)", said)
+    assert bad and rejections, said
+    return bad.group(1), rejections.group(0)
+
+
+def _assert_csv_replays_as_the_ulog(sensors, from_ulog, log_said, ulog_said, tmp_path) -> None:
+    """The flight converted by `companion log`, the outage's no-fix samples included,
+    replays with the options it printed to the very solutions of the ULog."""
+    rows = [line.split(",") for line in sensors.read_text().splitlines()]
+    fix = rows[0].index("fix")
+    assert any(r[1] == "gps" and r[fix] in ("0", "1") for r in rows), "no no-fix sample"
+    said = " ".join(log_said.split())
+    options = said.split(f"companion replay {sensors} ", 1)[1].split()
+    assert options == ["--declination", "11.7", "--gps-delay", "0.1"], said  # sim.toml's
+    out = tmp_path / "from_csv.csv"
+    # A CSV's replay publishes on its own grid (from the first sample, at the first sample
+    # past each tick), the ULog's on the plug-in's: at the IMU's 100 Hz nearly every instant
+    # the ULog's replay published is among the CSV's (not those after a gap in the IMU).
+    result = subprocess.run(
+        [sys.executable, "-m", "companion", "replay", str(sensors), "--out", str(out),
+         *options, "--rate", "100"],
+        cwd=REPO, capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    csv_said = " ".join(result.stdout.split())
+    assert _replay_figures(csv_said) == ("0", _replay_figures(ulog_said)[1]), csv_said
+    a, b = from_ulog.read_text().splitlines(), out.read_text().splitlines()
+    assert a[0] == b[0]
+    by_time: dict[str, str] = {}
+    for row in b[1:]:
+        by_time.setdefault(row.split(",", 1)[0], row)
+    common = [row for row in a[1:] if row.split(",", 1)[0] in by_time]
+    assert len(common) > 0.95 * (len(a) - 1), (len(common), len(a))
+    assert [by_time[row.split(",", 1)[0]] for row in common] == common  # to the last digit
 
 
 def _assert_replays_to_rounding(flight, out) -> None:

@@ -60,6 +60,7 @@ def test_a_flight_log_converts_to_the_sensor_log_replay_reads(tmp_path: Path) ->
     )
     assert done.returncode == 0, done.stderr
     assert f"{len(samples)} sensor rows" in done.stdout
+    assert "replay it with" not in done.stdout  # no navigator settings in this log's INFO
     stats = LogStats()
     back = list(read_sensor_log(csv_path, stats))
     assert stats.bad == 0  # no-fix samples included
