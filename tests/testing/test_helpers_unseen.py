@@ -40,7 +40,9 @@ class GcsScript(threading.Thread):
                 self.conn.mav.heartbeat_send(d.MAV_TYPE_GCS, d.MAV_AUTOPILOT_INVALID, 0, 0, 0)
                 next_beat = time.monotonic() + 1.0
             msg = self.conn.recv_match(blocking=True, timeout=0.1)
-            if msg is None or msg.get_type() == "BAD_DATA":
+            # pymavlink's own dialect lacks the vehicle's PLUGIN_HEALTH and NAV_STATUS: it
+            # hands them over as UNKNOWN_<id>, with no header, so from "system 0".
+            if msg is None or msg.get_type() == "BAD_DATA" or msg.get_type().startswith("UNK"):
                 continue
             source = (msg.get_srcSystem(), msg.get_srcComponent())
             self.heard[source[0]] = self.heard.get(source[0], 0) + 1
