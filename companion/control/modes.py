@@ -35,14 +35,25 @@ Altitude = ALTITUDE_HOLD, Position = CRUISE: the track held against the wind; QG
 4.4.5 shows it as "Cruise"); our Hold is automatic, not MAVLink's pilot-driven ORBIT
 (which QGroundControl would also rename "Orbit").
 
+Reporting MAV_AUTOPILOT_GENERIC (the link's ``autopilot = "generic"``, for MAVProxy), the
+vehicle numbers its modes as ArduPlane does, both ways: pymavlink names a generic fixed
+wing's custom_mode from ArduPlane's table (mavutil.mode_string_v10, mode_mapping), so the
+HEARTBEAT, CURRENT_MODE and AVAILABLE_MODES carry ``ModeInfo.generic`` (MAVProxy's prompt
+then reads LOITER>, AUTO>, RTL>) and a main mode alone is ArduPlane's. Each ArduPlane mode
+is the vehicle mode that flies as it does (``_ARDUPLANE``): CIRCLE (a circle where it is)
+is Loiter, STABILIZE and FBWA (wings levelled when the sticks are released) Stabilized,
+FBWB Altitude, CRUISE (heading and height held) Position, AUTOLAND Land; TRAINING,
+AUTOTUNE, AVOID_ADSB, THERMAL, INITIALISING and the quadplane modes have no counterpart and
+are refused. Rattitude, which ArduPlane lacks, is reported as GENERIC_RATTITUDE, a number
+outside ArduPlane's table (MAVProxy shows "Mode(100)" rather than another mode's name).
+
 ``decode_set_mode`` reads DO_SET_MODE / SET_MODE in either encoding:
 1. a full 32-bit PX4 custom_mode (≥ 65536) → PX4;
 2. a sub mode (param3) → PX4 main/sub (MAVSDK, pymavlink for PX4);
 3. reporting PX4, a main mode alone → PX4 (ArduPlane's number if PX4 has no such mode,
    except PX4's Offboard, 6, which is refused rather than read as ArduPlane's FBWB);
-4. otherwise ArduPlane's numbers (MAVProxy's ``mode AUTO``: 10), except 1 and 7, which are
-   PX4's MANUAL and STABILIZED as MAVSDK sends them (ArduPlane's CIRCLE and CRUISE, which
-   we do not fly, lose out);
+4. reporting generic, a main mode alone → ArduPlane's number (MAVProxy's ``mode AUTO``:
+   10; ``mode CIRCLE``: 1, not PX4's MANUAL);
 5. without the custom-mode flag, base_mode's AUTO/GUIDED/STABILIZE/MANUAL bits.
 """
 
@@ -87,6 +98,15 @@ class ModeInfo:
     user_selectable: bool = True
 
     @property
+    def generic(self) -> int:
+        """Its custom_mode reporting MAV_AUTOPILOT_GENERIC: ArduPlane's number."""
+        return GENERIC_RATTITUDE if self.arduplane == NO_ARDUPLANE else self.arduplane
+
+    def custom_mode(self, px4: bool) -> int:
+        """Its custom_mode reporting PX4 (``px4``) or generic."""
+        return self.px4 if px4 else self.generic
+
+    @property
     def pilot(self) -> bool:
         """Flown from the pilot's sticks (the receiver's, else the joystick's)."""
         return bool(self.base_flags & d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED)
@@ -97,6 +117,7 @@ _STAB = d.MAV_MODE_FLAG_STABILIZE_ENABLED
 _NONE = d.MAV_STANDARD_MODE_NON_STANDARD
 _PILOT = d.MAV_MODE_FLAG_MANUAL_INPUT_ENABLED
 NO_ARDUPLANE = -1  # ArduPlane has no such mode: a switch position cannot select it
+GENERIC_RATTITUDE = 100  # Rattitude's number reporting generic: not one of ArduPlane's
 MODES: tuple[ModeInfo, ...] = (
     ModeInfo(FlightMode.MANUAL, "Manual", px4_custom_mode(PX4_MAIN_MANUAL), 0,
              _NONE, _PILOT),
@@ -129,9 +150,10 @@ MODES: tuple[ModeInfo, ...] = (
 BY_MODE = {m.mode: m for m in MODES}
 PILOT_MODES = frozenset(m.mode for m in MODES if m.pilot)
 _ARDUPLANE = {m.arduplane: m.mode for m in MODES if m.arduplane != NO_ARDUPLANE} | {
-    1: FlightMode.LOITER,
-    2: FlightMode.STABILIZED,
+    1: FlightMode.LOITER,  # CIRCLE: circles where it is, as our Loiter
+    2: FlightMode.STABILIZED,  # STABILIZE: levels the wings when the sticks are released
 }
+_GENERIC = _ARDUPLANE | {GENERIC_RATTITUDE: FlightMode.RATTITUDE}
 _PX4 = {m.px4: m.mode for m in MODES}
 _STANDARD = {m.standard: m.mode for m in MODES if m.standard != d.MAV_STANDARD_MODE_NON_STANDARD}
 _STANDARD[d.MAV_STANDARD_MODE_ORBIT] = FlightMode.LOITER  # the nearest we fly
@@ -153,11 +175,16 @@ def decode_set_mode(
         return _from_base_flags(base_mode)
     if custom >= 1 << 16:
         return from_px4((custom >> 16) & 0xFF, (custom >> 24) & 0xFF)
-    if sub or reporting_px4 or custom in (PX4_MAIN_MANUAL, PX4_MAIN_STABILIZED):
+    if sub or reporting_px4:
         mode = from_px4(custom, sub)
         if mode is not None or sub or (reporting_px4 and custom == PX4_MAIN_OFFBOARD):
             return mode
-    return _ARDUPLANE.get(custom)
+    return _ARDUPLANE.get(custom) if reporting_px4 else _GENERIC.get(custom)
+
+
+def from_generic(custom_mode: int) -> FlightMode | None:
+    """The mode a generic-reporting heartbeat's custom_mode names (ArduPlane's number)."""
+    return _GENERIC.get(custom_mode)
 
 
 def from_standard(standard_mode: int) -> FlightMode | None:

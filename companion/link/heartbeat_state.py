@@ -22,14 +22,17 @@ COMMANDER_WAIT_S = 5.0  # its status comes at 3 Hz armed, 1 Hz on the ground
 class HeartbeatFollower:
     """Keeps a VehicleState as the bus says, from the commander's status and the health."""
 
-    def __init__(self, state: VehicleState, commander: bool, now_s: float) -> None:
+    def __init__(
+        self, state: VehicleState, commander: bool, now_s: float, px4: bool = True
+    ) -> None:
         self.state = state
         self.commander = commander
+        self.px4 = px4  # PX4's custom_mode packing, else ArduPlane's numbers (generic)
         self.started_s = now_s
         # Without a commander, the mode shown is the one a commander would start in.
         self.assumed: FlightMode | None = None if commander else INITIAL_MODE
         state.known = not commander
-        state.custom_mode, state.mode_flags = heartbeat_mode(None, self.assumed)
+        state.custom_mode, state.mode_flags = heartbeat_mode(None, self.assumed, px4)
 
     def update(
         self, status: VehicleStatus | None, health: SystemHealth | None, now_s: float
@@ -42,7 +45,7 @@ class HeartbeatFollower:
             or not self.commander
             or now_s - self.started_s >= COMMANDER_WAIT_S  # then: no known mode, said so
         )
-        custom, flags = heartbeat_mode(status, self.assumed)
+        custom, flags = heartbeat_mode(status, self.assumed, self.px4)
         changed = custom != state.custom_mode and status is not None
         state.custom_mode, state.mode_flags = custom, flags
         # Armed as the execution control says; until its table is read (once a second), as

@@ -6,6 +6,8 @@ sequence number never changes because the set of modes never does. Until the com
 has spoken, the mode reported is the ``assumed`` one: the commander's initial mode on a
 vehicle without a commander, none (no CURRENT_MODE, an unknown custom mode) where a
 commander runs, since a link restarted in flight would otherwise announce a false mode.
+Every custom_mode is in the reported autopilot's numbering (``px4``: PX4's packing, else
+ArduPlane's numbers, ``companion.control.modes``).
 """
 
 from __future__ import annotations
@@ -29,22 +31,28 @@ def _info(status: VehicleStatus | None, assumed: FlightMode | None) -> ModeInfo 
 
 
 def heartbeat_mode(
-    status: VehicleStatus | None, assumed: FlightMode | None = INITIAL_MODE
+    status: VehicleStatus | None, assumed: FlightMode | None = INITIAL_MODE, px4: bool = True
 ) -> tuple[int, int]:
     """(custom_mode, extra base_mode flags) for the heartbeat; (0, 0) for no known mode."""
     info = _info(status, assumed)
-    return (info.px4, info.base_flags) if info else (0, 0)
+    return (info.custom_mode(px4), info.base_flags) if info else (0, 0)
 
 
 def current_mode(
-    mav: Any, status: VehicleStatus | None, assumed: FlightMode | None = INITIAL_MODE
+    mav: Any,
+    status: VehicleStatus | None,
+    assumed: FlightMode | None = INITIAL_MODE,
+    px4: bool = True,
 ) -> Any:
     """CURRENT_MODE (the ``assumed`` mode before the commander has spoken; None for none)."""
     info = _info(status, assumed)
-    return None if info is None else mav.current_mode_encode(info.standard, info.px4, info.px4)
+    if info is None:
+        return None
+    custom = info.custom_mode(px4)
+    return mav.current_mode_encode(info.standard, custom, custom)
 
 
-def available_modes(mav: Any, index: int) -> list[Any]:
+def available_modes(mav: Any, index: int, px4: bool = True) -> list[Any]:
     """AVAILABLE_MODES: every mode for index 0, else the one at that 1-based index."""
     chosen = range(1, len(MODES) + 1) if index == 0 else [index]
     out = []
@@ -55,7 +63,7 @@ def available_modes(mav: Any, index: int) -> list[Any]:
         props = 0 if info.user_selectable else d.MAV_MODE_PROPERTY_NOT_USER_SELECTABLE
         out.append(
             mav.available_modes_encode(
-                len(MODES), i, info.standard, info.px4, props, info.name.encode()
+                len(MODES), i, info.standard, info.custom_mode(px4), props, info.name.encode()
             )
         )
     return out

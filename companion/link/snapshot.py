@@ -67,6 +67,7 @@ class Snapshot:
     prearm_ok: bool | None = None  # the pre-arm checks pass (None: not judged yet)
     # The mode shown before the commander has spoken (None: none, where a commander runs).
     assumed_mode: FlightMode | None = INITIAL_MODE
+    px4_modes: bool = True  # custom_mode in PX4's packing, else ArduPlane's numbers
 
 
 # Snapshot field -> the bus channel it holds: what the link reads for its streams.

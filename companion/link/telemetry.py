@@ -286,7 +286,7 @@ STREAMS: dict[int, Stream] = {
             "CURRENT_MODE",
             d.MAVLINK_MSG_ID_CURRENT_MODE,
             0.5,
-            lambda m, s: current_mode(m, s.status, s.assumed_mode),
+            lambda m, s: current_mode(m, s.status, s.assumed_mode, s.px4_modes),
         ),
         Stream(
             "AVAILABLE_MODES_MONITOR",

@@ -24,7 +24,7 @@ os.environ.setdefault("MAVLINK20", "1")
 from pymavlink import mavutil
 
 from companion.control.mission.plan import load_plan
-from companion.control.modes import from_px4
+from companion.control.modes import from_generic, from_px4
 from companion.messages import FlightMode
 from mavlink_dialect import companion as d
 
@@ -121,9 +121,12 @@ class Watcher:
         return ack
 
     def mode(self, msg: Any) -> FlightMode | None:
-        """The vehicle's mode in a HEARTBEAT of its autopilot (PX4's custom_mode packing)."""
+        """The vehicle's mode in a HEARTBEAT of its autopilot (PX4's custom_mode packing,
+        ArduPlane's numbers when it reports generic)."""
         if msg.get_type() != "HEARTBEAT" or msg.get_srcComponent() != 1:
             return None
+        if msg.autopilot == d.MAV_AUTOPILOT_GENERIC:
+            return from_generic(msg.custom_mode)
         return from_px4((msg.custom_mode >> 16) & 0xFF, (msg.custom_mode >> 24) & 0xFF)
 
     def upload_plan(self, plan: str | Path, timeout_s: float = 30.0) -> dict[int, int]:

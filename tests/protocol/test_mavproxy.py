@@ -112,7 +112,8 @@ def test_mavproxy_switches_modes_auto_rtl_loiter(vehicle_factory, tmp_path):
     port = free_udp_port()
     # MAVProxy's `mode NAME` passes pymavlink's PX4 mode tuple where a number belongs
     # (mavproxy_mode.cmd_mode → set_mode_px4), so a PX4-reporting vehicle cannot be switched
-    # by name: MAVProxy users set the link's autopilot to "generic" (ArduPlane mode numbers).
+    # by name: MAVProxy users set the link's autopilot to "generic" (ArduPlane mode numbers,
+    # both ways: MAVProxy names the heartbeat's mode, "Mode LOITER" and the prompt LOITER>).
     endpoint = f"udpin://127.0.0.1:{port}"
     vehicle = vehicle_factory(client_vehicle(endpoint, tmp_path / "state", autopilot="generic"))
     status = vehicle.bus.latest_reader("vehicle/status")
@@ -128,11 +129,16 @@ def test_mavproxy_switches_modes_auto_rtl_loiter(vehicle_factory, tmp_path):
         for command, mode in (
             ("mode AUTO", FlightMode.MISSION),
             ("mode RTL", FlightMode.RTL),
+            ("mode CRUISE", FlightMode.POSITION),  # had been taken for PX4's Stabilized (7)
             ("mode LOITER", FlightMode.LOITER),
         ):
             mavproxy.type(command)
             wait_for(lambda m=mode: status.get().mode == m, 10, command)
             seen.append(FlightMode(status.get().mode))
+            name = command.split()[1]
+            said = f"Mode {name}"  # MAVProxy's word on the heartbeat's new mode
+            wait_for(lambda s=said: any(s in x for x in mavproxy.lines), 10, said)
     finally:
-        mavproxy.close()
-    assert seen == [FlightMode.MISSION, FlightMode.RTL, FlightMode.LOITER]
+        output = mavproxy.close()
+    assert seen == [FlightMode.MISSION, FlightMode.RTL, FlightMode.POSITION, FlightMode.LOITER]
+    assert "LOITER>" in output and "Mode(" not in output, output

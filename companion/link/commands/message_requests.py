@@ -44,7 +44,8 @@ class MessageRequests:
         if msg_id == d.MAVLINK_MSG_ID_PROTOCOL_VERSION:
             return Outcome(extra=[self.identity.protocol_version()])
         if msg_id == d.MAVLINK_MSG_ID_AVAILABLE_MODES:
-            modes = available_modes(self.mav, whole_or(args.params[1], 0))
+            px4 = self.identity.autopilot == d.MAV_AUTOPILOT_PX4
+            modes = available_modes(self.mav, whole_or(args.params[1], 0), px4)
             return Outcome(extra=modes) if modes else Outcome(d.MAV_RESULT_DENIED)
         if self.metadata is not None and msg_id in METADATA_MESSAGES:
             time_boot_ms = self.port.snapshot.time_boot_ms

@@ -137,11 +137,11 @@ class MavlinkLink(Plugin):
         self.endpoints = open_endpoints(ctx.settings["endpoints"])
         autopilot = AUTOPILOTS[ctx.settings["autopilot"]]
         self.identity = IdentityService(self.mav, sysid, autopilot, CAPABILITIES)
-        # Where a commander runs, the heartbeat waits for its status (heartbeat_state).
-        commander = COMMANDER in ctx.plugins
-        self.heartbeat = HeartbeatFollower(self.identity.state, commander, time.monotonic())
+        # The heartbeat waits for a commander's status; modes PX4's or ArduPlane's numbers.
+        px4, commander = autopilot == d.MAV_AUTOPILOT_PX4, COMMANDER in ctx.plugins
+        self.heartbeat = HeartbeatFollower(self.identity.state, commander, time.monotonic(), px4)
         self.commands = CommandService(self.mav, sysid, ctx.settings["compid"])
-        self.snapshot = Snapshot(assumed_mode=self.heartbeat.assumed)
+        self.snapshot = Snapshot(assumed_mode=self.heartbeat.assumed, px4_modes=px4)
         self.devices = DeviceWatch(ctx.plugins)  # silent or garbled devices refuse arming
         self.boot_us = ctx.clock.now_us()
         bus = ctx.bus
@@ -285,7 +285,7 @@ class MavlinkLink(Plugin):
         s.unix_us = time.time_ns() // 1000
         if self.heartbeat.update(s.status, s.health, time.monotonic()):
             # A change of mode is announced at once, not at the stream's next turn.
-            msg = current_mode(self.mav, s.status)
+            msg = current_mode(self.mav, s.status, px4=s.px4_modes)
             if msg is not None:
                 self.router.send([Outgoing(msg, None)], time.monotonic())
 
