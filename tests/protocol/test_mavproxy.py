@@ -142,3 +142,35 @@ def test_mavproxy_switches_modes_auto_rtl_loiter(vehicle_factory, tmp_path):
         output = mavproxy.close()
     assert seen == [FlightMode.MISSION, FlightMode.RTL, FlightMode.POSITION, FlightMode.LOITER]
     assert "LOITER>" in output and "Mode(" not in output, output
+
+
+@pytest.mark.timeout(120)
+def test_mavproxy_wp_save_writes_the_items_from_seq_0_and_they_load_back(vehicle_factory, tmp_path):
+    # No home item (as PX4 and MAVLink's GENERIC): seq 0 is the first item to fly, so a file
+    # without ArduPilot's home line is what `wp save` writes and `wp load` sends back.
+    port = free_udp_port()
+    endpoint = f"udpin://127.0.0.1:{port}"
+    vehicle = vehicle_factory(client_vehicle(endpoint, tmp_path / "state", autopilot="generic"))
+    vehicle.wait_running("link")
+    wp, saved = tmp_path / "wp.txt", tmp_path / "saved.txt"
+    wp.write_text(WAYPOINTS)
+    mission = tmp_path / "state" / "missions" / "mission.json"
+    mavproxy = MavProxy(port, tmp_path)
+    try:
+        mavproxy.connected(vehicle)
+        mavproxy.type(f"wp load {wp}")
+        wait_for(mission.exists, 20, "the uploaded mission stored")
+        mavproxy.type("wp list")
+        wait_for(lambda: any("Requesting 3 waypoints" in x for x in mavproxy.lines), 20, "list")
+        time.sleep(2.0)
+        mavproxy.type(f"wp save {saved}")
+        wait_for(saved.exists, 20, "wp save")
+    finally:
+        mavproxy.close()
+    rows = [line.split("\t") for line in saved.read_text().splitlines()[1:]]
+    sent = [line.split("\t") for line in WAYPOINTS.splitlines()[1:]]
+
+    def key(row: list[str]) -> tuple:
+        return int(row[0]), int(row[3]), *(round(float(v), 6) for v in row[8:11])
+
+    assert [key(r) for r in rows] == [key(s) for s in sent]
