@@ -99,6 +99,8 @@ RULES: dict[int, tuple[Param, ...]] = {
     d.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES: (),
     d.MAV_CMD_SET_MESSAGE_INTERVAL: (MSG_ID, Param(2, "interval", -1, MAX_INTERVAL_US)),
     d.MAV_CMD_GET_MESSAGE_INTERVAL: (MSG_ID,),
+    d.MAV_CMD_GET_HOME_POSITION: (),
+    d.MAV_CMD_REQUEST_PROTOCOL_VERSION: (),
     d.MAV_CMD_DO_SET_MODE: (
         Param(1, "base mode", 0, 255, whole=True),
         Param(2, "custom mode", 0, 2**32 - 1, optional=True, whole=True),

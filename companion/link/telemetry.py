@@ -190,8 +190,9 @@ def _home_position(mav: Any, s: Snapshot) -> Any:
     lat, lon, alt = s.home
     q = [1.0, 0.0, 0.0, 0.0]
     return mav.home_position_encode(
-        _int32(lat * 1e7), _int32(lon * 1e7), _int32(alt * 1000), 0, 0, 0, q, 0, 0, 0
-    )
+        _int32(lat * 1e7), _int32(lon * 1e7), _int32(alt * 1000), 0, 0, 0, q, 0, 0, 0,
+        s.time_boot_ms * 1000,  # time since boot, as PX4 stamps it
+    )  # fmt: skip
 
 
 def _u32(x: int) -> int:

@@ -16,7 +16,8 @@ METADATA_MESSAGES = (d.MAVLINK_MSG_ID_COMPONENT_METADATA, d.MAVLINK_MSG_ID_COMPO
 
 
 class MessageRequests:
-    """REQUEST_MESSAGE, REQUEST_AUTOPILOT_CAPABILITIES, SET_ and GET_MESSAGE_INTERVAL."""
+    """REQUEST_MESSAGE, REQUEST_AUTOPILOT_CAPABILITIES, SET_ and GET_MESSAGE_INTERVAL, and
+    the older one-message requests GET_HOME_POSITION and REQUEST_PROTOCOL_VERSION."""
 
     def __init__(
         self,
@@ -36,6 +37,8 @@ class MessageRequests:
         service.register(d.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES, self.capabilities)
         service.register(d.MAV_CMD_SET_MESSAGE_INTERVAL, self.set_interval)
         service.register(d.MAV_CMD_GET_MESSAGE_INTERVAL, self.get_interval)
+        service.register(d.MAV_CMD_GET_HOME_POSITION, self.home_position)
+        service.register(d.MAV_CMD_REQUEST_PROTOCOL_VERSION, self.protocol_version)
 
     def request_message(self, args: CommandArgs) -> Outcome:
         msg_id = round(args.params[0])
@@ -58,6 +61,18 @@ class MessageRequests:
                 return Outcome(d.MAV_RESULT_TEMPORARILY_REJECTED)
             return Outcome(extra=[msg])
         return Outcome(d.MAV_RESULT_UNSUPPORTED)
+
+    def home_position(self, args: CommandArgs) -> Outcome:
+        """As REQUEST_MESSAGE for HOME_POSITION (deprecated for it, still sent by MAVProxy
+        and older scripts): the ack, then the message; TEMPORARILY_REJECTED before a home."""
+        msg = STREAMS[d.MAVLINK_MSG_ID_HOME_POSITION].build(self.mav, self.port.snapshot)
+        if msg is None:
+            return Outcome(d.MAV_RESULT_TEMPORARILY_REJECTED)
+        return Outcome(extra=[msg])
+
+    def protocol_version(self, args: CommandArgs) -> Outcome:
+        """As REQUEST_MESSAGE for PROTOCOL_VERSION: MAVLink 2 spoken."""
+        return Outcome(extra=[self.identity.protocol_version()])
 
     def capabilities(self, args: CommandArgs) -> Outcome:
         return Outcome(extra=[self.identity.autopilot_version()])

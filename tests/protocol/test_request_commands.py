@@ -1,0 +1,54 @@
+"""The older one-message requests, as MAVProxy and scripts still send them: the command's
+own ack, then the message (as REQUEST_MESSAGE for it gives)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from pymavlink.dialects.v20 import common as m
+
+from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.support.configs import client_vehicle
+from tests.support.plugins import FakeNav
+from tests.support.vehicle import wait_for
+
+
+@pytest.fixture
+def station(vehicle_factory, tmp_path):
+    port = free_udp_port()
+    vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path))
+    gcs = GroundStation(port)
+    gcs.connect()
+    yield gcs
+    gcs.close()
+
+
+def _home(gcs: GroundStation):
+    gcs.command(m.MAV_CMD_GET_HOME_POSITION)
+    if gcs.ack(m.MAV_CMD_GET_HOME_POSITION).result != m.MAV_RESULT_ACCEPTED:
+        return None  # no home yet: TEMPORARILY_REJECTED
+    return gcs.recv("HOME_POSITION")
+
+
+def test_get_home_position_sends_home_with_the_vehicles_time(station):
+    home = wait_for(lambda: _home(station), 10, "HOME_POSITION after GET_HOME_POSITION")
+    assert (home.latitude, home.longitude) == (round(FakeNav.LAT * 1e7), round(FakeNav.LON * 1e7))
+    assert home.time_usec > 0  # time since boot, as PX4 stamps it (it was 0)
+    later = _home(station)
+    assert later is not None and later.time_usec > home.time_usec
+
+
+def test_request_protocol_version_is_acked_and_answered(station):
+    station.command(m.MAV_CMD_REQUEST_PROTOCOL_VERSION, 1)  # param1 1, as the spec asks
+    assert station.ack(m.MAV_CMD_REQUEST_PROTOCOL_VERSION).result == m.MAV_RESULT_ACCEPTED
+    version = station.recv("PROTOCOL_VERSION")
+    assert (version.version, version.min_version, version.max_version) == (200, 100, 200)
+
+
+def test_hostile_parameters_of_the_requests_change_nothing(station):
+    """Neither reads a parameter: NaN and infinity in them are ignored, answered once."""
+    for command in (m.MAV_CMD_GET_HOME_POSITION, m.MAV_CMD_REQUEST_PROTOCOL_VERSION):
+        station.command(command, math.nan, math.inf, -math.inf)
+        ack = station.ack(command)
+        assert ack.result in (m.MAV_RESULT_ACCEPTED, m.MAV_RESULT_TEMPORARILY_REJECTED)
