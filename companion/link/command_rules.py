@@ -116,6 +116,10 @@ RULES: dict[int, tuple[Param, ...]] = {
         Param(2, "last item", 0, 65535, optional=True, whole=True),
     ),
     d.MAV_CMD_NAV_RETURN_TO_LAUNCH: (),
+    d.MAV_CMD_DO_SET_MISSION_CURRENT: (
+        Param(1, "item", -1, 65535, whole=True),
+        Param(2, "reset", 0, 1, optional=True, whole=True),
+    ),
     d.MAV_CMD_DO_GO_AROUND: (Param(1, "altitude", -MAX_ALT_M, MAX_ALT_M, optional=True),),
     d.MAV_CMD_DO_REPOSITION: (
         Param(1, "ground speed", -1, 1000, optional=True),

@@ -43,7 +43,9 @@ class Outcome:
     """What a handler decided: a final result, or a deferral keyed by a bus sequence."""
 
     result: int = d.MAV_RESULT_ACCEPTED
-    extra: list[Any] = field(default_factory=list)  # messages to send after the ack
+    # Messages to send after the ack: to the sender, or as an Outgoing to whom it names
+    # (None: every ground station, for news such as a new MISSION_CURRENT or PARAM_VALUE).
+    extra: list[Any] = field(default_factory=list)
     defer_seq: int | None = None
     timeout_s: float = 3.0
 
@@ -157,7 +159,8 @@ class CommandService:
             self._done[key] = (now_s, None)
             return []
         self._done[key] = (now_s, outcome.result)
-        return [self.ack(args, outcome.result)] + [Outgoing(m, peer) for m in outcome.extra]
+        extra = [m if isinstance(m, Outgoing) else Outgoing(m, peer) for m in outcome.extra]
+        return [self.ack(args, outcome.result), *extra]
 
     def _run(self, handler: Handler, args: CommandArgs) -> Outcome:
         reason = self.check(args) if self.check is not None else None

@@ -19,6 +19,7 @@ from companion.control.mission.items import MISSION_TYPES, MissionItem, check_mi
 from companion.control.mission.mission_files import MissionStore
 from companion.control.prearm import PlanVerdicts
 from companion.link.microservice import Outgoing, Peer
+from companion.link.snapshot import Snapshot
 from companion.messages import MissionState
 from mavlink_dialect import companion as d
 
@@ -198,10 +199,17 @@ class MissionService:
             )
         return [Outgoing(msg, peer)]
 
+    def set_current(self, seq: int) -> bool:
+        """Make item ``seq`` the current one (MISSION_SET_CURRENT, DO_SET_MISSION_CURRENT);
+        False, nothing changed, when the mission has no such item."""
+        if not 0 <= seq < len(self.store.items[0]):
+            return False
+        self.current = seq
+        self._changed(0)
+        return True
+
     def _set_current(self, seq: int, peer: Peer) -> list[Outgoing]:
-        if 0 <= seq < len(self.store.items[0]):
-            self.current = seq
-            self._changed(0)
+        if self.set_current(seq):
             return [Outgoing(self.mission_current(), None)]  # news for every ground station
         # No such item: the unchanged item to the sender only, as a refused PARAM_SET is
         # answered; a flood of them on one link must not crowd telemetry off the others.
@@ -221,6 +229,11 @@ class MissionService:
         if mission_type == 0:
             self.completed = self.paused = False
         self.on_change(mission_type)
+
+    def describe(self, s: Snapshot) -> None:
+        """The stored plans as the telemetry tells of them (MISSION_CURRENT)."""
+        s.mission_seq, s.mission_total = self.current, len(self.store.items[0])
+        s.mission_completed, s.mission_paused = self.completed, self.paused
 
     def mission_current(self) -> Any:
         return mission_current_message(self.mav, self.current, len(self.store.items[0]))

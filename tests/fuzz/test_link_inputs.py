@@ -52,7 +52,10 @@ def command_service() -> Iterator[tuple[CommandService, RecordingVehicle]]:
     service = CommandService(mav, 1, 1)
     vehicle = RecordingVehicle()
     params = ParamsService(mav, ParamStore(IMU_CAL_PARAMS), 1, 1)  # the IMU's calibration
-    register_commands(service, vehicle, identity, router, None, params)
+    missions = MissionService(mav, MissionStore(None), 1, 1)  # three items, in memory
+    waypoint = MissionItem(0, 3, d.MAV_CMD_NAV_WAYPOINT, 0, 1, 0, 0, 0, 0, 0, 0, 50.0)
+    missions.store.replace(0, [waypoint, waypoint, waypoint])
+    register_commands(service, vehicle, identity, router, None, params, missions)
     try:
         yield service, vehicle
     finally:

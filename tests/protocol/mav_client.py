@@ -15,7 +15,7 @@ from mavlink_dialect import companion as d
 from mavlink_dialect import companion as dialect
 from tests.support.configs import FAKE_NAV, link, plugin, vehicle_config
 
-__all__ = ["GroundStation", "free_udp_port", "two_stations", "upload_mission"]
+__all__ = ["GroundStation", "answer", "free_udp_port", "two_stations", "upload_mission"]
 
 
 class GroundStation:
@@ -64,6 +64,25 @@ class GroundStation:
 
     def close(self) -> None:
         self.conn.close()
+
+
+def answer(
+    gcs: GroundStation, command: int, *params: float, target=(1, 1), timeout_s: float = 15.0
+) -> tuple[Any, str]:
+    """Send a command; its COMMAND_ACK and the text of the STATUSTEXTs that came with it,
+    chunks joined (a refusal's reason goes out just before the ack, as ArduPilot's)."""
+    gcs.command(command, *params, target=target)
+    texts: list[str] = []
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        msg = gcs.conn.recv_match(type=["COMMAND_ACK", "STATUSTEXT"], blocking=True, timeout=0.2)
+        if msg is None:
+            continue
+        if msg.get_type() == "STATUSTEXT":
+            texts.append(msg.text)
+        elif msg.command == command:
+            return msg, "".join(texts)
+    raise AssertionError(f"no COMMAND_ACK for {command} within {timeout_s} s")
 
 
 def upload_mission(gcs: GroundStation) -> None:

@@ -14,12 +14,14 @@ from companion.link.command_service import CommandService
 from companion.link.commands.arming import ArmingCommands
 from companion.link.commands.calibration import CalibrationCommands
 from companion.link.commands.message_requests import MessageRequests
+from companion.link.commands.mission_commands import MissionCommands
 from companion.link.commands.mode_commands import ModeCommands
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
 from companion.link.commands.storage import StorageCommands
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
 from companion.link.metadata_service import MetadataService
+from companion.link.mission_service import MissionService
 from companion.link.params_service import ParamsService
 
 __all__ = [
@@ -27,6 +29,7 @@ __all__ = [
     "ArmingCommands",
     "CalibrationCommands",
     "MessageRequests",
+    "MissionCommands",
     "ModeCommands",
     "StorageCommands",
     "VehiclePort",
@@ -41,6 +44,7 @@ def register_commands(
     router: LinkRouter,
     metadata: MetadataService | None = None,
     params: ParamsService | None = None,
+    missions: MissionService | None = None,
 ) -> None:
     """Register every supported MAV_CMD with ``service``, behind the parameter rules (the
     sensor calibrations when there are parameters to keep their results). A command
@@ -50,6 +54,8 @@ def register_commands(
     ArmingCommands(port).register(service)
     ModeCommands(port, identity.autopilot).register(service)
     MessageRequests(port, identity, router, metadata).register(service)
+    if missions is not None:
+        MissionCommands(port, missions).register(service)
     if params is not None:
         calibration = Calibration(port, params)
         CalibrationCommands(port, calibration).register(service)

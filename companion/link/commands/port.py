@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any, Protocol
 
 from companion.link.codec import dialect as d
+from companion.link.command_service import CommandService, Outcome
 from companion.link.snapshot import Snapshot
 
 # How long a command handed to another plug-in waits for its answer: a busy machine may
@@ -46,6 +47,23 @@ class VehiclePort(Protocol):
     def simulated(self) -> bool:
         """Whether the vehicle runs on the simulator's clock."""
         ...
+
+
+def refuse(port: VehiclePort, service: CommandService | None, text: str) -> Outcome:
+    """DENIED, said and counted as a broken parameter rule is (at most a few texts a
+    second: a flood of refused commands must not flood every link with texts)."""
+    if service is None:
+        port.statustext(text)
+    else:
+        service.refused += 1
+        service.on_refusal(text)
+    return Outcome(d.MAV_RESULT_DENIED)
+
+
+def flying(port: VehiclePort) -> bool:
+    """Whether the flight controller runs and says the aircraft is off the ground."""
+    control = port.snapshot.control
+    return control is not None and not control.landed
 
 
 def armed(port: VehiclePort) -> bool:

@@ -169,8 +169,9 @@ class MavlinkLink(Plugin):
         self._serve_missions(ctx, sysid)
         self._serve_logs(ctx, sysid)
         register_commands(
-            self.commands, self, self.identity, self.router, self.metadata, self._params_service
-        )
+            self.commands, self, self.identity, self.router, self.metadata, self._params_service,
+            self.missions,
+        )  # fmt: skip
         self.commands.on_refusal = self.refusal_text
         # Woken by an ack, a text, a change of mode or arming (announced at once), and a
         # navigation state when a stream carrying it is due.
@@ -278,9 +279,7 @@ class MavlinkLink(Plugin):
             armed = s.health is not None and bool(s.health.flight_running)
             checks = self.param("ARMING_CHECK") >= 0.5
             s.prearm_ok = armed or not checks or not self.prearm_failures()
-        s.mission_seq = self.missions.current
-        s.mission_total = len(self.missions.store.items[0])
-        s.mission_completed, s.mission_paused = self.missions.completed, self.missions.paused
+        self.missions.describe(s)
         s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
         s.unix_us = time.time_ns() // 1000
         if self.heartbeat.update(s.status, s.health, time.monotonic()):

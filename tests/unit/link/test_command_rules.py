@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from companion.control.mission.mission_files import MissionStore
 from companion.link.codec import new_encoder
 from companion.link.command_rules import RULES, refusal
 from companion.link.command_service import CommandArgs, CommandService, Outcome
@@ -12,6 +13,7 @@ from companion.link.endpoints import open_endpoint
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
 from companion.link.microservice import Peer
+from companion.link.mission_service import MissionService
 from companion.link.params_service import ParamsService
 from companion.params import ParamStore
 from companion.sensors.imu_calibration import IMU_CAL_PARAMS
@@ -30,7 +32,8 @@ def linked_service() -> CommandService:
         router = LinkRouter(mav, [endpoint], [], None)
         service = CommandService(mav, 1, 1)
         params = ParamsService(mav, ParamStore(IMU_CAL_PARAMS), 1, 1)
-        register_commands(service, RecordingVehicle(), identity, router, None, params)
+        missions = MissionService(mav, MissionStore(None), 1, 1)  # in memory
+        register_commands(service, RecordingVehicle(), identity, router, None, params, missions)
     finally:
         endpoint.close()
     return service
