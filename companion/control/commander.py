@@ -68,6 +68,7 @@ MODE_COMMANDS = frozenset(
         CommandId.TAKEOFF,
         CommandId.ORBIT,
         CommandId.GO_AROUND,
+        CommandId.CHANGE_SPEED,
     }
 )
 # Commands that fly a mode a fixed wing cannot fly from the runway.
@@ -103,6 +104,7 @@ class Commander:
         self.changes = 0
         self.position: tuple[float, float, float] | None = None
         self.go_arounds = 0
+        self.speed = math.nan  # DO_CHANGE_SPEED's airspeed (NaN: none), as PX4's navigator
         self.land_phase = 0  # the flight controller's, from its status
         self.landed = False  # armed and the flight controller says it stands on the ground
         self.rejected_nav = 0  # solutions whose "valid" position was not a place
@@ -127,6 +129,8 @@ class Commander:
         """Arming sets home where the aircraft is (the place it will return to)."""
         if armed and not self.armed and self.position is not None:
             self.home = self.position
+        if not armed:
+            self.speed = math.nan  # the flight is over: the next flies the cruise airspeed
         self.armed = armed
 
     def handle(self, cmd: VehicleCommand) -> Decision | None:
@@ -154,6 +158,8 @@ class Commander:
             return self._takeoff(p[2])
         if kind == CommandId.SET_HOME:
             return self._set_home(p)
+        if kind == CommandId.CHANGE_SPEED:
+            return self._change_speed(p[0])
         if kind == CommandId.GO_AROUND:
             if self.land_phase not in LANDING_PHASES:
                 return Decision(CommandResult.DENIED, "Go around: not landing")
@@ -216,6 +222,14 @@ class Commander:
             self.target = (math.nan, math.nan, alt)
         return decision
 
+    def _change_speed(self, speed: float) -> Decision:
+        """Fly ``speed`` m/s airspeed (NaN: the default again) until the mode changes (the
+        link has checked it against the airframe's limits, the controller bounds it)."""
+        if not (math.isnan(speed) or (math.isfinite(speed) and speed > 0)):
+            return Decision(CommandResult.DENIED, f"Change speed: {speed:g} m/s")
+        self.speed = speed
+        return ACCEPTED
+
     def failsafe(self, mode: FlightMode) -> Decision:
         """A failsafe's mode change (Return, or Loiter where the aircraft is)."""
         return self._enter(mode)
@@ -237,6 +251,12 @@ class Commander:
             self.target, self.radius = target, radius
         else:
             self.target, self.radius = NO_POINT, math.nan
+        # A speed asked for holds in its mode (PX4's navigator resets it on a change of mode
+        # but for the loiter a take-off ends in).
+        if mode != self.mode and not (
+            self.mode == FlightMode.TAKEOFF and mode == FlightMode.LOITER
+        ):
+            self.speed = math.nan
         # Every accepted command counts, not only a change of mode: a second go-to in
         # Guided is a new target the controller must turn to.
         self.changes += 1
@@ -293,7 +313,7 @@ class Commander:
         msg.target_lat_deg, msg.target_lon_deg, msg.target_alt_msl_m = self.target
         msg.target_radius_m = self.radius
         msg.mission_first, msg.changes = self.mission_first, self.changes
-        msg.go_arounds = self.go_arounds
+        msg.go_arounds, msg.speed_m_s = self.go_arounds, self.speed
         return msg
 
 

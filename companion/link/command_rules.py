@@ -120,6 +120,11 @@ RULES: dict[int, tuple[Param, ...]] = {
         Param(1, "item", -1, 65535, whole=True),
         Param(2, "reset", 0, 1, optional=True, whole=True),
     ),
+    d.MAV_CMD_DO_CHANGE_SPEED: (
+        Param(1, "speed type", 0, 3, whole=True),
+        Param(2, "speed", -2, 1000),  # -1 no change, -2 the default; m/s
+        Param(3, "throttle", -2, 100, optional=True),  # -1 no change, -2 the default; %
+    ),
     d.MAV_CMD_DO_GO_AROUND: (Param(1, "altitude", -MAX_ALT_M, MAX_ALT_M, optional=True),),
     d.MAV_CMD_DO_REPOSITION: (
         Param(1, "ground speed", -1, 1000, optional=True),

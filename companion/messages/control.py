@@ -52,6 +52,7 @@ class CommandId(enum.IntEnum):
     TAKEOFF = 11  # param3 = alt_msl_m to climb to (NaN: the default height)
     ORBIT = 12  # param1..4 = lat_deg, lon_deg, alt_msl_m, radius_m (NaN: here / default)
     GO_AROUND = 13  # abort the landing in progress: climb out and come round again
+    CHANGE_SPEED = 14  # param1 = airspeed_m_s to fly (NaN: back to the cruise airspeed)
 
 
 class CommandResult(enum.IntEnum):
@@ -127,6 +128,9 @@ class VehicleStatus(Message):
         ("mission_first", ctypes.c_int32),  # MISSION: the item to start from
         ("changes", ctypes.c_uint32),  # accepted mode commands since start (new target too)
         ("go_arounds", ctypes.c_uint32),  # go-arounds ordered since start
+        # DO_CHANGE_SPEED's airspeed until the mode changes or the flight ends (NaN or 0:
+        # none, the cruise airspeed or the mission's own speed).
+        ("speed_m_s", ctypes.c_double),
     ]
 
 

@@ -18,6 +18,7 @@ from companion.control.flight.landing_flight import LandingFlight, MissionRef, M
 from companion.control.flight.mode_targets import arrive, mode_target
 from companion.control.flight.output import ControlOutput
 from companion.control.flight.pilot_flight import PilotFlight
+from companion.control.flight.speed_demand import CommandedSpeed, speed_demand
 from companion.control.flight.takeoff import RunwayTakeoff
 from companion.control.inputs import nav_usable, rates_or_zero, status_usable, sticks_usable
 from companion.control.laws.attitude import AttitudeController
@@ -61,6 +62,7 @@ class FlightController:
         self.takeoff: RunwayTakeoff | None = None
         self.go_arounds: int | None = None  # the commander's count when last seen
         self.landed: bool | None = None
+        self.speed = CommandedSpeed()  # DO_CHANGE_SPEED's, from the status
         self.rejected = 0  # steps whose inputs were not usable (last good output kept)
         self._last_out = ControlOutput()
         self._last_t: float | None = None
@@ -143,6 +145,7 @@ class FlightController:
             out.throttle = self.config["TRIM_THROTTLE"] if not self.landed else 0.0
             return out
         setpoint = self._dead_reckoning(self._setpoint(mode, status, pos, nav, t_s, out), pos, nav)
+        self.speed.follow(status.speed_m_s, self.executor)
         if setpoint is None:
             self.attitude.reset()
             return out  # on the ground with nothing that flies from there: idle
@@ -338,13 +341,9 @@ class FlightController:
     ) -> ControlOutput:  # fmt: skip
         """Fly ``sp`` by the energy controller and the line guidance (or at ``roll_dem``)."""
         cfg = self.config
-        speed_dem = sp.speed if math.isfinite(sp.speed) else cfg["AIRSPEED_CRUISE"]
-        if sp.approach:  # slowed and configured before the final: no speed left to lose on it
-            speed_dem = least_speed = cfg["TECS_LAND_ARSPD"]
+        speed_dem, speed_min = speed_demand(sp, self.speed.value, cfg.values, least_speed)
+        if sp.approach:
             out.flaps = landing_flaps(cfg.values)
-        # The landing approach alone may fly slower than AIRSPEED_MIN.
-        speed_min = min(cfg["AIRSPEED_MIN"], least_speed)
-        speed_dem = max(speed_min, min(cfg["AIRSPEED_MAX"], speed_dem))
         lateral = self._lateral(sp, pos, vel, dt)
         if not math.isfinite(roll_dem):
             roll_dem = bank_for(lateral.lat_acc, cfg.bank_limit(speed_dem))

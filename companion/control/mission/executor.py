@@ -23,6 +23,7 @@ from companion.control.mission.items import (
     MAX_JUMPS_PER_STEP,
     SKIPPED,
     MissionItem,
+    change_speed,
     next_flown,
 )
 from companion.control.mission.leg_geometry import CircleProgress, past_point, tangent_angle
@@ -176,8 +177,8 @@ class MissionExecutor:
     def _item(self, item: MissionItem, pos: Point, alt: float, t_s: float) -> Setpoint | None:
         """The setpoint of ``item``, or None when it is done (and the next is current)."""
         cmd = item.command
-        if cmd == d.MAV_CMD_DO_CHANGE_SPEED:
-            self.speed = item.param2 if item.param2 > 0 else math.nan
+        if cmd == d.MAV_CMD_DO_CHANGE_SPEED:  # an airspeed or ground speed; -1: no change
+            self.speed = change_speed(item, self.speed)
             self._advance(False, self._prev, self._prev_alt)
             return None
         if cmd == d.MAV_CMD_DO_JUMP:

@@ -129,6 +129,15 @@ class MissionItem:
         return self.param2 if self.param2 > 0 else default_m
 
 
+def change_speed(item: MissionItem, speed: float) -> float:
+    """The speed flown after a DO_CHANGE_SPEED item (NaN: the default): param2 m/s for an
+    airspeed or a ground speed (param1 0 or 1, both flown as the airspeed, as PX4 does),
+    the default again for -2 or 0; -1, and climb or descent speeds (2, 3), change nothing."""
+    if item.param1 not in (0.0, 1.0) or item.param2 == -1:
+        return speed
+    return item.param2 if item.param2 > 0 else math.nan
+
+
 def check_params(item: MissionItem) -> int:
     """INVALID_PARAMn for a parameter that is infinite, huge, or NaN where a number is read."""
     needed = NEEDS_NUMBER.get(item.command, ())

@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass
 
 from companion.control.mission.executor import SKIPPED, Kind, MissionExecutor, Setpoint
+from companion.control.mission.items import change_speed
 from companion.control.mission.zones import point_to_segment
 from mavlink_dialect import companion as d
 
@@ -103,7 +104,8 @@ def _previous_place(ex: MissionExecutor, seq: int) -> int | None:
 
 
 def _speed_before(ex: MissionExecutor, seq: int) -> float:
-    for item in reversed(ex.items[: max(0, seq)]):
+    speed = math.nan
+    for item in ex.items[: max(0, seq)]:
         if item.command == d.MAV_CMD_DO_CHANGE_SPEED:
-            return item.param2 if item.param2 > 0 else math.nan
-    return math.nan
+            speed = change_speed(item, speed)
+    return speed

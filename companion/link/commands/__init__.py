@@ -17,6 +17,7 @@ from companion.link.commands.message_requests import MessageRequests
 from companion.link.commands.mission_commands import MissionCommands
 from companion.link.commands.mode_commands import ModeCommands
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
+from companion.link.commands.speed_commands import SpeedCommands
 from companion.link.commands.storage import StorageCommands
 from companion.link.identity import IdentityService
 from companion.link.link_router import LinkRouter
@@ -31,6 +32,7 @@ __all__ = [
     "MessageRequests",
     "MissionCommands",
     "ModeCommands",
+    "SpeedCommands",
     "StorageCommands",
     "VehiclePort",
     "register_commands",
@@ -53,6 +55,7 @@ def register_commands(
     service.on_refusal = port.statustext
     ArmingCommands(port).register(service)
     ModeCommands(port, identity.autopilot).register(service)
+    SpeedCommands(port, params).register(service)
     MessageRequests(port, identity, router, metadata).register(service)
     if missions is not None:
         MissionCommands(port, missions).register(service)

@@ -225,7 +225,7 @@ def test_do_change_speed_sets_the_setpoint_speed():
         wp(0, (500.0, 0.0)),
         speed(1, 22.0),
         wp(2, (1_000.0, 0.0)),
-        speed(3, -1.0),  # back to cruise
+        speed(3, -2.0),  # back to cruise (-1 would be "no change", as the spec has it)
         wp(4, (1_500.0, 0.0)),
     ]
     ex = executor(items)
