@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from companion.control.mission.fence import honoured
+from companion.control.mission.fence import Fence, honoured
 from companion.control.mission.items import MISSION_TYPES, MissionItem, check_mission
 from companion.control.mission.mission_files import MissionStore
 from companion.control.prearm import PlanVerdicts
@@ -81,6 +81,7 @@ class MissionService:
         self.refused = 0
         self.rejected_target = 0  # for another component of this system
         self.verdicts = PlanVerdicts()  # the pre-arm checks' view of the stored plans
+        self.fence = self._fence()
 
     def _ack(self, peer: Peer, result: int, mission_type: int) -> Outgoing:
         msg = self.mav.mission_ack_encode(peer.sysid, peer.compid, result, mission_type)
@@ -225,15 +226,22 @@ class MissionService:
             self.completed = mission_state == MissionState.COMPLETE
             self.paused = self.paused and not self.completed
 
+    def _fence(self) -> Fence | None:
+        items = self.store.items[d.MAV_MISSION_TYPE_FENCE]
+        return Fence.from_items(items) if items else None
+
     def _changed(self, mission_type: int) -> None:
         if mission_type == 0:
             self.completed = self.paused = False
+        if mission_type == d.MAV_MISSION_TYPE_FENCE:
+            self.fence = self._fence()
         self.on_change(mission_type)
 
     def describe(self, s: Snapshot) -> None:
-        """The stored plans as the telemetry tells of them (MISSION_CURRENT)."""
+        """The stored plans as the telemetry tells of them (MISSION_CURRENT, SYS_STATUS)."""
         s.mission_seq, s.mission_total = self.current, len(self.store.items[0])
         s.mission_completed, s.mission_paused = self.completed, self.paused
+        s.fence = self.fence
 
     def mission_current(self) -> Any:
         return mission_current_message(self.mav, self.current, len(self.store.items[0]))

@@ -10,6 +10,7 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+from companion.control.mission.fence import Fence
 from companion.control.modes import INITIAL_MODE
 from companion.messages import (
     Baro,
@@ -65,6 +66,8 @@ class Snapshot:
     home: tuple[float, float, float] | None = None  # lat_deg, lon_deg, alt_msl_m
     health_cursor: int = 0  # PLUGIN_HEALTH sends one row at a time, round the table
     prearm_ok: bool | None = None  # the pre-arm checks pass (None: not judged yet)
+    fence: Fence | None = None  # the stored geofence (None: none stored)
+    fence_enabled: bool = False  # FENCE_ENABLE: a breach turns the aircraft home
     # The mode shown before the commander has spoken (None: none, where a commander runs).
     assumed_mode: FlightMode | None = INITIAL_MODE
     px4_modes: bool = True  # custom_mode in PX4's packing, else ArduPlane's numbers

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from companion.link.codec import dialect as d
 from companion.messages import BatteryLevel
-from companion.messages.navigation import NAV_ATTITUDE_VALID
+from companion.messages.navigation import NAV_ATTITUDE_VALID, NAV_POSITION_VALID
 
 if TYPE_CHECKING:
     from companion.link.snapshot import Snapshot
@@ -103,14 +103,30 @@ def _battery_fields(s: Snapshot) -> tuple[int, int, int]:
     return volts, amps, left
 
 
+def geofence_bits(s: Snapshot) -> tuple[int, int, int]:
+    """MAV_SYS_STATUS_GEOFENCE as ArduPilot sets it: present with a fence stored, enabled
+    with FENCE_ENABLE on, healthy unless an enabled fence is breached (MAVProxy says "fence
+    breach" whenever the healthy bit drops; it had at every connect, the bits all 0)."""
+    bit = d.MAV_SYS_STATUS_GEOFENCE
+    present = bit if s.fence is not None else 0
+    enabled = bit if present and s.fence_enabled else 0
+    breached, nav = False, s.nav
+    if enabled and nav is not None and nav.flags & NAV_POSITION_VALID and s.fence is not None:
+        breached = s.fence.breach(nav.lat_deg, nav.lon_deg) is not None
+    return present, enabled, 0 if breached else bit
+
+
 def sys_status(mav: Any, s: Snapshot) -> Any:
     present, healthy = sensor_bits(s)
+    fence_present, fence_enabled, fence_healthy = geofence_bits(s)
+    enabled = present | fence_enabled
+    present, healthy = present | fence_present, healthy | fence_healthy
     load = 0
     if s.health is not None:
         load = min(1000, round(sum(r.cpu_pct for r in s.health.rows()) * 10 / 2))
     volts, amps, left = _battery_fields(s)
     return mav.sys_status_encode(
-        present, present, healthy, load, volts, amps, left, 0, 0, 0, 0, 0, 0
+        present, enabled, healthy, load, volts, amps, left, 0, 0, 0, 0, 0, 0
     )
 
 

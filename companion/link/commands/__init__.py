@@ -13,6 +13,7 @@ from companion.link.command_rules import RULES, refusal
 from companion.link.command_service import CommandService
 from companion.link.commands.arming import ArmingCommands
 from companion.link.commands.calibration import CalibrationCommands
+from companion.link.commands.fence_commands import FenceCommands
 from companion.link.commands.message_requests import MessageRequests
 from companion.link.commands.mission_commands import MissionCommands
 from companion.link.commands.mode_commands import ModeCommands
@@ -29,6 +30,7 @@ __all__ = [
     "BUS_ACK_TIMEOUT_S",
     "ArmingCommands",
     "CalibrationCommands",
+    "FenceCommands",
     "MessageRequests",
     "MissionCommands",
     "ModeCommands",
@@ -56,6 +58,7 @@ def register_commands(
     ArmingCommands(port).register(service)
     ModeCommands(port, identity.autopilot).register(service)
     SpeedCommands(port, params).register(service)
+    FenceCommands(port, params).register(service)
     MessageRequests(port, identity, router, metadata).register(service)
     if missions is not None:
         MissionCommands(port, missions).register(service)

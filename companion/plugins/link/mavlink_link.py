@@ -280,6 +280,7 @@ class MavlinkLink(Plugin):
             checks = self.param("ARMING_CHECK") >= 0.5
             s.prearm_ok = armed or not checks or not self.prearm_failures()
         self.missions.describe(s)
+        s.fence_enabled = self.store.values.get("FENCE_ENABLE", 0.0) >= 0.5  # the commander's
         s.time_boot_ms = max(0, (self.ctx.clock.now_us() - self.boot_us) // 1000) & 0xFFFFFFFF
         s.unix_us = time.time_ns() // 1000
         if self.heartbeat.update(s.status, s.health, time.monotonic()):
