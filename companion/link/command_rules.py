@@ -125,6 +125,7 @@ RULES: dict[int, tuple[Param, ...]] = {
         Param(2, "speed", -2, 1000),  # -1 no change, -2 the default; m/s
         Param(3, "throttle", -2, 100, optional=True),  # -1 no change, -2 the default; %
     ),
+    d.MAV_CMD_DO_PAUSE_CONTINUE: (Param(1, "continue", 0, 1, whole=True),),
     d.MAV_CMD_DO_FENCE_ENABLE: (Param(1, "enable", 0, 2, whole=True),),
     d.MAV_CMD_DO_GO_AROUND: (Param(1, "altitude", -MAX_ALT_M, MAX_ALT_M, optional=True),),
     d.MAV_CMD_DO_REPOSITION: (
