@@ -15,7 +15,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from companion.control.mission.fence import Fence, honoured
-from companion.control.mission.items import MISSION_TYPES, MissionItem, check_mission
+from companion.control.mission.items import (
+    MISSION_TYPES,
+    MissionItem,
+    first_refusal,
+    refusal_text,
+)
 from companion.control.mission.mission_files import MissionStore
 from companion.control.prearm import PlanVerdicts
 from companion.link.microservice import Outgoing, Peer
@@ -162,7 +167,7 @@ class MissionService:
         notes: list[str] = []
         if mission_type == d.MAV_MISSION_TYPE_FENCE:  # zones that enclose nothing: left out
             items, notes = honoured(items)
-        result = check_mission(items)
+        result, bad = first_refusal(items)
         if result == d.MAV_MISSION_ACCEPTED:
             self.store.replace(mission_type, items)
             self.current = 0 if mission_type == 0 else self.current
@@ -172,7 +177,9 @@ class MissionService:
                 self.say(note, d.MAV_SEVERITY_WARNING)
         else:
             self.refused += 1
-            log.warning("mission upload refused: %s", d.enums["MAV_MISSION_RESULT"][result].name)
+            text = refusal_text(result, bad)  # the ack's code alone names no item
+            log.warning("%s", text)
+            self.say(text, d.MAV_SEVERITY_WARNING)
         return [self._ack(peer, result, mission_type)]
 
     def _send_item(self, seq: int, mission_type: int, peer: Peer, legacy: bool) -> list[Outgoing]:

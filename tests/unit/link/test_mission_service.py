@@ -63,6 +63,8 @@ def test_upload_then_download_round_trip_and_it_survives_a_restart(bench):
 
 
 def test_an_item_the_vehicle_cannot_fly_is_refused_and_the_old_mission_stays(bench):
+    said = []
+    bench.service.say = lambda text, severity: said.append((text, severity))
     bench.upload([bench.item(0)])
     bad = [bench.item(0), bench.item(1, command=d.MAV_CMD_NAV_VTOL_TAKEOFF)]
     assert bench.upload(bad).type == d.MAV_MISSION_UNSUPPORTED
@@ -71,6 +73,13 @@ def test_an_item_the_vehicle_cannot_fly_is_refused_and_the_old_mission_stays(ben
     nowhere = [bench.item(0, x=0, y=0)]
     assert bench.upload(nowhere).type == d.MAV_MISSION_INVALID_PARAM5_X
     assert len(bench.service.store.items[0]) == 1
+    # The ack's code names no item: a ground station is told which one and why.
+    assert said == [
+        ("Mission refused: item 1 (NAV_VTOL_TAKEOFF): a command this vehicle does not fly",
+         d.MAV_SEVERITY_WARNING),
+        ("Mission refused: item 1 (DO_JUMP): invalid param1", d.MAV_SEVERITY_WARNING),
+        ("Mission refused: item 0 (NAV_WAYPOINT): latitude out of range", d.MAV_SEVERITY_WARNING),
+    ]  # fmt: skip
 
 
 def test_fence_and_rally_are_separate_lists(bench):
@@ -112,7 +121,9 @@ def test_a_zone_that_encloses_nothing_is_left_out_and_named_the_rest_installed(b
     # A zone that is broken, not empty, still refuses the upload (a NaN radius).
     said.clear()
     broken = bench.item(0, circle, mission_type=1, p1=float("nan"))
-    assert bench.upload([broken], 1).type == d.MAV_MISSION_INVALID_PARAM1 and said == []
+    assert bench.upload([broken], 1).type == d.MAV_MISSION_INVALID_PARAM1
+    assert said == [("Mission refused: item 0 (NAV_FENCE_CIRCLE_INCLUSION): invalid param1",
+                     d.MAV_SEVERITY_WARNING)]  # fmt: skip
 
 
 def test_interrupted_upload_retries_then_gives_up_keeping_the_old_mission(bench):
