@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -24,6 +25,7 @@ from companion.control.mission.items import (
 from companion.control.mission.mission_files import MissionStore
 from companion.control.prearm import PlanVerdicts
 from companion.link.microservice import Outgoing, Peer
+from companion.link.refusal_texts import RefusalTexts
 from companion.link.snapshot import Snapshot
 from companion.messages import MissionState
 from mavlink_dialect import companion as d
@@ -77,6 +79,11 @@ class MissionService:
         self.current = 0
         self.on_change: Callable[[int], None] = lambda mission_type: None
         self.say: Callable[[str, int], None] = lambda text, severity: None  # STATUSTEXT
+        # A refusal's text at most twice a second: a flood of bad uploads must not become a
+        # flood of STATUSTEXT on the radio (each is still counted in ``refused``).
+        self.refusal = RefusalTexts(
+            lambda text: self.say(text, d.MAV_SEVERITY_WARNING), time.monotonic
+        )
         # The stored mission was flown to its end: MISSION_CURRENT says so after the flight
         # controller stops (landed and disarmed), as PX4's does, until the mission changes.
         self.completed = False
@@ -179,7 +186,7 @@ class MissionService:
             self.refused += 1
             text = refusal_text(result, bad)  # the ack's code alone names no item
             log.warning("%s", text)
-            self.say(text, d.MAV_SEVERITY_WARNING)
+            self.refusal(text)
         return [self._ack(peer, result, mission_type)]
 
     def _send_item(self, seq: int, mission_type: int, peer: Peer, legacy: bool) -> list[Outgoing]:

@@ -65,6 +65,7 @@ def test_upload_then_download_round_trip_and_it_survives_a_restart(bench):
 def test_an_item_the_vehicle_cannot_fly_is_refused_and_the_old_mission_stays(bench):
     said = []
     bench.service.say = lambda text, severity: said.append((text, severity))
+    bench.service.refusal.period_s = 0.0  # each told here; the flood's limit: below
     bench.upload([bench.item(0)])
     bad = [bench.item(0), bench.item(1, command=d.MAV_CMD_NAV_VTOL_TAKEOFF)]
     assert bench.upload(bad).type == d.MAV_MISSION_UNSUPPORTED
@@ -80,6 +81,16 @@ def test_an_item_the_vehicle_cannot_fly_is_refused_and_the_old_mission_stays(ben
         ("Mission refused: item 1 (DO_JUMP): invalid param1", d.MAV_SEVERITY_WARNING),
         ("Mission refused: item 0 (NAV_WAYPOINT): latitude out of range", d.MAV_SEVERITY_WARNING),
     ]  # fmt: skip
+
+
+def test_a_flood_of_refused_uploads_is_told_once_and_counted_whole(bench):
+    said = []
+    bench.service.say = lambda text, severity: said.append(text)
+    refused = bench.service.refused
+    for _ in range(20):
+        bench.upload([bench.item(0, x=0, y=0)])
+    assert bench.service.refused - refused == 20
+    assert said == ["Mission refused: item 0 (NAV_WAYPOINT): latitude out of range"]
 
 
 def test_fence_and_rally_are_separate_lists(bench):
@@ -121,6 +132,7 @@ def test_a_zone_that_encloses_nothing_is_left_out_and_named_the_rest_installed(b
     # A zone that is broken, not empty, still refuses the upload (a NaN radius).
     said.clear()
     broken = bench.item(0, circle, mission_type=1, p1=float("nan"))
+    bench.service.refusal.period_s = 0.0
     assert bench.upload([broken], 1).type == d.MAV_MISSION_INVALID_PARAM1
     assert said == [("Mission refused: item 0 (NAV_FENCE_CIRCLE_INCLUSION): invalid param1",
                      d.MAV_SEVERITY_WARNING)]  # fmt: skip
