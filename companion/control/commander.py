@@ -69,6 +69,7 @@ MODE_COMMANDS = frozenset(
         CommandId.ORBIT,
         CommandId.GO_AROUND,
         CommandId.CHANGE_SPEED,
+        CommandId.SET_MISSION_CURRENT,
     }
 )
 # Commands that fly a mode a fixed wing cannot fly from the runway.
@@ -83,18 +84,21 @@ LANDING_PHASES = (LandPhase.APPROACH, LandPhase.FLARE)  # a go-around can still 
 
 
 class Commander:
-    """Mode state machine; ``mission_count`` says how many mission items are stored and
-    ``mission_lands`` whether the stored mission has a DO_LAND_START."""
+    """Mode state machine; ``mission_count`` says how many mission items are stored,
+    ``mission_lands`` whether the stored mission has a DO_LAND_START and
+    ``mission_takeoff`` which item is its first take-off (-1: none)."""
 
     def __init__(
         self,
         mission_count: Callable[[], int],
         mission_lands: Callable[[], bool] = lambda: False,
         min_height: Callable[[], float] = lambda: COMMANDER_PARAMS[0].default,
+        mission_takeoff: Callable[[], int] = lambda: -1,
     ) -> None:
         self.mission_count = mission_count
         self.mission_lands = mission_lands
         self.min_height = min_height
+        self.mission_takeoff = mission_takeoff
         self.mode = INITIAL_MODE
         self.armed = False
         self.home: tuple[float, float, float] | None = None
@@ -104,6 +108,7 @@ class Commander:
         self.changes = 0
         self.position: tuple[float, float, float] | None = None
         self.go_arounds = 0
+        self.mission_jumps, self.mission_jump_to = 0, -1  # set-currents accepted, the last
         self.speed = math.nan  # DO_CHANGE_SPEED's airspeed (NaN: none), as PX4's navigator
         self.land_phase = 0  # the flight controller's, from its status
         self.landed = False  # armed and the flight controller says it stands on the ground
@@ -146,10 +151,9 @@ class Commander:
         if (grounded := self._grounded(_AIRBORNE_COMMANDS.get(kind))) is not None:
             return grounded
         if kind == CommandId.MISSION_START:
-            decision = self._enter(FlightMode.MISSION)
-            if decision.result == CommandResult.ACCEPTED:
-                self.mission_first = max(0, _whole(p[0], 0))
-            return decision
+            return self._mission_start(_whole(p[0], -1))
+        if kind == CommandId.SET_MISSION_CURRENT:
+            return self._set_current(_whole(p[0], -1))
         if kind == CommandId.RETURN_TO_LAUNCH:
             return self._enter(FlightMode.RTL)
         if kind in (CommandId.REPOSITION, CommandId.LOITER, CommandId.ORBIT):
@@ -166,6 +170,32 @@ class Commander:
             self.go_arounds += 1
             return ACCEPTED
         return None
+
+    def _mission_start(self, first: int) -> Decision:
+        """Mission mode; param1 as PX4 takes it: an item (0 or more) starts there, as a
+        set-current would, anything else the item set current last (or left at)."""
+        decision = self._enter(FlightMode.MISSION)
+        if decision.result == CommandResult.ACCEPTED and 0 <= first < self.mission_count():
+            self._jump(first)
+        return decision
+
+    def _set_current(self, seq: int) -> Decision:
+        """MISSION_SET_CURRENT / DO_SET_MISSION_CURRENT: a mission flying goes to item
+        ``seq`` at once, any other mode enters the mission there. Refused beyond the
+        mission, and on the ground beyond its take-off (that would never be flown)."""
+        count, takeoff = self.mission_count(), self.mission_takeoff()
+        if not 0 <= seq < count:
+            what = "no mission stored" if count == 0 else f"the mission has {count} items"
+            return Decision(CommandResult.DENIED, f"Set mission item: no item {seq} ({what})")
+        if (not self.armed or self.landed) and 0 <= takeoff < seq:
+            reason = f"Set mission item: {seq} skips the take-off (item {takeoff}) on the ground"
+            return Decision(CommandResult.DENIED, reason)
+        self._jump(seq)
+        return ACCEPTED
+
+    def _jump(self, seq: int) -> None:
+        self.mission_first, self.mission_jump_to = seq, seq
+        self.mission_jumps += 1
 
     def _grounded(self, mode: FlightMode | None) -> Decision | None:
         """Refused: a mode that cannot fly from the runway, asked for armed on the ground
@@ -292,7 +322,8 @@ class Commander:
         """What a restarted commander needs to carry this flight on."""
         return FlightState(
             self.armed, int(self.mode), self.home, self.target, self.radius,
-            self.mission_first, self.changes, self.go_arounds,
+            self.mission_first, self.changes, self.go_arounds, self.mission_jumps,
+            self.mission_jump_to,
         )  # fmt: skip
 
     def restore(self, saved: FlightState) -> None:
@@ -303,6 +334,7 @@ class Commander:
         # this (its process restarted too) takes the mission up there, not at item 0.
         self.mission_first = saved.mission_seq
         self.changes, self.go_arounds = saved.changes, saved.go_arounds
+        self.mission_jumps, self.mission_jump_to = saved.mission_jumps, saved.mission_jump_to
         self.armed = True
 
     def status(self, t_us: int) -> VehicleStatus:
@@ -314,6 +346,7 @@ class Commander:
         msg.target_radius_m = self.radius
         msg.mission_first, msg.changes = self.mission_first, self.changes
         msg.go_arounds, msg.speed_m_s = self.go_arounds, self.speed
+        msg.mission_jumps, msg.mission_jump_to = self.mission_jumps, self.mission_jump_to
         return msg
 
 

@@ -17,7 +17,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from companion.control.flight.controller import LANDED_SPEED
+from companion.control.flight.on_ground import LANDED_SPEED
 from companion.messages import FlightMode
 from companion.messages.navigation import NAV_POSITION_VALID
 from companion.params.atomic import atomic_write_text
@@ -42,6 +42,8 @@ class FlightState:
     mission_seq: int  # the item the mission was flying to
     changes: int  # accepted mode commands (the controller's "new mode" key)
     go_arounds: int
+    mission_jumps: int = 0  # set-currents accepted (an older file has none: 0)
+    mission_jump_to: int = -1  # the item of the last (-1: none)
 
     def to_json(self) -> str:
         """One JSON object; NaN written as null."""
@@ -66,6 +68,8 @@ class FlightState:
                 mission_seq=max(0, int(data["mission_seq"])),
                 changes=max(0, int(data["changes"])),
                 go_arounds=max(0, int(data["go_arounds"])),
+                mission_jumps=max(0, int(data.get("mission_jumps", 0))),
+                mission_jump_to=max(-1, int(data.get("mission_jump_to", -1))),
             )
         except (KeyError, TypeError, ValueError, OverflowError) as exc:
             raise ValueError(f"not a flight state: {exc}") from None

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-from companion.control.flight.controller import AIRBORNE_AGL_M, LANDED_SPEED
+from companion.control.flight.on_ground import AIRBORNE_AGL_M, LANDED_SPEED
 from companion.control.mission.items import DO_COMMANDS, MissionItem
 from companion.control.modes import BY_MODE
 from companion.messages import FlightMode, NavState

@@ -53,6 +53,7 @@ class CommandId(enum.IntEnum):
     ORBIT = 12  # param1..4 = lat_deg, lon_deg, alt_msl_m, radius_m (NaN: here / default)
     GO_AROUND = 13  # abort the landing in progress: climb out and come round again
     CHANGE_SPEED = 14  # param1 = airspeed_m_s to fly (NaN: back to the cruise airspeed)
+    SET_MISSION_CURRENT = 15  # param1 = the mission item to fly to (or start at) now
 
 
 class CommandResult(enum.IntEnum):
@@ -128,6 +129,11 @@ class VehicleStatus(Message):
         ("mission_first", ctypes.c_int32),  # MISSION: the item to start from
         ("changes", ctypes.c_uint32),  # accepted mode commands since start (new target too)
         ("go_arounds", ctypes.c_uint32),  # go-arounds ordered since start
+        # Set-currents accepted (MISSION_SET_CURRENT, DO_SET_MISSION_CURRENT) and the item
+        # of the last: a running mission flies to it when the count grows, another mode
+        # enters the mission there. A count seen first (a restart) is not a jump.
+        ("mission_jumps", ctypes.c_uint32),
+        ("mission_jump_to", ctypes.c_int32),
         # DO_CHANGE_SPEED's airspeed until the mode changes or the flight ends (NaN or 0:
         # none, the cruise airspeed or the mission's own speed).
         ("speed_m_s", ctypes.c_double),

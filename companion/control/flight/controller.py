@@ -16,6 +16,7 @@ from companion.control.flight.flight_params import FlightConfig
 from companion.control.flight.landing import landing_flaps
 from companion.control.flight.landing_flight import LandingFlight, MissionRef, Motion
 from companion.control.flight.mode_targets import arrive, mode_target
+from companion.control.flight.on_ground import landed_now
 from companion.control.flight.output import ControlOutput
 from companion.control.flight.pilot_flight import PilotFlight
 from companion.control.flight.speed_demand import CommandedSpeed, speed_demand
@@ -29,17 +30,16 @@ from companion.control.mission.executor import Kind, MissionExecutor, Setpoint
 from companion.control.mission.items import MissionItem
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.resume import start_mission
+from companion.control.mission.set_current import MissionJumps
 from companion.control.modes import PILOT_MODES
 from companion.geodesy import STANDARD_GRAVITY as G
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode, NavState, TakeoffPhase, VehicleStatus
 from companion.messages.navigation import NAV_DEAD_RECKONING
 
-AIRBORNE_AGL_M = 10.0
 # An implicit take-off (a mission without one, started on the ground) climbs at least this
 # high before it turns towards the first item: a take-off's wings-level climb-out and more.
 IMPLICIT_TAKEOFF_AGL_M = 25.0
-LANDED_SPEED = 8.0  # m/s: slower than this near the ground is "on the ground"
 # Turns are planned at this fraction of the bank limit: the rest is for gusts and for
 # the airspeed a turn gains or loses.
 TURN_BANK_FRACTION = 0.7
@@ -61,6 +61,7 @@ class FlightController:
         self.jumps = JumpCounts()  # DO_JUMP counts on disk: the plug-in gives it a folder
         self.takeoff: RunwayTakeoff | None = None
         self.go_arounds: int | None = None  # the commander's count when last seen
+        self.set_currents = MissionJumps()  # MISSION_SET_CURRENT's, from the status
         self.landed: bool | None = None
         self.speed = CommandedSpeed()  # DO_CHANGE_SPEED's, from the status
         self.rejected = 0  # steps whose inputs were not usable (last good output kept)
@@ -93,6 +94,7 @@ class FlightController:
         """A new mission was stored: the next MISSION start uses it."""
         self.items = list(items)
         self.executor = None
+        self.set_currents.forget()
 
     def _ensure_frame(self, nav: NavState, status: VehicleStatus) -> LocalFrame:
         if status.home_valid:
@@ -134,7 +136,9 @@ class FlightController:
         else:
             self.wind.update(vel, nav.yaw_rad, dt)
         airspeed = self.wind.airspeed
-        self._update_landed(nav, airspeed)
+        agl, least = nav.alt_msl_m - self.home_alt, self.config["AIRSPEED_MIN"]
+        self.landed = landed_now(self.landed, agl, nav, airspeed, least)
+        self.set_currents.see(status.mission_jumps, status.mission_jump_to)
         self.jumps.first_solution(bool(self.landed))  # before a mission takes them up
         out = ControlOutput(airspeed=airspeed, landed=bool(self.landed))
         out.brakes = self.config["LAND_BRAKE"] if self.landed else 0.0
@@ -186,22 +190,6 @@ class FlightController:
             alt = setpoint.alt_msl if setpoint is not None else nav.alt_msl_m
             self._hold_course = Setpoint(Kind.LINE, pos, track_ahead(pos, nav), alt)
         return self._hold_course
-
-    def _update_landed(self, nav: NavState, airspeed: float) -> None:
-        agl = nav.alt_msl_m - self.home_alt
-        if self.landed is None:  # first solution: started on the runway or in the air?
-            self.landed = agl < AIRBORNE_AGL_M and airspeed < self.config["AIRSPEED_MIN"] * 0.7
-        elif self.landed and agl > AIRBORNE_AGL_M and self._moving(nav, airspeed):
-            # Height alone is not flight: a drifting navigator can say 30 m while the
-            # aircraft stands on the runway, and leaving "landed" opens the throttle.
-            self.landed = False
-        elif not self.landed and agl < 2.0 and math.hypot(nav.vn_m_s, nav.ve_m_s) < LANDED_SPEED:
-            self.landed = True
-
-    @staticmethod
-    def _moving(nav: NavState, airspeed: float) -> bool:
-        ground = math.hypot(nav.vn_m_s, nav.ve_m_s)
-        return max(ground, airspeed if math.isfinite(airspeed) else 0.0) >= LANDED_SPEED
 
     def _taking_off(self, nav: NavState) -> bool:
         return self.takeoff is not None and self.takeoff.phase != TakeoffPhase.CLIMB_OUT
@@ -262,15 +250,27 @@ class FlightController:
         entered: bool, out: ControlOutput,
     ) -> Setpoint | None:  # fmt: skip
         ex, resumed = self.executor, None
-        if ex is None or (entered and ex.finished):
+        # A set-current: a mission flown goes to its item now, with the leg from here.
+        jump = self.set_currents.take(self.items) if status.mode == FlightMode.MISSION else None
+        if ex is None or (entered and ex.finished) or jump is not None:
             assert self.frame is not None
-            ex = MissionExecutor(  # what it says goes out with the landing's texts
-                self.items, self.frame, self.home_alt, self.config.executor, said=self.lander.said
+            old, ex = (
+                ex,
+                MissionExecutor(  # what it says goes out with the landing's texts
+                    self.items,
+                    self.frame,
+                    self.home_alt,
+                    self.config.executor,
+                    said=self.lander.said,
+                ),
             )
             # In the air (a restarted controller, say) the leg is taken up as it was flown.
             radius = None if self.landed else self._turn_radius()
-            resumed = start_mission(ex, status.mission_first, pos, nav.alt_msl_m, radius)
+            first = status.mission_first if jump is None else jump
+            resumed = start_mission(ex, first, pos, nav.alt_msl_m, radius)
             ex.jumps_done.update(self.jumps.take_up(self.items))  # restarted in the air
+            if jump is not None and old is not None:  # DO_JUMP counts kept as they are
+                ex.jumps_done.update(old.jumps_done)
             self.executor = ex
         setpoint = ex.step(pos, nav.alt_msl_m, t_s, self._turn_radius())
         if setpoint.kind in (Kind.LINE, Kind.CIRCLE) and ex.leads_to_landing():

@@ -29,6 +29,7 @@ from companion.control.flight_state import (
 from companion.control.ground_rules import ground_notice, standing
 from companion.control.mission.fence import Fence
 from companion.control.mission.mission_files import MissionStore, StoreFollower
+from companion.control.mission.set_current import first_takeoff
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch, ReceiverProcess
 from companion.messages import (
     NAME_LEN,
@@ -101,9 +102,9 @@ class CommanderPlugin(Plugin):
             lambda: len(self.store.items[d.MAV_MISSION_TYPE_MISSION]),
             lambda: land_start(self.store.items[d.MAV_MISSION_TYPE_MISSION]) is not None,
             lambda: self.live[MIN_ALT_PARAM],
+            lambda: first_takeoff(self.store.items[d.MAV_MISSION_TYPE_MISSION]),
         )
-        self.failsafes = Failsafes(self.live.values)
-        self.pilot = PilotWatch(self.live.values)
+        self.failsafes, self.pilot = Failsafes(self.live.values), PilotWatch(self.live.values)
         self.battery_failsafe = BatteryFailsafe(self.live.values)
         bus = ctx.bus
         self.commands = bus.queue_reader("link/commands")
