@@ -84,6 +84,10 @@ class MissionService:
         self.refusal = RefusalTexts(
             lambda text: self.say(text, d.MAV_SEVERITY_WARNING), time.monotonic
         )
+        # MISSION_SET_CURRENT's item for the commander (False: none runs, the link's own).
+        self.ask_commander: Callable[[int], bool] = lambda seq: False
+        self.jumps: int | None = None  # the commander's set-currents, when last seen
+        self.news = False  # a set-current accepted: MISSION_CURRENT to every station
         # The stored mission was flown to its end: MISSION_CURRENT says so after the flight
         # controller stops (landed and disarmed), as PX4's does, until the mission changes.
         self.completed = False
@@ -224,6 +228,8 @@ class MissionService:
         return True
 
     def _set_current(self, seq: int, peer: Peer) -> list[Outgoing]:
+        if 0 <= seq < len(self.store.items[0]) and self.ask_commander(seq):
+            return []  # MISSION_CURRENT once the commander accepts (``follow_status``)
         if self.set_current(seq):
             return [Outgoing(self.mission_current(), None)]  # news for every ground station
         # No such item: the unchanged item to the sender only, as a refused PARAM_SET is
@@ -240,6 +246,16 @@ class MissionService:
             self.completed = mission_state == MissionState.COMPLETE
             self.paused = self.paused and not self.completed
 
+    def follow_status(self, status: Any) -> None:
+        """The commander's status: a set-current it accepted makes its item the current one
+        (the count seen first, after a restart of either, is none)."""
+        if status is None:
+            return
+        count, item = int(status.mission_jumps), int(status.mission_jump_to)
+        if self.jumps is not None and count > self.jumps and 0 <= item < len(self.store.items[0]):
+            self.current, self.completed, self.news = item, False, True
+        self.jumps = count
+
     def _fence(self) -> Fence | None:
         items = self.store.items[d.MAV_MISSION_TYPE_FENCE]
         return Fence.from_items(items) if items else None
@@ -253,6 +269,7 @@ class MissionService:
 
     def describe(self, s: Snapshot) -> None:
         """The stored plans as the telemetry tells of them (MISSION_CURRENT, SYS_STATUS)."""
+        self.follow_status(s.status)
         s.mission_seq, s.mission_total = self.current, len(self.store.items[0])
         s.mission_completed, s.mission_paused = self.completed, self.paused
         s.fence = self.fence
@@ -266,6 +283,9 @@ class MissionService:
 
     def tick(self, now_s: float) -> list[Outgoing]:
         out: list[Outgoing] = []
+        if self.news:
+            out.append(Outgoing(self.mission_current(), None))
+            self.news = False
         for mission_type, upload in list(self.uploads.items()):
             if now_s - upload.asked_at < ITEM_TIMEOUT_S:
                 continue

@@ -2,7 +2,10 @@
 
 DO_SET_MISSION_CURRENT (MAVProxy's ``wp set N``) does what the MISSION_SET_CURRENT message
 does: param1 the item (-1: keep the current one), refused beyond the mission; param2
-(reset) needs nothing more, as making an item current already clears "complete".
+(reset) needs nothing more, as making an item current already clears "complete". The
+commander decides (``Commander._set_current``): a mission flying goes to the item at once,
+another mode enters the mission there; refused on the ground beyond the take-off. The
+answer waits for it, as for the other commander commands; MISSION_CURRENT follows.
 
 DO_PAUSE_CONTINUE, as ArduPlane takes it: param1 0 pauses (what QGroundControl's Pause
 does: circle here, or keep the point a go-to flies to), 1 continues the mission left
@@ -31,6 +34,7 @@ class MissionCommands:
         self.port = port
         self.missions = missions
         self.service: CommandService | None = None
+        missions.ask_commander = self.ask_commander  # MISSION_SET_CURRENT, the message
 
     def register(self, service: CommandService) -> None:
         self.service = service
@@ -42,10 +46,19 @@ class MissionCommands:
         seq = round(args.params[0])
         seq = self.missions.current if seq == -1 else seq
         total = len(self.missions.store.items[d.MAV_MISSION_TYPE_MISSION])
+        if 0 <= seq < total and round(args.params[0]) != -1 and self.port.has_commander():
+            return self._commander(CommandId.SET_MISSION_CURRENT, (float(seq),))
         if not self.missions.set_current(seq):
             what = "no mission stored" if total == 0 else f"the mission has {total} items"
             return refuse(self.port, self.service, f"Set mission item: no item {seq} ({what})")
         return Outcome(extra=[Outgoing(self.missions.mission_current(), None)])
+
+    def ask_commander(self, seq: int) -> bool:
+        """MISSION_SET_CURRENT's item for the commander; False when none runs."""
+        if not self.port.has_commander():
+            return False
+        self.port.publish_command(CommandId.SET_MISSION_CURRENT, (float(seq),))
+        return True
 
     def pause_continue(self, args: CommandArgs) -> Outcome:
         """Pause (0): hold here; continue (1): the mission again from where it was left."""
