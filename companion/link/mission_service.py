@@ -88,6 +88,7 @@ class MissionService:
         self.ask_commander: Callable[[int], bool] = lambda seq: False
         self.jumps: int | None = None  # the commander's set-currents, when last seen
         self.news = False  # a set-current accepted: MISSION_CURRENT to every station
+        self.running = False  # the flight controller flies the mission (MISSION_CURRENT's)
         # The stored mission was flown to its end: MISSION_CURRENT says so after the flight
         # controller stops (landed and disarmed), as PX4's does, until the mission changes.
         self.completed = False
@@ -270,12 +271,16 @@ class MissionService:
     def describe(self, s: Snapshot) -> None:
         """The stored plans as the telemetry tells of them (MISSION_CURRENT, SYS_STATUS)."""
         self.follow_status(s.status)
+        self.running = s.control is not None and s.control.mission_state == MissionState.ACTIVE
         s.mission_seq, s.mission_total = self.current, len(self.store.items[0])
         s.mission_completed, s.mission_paused = self.completed, self.paused
         s.fence = self.fence
 
     def mission_current(self) -> Any:
-        return mission_current_message(self.mav, self.current, len(self.store.items[0]))
+        total = len(self.store.items[0])
+        if self.running and total:  # the mission flies: the item set, active
+            return self.mav.mission_current_encode(self.current, total, d.MISSION_STATE_ACTIVE)
+        return mission_current_message(self.mav, self.current, total)
 
     def next_due(self) -> float:
         """When an upload's item is next asked for again."""

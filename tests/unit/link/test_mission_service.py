@@ -9,7 +9,8 @@ from companion.link.codec import new_encoder, new_parser
 from companion.link.flight_messages import mission_current
 from companion.link.microservice import Peer
 from companion.link.mission_service import MAX_RETRIES, MissionService
-from companion.messages import ControlStatus, MissionState
+from companion.link.snapshot import Snapshot
+from companion.messages import ControlStatus, MissionState, VehicleStatus
 from mavlink_dialect import companion as d
 
 GCS = Peer(255, 190, 0)
@@ -227,3 +228,39 @@ def test_leaving_the_mission_keeps_its_item_as_px4_and_ardupilot_do(bench):
     assert state(None) == (3, d.MISSION_STATE_COMPLETE)
     bench.upload([bench.item(i) for i in range(4)])  # a new plan: not started
     assert state(None) == (0, d.MISSION_STATE_NOT_STARTED)
+
+
+def _status(jumps: int, item: int):
+    return VehicleStatus(mission_jumps=jumps, mission_jump_to=item)
+
+
+def _snapshot(status, control=None):
+    s = Snapshot()
+    s.status, s.control = status, control
+    return s
+
+
+def test_with_a_commander_the_message_goes_to_it_and_the_item_becomes_current_once_counted(
+    bench,
+):
+    """MISSION_SET_CURRENT is the commander's to decide: nothing changes, nothing is said,
+    until its status counts the set-current (a count seen first, after a restart, is
+    none); then the item is current and MISSION_CURRENT goes to every station, active
+    while the mission flies."""
+    bench.upload([bench.item(i) for i in range(4)])
+    asked = []
+    bench.service.ask_commander = lambda seq: asked.append(seq) or True
+    bench.service.describe(_snapshot(_status(5, 1)))  # the count seen first: no jump
+    assert bench.service.current == 0 and bench.service.tick(0.0) == []
+    assert bench.send(bench.gcs.mission_set_current_encode(1, 1, 2)) == []
+    assert asked == [2] and bench.service.current == 0
+    flying = ControlStatus(t_us=1, mission_seq=1, mission_state=MissionState.ACTIVE)
+    bench.service.describe(_snapshot(_status(6, 2), flying))
+    assert bench.service.current == 2
+    (news,) = [o for o in bench.service.tick(0.0) if o.to is None]
+    assert (news.msg.seq, news.msg.mission_state) == (2, d.MISSION_STATE_ACTIVE)
+    assert bench.service.tick(0.0) == []  # said once
+    bench.service.describe(_snapshot(_status(6, 2), flying))  # the same count: nothing new
+    assert bench.service.tick(0.0) == []
+    assert bench.send(bench.gcs.mission_set_current_encode(1, 1, 9))[0].seq == 2  # beyond
+    assert asked == [2]  # the link refuses it itself
