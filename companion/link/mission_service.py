@@ -278,8 +278,9 @@ class MissionService:
 
     def mission_current(self) -> Any:
         total = len(self.store.items[0])
-        if self.running and total:  # the mission flies: the item set, active
-            return self.mav.mission_current_encode(self.current, total, d.MISSION_STATE_ACTIVE)
+        if total and (self.running or self.paused):  # flying it, or left before its end
+            state = d.MISSION_STATE_ACTIVE if self.running else d.MISSION_STATE_PAUSED
+            return self.mav.mission_current_encode(self.current, total, state)
         return mission_current_message(self.mav, self.current, total)
 
     def next_due(self) -> float:

@@ -263,4 +263,8 @@ def test_with_a_commander_the_message_goes_to_it_and_the_item_becomes_current_on
     bench.service.describe(_snapshot(_status(6, 2), flying))  # the same count: nothing new
     assert bench.service.tick(0.0) == []
     assert bench.send(bench.gcs.mission_set_current_encode(1, 1, 9))[0].seq == 2  # beyond
+    bench.service.paused = True  # paused (a hold): said so with the item set
+    bench.service.describe(_snapshot(_status(7, 3)))
+    (news,) = bench.service.tick(0.0)
+    assert (news.msg.seq, news.msg.mission_state) == (3, d.MISSION_STATE_PAUSED)
     assert asked == [2]  # the link refuses it itself
