@@ -112,7 +112,7 @@ RULES: dict[int, tuple[Param, ...]] = {
         Param(2, "custom mode", 0, 2**32 - 1, whole=True),
     ),
     d.MAV_CMD_MISSION_START: (
-        Param(1, "first item", 0, 65535, optional=True, whole=True),
+        Param(1, "first item", -1, 65535, optional=True, whole=True),  # -1: the item kept
         Param(2, "last item", 0, 65535, optional=True, whole=True),
     ),
     d.MAV_CMD_NAV_RETURN_TO_LAUNCH: (),
