@@ -106,3 +106,19 @@ def test_an_item_the_mission_lacks_is_denied_with_the_reason(station, item, text
     assert ack.result == m.MAV_RESULT_DENIED
     assert text in said
     assert station.recv("MISSION_CURRENT").seq == 1  # unchanged
+
+
+def test_mission_start_param1_as_px4_nan_keeps_the_item_set_an_item_is_a_set_current(station):
+    station.command(m.MAV_CMD_DO_SET_MISSION_CURRENT, 2, target=MAVPROXY)
+    assert station.ack(m.MAV_CMD_DO_SET_MISSION_CURRENT).result == m.MAV_RESULT_ACCEPTED
+    station.recv("MISSION_CURRENT", seq=2)
+    for first in (math.nan, -1):
+        station.command(m.MAV_CMD_MISSION_START, first, math.nan)
+        assert station.ack(m.MAV_CMD_MISSION_START).result == m.MAV_RESULT_ACCEPTED
+    time.sleep(0.5)
+    while station.conn.recv_match(blocking=False) is not None:  # what came before
+        pass
+    assert station.recv("MISSION_CURRENT").seq == 2
+    station.command(m.MAV_CMD_MISSION_START, 0, math.nan)
+    assert station.ack(m.MAV_CMD_MISSION_START).result == m.MAV_RESULT_ACCEPTED
+    station.recv("MISSION_CURRENT", seq=0)

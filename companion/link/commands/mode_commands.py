@@ -78,7 +78,8 @@ class ModeCommands:
         return self.set_mode(decode_set_mode(base, custom, 0, self.px4), "SET_MODE")
 
     def mission_start(self, args: CommandArgs) -> Outcome:
-        first, last = whole_or(args.params[0], 0), whole_or(args.params[1], -1)
+        # param1 as PX4's: an item starts there, NaN or -1 the item set current or left at.
+        first, last = whole_or(args.params[0], -1), whole_or(args.params[1], -1)
         return self.to_commander(CommandId.MISSION_START, (float(first), float(last)))
 
     def go_around(self, args: CommandArgs) -> Outcome:
