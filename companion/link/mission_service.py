@@ -20,10 +20,10 @@ from companion.control.mission.items import (
     MISSION_TYPES,
     MissionItem,
     first_refusal,
-    refusal_text,
 )
 from companion.control.mission.mission_files import MissionStore
 from companion.control.prearm import PlanVerdicts
+from companion.link.command_service import command_name
 from companion.link.microservice import Outgoing, Peer
 from companion.link.refusal_texts import RefusalTexts
 from companion.link.snapshot import Snapshot
@@ -80,7 +80,8 @@ class MissionService:
         self.on_change: Callable[[int], None] = lambda mission_type: None
         self.say: Callable[[str, int], None] = lambda text, severity: None  # STATUSTEXT
         # A refusal's text at most twice a second: a flood of bad uploads must not become a
-        # flood of STATUSTEXT on the radio (each is still counted in ``refused``).
+        # flood of STATUSTEXT on the radio (each is still counted in ``refused``). The link
+        # plug-in gives it the limiter its command refusals go through: one flood, one limit.
         self.refusal = RefusalTexts(
             lambda text: self.say(text, d.MAV_SEVERITY_WARNING), time.monotonic
         )
@@ -189,7 +190,8 @@ class MissionService:
                 self.say(note, d.MAV_SEVERITY_WARNING)
         else:
             self.refused += 1
-            text = refusal_text(result, bad)  # the ack's code alone names no item
+            assert bad is not None  # a refusal is always an item's
+            text = _refusal_text(result, bad)  # the ack's code alone names no item
             log.warning("%s", text)
             self.refusal(text)
         return [self._ack(peer, result, mission_type)]
@@ -314,3 +316,19 @@ def _bad_legacy_position(msg: Any) -> int | None:
     if not math.isfinite(msg.y) or abs(msg.y) > 1e3:
         return d.MAV_MISSION_INVALID_PARAM6_Y
     return None
+
+
+_WHY = {
+    d.MAV_MISSION_UNSUPPORTED: "a command this vehicle does not fly",
+    d.MAV_MISSION_UNSUPPORTED_FRAME: "a frame this vehicle does not take",
+    d.MAV_MISSION_INVALID_PARAM5_X: "latitude out of range",
+    d.MAV_MISSION_INVALID_PARAM6_Y: "longitude out of range",
+    d.MAV_MISSION_INVALID_PARAM7: "altitude out of range",
+}
+
+
+def _refusal_text(result: int, item: MissionItem) -> str:
+    """What a ground station is told of a refused upload: the item, its command, why."""
+    name = d.enums["MAV_MISSION_RESULT"][result].name
+    why = _WHY.get(result) or name.removeprefix("MAV_MISSION_").lower().replace("_", " ")
+    return f"Mission refused: item {item.seq} ({command_name(item.command)}): {why}"

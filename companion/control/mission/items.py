@@ -192,27 +192,6 @@ def first_refusal(items: list[MissionItem]) -> tuple[int, MissionItem | None]:
     return d.MAV_MISSION_ACCEPTED, None
 
 
-_WHY = {
-    d.MAV_MISSION_UNSUPPORTED: "a command this vehicle does not fly",
-    d.MAV_MISSION_UNSUPPORTED_FRAME: "a frame this vehicle does not take",
-    d.MAV_MISSION_INVALID_PARAM5_X: "latitude out of range",
-    d.MAV_MISSION_INVALID_PARAM6_Y: "longitude out of range",
-    d.MAV_MISSION_INVALID_PARAM7: "altitude out of range",
-}
-
-
-def refusal_text(result: int, item: MissionItem | None) -> str:
-    """What a ground station is told of a refused upload: the item, its command, why."""
-    why = _WHY.get(result) or d.enums["MAV_MISSION_RESULT"][result].name.removeprefix(
-        "MAV_MISSION_"
-    ).lower().replace("_", " ")
-    if item is None:
-        return f"Mission refused: {why}"
-    entry = d.enums["MAV_CMD"].get(item.command)
-    name = entry.name.removeprefix("MAV_CMD_") if entry is not None else str(item.command)
-    return f"Mission refused: item {item.seq} ({name}): {why}"
-
-
 def next_flown(
     items: Sequence[MissionItem], seq: int, jumps_done: Mapping[int, int]
 ) -> MissionItem | None:

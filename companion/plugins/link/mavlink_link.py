@@ -200,11 +200,11 @@ class MavlinkLink(Plugin):
 
     def _serve_missions(self, ctx: PluginContext, sysid: int) -> None:
         store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")
-        self.missions = MissionService(self.mav, store, sysid, ctx.settings["compid"])
-        self.router.add_service(self.missions)
+        self.missions = m = MissionService(self.mav, store, sysid, ctx.settings["compid"])
+        self.router.add_service(m)
         # The other plug-ins follow the stored lists through this, not the files' times.
         self.mission_changes = ctx.bus.writer("mission/changed")
-        self.missions.on_change, self.missions.say = self._mission_changed, self.statustext
+        m.on_change, m.say, m.refusal = self._mission_changed, self.statustext, self.refusal_text
         self._mission_changed(0)
 
     def _serve_logs(self, ctx: PluginContext, sysid: int) -> None:
