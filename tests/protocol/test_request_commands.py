@@ -5,23 +5,11 @@ from __future__ import annotations
 
 import math
 
-import pytest
 from pymavlink.dialects.v20 import common as m
 
-from tests.protocol.mav_client import GroundStation, free_udp_port
-from tests.support.configs import client_vehicle
+from tests.protocol.mav_client import GroundStation
 from tests.support.plugins import FakeNav
 from tests.support.vehicle import wait_for
-
-
-@pytest.fixture
-def station(vehicle_factory, tmp_path):
-    port = free_udp_port()
-    vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path))
-    gcs = GroundStation(port)
-    gcs.connect()
-    yield gcs
-    gcs.close()
 
 
 def _home(gcs: GroundStation):
@@ -31,24 +19,24 @@ def _home(gcs: GroundStation):
     return gcs.recv("HOME_POSITION")
 
 
-def test_get_home_position_sends_home_with_the_vehicles_time(station):
-    home = wait_for(lambda: _home(station), 10, "HOME_POSITION after GET_HOME_POSITION")
+def test_get_home_position_sends_home_with_the_vehicles_time(client_gcs):
+    home = wait_for(lambda: _home(client_gcs), 10, "HOME_POSITION after GET_HOME_POSITION")
     assert (home.latitude, home.longitude) == (round(FakeNav.LAT * 1e7), round(FakeNav.LON * 1e7))
     assert home.time_usec > 0  # time since boot, as PX4 stamps it (it was 0)
-    later = _home(station)
+    later = _home(client_gcs)
     assert later is not None and later.time_usec > home.time_usec
 
 
-def test_request_protocol_version_is_acked_and_answered(station):
-    station.command(m.MAV_CMD_REQUEST_PROTOCOL_VERSION, 1)  # param1 1, as the spec asks
-    assert station.ack(m.MAV_CMD_REQUEST_PROTOCOL_VERSION).result == m.MAV_RESULT_ACCEPTED
-    version = station.recv("PROTOCOL_VERSION")
+def test_request_protocol_version_is_acked_and_answered(client_gcs):
+    client_gcs.command(m.MAV_CMD_REQUEST_PROTOCOL_VERSION, 1)  # param1 1, as the spec asks
+    assert client_gcs.ack(m.MAV_CMD_REQUEST_PROTOCOL_VERSION).result == m.MAV_RESULT_ACCEPTED
+    version = client_gcs.recv("PROTOCOL_VERSION")
     assert (version.version, version.min_version, version.max_version) == (200, 100, 200)
 
 
-def test_hostile_parameters_of_the_requests_change_nothing(station):
+def test_hostile_parameters_of_the_requests_change_nothing(client_gcs):
     """Neither reads a parameter: NaN and infinity in them are ignored, answered once."""
     for command in (m.MAV_CMD_GET_HOME_POSITION, m.MAV_CMD_REQUEST_PROTOCOL_VERSION):
-        station.command(command, math.nan, math.inf, -math.inf)
-        ack = station.ack(command)
+        client_gcs.command(command, math.nan, math.inf, -math.inf)
+        ack = client_gcs.ack(command)
         assert ack.result in (m.MAV_RESULT_ACCEPTED, m.MAV_RESULT_TEMPORARILY_REJECTED)

@@ -11,8 +11,7 @@ import time
 import pytest
 from pymavlink.dialects.v20 import common as m
 
-from tests.protocol.mav_client import GroundStation, answer, free_udp_port, upload_mission
-from tests.support.configs import client_vehicle
+from tests.protocol.mav_client import GroundStation, answer, upload_mission
 
 MAVPROXY = (1, 0)  # MAVProxy addresses component 0 by default
 
@@ -43,19 +42,9 @@ def _said(gcs: GroundStation, text: str, timeout_s: float = 10.0) -> None:
 
 
 @pytest.fixture
-def vehicle(vehicle_factory, tmp_path):
-    port = free_udp_port()
-    vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path))
-    gcs = GroundStation(port)
-    gcs.connect()
-    yield gcs
-    gcs.close()
-
-
-@pytest.fixture
-def station(vehicle):
-    _upload_waypoints(vehicle, 3)
-    return vehicle
+def station(client_gcs):
+    _upload_waypoints(client_gcs, 3)
+    return client_gcs
 
 
 def test_the_item_becomes_current_in_mission_current_and_the_download(station):
@@ -75,9 +64,9 @@ def test_the_message_makes_the_item_current_too(station):
     assert station.recv("MISSION_CURRENT", seq=1).total == 3
 
 
-def test_on_the_ground_an_item_beyond_the_take_off_is_refused_with_the_reason(vehicle):
-    upload_mission(vehicle)  # take-off, then a waypoint
-    station = vehicle
+def test_on_the_ground_an_item_beyond_the_take_off_is_refused_with_the_reason(client_gcs):
+    upload_mission(client_gcs)  # take-off, then a waypoint
+    station = client_gcs
     station.command(m.MAV_CMD_DO_SET_MISSION_CURRENT, 1, target=MAVPROXY)
     assert station.ack(m.MAV_CMD_DO_SET_MISSION_CURRENT).result == m.MAV_RESULT_DENIED
     _said(station, "Set mission item: 1 skips the take-off (item 0) on the ground")

@@ -30,6 +30,14 @@ def read_when_ready(endpoint: SerialEndpoint, limit_s: float = 5.0) -> bytes:
     return b""
 
 
+def opened_within(endpoint: SerialEndpoint, limit_s: float) -> bool:
+    """Whether the endpoint has its device open (it retries on its back-off) in time."""
+    deadline = time.monotonic() + limit_s
+    while not endpoint.filenos() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return bool(endpoint.filenos())
+
+
 def test_bytes_flow_both_ways_and_a_custom_rate_reopens(tmp_path):
     pty = Pty(tmp_path / "ttyRadio")
     try:
@@ -53,10 +61,7 @@ def test_a_radio_pulled_out_and_plugged_back_in_is_reopened(tmp_path):
     assert radio.filenos() == [] and radio.send(b"lost") == 0 and radio.write_errors == 1
     pty = Pty(link)  # plugged back in, at the same path
     try:
-        deadline = time.monotonic() + 5.0
-        while not radio.filenos() and time.monotonic() < deadline:
-            time.sleep(0.05)
-        assert radio.filenos(), "reopened within the 2 s back-off"
+        assert opened_within(radio, 5.0), "reopened within the 2 s back-off"
         os.write(pty.master, b"back")
         assert read_when_ready(radio) == b"back" and radio.reopens == 1
         assert radio.send(b"again") == 5 and os.read(pty.master, 64) == b"again"
@@ -71,10 +76,7 @@ def test_a_radio_missing_at_start_is_waited_for_and_taken_when_it_comes(tmp_path
     assert radio.filenos() == [] and radio.send(b"early") == 0 and radio.write_errors == 1
     pty = Pty(link)  # the adapter enumerates after the link started
     try:
-        deadline = time.monotonic() + 5.0
-        while not radio.filenos() and time.monotonic() < deadline:
-            time.sleep(0.05)
-        assert radio.filenos(), "opened within the 2 s back-off"
+        assert opened_within(radio, 5.0), "opened within the 2 s back-off"
         os.write(pty.master, b"ground")
         assert read_when_ready(radio) == b"ground" and radio.reopens == 0
         assert radio.send(b"air") == 3 and os.read(pty.master, 64) == b"air"
