@@ -72,6 +72,14 @@ MODE_COMMANDS = frozenset(
         CommandId.SET_MISSION_CURRENT,
     }
 )
+# The mode commands that choose what the aircraft flies (not a speed, home or mission item):
+# an operator's choice, which a failsafe's later recovery must not undo.
+MODE_CHOICES = MODE_COMMANDS - {
+    CommandId.SET_HOME,
+    CommandId.CHANGE_SPEED,
+    CommandId.SET_MISSION_CURRENT,
+    CommandId.GO_AROUND,
+}
 # Commands that fly a mode a fixed wing cannot fly from the runway.
 _AIRBORNE_COMMANDS = {
     CommandId.RETURN_TO_LAUNCH: FlightMode.RTL,

@@ -4,7 +4,9 @@ Pure: the time, the mode and what the link, the navigator and the fence say in; 
 changes and operator messages out (the ``vehicle.commander`` plug-in applies them).
 As ArduPlane and PX4 do it:
 - no ground-station heartbeat for ``FS_GCS_TIMEOUT`` while flying → Return; when the
-  link comes back the mission is resumed if it was flying one and ``FS_GCS_RESUME`` is 1;
+  link comes back the mission is resumed if it was flying one and ``FS_GCS_RESUME`` is 1,
+  unless the operator chose another mode meanwhile (a Return commanded over another link
+  or on the mode switch stands);
 - GPS lost (the navigator has had no usable fix for ``FS_GPS_LOST_S`` of its own sensor
   time) → the controller holds heading and height; when GPS has been steady again for
   ``FS_GPS_BACK_S`` the aircraft loiters where it is;
@@ -114,6 +116,8 @@ class Failsafes:
     def __init__(self, params: dict[str, float]) -> None:
         self.params = params
         self.gcs_lost = self.gps_lost = self.fence_breached = False
+        # What the link's return resumes: the mode the failsafe interrupted, or the one the
+        # operator chose since (``operator_chose``).
         self.mode_before_gcs: FlightMode | None = None
         self.mode_seen: FlightMode | None = None  # the mode at the last step
         self.gps = Hysteresis(params["FS_GPS_LOST_S"], params["FS_GPS_BACK_S"])
@@ -127,6 +131,14 @@ class Failsafes:
             actions = self._reassert(s.mode)
         self.mode_seen = s.mode
         return actions
+
+    def operator_chose(self, mode: FlightMode) -> None:
+        """The operator chose ``mode`` (a mode command accepted, the mode switch moved).
+        While the ground station is lost that choice, not the mode the failsafe took over
+        from, says whether the mission resumes when the link returns: a Return chosen
+        while the failsafe returned home is kept."""
+        if self.gcs_lost:
+            self.mode_before_gcs = mode
 
     def _reassert(self, mode: FlightMode) -> list[Action]:
         """The operator chose another mode while a failsafe still holds: act on it again."""

@@ -106,7 +106,9 @@ def station(sim) -> Iterator[Station]:
 
 
 @pytest.mark.timeout(240)
-def test_ground_station_lost_returns_home_then_resumes_the_mission(station):
+def test_ground_station_lost_returns_home_then_resumes_the_mission_unless_told_to_return(
+    station,
+):
     station.fly_mission()
     # Airborne, judged by the vehicle (past the take-off item), not by wall time: a
     # busy machine runs the simulation slower.
@@ -117,6 +119,19 @@ def test_ground_station_lost_returns_home_then_resumes_the_mission(station):
     station.beating = True
     station.until(lambda: station.in_mode(FlightMode.MISSION), 30, "back in the mission")
     station.until(lambda: station.said("resuming the mission"), 5, "told so")
+    # Lost again, and now the operator commands Return (the command gets through while the
+    # heartbeats do not, as over a second link): the link's return keeps it.
+    station.beating = False
+    station.until(lambda: station.in_mode(FlightMode.RTL), 30, "returning again")
+    assert station.acked(d.MAV_CMD_NAV_RETURN_TO_LAUNCH) == d.MAV_RESULT_ACCEPTED
+    told = sum("Ground station back" in t for t in station.texts)
+    station.beating = True
+    station.until(
+        lambda: sum("Ground station back" in t for t in station.texts) > told, 30, "told it is back"
+    )
+    station.pump(2.0)
+    assert station.in_mode(FlightMode.RTL)
+    assert sum("resuming the mission" in t for t in station.texts) == 1
 
 
 @pytest.mark.timeout(240)

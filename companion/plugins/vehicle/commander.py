@@ -16,8 +16,9 @@ import time
 from pathlib import Path
 from typing import Any
 
+from companion.control import commander as rules
 from companion.control.battery_failsafe import BATTERY_FS_PARAMS, BatteryFailsafe
-from companion.control.commander import COMMANDER_PARAMS, MIN_ALT_PARAM, MODE_COMMANDS, Commander
+from companion.control.commander import COMMANDER_PARAMS, MIN_ALT_PARAM, Commander
 from companion.control.failsafe import FAILSAFE_PARAMS, Failsafes, Situation
 from companion.control.flight.landing_flight import land_start
 from companion.control.flight_state import (
@@ -314,7 +315,7 @@ class CommanderPlugin(Plugin):
         """The mode commands handled, as their acks (published after the new status)."""
         acks = []
         for cmd in self.commands.drain():
-            if cmd.command not in MODE_COMMANDS:
+            if cmd.command not in rules.MODE_COMMANDS:
                 continue  # START, STOP, restarts: the execution control's
             decision = self.commander.handle(cmd)
             if decision is None:
@@ -324,6 +325,8 @@ class CommanderPlugin(Plugin):
             ack.source = self.ctx.name.encode()[: NAME_LEN - 1]
             ack.reason = decision.reason.encode()[:REASON_LEN]
             acks.append(ack)
+            if decision.result == 0 and cmd.command in rules.MODE_CHOICES:
+                self.failsafes.operator_chose(self.commander.mode)
             if decision.reason:
                 self.ctx.log.info("refused: %s", decision.reason)
         return acks
@@ -373,7 +376,9 @@ class CommanderPlugin(Plugin):
             name = mode.name.title()
             text = f"Mode switch: {name}" if decision.result == 0 else decision.reason
             self._say(now, text, d.MAV_SEVERITY_INFO)
-            changed |= decision.result == 0
+            if decision.result == 0:
+                self.failsafes.operator_chose(mode)
+                changed = True
         return changed
 
     def _say(self, now: int, text: str, severity: int) -> None:

@@ -160,3 +160,31 @@ def test_good_news_is_said_at_notice_and_bad_news_at_critical():
     fence.step(_at(0.0, FlightMode.MISSION, "fence"))
     (inside,) = fence.step(_at(0.1, FlightMode.RTL))
     assert inside.severity == d.MAV_SEVERITY_NOTICE
+
+
+def test_a_return_the_operator_chose_while_the_link_was_lost_is_not_undone_when_it_returns():
+    """Commanded over a second link or on the mode switch: the link's return keeps it."""
+    fs = _failsafes(FS_GCS_TIMEOUT=5.0)
+    assert _modes(fs, [_at(0.0, FlightMode.MISSION, silence=6.0)]) == [FlightMode.RTL]
+    fs.operator_chose(FlightMode.RTL)
+    (back,) = fs.step(_at(0.1, FlightMode.RTL, silence=0.5))
+    assert back.mode is None and back.text == "Ground station back"
+
+
+def test_a_mission_the_operator_chose_while_the_link_was_lost_resumes_when_it_returns():
+    """Start Mission while still lost is taken back (Return again), and flown once the
+    link returns, as it would have been had the operator not touched anything."""
+    fs = _failsafes(FS_GCS_TIMEOUT=5.0)
+    fs.step(_at(0.0, FlightMode.LOITER, silence=6.0))
+    fs.operator_chose(FlightMode.MISSION)
+    assert _modes(fs, [_at(0.1, FlightMode.MISSION, silence=6.1)]) == [FlightMode.RTL]
+    (back,) = fs.step(_at(0.2, FlightMode.RTL, silence=0.5))
+    assert back.mode == FlightMode.MISSION
+
+
+def test_a_choice_made_before_the_link_was_lost_does_not_count():
+    fs = _failsafes(FS_GCS_TIMEOUT=5.0)
+    fs.operator_chose(FlightMode.RTL)  # the failsafe holds nothing yet
+    fs.step(_at(0.0, FlightMode.MISSION, silence=6.0))
+    (back,) = fs.step(_at(0.1, FlightMode.RTL, silence=0.5))
+    assert back.mode == FlightMode.MISSION
