@@ -18,6 +18,7 @@ from typing import Any
 from companion.control.mission.fence import Fence, honoured
 from companion.control.mission.items import (
     MISSION_TYPES,
+    TAKEOFF_NOT_FIRST,
     MissionItem,
     first_refusal,
 )
@@ -324,6 +325,8 @@ _WHY = {
     d.MAV_MISSION_INVALID_PARAM5_X: "latitude out of range",
     d.MAV_MISSION_INVALID_PARAM6_Y: "longitude out of range",
     d.MAV_MISSION_INVALID_PARAM7: "altitude out of range",
+    TAKEOFF_NOT_FIRST: "a take-off after an item to fly to; an ArduPilot .waypoints file's"
+    " line 0 is home: delete it",
 }
 
 

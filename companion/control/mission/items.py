@@ -183,12 +183,24 @@ def check_mission(items: list[MissionItem]) -> int:
     return first_refusal(items)[0]
 
 
+# A take-off after an item the aircraft flies to (as PX4 refuses it): from the runway the
+# mission would fly that item first, and an ArduPilot .waypoints file's line 0 (home, at
+# ground level, sent as item 0 by MAVProxy's `wp load`) is such an item.
+TAKEOFF_NOT_FIRST = d.MAV_MISSION_ERROR
+
+
 def first_refusal(items: list[MissionItem]) -> tuple[int, MissionItem | None]:
     """The first refused item of a mission and why (MAV_MISSION_ACCEPTED, None: none)."""
+    flown_before = False
     for item in items:
         result = check_item(item, len(items))
         if result != d.MAV_MISSION_ACCEPTED:
             return result, item
+        if item.mission_type != d.MAV_MISSION_TYPE_MISSION:
+            continue
+        if item.command == d.MAV_CMD_NAV_TAKEOFF and flown_before:
+            return TAKEOFF_NOT_FIRST, item
+        flown_before |= item.command in NAV_COMMANDS
     return d.MAV_MISSION_ACCEPTED, None
 
 

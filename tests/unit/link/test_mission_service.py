@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from pymavlink import mavwp
 
 from companion.control.mission.mission_files import MissionStore
 from companion.link.codec import new_encoder, new_parser
@@ -82,6 +83,61 @@ def test_an_item_the_vehicle_cannot_fly_is_refused_and_the_old_mission_stays(ben
         ("Mission refused: item 1 (DO_JUMP): invalid param1", d.MAV_SEVERITY_WARNING),
         ("Mission refused: item 0 (NAV_WAYPOINT): latitude out of range", d.MAV_SEVERITY_WARNING),
     ]  # fmt: skip
+
+
+# An ArduPilot .waypoints file as Mission Planner saves one: line 0 is home (at ground level,
+# absolute), then the take-off and the waypoints. MAVProxy's `wp load` sends every line.
+WAYPOINTS_FILE = """QGC WPL 110
+0\t1\t0\t16\t0\t0\t0\t0\t-37.9105000\t145.1340000\t126.000000\t1
+1\t0\t3\t22\t15.0\t0\t0\t0\t-37.9105000\t145.1400000\t60.000000\t1
+2\t0\t3\t16\t0\t0\t0\t0\t-37.9010000\t145.1500000\t100.000000\t1
+3\t0\t3\t16\t0\t0\t0\t0\t-37.9010000\t145.1340000\t100.000000\t1
+"""
+
+
+def _loaded(bench, path, drop_first: bool):
+    """The file's items as MAVProxy's `wp load` sends them (pymavlink's loader), numbered
+    from 0 again when the home line is dropped."""
+    loader = mavwp.MAVWPLoader()
+    loader.load(str(path))
+    wps = [loader.wp(i) for i in range(loader.count())][int(drop_first) :]
+    items = []
+    for seq, wp in enumerate(wps):
+        items.append(bench.gcs.mission_item_int_encode(
+            1, 1, seq, wp.frame, wp.command, wp.current, wp.autocontinue, wp.param1,
+            wp.param2, wp.param3, wp.param4, round(wp.x * 1e7), round(wp.y * 1e7), wp.z, 0,
+        ))  # fmt: skip
+    return items
+
+
+def test_an_ardupilot_home_line_before_the_take_off_is_refused_and_said_why(bench, tmp_path):
+    """Flown, line 0 would be a waypoint at home at ground level before the take-off (PX4
+    refuses any take-off after an item to fly to, too)."""
+    said = []
+    bench.service.say = lambda text, severity: said.append(text)
+    path = tmp_path / "field.waypoints"
+    path.write_text(WAYPOINTS_FILE)
+    assert bench.upload(_loaded(bench, path, drop_first=False)).type == d.MAV_MISSION_ERROR
+    assert bench.service.store.items[0] == []
+    assert said == [
+        "Mission refused: item 1 (NAV_TAKEOFF): a take-off after an item to fly to; an"
+        " ArduPilot .waypoints file's line 0 is home: delete it"
+    ]
+    # As the docs say: the same file without its home line flies.
+    assert bench.upload(_loaded(bench, path, drop_first=True)).type == d.MAV_MISSION_ACCEPTED
+    assert [it.command for it in bench.service.store.items[0]] == [22, 16, 16]
+
+
+def test_markers_and_speed_changes_before_the_take_off_are_no_items_to_fly_to(bench):
+    before = [
+        bench.item(0, command=d.MAV_CMD_DO_CHANGE_SPEED, p1=1.0),
+        bench.item(1, command=d.MAV_CMD_NAV_TAKEOFF),
+        bench.item(2),
+    ]
+    assert bench.upload(before).type == d.MAV_MISSION_ACCEPTED
+    twice = [bench.item(0, command=d.MAV_CMD_NAV_TAKEOFF), bench.item(1),
+             bench.item(2, command=d.MAV_CMD_NAV_TAKEOFF)]  # fmt: skip
+    assert bench.upload(twice).type == d.MAV_MISSION_ERROR
 
 
 def test_a_flood_of_refused_uploads_is_told_once_and_counted_whole(bench):
