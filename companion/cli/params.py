@@ -110,11 +110,17 @@ def params_save(
 
 @params_app.command("load")
 def params_load(
-    file: Annotated[Path, typer.Argument(help=".params file to read")],
+    file: Annotated[
+        Path,
+        typer.Argument(
+            help="QGroundControl .params, MAVProxy param save or Mission Planner .param"
+        ),
+    ],
     config: Annotated[Path, CONFIG_OPT],
 ) -> None:
-    """Check a .params file against the config's declarations and store it (all or nothing);
-    a line at its parameter's default stores nothing."""
+    """Check a parameter file (QGroundControl's, MAVProxy's or Mission Planner's) against
+    the config's declarations and store it (all or nothing); a line at its parameter's
+    default stores nothing."""
     from companion.params import ParamError
     from companion.params.qgc_file import load_params
 

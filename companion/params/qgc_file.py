@@ -1,4 +1,6 @@
-"""QGroundControl ``.params`` files: ``vehicle-id component-id name value type`` per line.
+"""Parameter files: QGroundControl's ``.params`` (``vehicle-id component-id name value
+type`` per line, what ``save_params`` writes), and read also as ArduPilot users have them:
+MAVProxy's ``param save`` (``NAME VALUE``) and Mission Planner's ``.param`` (``NAME,VALUE``).
 
 A file lists every parameter the vehicle serves, so it lists an alias (a PX4 name such as
 RTL_RETURN_ALT, or RTL_DESCEND_ALT, which only reads RTL_ALT_M) beside the parameters it
@@ -11,6 +13,7 @@ more, one that contradicts it is refused, naming both.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -32,6 +35,34 @@ class _Line:
     lineno: int
     name: str
     value: float
+    printed_tol: float = 0.0  # half the last printed digit: MAVProxy writes 6 decimals
+
+
+MAVPROXY_DECIMALS = 6  # its `param save` prints "%f"
+
+
+def _printed_tol(text: str) -> float:
+    """How far a value MAVProxy wrote as ``text`` may be from the one it printed."""
+    _, dot, decimals = text.partition(".")
+    return 0.5 * 10.0**-MAVPROXY_DECIMALS if dot and len(decimals) == MAVPROXY_DECIMALS else 0.0
+
+
+FORMATS = (
+    "'sysid compid NAME VALUE type' (QGroundControl), 'NAME VALUE' (MAVProxy)"
+    " or 'NAME,VALUE' (Mission Planner)"
+)
+
+
+def _name_and_value(line: str) -> tuple[str, str, float] | None:
+    """A line's name, value and how far the value may be from what was printed (MAVProxy's
+    six decimals), in any of the three formats (None: in none of them)."""
+    comma = "," in line
+    fields = [f.strip() for f in line.split(",")] if comma else line.split()
+    if len(fields) == 2:
+        return fields[0], fields[1], 0.0 if comma else _printed_tol(fields[1])
+    if len(fields) >= 4 and not comma:  # QGroundControl's: full precision
+        return fields[2], fields[3], 0.0
+    return None
 
 
 def _lines(path: Path) -> list[_Line]:
@@ -41,12 +72,12 @@ def _lines(path: Path) -> list[_Line]:
         line = raw.strip()
         if not line or line.startswith("#"):
             continue
-        fields = line.split()
-        if len(fields) < 4:
-            raise ParamError(f"{path}:{lineno}: expected 'sysid compid name value type'")
-        name, text = fields[2], fields[3]
+        found = _name_and_value(line)
+        if found is None:
+            raise ParamError(f"{path}:{lineno}: expected {FORMATS}")
+        name, text, tol = found
         try:
-            lines.append(_Line(lineno, name, float(text)))
+            lines.append(_Line(lineno, name, float(text), tol))
         except ValueError:
             raise ParamError(f"{path}:{lineno}: {name}: {text!r} is not a number") from None
     return lines
@@ -64,7 +95,11 @@ class _FilePlan:
         return ParamError(f"{self.path}:{line.lineno}: {text}")
 
     def own(self, line: _Line) -> None:
-        """A parameter of the vehicle's own: its value, checked."""
+        """A parameter of the vehicle's own: its value, checked. One printed within its
+        last digit of the vehicle's value is that value, not a rounding of it."""
+        current = self.values.get(line.name)
+        if current is not None and abs(current - line.value) <= line.printed_tol:
+            line = dataclasses.replace(line, value=current)
         try:
             self.store.plan(line.name, line.value)
         except ParamError as exc:
@@ -94,8 +129,20 @@ class _FilePlan:
         return bool(planned)
 
     def agrees(self, line: _Line) -> bool:
-        """The alias of ``line`` reads its value from the file's values."""
-        return same_value(self.store.aliases[line.name].read(self.values), line.value)
+        """The alias of ``line`` reads its value from the file's values, to the digits the
+        file printed (MAVProxy's 0.133333 is 1/7.5): the alias's own last digit and what
+        the last digits of the values it reads move it by."""
+        alias = self.store.aliases[line.name]
+        read = alias.read(self.values)
+        if same_value(read, line.value):
+            return True
+        slack = line.printed_tol
+        for source in alias.sources:
+            setter = self.set_by.get(source)
+            if setter is not None and setter.printed_tol:
+                bumped = {**self.values, source: self.values[source] + setter.printed_tol}
+                slack += abs(alias.read(bumped) - read)
+        return abs(read - line.value) <= slack * (1 + 1e-6) + 1e-12
 
     def contradiction(self, line: _Line, owners: tuple[str, ...]) -> ParamError:
         """``line``'s alias reads otherwise than the values it follows."""
@@ -114,7 +161,8 @@ class _FilePlan:
 
 
 def load_params(store: ParamStore, path: Path) -> int:
-    """Apply a .params file; ParamError names the line and parameter of the first bad line.
+    """Apply a parameter file (any of the three formats); ParamError names the line and
+    parameter of the first bad line.
 
     Nothing is applied unless every line is good. A line at the parameter's default stores
     nothing (the parameter keeps following its default), so a whole file written by

@@ -13,6 +13,7 @@ import struct
 from pathlib import Path
 
 import pytest
+from pymavlink import mavparm
 from typer.testing import CliRunner
 
 from companion.cli import app
@@ -130,3 +131,22 @@ def test_every_follower_contradicting_what_it_follows_is_refused(changed, tmp_pa
         assert f"{name} {wrong:g} contradicts " in said, said
         assert any(f"{source} " in said.split("contradicts")[1] for source in alias.sources)
         assert store.stored == stored, f"{name}: nothing applied from a refused file"
+
+
+def test_every_follower_survives_a_file_mavproxy_saved(changed, tmp_path):
+    """MAVProxy's `param save` (pymavlink's own writer) prints 6 decimals: a follower's
+    0.133333 is 1/7.5, and a value at its default stays the default."""
+    config, before = changed
+    saved = mavparm.MAVParmDict()
+    for name in before.names:  # what the vehicle sends: float32 on the wire
+        saved[name] = struct.unpack("<f", struct.pack("<f", before.get(name)))[0]
+    parm = tmp_path / "mav.parm"
+    saved.save(str(parm))
+    params("reset", "-c", config)
+    params("load", str(parm), "-c", config)
+    _, after = _param_store(Path(config))
+    # What is stored moves by the last printed digit at most (a follower of it further:
+    # 5e-7 rad of AHRS_TRIM_X is 3e-5 degrees of SENS_BOARD_X_OFF).
+    owned = [n for n in before.names if n not in before.aliases]
+    moved = [n for n in owned if not math.isclose(after.get(n), before.get(n), abs_tol=5e-7)]
+    assert moved == [] and set(after.stored) == set(before.stored)

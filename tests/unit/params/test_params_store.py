@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import pytest
+from pymavlink import mavparm
 
 from companion.params import ParamDecl, ParamError, ParamStore
 from companion.params.qgc_file import load_params, save_params
@@ -68,6 +69,26 @@ def test_qgc_params_file_round_trip_and_bad_lines(tmp_path):
     path.write_text("1\t1\tFW_R_LIM\t95\t9\n")
     with pytest.raises(ParamError, match=r"v\.params:1: FW_R_LIM: 95 outside"):
         load_params(other, path)
+
+
+def test_mavproxy_and_mission_planner_files_load_as_ardupilot_users_have_them(tmp_path):
+    """MAVProxy's `param save` (written here by pymavlink's own MAVParmDict.save, which
+    MAVProxy calls) and Mission Planner's NAME,VALUE .param load like QGroundControl's."""
+    saved = mavparm.MAVParmDict()
+    saved["FW_R_LIM"], saved["FW_AIRSPD_TRIM"] = 55.5, 25.0
+    mavproxy = tmp_path / "mav.parm"
+    saved.save(str(mavproxy))
+    store = ParamStore(DECLS)
+    assert load_params(store, mavproxy) == 2
+    assert (store.get("FW_R_LIM"), store.get("FW_AIRSPD_TRIM")) == (55.5, 25.0)
+    planner = tmp_path / "plane.param"
+    planner.write_text("#NOTE: 06/12/2026 Frame : plane\nFW_R_LIM,50\r\nFW_AIRSPD_TRIM,30.5\r\n")
+    assert load_params(store, planner) == 2
+    assert (store.get("FW_R_LIM"), store.get("FW_AIRSPD_TRIM")) == (50.0, 30.5)
+    planner.write_text("FW_R_LIM,50,9\n")
+    with pytest.raises(ParamError, match=r"plane\.param:1: expected .*'NAME,VALUE'"):
+        load_params(store, planner)
+    assert store.get("FW_R_LIM") == 50.0
 
 
 def test_only_what_the_user_set_is_stored_and_a_moved_default_reaches_the_rest(tmp_path):
