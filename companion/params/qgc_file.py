@@ -14,12 +14,15 @@ more, one that contradicts it is refused, naming both.
 from __future__ import annotations
 
 import dataclasses
+import logging
 from dataclasses import dataclass
 from pathlib import Path
 
 from companion.params.store import ParamError, ParamStore, same_value
 
 MAV_PARAM_TYPE_REAL32 = 9
+
+log = logging.getLogger(__name__)
 
 
 def save_params(store: ParamStore, path: Path, sysid: int = 1, compid: int = 1) -> None:
@@ -97,6 +100,13 @@ class _FilePlan:
     def own(self, line: _Line) -> None:
         """A parameter of the vehicle's own: its value, checked. One printed within its
         last digit of the vehicle's value is that value, not a rounding of it."""
+        decl = self.store.decls.get(line.name)
+        if decl is not None and decl.min == decl.max and not same_value(decl.min, line.value):
+            # A fact of the vehicle the file came from (its system id, a battery monitor
+            # it had): not a setting, and this vehicle's stays.
+            log.warning("%s:%d: %s %g not set: this vehicle's is %g (fixed)",
+                        self.path, line.lineno, line.name, line.value, decl.min)  # fmt: skip
+            return
         current = self.values.get(line.name)
         if current is not None and abs(current - line.value) <= line.printed_tol:
             line = dataclasses.replace(line, value=current)

@@ -91,6 +91,17 @@ def test_mavproxy_and_mission_planner_files_load_as_ardupilot_users_have_them(tm
     assert store.get("FW_R_LIM") == 50.0
 
 
+def test_a_fact_of_the_vehicle_a_file_came_from_is_not_set_and_the_rest_loads(tmp_path, caplog):
+    """A backup of vehicle 2 restored into vehicle 1: its MAV_SYS_ID is a fact of vehicle 2
+    (fixed here), not a setting, and does not refuse the file."""
+    store = ParamStore((*DECLS, ParamDecl.fixed("MAV_SYS_ID", 1.0, "system id")))
+    path = tmp_path / "v2.params"
+    path.write_text("2\t1\tMAV_SYS_ID\t2\t6\n2\t1\tFW_R_LIM\t50\t9\n")
+    assert load_params(store, path) == 2
+    assert (store.get("MAV_SYS_ID"), store.get("FW_R_LIM")) == (1.0, 50.0)
+    assert "MAV_SYS_ID 2 not set: this vehicle's is 1 (fixed)" in caplog.text
+
+
 def test_only_what_the_user_set_is_stored_and_a_moved_default_reaches_the_rest(tmp_path):
     path = tmp_path / "p.json"
     ParamStore(DECLS, path).set("FW_R_LIM", 50.0)
