@@ -4,16 +4,11 @@ from __future__ import annotations
 
 import pytest
 
-from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.protocol.mav_client import connected_station
 from tests.support.configs import client_vehicle
 
 
 @pytest.fixture
 def client_gcs(vehicle_factory, tmp_path):
     """A pymavlink ground station connected to a vehicle with the commander (no mission)."""
-    port = free_udp_port()
-    vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path))
-    gcs = GroundStation(port)
-    gcs.connect()
-    yield gcs
-    gcs.close()
+    yield from connected_station(vehicle_factory, lambda url: client_vehicle(url, tmp_path))

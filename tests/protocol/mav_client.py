@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 os.environ.setdefault("MAVLINK20", "1")
@@ -15,7 +17,14 @@ from mavlink_dialect import companion as d
 from mavlink_dialect import companion as dialect
 from tests.support.configs import FAKE_NAV, link, plugin, vehicle_config
 
-__all__ = ["GroundStation", "answer", "free_udp_port", "two_stations", "upload_mission"]
+__all__ = [
+    "GroundStation",
+    "answer",
+    "connected_station",
+    "free_udp_port",
+    "two_stations",
+    "upload_mission",
+]
 
 
 class GroundStation:
@@ -98,6 +107,19 @@ def upload_mission(gcs: GroundStation) -> None:
             round((-37.9105 + dlat) * 1e7), round(145.134 * 1e7), 50, d.MAV_MISSION_TYPE_MISSION,
         )  # fmt: skip
     assert gcs.recv("MISSION_ACK", 10).type == d.MAV_MISSION_ACCEPTED
+
+
+def connected_station(
+    vehicle_factory: Any, config: Callable[[str], Path]
+) -> Iterator[GroundStation]:
+    """For a fixture to yield from: a vehicle started from ``config(udpin URL)`` and a
+    ground station connected to it, closed after the test."""
+    port = free_udp_port()
+    vehicle_factory(config(f"udpin://127.0.0.1:{port}"))
+    station = GroundStation(port)
+    station.connect()
+    yield station
+    station.close()
 
 
 def two_stations(

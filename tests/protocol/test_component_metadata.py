@@ -14,19 +14,14 @@ import pytest
 from pymavlink.dialects.v20 import common as m
 
 from tests.protocol.ftp_client import OPEN_FILE_RO, READ_FILE, FtpDownload, request
-from tests.protocol.mav_client import GroundStation, free_udp_port, two_stations
+from tests.protocol.mav_client import GroundStation, connected_station, two_stations
 from tests.protocol.test_params import fetch_all
 from tests.support.configs import link_vehicle
 
 
 @pytest.fixture
 def gcs(vehicle_factory, tmp_path):
-    port = free_udp_port()
-    vehicle_factory(link_vehicle(f"udpin://127.0.0.1:{port}", tmp_path))
-    station = GroundStation(port)
-    station.connect()
-    yield station
-    station.close()
+    yield from connected_station(vehicle_factory, lambda url: link_vehicle(url, tmp_path))
 
 
 def ftp_path(uri: str) -> str:

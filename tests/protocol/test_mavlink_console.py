@@ -17,7 +17,7 @@ import pytest
 
 from companion.link.shell_service import PROMPT
 from mavlink_dialect import companion as m
-from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.protocol.mav_client import GroundStation, connected_station
 from tests.support.configs import client_vehicle
 
 QGC_FLAGS = (
@@ -27,12 +27,8 @@ QGC_FLAGS = (
 
 @pytest.fixture
 def gcs(vehicle_factory, tmp_path):
-    port = free_udp_port()
-    vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path / "state"))
-    station = GroundStation(port)
-    station.connect()
-    yield station
-    station.close()
+    state = tmp_path / "state"
+    yield from connected_station(vehicle_factory, lambda url: client_vehicle(url, state))
 
 
 def _send(gcs: GroundStation, data: bytes, flags: int = QGC_FLAGS, device: int = 0) -> None:

@@ -14,7 +14,7 @@ from mavsdk.component_type import ComponentType
 
 from companion.link.stream_schedule import MAX_RATE_HZ
 from mavlink_dialect import companion as m
-from tests.protocol.mav_client import GroundStation, free_udp_port
+from tests.protocol.mav_client import GroundStation, connected_station, free_udp_port
 from tests.support.configs import TICKER, client_vehicle, plugin
 
 INTERVAL = m.MAV_CMD_SET_MESSAGE_INTERVAL
@@ -27,13 +27,8 @@ TECS = (m.MAVLINK_MSG_ID_VFR_HUD, m.MAVLINK_MSG_ID_NAV_CONTROLLER_OUTPUT)
 
 @pytest.fixture
 def gcs(vehicle_factory, tmp_path):
-    port = free_udp_port()
     imu = plugin("imu", TICKER, rate_hz=100.0)
-    vehicle_factory(client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path, (imu,)))
-    station = GroundStation(port)
-    station.connect()
-    yield station
-    station.close()
+    yield from connected_station(vehicle_factory, lambda url: client_vehicle(url, tmp_path, (imu,)))
 
 
 def _set(gcs: GroundStation, msg_id: int, interval_us: float) -> int:
