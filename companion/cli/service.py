@@ -14,6 +14,7 @@ from typing import Annotated
 import typer
 
 from companion.cli.app import CONFIG_OPT, NS_OPT, app, err, load_checked, out
+from companion.params.atomic import atomic_write_text
 
 service_app = typer.Typer(help="Start the vehicle at boot: a systemd service.")
 app.add_typer(service_app, name="service")
@@ -81,7 +82,7 @@ def install(
     spec = UnitSpec(config.resolve(), who, _command(), name, namespace, log_level)
     path = unit_path(unit_dir or UNIT_DIR, name, root)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(unit_text(spec))
+    atomic_write_text(path, unit_text(spec), shared=True)
     out.print(f"wrote {path} (runs as {who}, state in /var/lib/companion)", highlight=False)
     if manage:
         _systemctl("daemon-reload")

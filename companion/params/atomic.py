@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import stat
 import tempfile
 import time
 from pathlib import Path
@@ -14,13 +15,20 @@ from pathlib import Path
 ORPHAN_AGE_S = 60.0
 
 
-def atomic_write_text(path: Path, text: str) -> None:
+def atomic_write_text(path: Path, text: str, shared: bool = False) -> None:
     """Temp file in the same directory, fsync, rename over the old file, fsync the directory
-    (and, the first time, the directory's own parent, so the new directory survives too)."""
+    (and, the first time, the directory's own parent, so the new directory survives too).
+
+    The file is its owner's alone (0600), as the vehicle's own state is, unless ``shared``:
+    a file written for people and other programs (a saved parameter file, a plan, a systemd
+    unit) keeps the mode of the file it replaces, or a new file's usual 0666 less the umask,
+    as a plain write would give it."""
     created = not path.parent.is_dir()
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        if shared:
+            os.fchmod(fd, _plain_write_mode(path))
         with os.fdopen(fd, "w") as handle:
             handle.write(text)
             handle.flush()
@@ -33,6 +41,21 @@ def atomic_write_text(path: Path, text: str) -> None:
     if created:
         fsync_directory(path.parent.parent)
     remove_orphans(path)
+
+
+def _plain_write_mode(path: Path) -> int:
+    """The permission bits ``open(path, "w")`` would leave: the old file's, or 0666 less the
+    umask (read from /proc: setting it to read it would race with other threads' files)."""
+    try:
+        return stat.S_IMODE(path.stat().st_mode)
+    except OSError:
+        pass
+    umask = 0o022
+    with contextlib.suppress(OSError, ValueError):
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                umask = int(line.split()[1], 8)
+    return 0o666 & ~umask
 
 
 def remove_orphans(path: Path, now: float | None = None) -> list[Path]:

@@ -18,6 +18,7 @@ import logging
 from dataclasses import dataclass
 from pathlib import Path
 
+from companion.params.atomic import atomic_write_text
 from companion.params.store import ParamError, ParamStore, same_value
 
 MAV_PARAM_TYPE_REAL32 = 9
@@ -30,7 +31,7 @@ def save_params(store: ParamStore, path: Path, sysid: int = 1, compid: int = 1) 
     lines = ["# Onboard parameters for companion", "#", "# Vehicle-Id Component-Id Name Value Type"]
     for name in store.names:
         lines.append(f"{sysid}\t{compid}\t{name}\t{store.get(name)!r}\t{MAV_PARAM_TYPE_REAL32}")
-    path.write_text("\n".join(lines) + "\n")
+    atomic_write_text(path, "\n".join(lines) + "\n", shared=True)
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ from typing import Any
 
 from companion.control.mission.fence import CIRCLES, POLYGONS
 from companion.control.mission.items import MissionItem, check_mission
+from companion.params.atomic import atomic_write_text
 from mavlink_dialect import companion as d
 
 
@@ -269,7 +270,7 @@ def save_plan(path: str | Path, items: dict[int, list[MissionItem]]) -> dict[int
     """Write a .plan file with the mission, geofence and rally points; the count of each
     written (by mission type)."""
     plan = plan_json(items)
-    Path(path).write_text(json.dumps(plan, indent=2))
+    atomic_write_text(Path(path), json.dumps(plan, indent=2), shared=True)
     return plan_counts(plan)
 
 

@@ -71,3 +71,22 @@ def test_a_write_sweeps_old_orphans_and_leaves_a_write_in_progress(tmp_path: Pat
     assert not orphan.exists(), "a killed writer's file is swept"
     assert in_progress.exists(), "another process's write in progress is left alone"
     assert other.exists(), "another file's temporaries are its own writes' to sweep"
+
+
+def test_a_shared_file_gets_a_plain_writes_mode_and_state_stays_private(tmp_path: Path) -> None:
+    """A saved parameter file or plan is for people and other programs: readable as a
+    plain write would leave it (0666 less the umask), a replaced one keeps its mode; the
+    vehicle's own state is its owner's alone."""
+    old_umask = os.umask(0o027)
+    try:
+        shared = tmp_path / "backup.params"
+        atomic_write_text(shared, "x\n", shared=True)
+        assert shared.stat().st_mode & 0o777 == 0o640
+        shared.chmod(0o604)
+        atomic_write_text(shared, "y\n", shared=True)
+        assert shared.stat().st_mode & 0o777 == 0o604 and shared.read_text() == "y\n"
+        private = tmp_path / "state" / "params.json"
+        atomic_write_text(private, "{}")
+        assert private.stat().st_mode & 0o777 == 0o600
+    finally:
+        os.umask(old_umask)
