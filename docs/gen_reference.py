@@ -139,7 +139,8 @@ def bounds(decl: Any) -> str:
         return "; ".join(f"{v:g}: {text}" for v, text in decl.values)
     if math.isinf(decl.min) and math.isinf(decl.max):
         return "any"
-    return f"{number(decl.min)} .. {number(decl.max)}"
+    whole = ", whole numbers" if getattr(decl, "integer", False) else ""
+    return f"{number(decl.min)} .. {number(decl.max)}{whole}"
 
 
 def describe(decl: Any) -> str:
@@ -171,9 +172,10 @@ def parameters_page(plugins: Mapping[str, tuple[Any, dict[str, Any]]]) -> str:
         + "Every parameter the plug-ins declare (`Plugin.params` / `param_decls`), as the "
         "shipped `companion/configs/sim.toml` serves them with the c172p airframe (the "
         "controller's defaults come from the airframe file's `[control]` table). Every value "
-        "travels as REAL32; a value outside its range, or not one of its listed values, is "
-        "refused and the old value echoed. The vehicle's own names are ArduPlane's where "
-        "ArduPlane has the setting; *PX4 name* lists the PX4 names QGroundControl's PX4 "
+        "travels as REAL32; a value outside its range, not one of its listed values, or a "
+        "fraction of one that takes whole numbers, is refused and the old value echoed. "
+        "The vehicle's own names are ArduPlane's where ArduPlane has the setting; "
+        "*PX4 name* lists the PX4 names QGroundControl's PX4 "
         "pages read and write for it (one value, converted to PX4's meaning and units).\n\n"
         + param_rows(plugins)
         + "\n## PX4 names\n\nServed by `link.mavlink` so that QGroundControl's PX4 setup pages "

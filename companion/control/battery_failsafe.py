@@ -16,8 +16,12 @@ from companion.params import ParamDecl
 from mavlink_dialect import companion as d
 
 BATTERY_FS_PARAMS = (
-    ParamDecl("BATT_FS_LOW_ACT", 1.0, 0.0, 1.0, "", "On low battery: 0 warn only, 1 return home"),
-    ParamDecl("BATT_FS_CRT_ACT", 1.0, 0.0, 1.0, "", "On critical battery: 0 warn, 1 return home"),
+    ParamDecl.switch(
+        "BATT_FS_LOW_ACT", 1.0, "On low battery: 0 warn only, 1 return home", "Warn", "Return"
+    ),
+    ParamDecl.switch(
+        "BATT_FS_CRT_ACT", 1.0, "On critical battery: 0 warn, 1 return home", "Warn", "Return"
+    ),
 )
 NAMES = {BatteryLevel.LOW: "low", BatteryLevel.CRITICAL: "critical"}
 ACTION_PARAM = {BatteryLevel.LOW: "BATT_FS_LOW_ACT", BatteryLevel.CRITICAL: "BATT_FS_CRT_ACT"}

@@ -32,12 +32,12 @@ from companion.params import ParamDecl
 from mavlink_dialect import companion as d
 
 FAILSAFE_PARAMS = (
-    ParamDecl("FS_GCS_ENABLE", 1.0, 0.0, 1.0, "", "return home when the ground station is lost"),
+    ParamDecl.switch("FS_GCS_ENABLE", 1.0, "return home when the ground station is lost"),
     ParamDecl("FS_GCS_TIMEOUT", 5.0, 1.0, 300.0, "s", "ground-station silence that counts as lost"),
-    ParamDecl("FS_GCS_RESUME", 1.0, 0.0, 1.0, "", "resume the mission when the link returns"),
+    ParamDecl.switch("FS_GCS_RESUME", 1.0, "resume the mission when the link returns"),
     ParamDecl("FS_GPS_LOST_S", 1.0, 0.0, 60.0, "s", "no usable fix this long: GPS lost"),
     ParamDecl("FS_GPS_BACK_S", 3.0, 0.0, 60.0, "s", "good fixes this long: GPS back"),
-    ParamDecl("FENCE_ENABLE", 1.0, 0.0, 1.0, "", "return home when the fence is breached"),
+    ParamDecl.switch("FENCE_ENABLE", 1.0, "return home when the fence is breached"),
 )
 
 

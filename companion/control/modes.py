@@ -207,3 +207,24 @@ def _from_base_flags(base_mode: int) -> FlightMode | None:
 def from_arduplane(number: int) -> FlightMode | None:
     """An ArduPlane mode number (FLTMODE1..6 hold these), whatever the other encodings say."""
     return _ARDUPLANE.get(number)
+
+
+# ArduPlane's own names for the numbers ``_ARDUPLANE`` reads, as its users know them.
+_ARDUPLANE_NAMES = {0: "MANUAL", 1: "CIRCLE", 2: "STABILIZE", 4: "ACRO", 5: "FBWA", 6: "FBWB",
+                    7: "CRUISE", 10: "AUTO", 11: "RTL", 12: "LOITER", 13: "TAKEOFF",
+                    15: "GUIDED", 26: "AUTOLAND"}  # fmt: skip
+
+
+def arduplane_choices() -> tuple[tuple[float, str], ...]:
+    """Every ArduPlane mode number a switch position may hold (not Land, which no mode
+    list offers), named as ArduPlane names it and, where another, as this vehicle does
+    (``FBWA (Stabilized)``)."""
+    choices = []
+    for number, mode in sorted(_ARDUPLANE.items()):
+        if not BY_MODE[mode].user_selectable:
+            continue
+        ours = BY_MODE[mode].name
+        theirs = _ARDUPLANE_NAMES.get(number, str(number))
+        same = theirs.lower() == ours.lower()
+        choices.append((float(number), ours if same else f"{theirs} ({ours})"))
+    return tuple(choices)

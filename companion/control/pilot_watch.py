@@ -22,7 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from companion.control.failsafe import Action
-from companion.control.modes import PILOT_MODES, from_arduplane
+from companion.control.modes import PILOT_MODES, arduplane_choices, from_arduplane
 from companion.messages import FlightMode, PilotFlags, PilotInput
 from companion.params import ParamDecl
 from mavlink_dialect import companion as d
@@ -32,12 +32,26 @@ from mavlink_dialect import companion as d
 _DEFAULT_FLTMODES = (0, 0, 5, 5, 10, 10)
 PILOT_PARAMS = (
     *(
-        ParamDecl(f"FLTMODE{i + 1}", float(m), 0.0, 24.0, "", f"mode switch position {i + 1}")
+        ParamDecl(
+            f"FLTMODE{i + 1}",
+            float(m),
+            0.0,
+            24.0,
+            "",
+            f"mode switch position {i + 1}",
+            values=arduplane_choices(),
+        )
         for i, m in enumerate(_DEFAULT_FLTMODES)
     ),
-    ParamDecl("THR_FAILSAFE", 1.0, 0.0, 1.0, "", "act when the RC receiver is lost"),
+    ParamDecl.switch("THR_FAILSAFE", 1.0, "act when the RC receiver is lost"),
     ParamDecl("FS_LONG_TIMEOUT", 5.0, 1.0, 300.0, "s", "RC silence that counts as lost"),
-    ParamDecl("FS_LONG_ACTN", 0.0, 0.0, 1.0, "", "RC lost: 0 Return unless in Auto, 1 Return"),
+    ParamDecl.switch(
+        "FS_LONG_ACTN",
+        0.0,
+        "RC lost: 0 Return unless in Auto, 1 Return",
+        "Return unless in Mission",
+        "Return",
+    ),
     ParamDecl("RC_OVERRIDE_TIME", 3.0, 0.5, 60.0, "s", "joystick silence that counts as lost"),
 )
 

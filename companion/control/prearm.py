@@ -31,7 +31,7 @@ from mavlink_dialect import companion as d
 FORCE_ARM = 21196  # param2 of COMPONENT_ARM_DISARM that skips the checks
 PREFIX = "PreArm: "
 PREARM_PARAMS = (
-    ParamDecl("ARMING_CHECK", 1.0, 0.0, 1.0, "", "pre-arm checks (0: none, for the bench)"),
+    ParamDecl.switch("ARMING_CHECK", 1.0, "pre-arm checks (0: none, for the bench)", "None", "All"),
     ParamDecl("ARMING_GPS_EPH", 5.0, 0.5, 100.0, "m", "worst GPS horizontal accuracy to arm"),
     ParamDecl("ARMING_STALE_S", 1.0, 0.1, 10.0, "s", "a sensor older than this is not fresh"),
 )

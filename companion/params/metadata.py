@@ -44,6 +44,9 @@ def parameter_entry(decl: ParamDecl) -> dict[str, object]:
         entry["min"] = decl.min
     if math.isfinite(decl.max):
         entry["max"] = decl.max
+    if decl.integer:  # shown and stepped as whole numbers, not 8.000000
+        entry["decimalPlaces"] = 0
+        entry["increment"] = 1
     if decl.values:  # QGroundControl offers exactly these in a combo box
         entry["values"] = [{"value": v, "description": text} for v, text in decl.values]
     return entry

@@ -62,6 +62,7 @@ class ParamDecl:
     values: tuple[tuple[float, str], ...] = ()  # an enumeration: (value, meaning); no other
     alias: Alias | None = None  # another name for the vehicle's own parameter(s)
     origin: str = "default"  # where ``default`` comes from: "default" or "airframe NAME"
+    integer: bool = False  # whole numbers only (a channel's number): 2.5 is refused
 
     def __post_init__(self) -> None:  # as JSON brings them back: lists and a table
         object.__setattr__(self, "values", tuple((float(v), str(t)) for v, t in self.values))
@@ -76,12 +77,22 @@ class ParamDecl:
         a ground station asks for by its own name, or a term this vehicle has not got)."""
         return cls(name, value, value, value, unit, doc, values=values)
 
+    @classmethod
+    def switch(
+        cls, name: str, default: float, doc: str, off: str = "Disabled", on: str = "Enabled"
+    ) -> ParamDecl:
+        """A parameter that is 0 or 1 and nothing between (a half-enabled failsafe would
+        read as on in one place and off in another), offered as two named choices."""
+        return cls(name, default, 0.0, 1.0, "", doc, values=((0.0, off), (1.0, on)))
+
     def check(self, value: float) -> str | None:
         """Why ``value`` is not acceptable, or None."""
         if not math.isfinite(value):
             return f"{self.name}: {value} is not a finite number"
         if value < self.min or value > self.max:
             return f"{self.name}: {value:g} outside [{self.min:g}, {self.max:g}]"
+        if self.integer and value != math.floor(value):
+            return f"{self.name}: {value:g} is not a whole number"
         if self.values and not any(math.isclose(value, v, abs_tol=1e-6) for v, _ in self.values):
             allowed = ", ".join(f"{v:g}" for v, _ in self.values)
             return f"{self.name}: {value:g} is not one of {allowed}"

@@ -29,19 +29,24 @@ def _channel_params(n: int) -> tuple[ParamDecl, ...]:
         ParamDecl(f"RC{n}_MIN", 1100.0, 800.0, 2200.0, "us", f"channel {n}: lowest pulse"),
         ParamDecl(f"RC{n}_MAX", 1900.0, 800.0, 2200.0, "us", f"channel {n}: highest pulse"),
         ParamDecl(f"RC{n}_TRIM", 1500.0, 800.0, 2200.0, "us", f"channel {n}: centre pulse"),
-        ParamDecl(f"RC{n}_REVERSED", 0.0, 0.0, 1.0, "", f"channel {n}: 1 reverses it"),
+        ParamDecl.switch(f"RC{n}_REVERSED", 0.0, f"channel {n}: 1 reverses it",
+                         "Normal", "Reversed"),
         ParamDecl(f"RC{n}_DZ", 0.0, 0.0, 200.0, "us", f"channel {n}: dead zone (around the "
                   "trim; the throttle's above its lowest pulse)"),
     )  # fmt: skip
 
 
+def _channel_number(name: str, default: float, least: float, doc: str) -> ParamDecl:
+    return ParamDecl(name, default, least, CALIBRATED_CHANNELS, "", doc, integer=True)
+
+
 RC_PARAMS: tuple[ParamDecl, ...] = (
     *(p for n in range(1, CALIBRATED_CHANNELS + 1) for p in _channel_params(n)),
-    ParamDecl("RCMAP_ROLL", 1.0, 1.0, CALIBRATED_CHANNELS, "", "channel of the roll stick"),
-    ParamDecl("RCMAP_PITCH", 2.0, 1.0, CALIBRATED_CHANNELS, "", "channel of the pitch stick"),
-    ParamDecl("RCMAP_THROTTLE", 3.0, 1.0, CALIBRATED_CHANNELS, "", "channel of the throttle stick"),
-    ParamDecl("RCMAP_YAW", 4.0, 1.0, CALIBRATED_CHANNELS, "", "channel of the rudder stick"),
-    ParamDecl("FLTMODE_CH", 8.0, 0.0, CALIBRATED_CHANNELS, "", "mode switch channel; 0: none"),
+    _channel_number("RCMAP_ROLL", 1.0, 1.0, "channel of the roll stick"),
+    _channel_number("RCMAP_PITCH", 2.0, 1.0, "channel of the pitch stick"),
+    _channel_number("RCMAP_THROTTLE", 3.0, 1.0, "channel of the throttle stick"),
+    _channel_number("RCMAP_YAW", 4.0, 1.0, "channel of the rudder stick"),
+    _channel_number("FLTMODE_CH", 8.0, 0.0, "mode switch channel; 0: none"),
     ParamDecl("THR_FS_VALUE", 950.0, 800.0, 2200.0, "us", "throttle below this: receiver failsafe"),
 )
 

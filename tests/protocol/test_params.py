@@ -87,6 +87,30 @@ def test_out_of_range_set_is_refused_with_the_old_value_echoed_and_a_statustext(
     assert "SR_GPS" in seen["STATUSTEXT"].text and "outside" in seen["STATUSTEXT"].text
 
 
+def test_a_switch_set_half_on_is_refused_with_the_old_value_echoed(vehicle_and_gcs):
+    """A 0/1 parameter is one of its two choices, never 0.5 (which one reader took as on
+    and another as off). The reason is longer than one STATUSTEXT: its chunks join."""
+    _, gcs = vehicle_and_gcs()
+    gcs.mav.param_set_send(1, 1, b"SYS_FAILURE_EN", 0.5, m.MAV_PARAM_TYPE_REAL32)
+    echoed, parts, text_id, whole = None, {}, None, False
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline and not (echoed and whole):
+        msg = gcs.conn.recv_match(type=["PARAM_VALUE", "STATUSTEXT"], blocking=True, timeout=0.2)
+        if msg is None:
+            continue
+        if msg.get_type() == "PARAM_VALUE":
+            echoed = msg if msg.param_id == "SYS_FAILURE_EN" else echoed
+            continue
+        if text_id is None and "SYS_FAILURE_EN" in msg.text:
+            text_id = msg.id
+        if text_id is not None and msg.id == text_id:
+            parts[msg.chunk_seq] = msg.text
+            whole = len(msg.text) < 50  # the last chunk holds the NUL
+    assert echoed is not None and echoed.param_value == 0.0
+    text = "".join(parts[k] for k in sorted(parts))
+    assert text == "Param refused: SYS_FAILURE_EN: 0.5 is not one of 0, 1", text
+
+
 def test_two_stations_asking_together_each_get_every_index(vehicle_factory, tmp_path):
     """QGroundControl on one endpoint and MAVProxy on another, connecting at once."""
     qgc, mavproxy = two_stations(vehicle_factory, tmp_path, "twostations")

@@ -66,9 +66,10 @@ LANDING_PARAMS = (
     ParamDecl("LAND_STEER_P", 8.0, 0.0, 10.0, "", "rollout: rudder per radian of heading error"),
     ParamDecl("LAND_FLAP_PERCNT", 0.0, 0.0, 100.0, "%", "landing: flaps on the approach"),
     ParamDecl("RTL_AUTOLAND", 0.0, 0.0, 2.0, "", "Return lands at DO_LAND_START: 1 after "
-              "reaching home, 2 at once"),
-    ParamDecl("RNGFND_LANDING", 1.0, 0.0, 1.0, "", "landing: flare on the rangefinder's "
-              "height when it has a fresh valid reading (no effect without one)"),
+              "reaching home, 2 at once",
+              values=((0.0, "Disabled"), (1.0, "After reaching home"), (2.0, "At once"))),
+    ParamDecl.switch("RNGFND_LANDING", 1.0, "landing: flare on the rangefinder's height when "
+                     "it has a fresh valid reading (no effect without one)"),
 )  # fmt: skip
 
 
@@ -86,12 +87,9 @@ CONTROL_PARAMS = (
     _p("YAW_DAMP", 3.5, 0.0, 5.0, "s", "rudder per rad/s of yaw-rate error in a turn"),
     _p("SCALING_SPEED", 30.0, 5.0, 100.0, "m/s", "airspeed at which the loop gains apply as set"),
     _p("ROLL_LIMIT_DEG", 35.0, 5.0, 60.0, "deg", "largest bank angle"),
-    _p(
+    ParamDecl.switch(
         "STALL_PREVENTION",
         1.0,
-        0.0,
-        1.0,
-        "",
         "slow flight's stall margin: the bank limited to a level turn's load factor of at most "
         "(airspeed demand / AIRSPEED_MIN)², never under 35°, and the airspeed demand in a bank "
         "at least AIRSPEED_MIN × √(load factor) (0: off)",

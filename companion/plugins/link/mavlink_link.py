@@ -91,7 +91,7 @@ class MavlinkLink(Plugin):
         ParamDecl("SR_ATTITUDE", 10.0, 0.0, 100.0, "Hz", "ATTITUDE rate on every endpoint"),
         ParamDecl("SR_POSITION", 5.0, 0.0, 50.0, "Hz", "GLOBAL_POSITION_INT and VFR_HUD rate"),
         ParamDecl("SR_GPS", 2.0, 0.0, 10.0, "Hz", "GPS_RAW_INT rate"),
-        ParamDecl("SYS_FAILURE_EN", 0.0, 0.0, 1.0, "", "accept MAV_CMD_INJECT_FAILURE (simulator)"),
+        ParamDecl.switch("SYS_FAILURE_EN", 0.0, "accept MAV_CMD_INJECT_FAILURE (simulator)"),
         *PREARM_PARAMS,
         *PX4_PARAMS,
     )

@@ -32,15 +32,16 @@ def params(*argv: str) -> str:
 
 
 def _other(decl: ParamDecl) -> float:
-    """A value of ``decl`` other than its default that it takes (a channel may be 10.5:
-    its owner rounds it; RC_MAP_FLTMODE, which reads it, lists whole channels only)."""
+    """A value of ``decl`` other than its default that it takes (a channel a whole one)."""
     if decl.values:
         return next(v for v, _ in reversed(decl.values) if v != decl.default)
     top = decl.max if math.isfinite(decl.max) else 2 * abs(decl.default) + 1
     bottom = decl.min if math.isfinite(decl.min) else decl.default - 1
     if top > decl.default:
-        return decl.default + (top - decl.default) / 4
-    return decl.default - (decl.default - bottom) / 4
+        value = decl.default + (top - decl.default) / 4
+    else:
+        value = decl.default - (decl.default - bottom) / 4
+    return float(math.floor(value)) if decl.integer else value
 
 
 def owner_values(store: ParamStore) -> dict[str, float]:

@@ -107,8 +107,10 @@ def test_com_fltmode_writes_arduplane_numbers_the_switch_reads_back(mode):
 def test_com_fltmode_reads_every_number_the_switch_understands():
     s = store()
     s.set("FLTMODE1", 2.0)  # ArduPlane's STABILIZE: flown as Stabilized
-    s.set("FLTMODE2", 3.0)  # TRAINING: the position selects nothing here
-    assert s.get("COM_FLTMODE1") == 8.0 and s.get("COM_FLTMODE2") == -1.0
+    s.set("FLTMODE2", 1.0)  # CIRCLE: flown as Hold
+    assert s.get("COM_FLTMODE1") == 8.0 and s.get("COM_FLTMODE2") == 4.0
+    with pytest.raises(ParamError):
+        s.set("FLTMODE2", 3.0)  # TRAINING: no such mode here, so no position may select it
     with pytest.raises(ParamError):
         s.set("COM_FLTMODE1", -1.0)  # no number means "nothing" for sure
 
