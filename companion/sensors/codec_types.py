@@ -34,6 +34,11 @@ class Framer(Protocol):
         """The whole sentences or frames completed by ``data``."""
         ...
 
+    def rest_bytes(self) -> int:
+        """Bytes still to come of a frame begun but not ended, at least (0: none begun, or
+        its length unknown): a reader may wait for them instead of waking for each piece."""
+        ...
+
 
 @runtime_checkable
 class SentenceDecoder(Protocol[ReadingT_co]):

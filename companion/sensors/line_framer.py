@@ -10,11 +10,13 @@ field), so framing restarts there. Pure: no port, no clock.
 from __future__ import annotations
 
 import re
+from collections import deque
 from dataclasses import dataclass
 
 _STOP = re.compile(rb"[\r\n$]")  # what ends the sentence in progress
 _EOL = re.compile(rb"[\r\n]")
 DEFAULT_MAX_LEN = 200
+RECENT_FRAMES = 8  # sentences whose lengths say how long the next one is, at least
 
 
 @dataclass
@@ -36,6 +38,8 @@ class LineFramer:
         self._line: bytearray | None = None  # the sentence in progress, None between them
         self._discarding = False  # inside the tail of an over-long line
         self._in_run = False  # the last bytes outside a sentence were garbage
+        self._recent: deque[int] = deque(maxlen=RECENT_FRAMES)  # their lengths, '$' on
+        self._begun_in_feed = False  # the sentence in progress began in the last chunk
 
     @property
     def rejected(self) -> int:
@@ -44,6 +48,7 @@ class LineFramer:
 
     def feed(self, data: bytes) -> list[bytes]:
         """The sentences completed by this chunk, in order."""
+        self._begun_in_feed = False
         if (whole := self._one_whole_sentence(data)) is not None:
             return [whole]
         out: list[bytes] = []
@@ -70,9 +75,24 @@ class LineFramer:
             else:
                 out.append(bytes(self._line))
                 self.counters.frames += 1
+                self._recent.append(len(self._line))
                 self._line = None
             pos = end if stop is None else (cut if data[cut] == 0x24 else cut + 1)
         return out
+
+    def rest_bytes(self) -> int:
+        """Bytes still to come of a sentence the last chunk began, at least: the shortest
+        of the last few sentences and its line ending's first byte, less what has come (0:
+        none begun in that chunk, or no sentence seen yet).
+
+        A USB serial adapter hands a sentence over in pieces (every millisecond in low
+        latency mode: ten reads of a 98-byte VectorNav sentence at 115200 baud), each of
+        which would wake its reader for a sentence it cannot decode yet. Only the chunk
+        that began it says: a reader waits once a sentence, then takes the last pieces as
+        they come, so that the sentence is no later for the wait."""
+        if self._line is None or not self._begun_in_feed or not self._recent:
+            return 0
+        return max(0, min(self._recent) - len(self._line)) + 1
 
     def _one_whole_sentence(self, data: bytes) -> bytes | None:
         """``data`` as one sentence when it is exactly one, from its ``$`` to its line
@@ -91,10 +111,12 @@ class LineFramer:
         ):
             return None
         self.counters.frames += 1
+        self._recent.append(len(body))
         self._in_run = False  # as _begin() does
         return body
 
     def _begin(self) -> None:
+        self._begun_in_feed = True
         self._line = bytearray(b"$")
         self._discarding = False
         self._in_run = False

@@ -149,3 +149,41 @@ def test_the_magnetometer_and_pressure_come_on_their_own_grid_every_imu_sample_s
     assert len(baros) == len(mags)
     # Each one is a reading's own: stamped as the IMU sample it came with.
     assert set(mags) <= set(imus) and set(baros) == set(mags)
+
+
+@pytest.mark.timeout(60)
+def test_a_sentence_handed_over_in_pieces_does_not_wake_the_driver_for_each(
+    vehicle_factory, tmp_path
+):
+    """A USB serial adapter in low-latency mode hands a 115200-baud sentence over a
+    millisecond's worth of bytes at a time: the driver waits for the rest of a sentence it
+    has begun instead of waking for each of its ten pieces (it did), and misses none."""
+    pty = Pty(tmp_path / "ttyImu")
+    vehicle = imu_vehicle(vehicle_factory, pty)
+    stats = vehicle.bus.queue_reader("system/plugin_stats")
+    vehicle.wait_running("imu")
+    wait_for(lambda: pty.write(GOOD) or vehicle.row("imu").frames_ok > 8, 15, "the IMU heard")
+    line, piece = GOOD.encode(), 115_200 // 10 // 1000  # 11 bytes: a millisecond of line
+    pieces = [line[i : i + piece] for i in range(0, len(line), piece)]
+    assert len(pieces) >= 8
+
+    def imu_stats():
+        rows = [s for s in stats.take(1.5) if s.name == b"imu"]
+        return rows[-1] if rows else None
+
+    first = wait_for(imu_stats, 10, "the IMU's counters")
+    # 40 sentences a second, each piece on the line's schedule: a writer running late
+    # (a busy machine) catches up at once, as the line's bytes would have come anyway.
+    start, sent = time.monotonic(), 0
+    for n in range(120):
+        for i, part in enumerate(pieces):
+            time.sleep(max(0.0, start + n / 40 + i / 1000 - time.monotonic()))
+            pty.write(part.decode())
+        sent += 1
+    last = wait_for(
+        lambda: (s := imu_stats()) and s.frames_ok - first.frames_ok >= sent and s, 10, "all"
+    )
+    frames, steps = last.frames_ok - first.frames_ok, last.steps - first.steps
+    assert frames == sent, f"{frames} of {sent} sentences"
+    # Woken by its first piece, once more after the wait, then by the last piece or two.
+    assert steps <= len(pieces) // 2 * frames, f"{steps} reads, {frames} sentences"

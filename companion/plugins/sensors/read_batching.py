@@ -8,6 +8,7 @@ bus nothing is known of the flight, and every frame is read as it comes.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 
@@ -17,6 +18,11 @@ from companion.plugin import PluginContext, Setting
 from companion.sensors.framed_stream import spread_since
 from companion.sensors.read_pacing import ReadPacer
 from companion.sensors.serial_port import ReopeningSerial
+
+BITS_PER_BYTE = 10  # start, eight data bits, stop: the fewest any device's framing takes
+# A frame's rest due sooner than this is read as it comes: a USB adapter hands bytes over a
+# millisecond apart at best, so a shorter wait saves no wake-up.
+MIN_REST_WAIT_S = 0.001
 
 
 def batch_setting(what: str, default_s: float = 0.1) -> Setting:
@@ -74,6 +80,19 @@ class DeviceReads:
         self.period_us = 1e6 / rate_hz if rate_hz > 0 else 0.0  # the device's frame period
         self.batching = BatchedReads(ctx, per_frame) if "batch_s" in ctx.settings else None
         self._last_read_us: int | None = None
+        self._stop_fds = [] if ctx.stop_fd is None else [ctx.stop_fd]
+        self._rest_wait_s = 0.0
+
+    def expect_rest(self, rest_bytes: int) -> None:
+        """After a read that ended inside a frame: the next read first waits for as long as
+        the line takes to carry ``rest_bytes`` more at its baud rate, so that the frame's
+        pieces (a USB adapter's, a millisecond apart) wake the plug-in once or twice, not
+        once each. The frame is decoded when whole either way, so it is no later."""
+        baud = self.port.baud
+        wait_s = rest_bytes * BITS_PER_BYTE / baud if baud > 0 else 0.0
+        # Whole milliseconds (a poll's), rounded down: woken a little early, the read then
+        # takes the last piece as it comes rather than after the wait.
+        self._rest_wait_s = math.floor(wait_s * 1000) / 1000 if wait_s >= MIN_REST_WAIT_S else 0.0
 
     def read(self) -> tuple[bytes, int, int | None]:
         """What came (after the batch's wait), when its first byte came, and the time no
@@ -82,6 +101,9 @@ class DeviceReads:
         # call, not ``with bus.idle``'s two, at every read of a 100 Hz device).
         started = time.perf_counter()
         try:
+            if self._rest_wait_s:  # a stop request ends it; the read then sees the request
+                wait_readable(self._stop_fds, self._rest_wait_s)
+                self._rest_wait_s = 0.0
             if self.batching is not None:
                 self.batching.wait()
             data, t_us = self.port.read_stamped(self.ctx.clock.now_us)

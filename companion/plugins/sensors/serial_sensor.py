@@ -98,6 +98,7 @@ class SerialSensor(Plugin, Generic[ReadingT]):
         else:
             for reading in self.stream.feed(data, t_us):
                 self.publish(reading, t_us)
+        self.reads.expect_rest(self.framer.rest_bytes())
         health = self.ctx.health
         health.frames_ok, health.frames_bad = self.stream.frames_ok, self.stream.frames_bad
         health.bytes_in = self.port.bytes_in

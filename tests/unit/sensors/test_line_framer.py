@@ -31,6 +31,24 @@ def test_a_sentence_split_across_many_feeds_comes_out_whole():
         assert feed_in_pieces(framer, (GGA + b"\r\n") * 3, size) == [GGA] * 3
 
 
+def test_the_rest_of_a_sentence_just_begun_is_the_shortest_recent_one_less_what_came():
+    """What a driver waits for before its next read (``rest_bytes``): never past the end of
+    a sentence as short as the shortest of the last few, its CR included."""
+    framer = LineFramer()
+    assert framer.feed(GGA[:10]) == [] and framer.rest_bytes() == 0  # no length known yet
+    framer = LineFramer()
+    framer.feed(GGA + b"\r\n" + RMC + b"\r\n")
+    shortest = min(len(GGA), len(RMC))
+    assert framer.feed(GGA[:12]) == [] and framer.rest_bytes() == shortest - 12 + 1
+    assert framer.feed(GGA[12:20]) == [] and framer.rest_bytes() == 0  # waited for already
+    # A chunk that ends one sentence and begins the next: the new one's rest.
+    assert framer.feed(GGA[20:] + b"\r\n" + RMC[:5]) == [GGA]
+    assert framer.rest_bytes() == shortest - 5 + 1
+    assert framer.feed(RMC[5:] + b"\r\n") == [RMC] and framer.rest_bytes() == 0
+    framer.feed(b"$" + b"X" * 300 + b"\r\n$GP")  # an over-long line is no sentence's length
+    assert framer.rest_bytes() == shortest - 3 + 1
+
+
 def test_bare_cr_or_lf_endings_work_too():
     assert LineFramer().feed(GGA + b"\n" + RMC + b"\r") == [GGA, RMC]
 
