@@ -10,7 +10,8 @@ the OS-3000 compass (19200 baud, 20 Hz) and the NMEA GPS (4800 baud, a GGA and a
 once a second) on three ptys, and a thread per device writes each sentence in those
 pieces on the line's own schedule (a writer running late catches up at once, as the line
 would have carried the bytes anyway). Printed per device: sentences written, samples
-published, the plug-in's steps (each a wake-up and a read) per sentence, and the delay from
+published, the plug-in's steps (each a wake-up and a read) per sample, its process's CPU
+(a share of a core, over the writing; each plug-in is a process here), and the delay from
 a sentence's last piece written to its sample on the bus (p50 / p99 / max; this process's
 own wake-up included).
 """
@@ -28,6 +29,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from benchmarks.process_probes import cpu_seconds  # noqa: E402
 from tests.support.configs import plugin, vehicle_config  # noqa: E402
 from tests.support.hostile_sentences import compass_valid, imu_valid, nmea_valid  # noqa: E402
 from tests.support.pty import Pty  # noqa: E402
@@ -99,6 +101,8 @@ def report(vehicle: Vehicle, ptys: dict[str, Pty], seconds: float) -> None:
                 break
     list(stats.drain())
     before = latest_steps(stats, DEVICES)
+    pids = {n: vehicle.row(n).pid for n in DEVICES}
+    cpu_before, t_before = {n: cpu_seconds(pid) for n, pid in pids.items()}, time.monotonic()
     for reader in readers.values():
         list(reader.drain())
     ends: dict[str, list[float]] = {n: [] for n in DEVICES}
@@ -115,11 +119,13 @@ def report(vehicle: Vehicle, ptys: dict[str, Pty], seconds: float) -> None:
             got = list(reader.drain())
             arrivals[name] += [time.monotonic()] * len(got)
         time.sleep(0.0005)
+    cpu = {n: cpu_seconds(pid) - cpu_before[n] for n, pid in pids.items()}
+    wall = time.monotonic() - t_before
     time.sleep(1.2)  # the counters of the last second
     list(stats.drain())
     after = latest_steps(stats, DEVICES)
     print(f"{'device':8} {'baud':>7} {'samples':>8} {'published':>9} {'steps/sample':>12}"
-          f"  last piece -> bus p50 / p99 / max (ms)")  # fmt: skip
+          f" {'CPU %':>6}  last piece -> bus p50 / p99 / max (ms)")  # fmt: skip
     for name, (_, baud, _, piece_ms, _, _) in DEVICES.items():
         per = (after[name] - before[name]) / max(1, len(ends[name]))
         delays = sorted(1e3 * (a - e) for a, e in zip(arrivals[name], ends[name], strict=False))
@@ -127,7 +133,8 @@ def report(vehicle: Vehicle, ptys: dict[str, Pty], seconds: float) -> None:
         p99 = delays[min(len(delays) - 1, int(0.99 * len(delays)))] if delays else float("nan")
         worst = delays[-1] if delays else float("nan")
         print(f"{name:8} {baud:>7} {len(ends[name]):>8} {len(arrivals[name]):>9} {per:>12.1f}"
-              f"  {p50:.2f} / {p99:.2f} / {worst:.2f}  (pieces of {piece_ms} ms)")  # fmt: skip
+              f" {100 * cpu[name] / wall:>6.2f}  {p50:.2f} / {p99:.2f} / {worst:.2f}"
+              f"  (pieces of {piece_ms} ms)")  # fmt: skip
 
 
 def main() -> None:
