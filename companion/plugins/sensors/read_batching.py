@@ -86,8 +86,8 @@ class DeviceReads:
     def expect_rest(self, rest_bytes: int) -> None:
         """After a read that ended inside a frame: the next read first waits for as long as
         the line takes to carry ``rest_bytes`` more at its baud rate, so that the frame's
-        pieces (a USB adapter's, a millisecond apart) wake the plug-in once or twice, not
-        once each. The frame is decoded when whole either way, so it is no later."""
+        pieces (a USB adapter's, a millisecond apart) wake the plug-in three or four times,
+        not once each. The frame is decoded when whole either way, so it is no later."""
         baud = self.port.baud
         wait_s = rest_bytes * BITS_PER_BYTE / baud if baud > 0 else 0.0
         # Whole milliseconds (a poll's), rounded down: woken a little early, the read then
