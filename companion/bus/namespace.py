@@ -102,6 +102,34 @@ def alive_nodes(namespace: str) -> int:
     return sum(1 for s in states if isinstance(s, iox2.NodeState.Alive))
 
 
+def running_supervisor(namespace: str, node_name: str = "exec_control") -> int | None:
+    """The pid of a living vehicle supervisor on this namespace's bus (its node is named
+    ``node_name.PID``); None when there is none."""
+    import iceoryx2 as iox2
+
+    for state in iox2.Node.list(iox2.ServiceType.Ipc, make_config(namespace)):
+        if not isinstance(state, iox2.NodeState.Alive):
+            continue
+        details = state[0].details
+        if details is not None and details.name.as_str().split(".")[0] == node_name:
+            return int(details.process_id)
+    return None
+
+
+def in_use_refusal(namespace: str) -> str | None:
+    """Why a vehicle may not start on this namespace's bus: another vehicle runs on it
+    (two would read each other's sensors and commands, and share their devices' bytes);
+    None when it is free."""
+    pid = running_supervisor(namespace)
+    if pid is None:
+        return None
+    return (
+        f"bus namespace {namespace!r} is in use by the vehicle of process {pid}: stop it "
+        "first, or start this one on another namespace (--namespace NAME, or namespace in "
+        "the config's [vehicle] table)"
+    )
+
+
 def cleanup_namespace(namespace: str) -> int:
     """Remove what dead processes of this namespace left behind; return files removed.
 

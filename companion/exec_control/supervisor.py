@@ -14,7 +14,7 @@ import time
 from dataclasses import asdict
 
 from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
-from companion.bus.namespace import cleanup_namespace
+from companion.bus.namespace import cleanup_namespace, in_use_refusal
 from companion.bus.node import BusNode
 from companion.bus.patterns import Reader, Writer
 from companion.exec_control.child import FIRST_BACKOFF_S, Child
@@ -38,6 +38,7 @@ from companion.messages import (
 log = logging.getLogger(__name__)
 
 HEALTH_PERIOD_S = 1.0
+EXIT_BUS_IN_USE = 3  # another vehicle runs on this bus namespace: nothing was started
 FORKER_BACKOFF_S = 1.0
 # SIGCHLD wakes the loop when a plug-in dies; this is only the backstop (a signal that
 # reached another thread). Nothing else wakes an idle supervisor but the health table.
@@ -194,6 +195,9 @@ class Supervisor:
 
     def run(self, duration_s: float | None = None) -> int:
         """Supervise until SIGINT/SIGTERM (or ``duration_s``); return the exit status."""
+        if (refusal := in_use_refusal(self.cfg.namespace)) is not None:
+            log.error("%s", refusal)
+            return EXIT_BUS_IN_USE
         self.until = None if duration_s is None else time.monotonic() + duration_s
         signal.signal(signal.SIGTERM, self.request_stop)
         signal.signal(signal.SIGINT, self.request_stop)

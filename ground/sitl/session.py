@@ -23,13 +23,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 from bridges.jsbsim.options import BridgeOptions
-from companion.bus.namespace import cleanup_namespace
+from companion.bus.namespace import cleanup_namespace, in_use_refusal
 from companion.bus.node import BusNode
 from companion.control.mission.mission_files import MissionStore
 from companion.control.modes import BY_MODE
 from companion.exec_control.config import VehicleConfig, load_config
 from companion.exec_control.plugin_host import die_with_parent
-from companion.exec_control.supervisor import Supervisor
+from companion.exec_control.supervisor import EXIT_BUS_IN_USE, Supervisor
 from companion.exec_control.zygote import ForkServer
 from companion.messages import FlightMode, PluginState
 from ground.sitl.requests import SimRequest
@@ -259,6 +259,9 @@ def run_sim(req: SimRequest, opts: BridgeOptions, log_level: str = "INFO") -> in
     if opts.exact and not sync_hz:
         log.warning("--exact: only lockstep (--speed max) with nav.ins_ekf can follow control")
     opts = dataclasses.replace(opts, hold=True, sync_hz=sync_hz)
+    if (refusal := in_use_refusal(opts.namespace)) is not None:
+        log.error("%s", refusal)  # before the simulator's clock joins that vehicle's bus
+        return EXIT_BUS_IN_USE
     # The fork server imports the vehicle's libraries while JSBSim loads its model.
     forker = ForkServer(plugin_kinds(req.config), log_level)
     forker.start()
