@@ -93,7 +93,6 @@ def check_config(cfg: VehicleConfig, seconds: float = LISTEN_S) -> CheckResult:
         result.problems += [
             f"{spec.name}: {p}" for p in cls.bench_problems(spec.settings, cfg.vehicle)
         ]
-    result.problems += _shared_devices(result.devices)
     threads = [
         threading.Thread(target=_try_device, args=(r, seconds), name=f"check-{r.plugin}")
         for r in result.devices
@@ -105,15 +104,6 @@ def check_config(cfg: VehicleConfig, seconds: float = LISTEN_S) -> CheckResult:
     for report in result.devices:
         report.ok, report.advice = judge(report)
     return result
-
-
-def _shared_devices(reports: list[DeviceReport]) -> list[str]:
-    """Two plug-ins on one device would each read half of its bytes: neither would work."""
-    users: dict[str, list[str]] = {}
-    for r in reports:
-        users.setdefault(split_device(r.probe.device, r.probe.baud)[0], []).append(r.plugin)
-    return [f"{' and '.join(names)}: one device, {path}" for path, names in users.items()
-            if len(names) > 1]  # fmt: skip
 
 
 def _try_device(report: DeviceReport, seconds: float) -> None:

@@ -1,17 +1,22 @@
 """The config is the topology: check the channel graph before anything runs.
 
 Refused: a required input nobody produces, a Latest channel with two producers, a
-channel name the registry does not know. Types cannot disagree: each channel has one
-type in companion.messages. ``graph_lines`` is what ``companion graph`` prints.
+channel name the registry does not know, a device two plug-ins name (each would read part
+of its bytes: a path copied into a second entry and not changed). Types cannot disagree:
+each channel has one type in companion.messages. ``graph_lines`` is what ``companion
+graph`` prints.
 """
 
 from __future__ import annotations
 
+import os
 from collections import defaultdict
 
 from companion.exec_control.config import ConfigError, VehicleConfig
+from companion.exec_control.plugin_spec import PluginSpec
 from companion.messages import CHANNELS
 from companion.plugin import Ports
+from companion.sensors.serial_port import split_device
 
 # What the execution-control process itself reads and writes.
 EXEC_CONTROL = "exec_control"
@@ -35,8 +40,38 @@ def producers(cfg: VehicleConfig) -> dict[str, list[str]]:
     return out
 
 
+def devices(spec: PluginSpec) -> list[str]:
+    """The serial devices (paths, ``sim://`` names) a plug-in opens: its ``device``, and a
+    link's ``serial://`` endpoints. A path is taken through its links where it exists (two
+    /dev/serial/by-id names of one adapter are one device)."""
+    urls = [spec.settings.get("device")]
+    urls += [e.split("?")[0] for e in spec.settings.get("endpoints") or () if isinstance(e, str)]
+    found = []
+    for url in urls:
+        if not isinstance(url, str) or not url.startswith(("/", "serial://", "sim://")):
+            continue
+        path, _ = split_device(url, 0)
+        found.append(os.path.realpath(path) if os.path.exists(path) else path)
+    return found
+
+
+def _check_devices(cfg: VehicleConfig) -> None:
+    owner: dict[str, str] = {}
+    for spec in cfg.plugins:
+        for device in devices(spec):
+            if device in owner and owner[device] != spec.name:
+                raise ConfigError(
+                    cfg.path, spec.line, spec.name,
+                    f"device {device} is {owner[device]}'s too: one plug-in per device (two"
+                    " would each read part of its bytes)",
+                )  # fmt: skip
+            owner.setdefault(device, spec.name)
+
+
 def check_topology(cfg: VehicleConfig) -> None:
-    """Raise ConfigError (file, line, plug-in) on the first broken connection."""
+    """Raise ConfigError (file, line, plug-in) on the first broken connection or device
+    named twice."""
+    _check_devices(cfg)
     made = producers(cfg)
     for name, ports, line in _all_ports(cfg):
         for chan in (*ports.inputs, *ports.optional_inputs, *ports.outputs):

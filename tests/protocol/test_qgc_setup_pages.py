@@ -104,7 +104,12 @@ ABSENT_ON_PURPOSE = {
     "LND_FLIGHT_T_HI", "LND_FLIGHT_T_LO", "BAT1_V_DIV", "BAT1_A_PER_V", "UAVCAN_ENABLE",
     "RC_CHAN_CNT", "SYS_HAS_MAG", "CAL_MAG_SIDES",
 }  # fmt: skip
-ABSENT_DEVICE = "serial:///dev/companion-test-absent:100000"
+
+
+def absent(device: str) -> str:
+    """A device path nothing answers on (one for each plug-in: a config naming one device
+    twice is refused)."""
+    return f"serial:///dev/companion-test-absent-{device}:100000"
 
 
 def whole_vehicle(port: int, state) -> str:
@@ -112,10 +117,10 @@ def whole_vehicle(port: int, state) -> str:
     controller (in the flight group, never started here): every owner of a setting PX4
     names."""
     extra = (
-        plugin("rc", "sensors.rc_input", device=ABSENT_DEVICE),
-        plugin("battery", "sensors.battery", device=ABSENT_DEVICE),
-        plugin("imu", "sensors.serial_imu", device=ABSENT_DEVICE, publish_baro=False),
-        plugin("compass", "sensors.os3000", device=ABSENT_DEVICE),
+        plugin("rc", "sensors.rc_input", device=absent("rc")),
+        plugin("battery", "sensors.battery", device=absent("battery")),
+        plugin("imu", "sensors.serial_imu", device=absent("imu"), publish_baro=False),
+        plugin("compass", "sensors.os3000", device=absent("compass")),
     )
     control = plugin("control", "control.fixed_wing", group="flight")
     return client_vehicle(f"udpin://127.0.0.1:{port}", state, extra, control, airframe="c172p")

@@ -155,3 +155,40 @@ def test_the_shipped_sim_config_loads_with_the_bridge_devices():
     check_topology(cfg)
     servos = next(p for p in cfg.plugins if p.kind == "actuators.minissc")
     assert servos.group == "flight" and cfg.vehicle["airframe"] == "J3Cub"
+
+
+def test_a_device_two_plugins_name_is_refused(tmp_path):
+    """aircraft.toml copied, a second entry's path left as the first's: each plug-in would
+    read part of the port's bytes, and neither device would be heard whole."""
+    text = (REPO / "companion" / "configs" / "aircraft.toml").read_text()
+    gps = "/dev/serial/by-id/usb-Prolific_Technology_Inc._USB-Serial_Controller_D-if00-port0"
+    compass = "/dev/serial/by-id/usb-FTDI_FT232R_USB_UART_A9COMPASS-if00-port0"
+    assert gps in text and compass in text
+    path = tmp_path / "aircraft.toml"
+    path.write_text(text.replace(compass, gps))
+    with pytest.raises(ConfigError, match=f"device {gps} is gps's too: one plug-in per device"):
+        check_topology(load_config(path))
+    # The radio's serial endpoint counts too.
+    path.write_text(text.replace(
+        "serial:///dev/serial/by-id/usb-FTDI_FT231X_USB_UART_DN04RADIO-if00-port0:57600",
+        f"serial://{gps}:57600",
+    ))  # fmt: skip
+    with pytest.raises(ConfigError, match=r"gps: device \S+ is link's too"):
+        check_topology(load_config(path))
+    path.write_text(text)
+    check_topology(load_config(path))  # as shipped: every device once
+
+
+def test_two_names_of_one_device_are_one_device(tmp_path):
+    """Two links to one port (a by-id name and the udev rule's name of one adapter)."""
+    port = tmp_path / "ttyUSB0"
+    port.write_text("")
+    (tmp_path / "by-id-gps").symlink_to(port)
+    (tmp_path / "companion-gps").symlink_to(port)
+    text = vehicle_config(
+        "v",
+        plugin("gps", "sensors.nmea_gps", device=str(tmp_path / "by-id-gps")),
+        plugin("compass", "sensors.os3000", device=str(tmp_path / "companion-gps")),
+    )
+    err = refuse(tmp_path, text)
+    assert f"compass: device {port} is gps's too" in str(err)
