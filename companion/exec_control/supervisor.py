@@ -195,9 +195,6 @@ class Supervisor:
 
     def run(self, duration_s: float | None = None) -> int:
         """Supervise until SIGINT/SIGTERM (or ``duration_s``); return the exit status."""
-        if (refusal := in_use_refusal(self.cfg.namespace)) is not None:
-            log.error("%s", refusal)
-            return EXIT_BUS_IN_USE
         self.until = None if duration_s is None else time.monotonic() + duration_s
         signal.signal(signal.SIGTERM, self.request_stop)
         signal.signal(signal.SIGINT, self.request_stop)
@@ -208,6 +205,13 @@ class Supervisor:
                 child.forker = self.forker
             if self.forker.proc is None:
                 self.forker.start()
+        # Only once the fork server is forked: this process's first use of iceoryx2, made
+        # before, is inherited by every forked plug-in, and a restarted one then found its
+        # killed predecessors' subscriptions still held (ExceedsMaxSupportedSubscribers).
+        if (refusal := in_use_refusal(self.cfg.namespace)) is not None:
+            log.error("%s", refusal)
+            self.forker.stop()
+            return EXIT_BUS_IN_USE
         cleanup_namespace(self.cfg.namespace)  # leftovers of a crashed earlier run
         note_refused_raises(self.cfg.plugins)
         bus = BusNode(self.cfg.namespace, "exec_control")

@@ -259,12 +259,15 @@ def run_sim(req: SimRequest, opts: BridgeOptions, log_level: str = "INFO") -> in
     if opts.exact and not sync_hz:
         log.warning("--exact: only lockstep (--speed max) with nav.ins_ekf can follow control")
     opts = dataclasses.replace(opts, hold=True, sync_hz=sync_hz)
-    if (refusal := in_use_refusal(opts.namespace)) is not None:
-        log.error("%s", refusal)  # before the simulator's clock joins that vehicle's bus
-        return EXIT_BUS_IN_USE
     # The fork server imports the vehicle's libraries while JSBSim loads its model.
     forker = ForkServer(plugin_kinds(req.config), log_level)
     forker.start()
+    # After the fork (this process's iceoryx2 must not be the plug-ins': see the
+    # supervisor), before the simulator's clock joins that vehicle's bus.
+    if (refusal := in_use_refusal(opts.namespace)) is not None:
+        log.error("%s", refusal)
+        forker.stop()
+        return EXIT_BUS_IN_USE
     try:
         bridge = BridgeProcess(opts)
     except BaseException:
