@@ -102,16 +102,21 @@ def alive_nodes(namespace: str) -> int:
     return sum(1 for s in states if isinstance(s, iox2.NodeState.Alive))
 
 
-def running_supervisor(namespace: str, node_name: str = "exec_control") -> int | None:
-    """The pid of a living vehicle supervisor on this namespace's bus (its node is named
-    ``node_name.PID``); None when there is none."""
+# The vehicle supervisor's bus node is named after this (``SUPERVISOR_NODE.PID``), which is
+# how ``running_supervisor`` tells it from any other process on the bus.
+SUPERVISOR_NODE = "exec_control"
+
+
+def running_supervisor(namespace: str) -> int | None:
+    """The pid of a living vehicle supervisor on this namespace's bus; None when there is
+    none."""
     import iceoryx2 as iox2
 
     for state in iox2.Node.list(iox2.ServiceType.Ipc, make_config(namespace)):
         if not isinstance(state, iox2.NodeState.Alive):
             continue
         details = state[0].details
-        if details is not None and details.name.as_str().split(".")[0] == node_name:
+        if details is not None and details.name.as_str().split(".")[0] == SUPERVISOR_NODE:
             return int(details.process_id)
     return None
 

@@ -14,7 +14,7 @@ import time
 from dataclasses import asdict
 
 from companion.bus.clock import MonotonicClock, SimulationClock, VehicleClock
-from companion.bus.namespace import cleanup_namespace, in_use_refusal
+from companion.bus.namespace import SUPERVISOR_NODE, cleanup_namespace, in_use_refusal
 from companion.bus.node import BusNode
 from companion.bus.patterns import Reader, Writer
 from companion.exec_control.child import FIRST_BACKOFF_S, Child
@@ -214,7 +214,7 @@ class Supervisor:
             return EXIT_BUS_IN_USE
         cleanup_namespace(self.cfg.namespace)  # leftovers of a crashed earlier run
         note_refused_raises(self.cfg.plugins)
-        bus = BusNode(self.cfg.namespace, "exec_control")
+        bus = BusNode(self.cfg.namespace, SUPERVISOR_NODE)
         try:
             self._loop(bus)
         finally:
