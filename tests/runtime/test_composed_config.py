@@ -74,10 +74,6 @@ def test_the_shipped_composed_config_is_sim_toml_in_one_process():
     own = tomllib.loads((configs / "sim.toml").read_text())
     composed = tomllib.loads((configs / "sim_composed.toml").read_text())
     assert composed["vehicle"].pop("process") == "vehicle"
-    # The one other difference: a small board's navigator is woken once a state, not once
-    # an IMU sample (the same states: tests/sim/test_composed_lockstep.py).
-    imu = next(p for p in composed["plugins"] if p["name"] == "imu")
-    assert imu["settings"].pop("wake_hz") == 50.0
     assert composed == own, "sim_composed.toml must fly the vehicle sim.toml flies"
 
 

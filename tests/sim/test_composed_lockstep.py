@@ -1,6 +1,8 @@
 """The same exact-lockstep mission flown with one process per plug-in and with the plug-ins
-composed into two processes (``companion/configs/sim_composed.toml``) is the same flight:
-the same seed writes the same truth file, frame for frame, whichever layout flew it.
+composed into one process (``companion/configs/sim_composed.toml``) is the same flight:
+the same seed writes the same truth file, frame for frame, whichever layout flew it. The
+one-process-per-plug-in flight also wakes its navigator on every IMU sample (``wake_hz``
+0), the composed one once a state (the shipped 50): the navigator's states are the same.
 """
 
 from __future__ import annotations
@@ -61,9 +63,19 @@ def _first_difference(a: Path, b: Path) -> str:
     return "none" if first is None else f"{first[1]} at {first[0]:.2f} s"
 
 
+def _woken_every_sample(tmp_path: Path) -> str:
+    """sim.toml with the navigator woken on every IMU sample, not once a state."""
+    text = (REPO / "companion" / "configs" / "sim.toml").read_text()
+    shipped = 'device = "sim://imu", baud = 115200, wake_hz = 50.0'
+    assert shipped in text, "sim.toml's IMU line changed: update this test"
+    path = tmp_path / "every_sample.toml"
+    path.write_text(text.replace(shipped, 'device = "sim://imu", baud = 115200, wake_hz = 0.0'))
+    return str(path)
+
+
 @pytest.mark.timeout(1300)
 def test_the_composed_layout_flies_the_same_flight(tmp_path):
-    own, _ = _fly(tmp_path, "own_processes")
+    own, _ = _fly(tmp_path, "own_processes", "--config", _woken_every_sample(tmp_path))
     composed, _ = _fly(tmp_path, "composed", "--config", COMPOSED)
     climb = np.array(read_truth(own)["alt"])
     assert climb[-1] - climb[0] > 20, "the aircraft took off"
