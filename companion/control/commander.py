@@ -10,6 +10,10 @@ A reposition without a point (QGroundControl's Pause and Change altitude, PX4's
 DO_REPOSITION with NaN latitude/longitude) keeps the point being flown to, or circles here,
 at the altitude given (or the present one).
 
+Return flies to the nearest rally point instead of home when there is one and it is
+nearer (``companion.control.mission.rally``), chosen as it is entered and kept as its
+target; it says which on ``notices``.
+
 No command sends the aircraft below a safe height (``GUIDED_ALT_MIN`` above home: the
 vehicle has no terrain data, so home's height stands for the ground's). A target given
 under it is refused with the reason; a target without an altitude is flown at the present
@@ -19,13 +23,14 @@ altitude, or at that minimum if the aircraft is lower.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 from companion.control.flight_state import FlightState
 from companion.control.ground_rules import AIRBORNE_ONLY, refusal
 from companion.control.inputs import position_usable
 from companion.control.mission.items import MAX_ALT_M
+from companion.control.mission.rally import RALLY_PARAMS, RallyPoints, choose_return
 from companion.control.modes import INITIAL_MODE
 from companion.messages import (
     CommandId,
@@ -94,7 +99,8 @@ LANDING_PHASES = (LandPhase.APPROACH, LandPhase.FLARE)  # a go-around can still 
 class Commander:
     """Mode state machine; ``mission_count`` says how many mission items are stored,
     ``mission_lands`` whether the stored mission has a DO_LAND_START and
-    ``mission_takeoff`` which item is its first take-off (-1: none)."""
+    ``mission_takeoff`` which item is its first take-off (-1: none); ``rally_params`` the
+    live values of ``RALLY_PARAMS``, ``rally`` the rally points Return may fly to."""
 
     def __init__(
         self,
@@ -102,11 +108,15 @@ class Commander:
         mission_lands: Callable[[], bool] = lambda: False,
         min_height: Callable[[], float] = lambda: COMMANDER_PARAMS[0].default,
         mission_takeoff: Callable[[], int] = lambda: -1,
+        rally_params: Mapping[str, float] | None = None,
     ) -> None:
         self.mission_count = mission_count
         self.mission_lands = mission_lands
         self.min_height = min_height
         self.mission_takeoff = mission_takeoff
+        self.rally_params = rally_params or {p.name: p.default for p in RALLY_PARAMS}
+        self.rally = RallyPoints()
+        self.notices: list[str] = []  # what the operator is told of a choice made
         self.mode = INITIAL_MODE
         self.armed = False
         self.home: tuple[float, float, float] | None = None
@@ -287,6 +297,8 @@ class Commander:
                 name = "Go to" if mode == FlightMode.GUIDED else "Hold"
                 return Decision(CommandResult.DENIED, f"{name}: no position yet")
             self.target, self.radius = target, radius
+        elif mode == FlightMode.RTL:
+            self.target, self.radius = self._return_target(), math.nan
         else:
             self.target, self.radius = NO_POINT, math.nan
         # A speed asked for holds in its mode (PX4's navigator resets it on a change of mode
@@ -300,6 +312,21 @@ class Commander:
         self.changes += 1
         self.mode = mode
         return ACCEPTED
+
+    def take_notices(self) -> list[str]:
+        """What the operator is to be told since the last call (then forgotten)."""
+        notices, self.notices = self.notices, []
+        return notices
+
+    def _return_target(self) -> tuple[float, float, float]:
+        """Return's rally point (NO_POINT: home), from where the aircraft is now."""
+        if self.home is None or self.position is None:
+            return NO_POINT
+        here = (self.position[0], self.position[1])
+        choice = choose_return(self.rally, here, self.home, self.floor(), self.rally_params)
+        if choice.text:
+            self.notices.append(choice.text)
+        return choice.point or NO_POINT
 
     def _target(self, point: tuple[float, ...] | None) -> tuple[float, float, float] | None:
         here = self.position

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 from companion.control.failsafe import Action
 from companion.control.modes import PILOT_MODES, arduplane_choices, from_arduplane
-from companion.messages import FlightMode, PilotFlags, PilotInput
+from companion.messages import FlightMode, PilotFlags, PilotInput, PluginState, SystemHealth
 from companion.params import ParamDecl
 from mavlink_dialect import companion as d
 
@@ -56,12 +56,25 @@ PILOT_PARAMS = (
 )
 
 
+RC_PLUGIN = b"sensors.rc_input"  # whose process the RC failsafe names when it is down
+
+
 @dataclass(frozen=True)
 class ReceiverProcess:
     """The RC receiver's plug-in as the health table shows it."""
 
     running: bool
     restarts: int
+
+
+def receiver_process(health: SystemHealth | None) -> ReceiverProcess | None:
+    """The RC receiver plug-in's process in the health table (None: none listed)."""
+    if health is None:
+        return None
+    row = next((r for r in health.rows() if r.kind == RC_PLUGIN), None)
+    if row is None:
+        return None
+    return ReceiverProcess(row.state == PluginState.RUNNING, int(row.restarts))
 
 
 class PilotWatch:

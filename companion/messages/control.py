@@ -122,7 +122,7 @@ class VehicleStatus(Message):
         ("home_lat_deg", ctypes.c_double),
         ("home_lon_deg", ctypes.c_double),
         ("home_alt_msl_m", ctypes.c_double),
-        ("target_lat_deg", ctypes.c_double),  # GUIDED: where to go (NaN otherwise)
+        ("target_lat_deg", ctypes.c_double),  # GUIDED, LOITER: where; RTL: a rally point
         ("target_lon_deg", ctypes.c_double),
         ("target_alt_msl_m", ctypes.c_double),
         ("target_radius_m", ctypes.c_double),  # LOITER/ORBIT circle radius (NaN: default)

@@ -1,7 +1,8 @@
 """QGroundControl 4.4.5's Land with the square plan and its fence (issue 42's click-through).
 
-The Plan view's upload (mission, fence, rally), Start Mission, Return, then the shipped
-custom action Land (COMMAND_LONG MAV_CMD_NAV_LAND, every parameter 0). The plan has no
+The Plan view's upload (mission, fence, rally), Start Mission, Return (to the plan's rally
+point, nearer than home from the square's far side), then the shipped custom action Land
+(COMMAND_LONG MAV_CMD_NAV_LAND, every parameter 0). The plan has no
 landing, so Land builds its pattern onto the runway of the take-off; the default one's
 loiter (800 m behind the touchdown point) lay across the fence's west edge, 700 m west of
 home, and the fence failsafe turned the landing into Return. Now the pattern keeps inside
@@ -35,7 +36,9 @@ PLAN = REPO / "qgc_plans" / "square.plan"
 pytestmark = pytest.mark.vehicle(airframe="c172p", duration=1500)
 WALL_S = 1500.0  # a hang guard only: the flight is judged by the vehicle's telemetry
 HOME = LocalFrame(-37.9105, 145.134)  # the plan's home, where the simulation starts
-NEAR_HOME_M = 500.0  # Land from Return once this near home, as in the click-through
+NEAR_M = 500.0  # Land from Return once this near where it returns to
+_RALLY_ITEM = checked_plan(PLAN)[d.MAV_MISSION_TYPE_RALLY][0]
+RALLY = HOME.ne(_RALLY_ITEM.x / 1e7, _RALLY_ITEM.y / 1e7)
 CLIMB_OUT_CHECK_M = 200.0  # the roll and the wings-level climb-out follow the runway line
 SAID = re.compile(r"Land: course (\d+), (\d+) m final, loiter (right|left)")
 
@@ -54,7 +57,7 @@ class Heard:
         self.modes: list[FlightMode] = []
         self.texts: list[str] = []
         self.armed = True
-        self.home_m = math.inf  # from home (the plan's, where the simulation starts)
+        self.rally_m = math.inf  # from the plan's rally point, where Return goes
         self._by_px4 = {m.px4: mode for mode, m in BY_MODE.items()}
 
     def pump(self, done: Callable[[], bool], what: str) -> None:
@@ -74,7 +77,8 @@ class Heard:
         if kind == "STATUSTEXT":
             self.texts.append(msg.text)
         elif kind == "GLOBAL_POSITION_INT":
-            self.home_m = math.hypot(*HOME.ne(msg.lat / 1e7, msg.lon / 1e7))
+            north, east = HOME.ne(msg.lat / 1e7, msg.lon / 1e7)
+            self.rally_m = math.hypot(north - RALLY[0], east - RALLY[1])
         else:
             mode = self._by_px4.get(msg.custom_mode)
             if mode is not None and (not self.modes or self.modes[-1] != mode):
@@ -97,7 +101,7 @@ def test_qgc_land_with_the_square_plans_fence_lands_inside_it(sim):
         qgc.connect()
         flag = d.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
         _accepted(qgc, d.MAV_CMD_DO_SET_MODE, flag, BY_MODE[FlightMode.RTL].px4)  # Return
-        heard.pump(lambda: heard.home_m < NEAR_HOME_M, "back near home")
+        heard.pump(lambda: heard.rally_m < NEAR_M, "near the rally point")
         _accepted(qgc, d.MAV_CMD_NAV_LAND, 0, 0, 0, 0, 0, 0, 0)  # the custom action Land
         heard.pump(lambda: not heard.armed, "disarmed")
     finally:
@@ -108,6 +112,7 @@ def test_qgc_land_with_the_square_plans_fence_lands_inside_it(sim):
     wait_for(lambda: sim.truth()["t"][-1] >= settled, 120, "the truth file past the disarm")
     modes, texts = heard.modes, heard.texts
     assert not any("Fence breached" in t for t in texts), texts
+    assert any(t.startswith("Return: to rally point 1") for t in texts), texts
     landing = modes[modes.index(FlightMode.LAND) :] if FlightMode.LAND in modes else []
     assert landing == [FlightMode.LAND], modes  # Land to the end: no Return after it
     said = next((m for t in texts if (m := SAID.search(t))), None)

@@ -15,7 +15,7 @@ from companion.control.flight.attitude_modes import Sticks
 from companion.control.flight.flight_params import FlightConfig
 from companion.control.flight.landing import landing_flaps
 from companion.control.flight.landing_flight import LandingFlight, MissionRef, Motion
-from companion.control.flight.mode_targets import arrive, mode_target
+from companion.control.flight.mode_targets import arrive, mode_target, return_point
 from companion.control.flight.on_ground import landed_now
 from companion.control.flight.output import ControlOutput
 from companion.control.flight.pilot_flight import PilotFlight
@@ -239,7 +239,8 @@ class FlightController:
             self.executor = ex
             return self._mission(status, pos, nav, t_s, False, out)
 
-        plan = MissionRef(self.items, self.frame, self.home_alt, self.executor)
+        back_to = return_point(status, self.frame)
+        plan = MissionRef(self.items, self.frame, self.home_alt, self.executor, back_to)
         radius = self._turn_radius()
         sp = self.lander.mode_landing(mode, where, entered, plan, self.config, radius, fly_mission)
         self.executor = plan.executor

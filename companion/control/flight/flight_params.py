@@ -66,7 +66,7 @@ LANDING_PARAMS = (
     ParamDecl("LAND_STEER_P", 8.0, 0.0, 10.0, "", "rollout: rudder per radian of heading error"),
     ParamDecl("LAND_FLAP_PERCNT", 0.0, 0.0, 100.0, "%", "landing: flaps on the approach"),
     ParamDecl("RTL_AUTOLAND", 0.0, 0.0, 2.0, "", "Return lands at DO_LAND_START: 1 after "
-              "reaching home, 2 at once",
+              "reaching home (or the rally point it flies to), 2 at once",
               values=((0.0, "Disabled"), (1.0, "After reaching home"), (2.0, "At once"))),
     ParamDecl.switch("RNGFND_LANDING", 1.0, "landing: flare on the rangefinder's height when "
                      "it has a fresh valid reading (no effect without one)"),

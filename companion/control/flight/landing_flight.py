@@ -69,6 +69,7 @@ class MissionRef:
     frame: LocalFrame | None
     home_alt: float
     executor: MissionExecutor | None
+    returns_to: tuple[float, float] = (0.0, 0.0)  # where Return flies: home, or a rally point
 
 
 Motion = tuple[tuple[float, float], tuple[float, float], NavState, float, float]
@@ -209,8 +210,9 @@ class LandingFlight:
     ) -> Setpoint | None:
         """The mission's landing from its first DO_LAND_START, None when not landing now.
         Land (PX4's Land, as a fixed wing flies it): at once. Return with RTL_AUTOLAND: 2
-        at once, 1 once home is reached (as ArduPlane). ``where``: position, navigation
-        solution, time; ``fly_mission`` steps the controller's mission on this executor."""
+        at once, 1 once home (or the rally point it flies to) is reached (as ArduPlane).
+        ``where``: position, navigation solution, time; ``fly_mission`` steps the
+        controller's mission on this executor."""
         pos, nav, t_s = where
         first = land_start(plan.items)
         if first is None and mode == FlightMode.LAND:
@@ -221,9 +223,9 @@ class LandingFlight:
         if entered:
             self.return_lands = autoland == 2
         if not self.return_lands:
-            home = (0.0, 0.0)
+            back = plan.returns_to
             reach = max(config["WP_LOITER_RAD"], turn_radius) * 1.5
-            if math.hypot(pos[0] - home[0], pos[1] - home[1]) > reach:
+            if math.hypot(pos[0] - back[0], pos[1] - back[1]) > reach:
                 return None
             self.return_lands = True
         if entered or plan.executor is None or plan.executor.current < first:

@@ -1,7 +1,7 @@
 """The setpoint a mode other than Mission flies when it is entered: take-off to a height,
-Return home, go to or circle a point, straight on for a pilot's mode without fresh sticks,
-else circle where the aircraft is; and the circle a return, a go-to or a take-off turns
-into on arrival (``arrive``)."""
+Return home (or to the rally point the commander chose), go to or circle a point,
+straight on for a pilot's mode without fresh sticks, else circle where the aircraft is;
+and the circle a return, a go-to or a take-off turns into on arrival (``arrive``)."""
 
 from __future__ import annotations
 
@@ -36,8 +36,10 @@ def mode_target(
             climb_to = home_alt + config["RTL_ALT_M"]
         return Setpoint(Kind.TAKEOFF, pos, pos, climb_to)
     if mode == FlightMode.RTL:
-        rtl_alt = home_alt + config["RTL_ALT_M"]
-        return Setpoint(Kind.LINE, pos, (0.0, 0.0), rtl_alt, radius)
+        alt = status.target_alt_msl_m  # a rally point's
+        if not (_has_target(status) and math.isfinite(alt)):
+            alt = home_alt + config["RTL_ALT_M"]
+        return Setpoint(Kind.LINE, pos, return_point(status, frame), alt, radius)
     target = (status.target_lat_deg, status.target_lon_deg, status.target_alt_msl_m)
     has_target = math.isfinite(target[0]) and math.isfinite(target[1])
     if math.isfinite(status.target_radius_m) and status.target_radius_m > 0:
@@ -51,6 +53,17 @@ def mode_target(
     if mode in PILOT_MODES:  # no fresh sticks: straight on, height held
         return Setpoint(Kind.LINE, pos, track_ahead(pos, nav), alt)
     return Setpoint(Kind.CIRCLE, pos, pos, alt, radius)
+
+
+def return_point(status: VehicleStatus, frame: LocalFrame | None) -> tuple[float, float]:
+    """Where Return flies (local north, east): the commander's rally point, else home."""
+    if frame is None or not _has_target(status):
+        return (0.0, 0.0)
+    return frame.ne(status.target_lat_deg, status.target_lon_deg)
+
+
+def _has_target(status: VehicleStatus) -> bool:
+    return math.isfinite(status.target_lat_deg) and math.isfinite(status.target_lon_deg)
 
 
 def arrive(

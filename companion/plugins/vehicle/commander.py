@@ -30,8 +30,9 @@ from companion.control.flight_state import (
 from companion.control.ground_rules import ground_notice, standing
 from companion.control.mission.fence import Fence
 from companion.control.mission.mission_files import MissionStore, StoreFollower
+from companion.control.mission.rally import RALLY_PARAMS, RallyPoints
 from companion.control.mission.set_current import first_takeoff
-from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch, ReceiverProcess
+from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch, receiver_process
 from companion.messages import (
     NAME_LEN,
     REASON_LEN,
@@ -40,7 +41,6 @@ from companion.messages import (
     FlightMode,
     MissionState,
     NavFlags,
-    PluginState,
     StatusText,
     VehicleCommand,
     VehicleStatus,
@@ -69,13 +69,14 @@ FAILSAFE_PERIOD_US = 100_000  # failsafes are judged ten times a (vehicle) secon
 RESUME_WAIT_US = 10_000_000
 REARM_WAIT_US = 5_000_000  # after asking to be armed again: the supervisor's answer, at most
 REARM_SEQ = (1 << 31) - 1  # the commander's own START, apart from the link's numbers
-RC_PLUGIN = b"sensors.rc_input"  # whose process the RC failsafe names when it is down
+ZONES = frozenset({d.MAV_MISSION_TYPE_FENCE, d.MAV_MISSION_TYPE_RALLY})
 
 
 class CommanderPlugin(Plugin):
     """Mode state for the link and the flight controller."""
 
-    params = (*COMMANDER_PARAMS, *FAILSAFE_PARAMS, *PILOT_PARAMS, *BATTERY_FS_PARAMS)
+    params = (*COMMANDER_PARAMS, *FAILSAFE_PARAMS, *PILOT_PARAMS, *BATTERY_FS_PARAMS,
+              *RALLY_PARAMS)  # fmt: skip
     inputs = ("link/commands",)
     optional_inputs = (
         "nav/state",
@@ -95,7 +96,6 @@ class CommanderPlugin(Plugin):
         state_dir = Path(ctx.vehicle.get("state_dir", "."))
         self._read_flight_state(state_dir)
         self.store = MissionStore(state_dir / "missions")
-        self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
         # The link stores missions in its own process and says so on mission/changed.
         self.follower = StoreFollower(self.store)
         self.live = LiveParams(ctx.bus, self.params, state_dir)
@@ -104,7 +104,9 @@ class CommanderPlugin(Plugin):
             lambda: land_start(self.store.items[d.MAV_MISSION_TYPE_MISSION]) is not None,
             lambda: self.live[MIN_ALT_PARAM],
             lambda: first_takeoff(self.store.items[d.MAV_MISSION_TYPE_MISSION]),
+            self.live.values,
         )
+        self._load_zones()
         self.failsafes, self.pilot = Failsafes(self.live.values), PilotWatch(self.live.values)
         self.battery_failsafe = BatteryFailsafe(self.live.values)
         bus = ctx.bus
@@ -128,9 +130,8 @@ class CommanderPlugin(Plugin):
         self.arm_again = bus.writer("link/commands")
         self.out = bus.writer("vehicle/status")
         self.texts = bus.writer("vehicle/statustext")
-        self.next_status_us = 0
+        self.next_status_us = self.next_failsafe_us = 0
         self.last_status = b""  # the last status published, time stamp left out
-        self.next_failsafe_us = 0
         self.nav_seen: Any = None  # the last solution read, usable or not
         self.nav_good: Any = None  # the last usable one
         self.arms = 0  # times armed, for the ground notice
@@ -157,8 +158,8 @@ class CommanderPlugin(Plugin):
             self.arms += int(bool(health.flight_running) and not c.armed)
             c.on_armed(bool(health.flight_running))
         self.live.poll()
-        if d.MAV_MISSION_TYPE_FENCE in self.follower.follow(self.mission_changes.get()):
-            self.fence = Fence.from_items(self.store.items[d.MAV_MISSION_TYPE_FENCE])
+        if self.follower.follow(self.mission_changes.get()) & ZONES:
+            self._load_zones()
         control = self.control.get()
         if control is not None and not control.fresh(now):
             control = None  # a stopped controller's last status says nothing now
@@ -173,6 +174,8 @@ class CommanderPlugin(Plugin):
         if now >= self.next_failsafe_us or now < self.next_failsafe_us - FAILSAFE_PERIOD_US:
             self.next_failsafe_us = now + FAILSAFE_PERIOD_US
             changed |= self._failsafes(now, nav)
+        for text in c.take_notices():  # where Return goes, after what sent it there
+            self._say(now, text, d.MAV_SEVERITY_INFO)
         if changed or now >= self.next_status_us:
             self._publish_status(c.status(now), c.armed)
             self.next_status_us = now + (STATUS_PERIOD_US if c.armed else DISARMED_STATUS_PERIOD_US)
@@ -272,6 +275,13 @@ class CommanderPlugin(Plugin):
             save_flight_state(self.state_dir, state)
             self.written, self.written_armed = text, state.armed
 
+    def _load_zones(self) -> None:
+        """The fence, and the rally points Return may fly to inside it."""
+        items = self.store.items
+        self.fence = Fence.from_items(items[d.MAV_MISSION_TYPE_FENCE])
+        rally = RallyPoints.from_items(items[d.MAV_MISSION_TYPE_RALLY], self.fence)
+        self.commander.rally = rally
+
     def _ground_notice(self, now: int, known: bool) -> None:
         """Armed on the ground, say once per arming and per mode entered what the aircraft
         will do from there (``companion.control.ground_rules``): never armed and silent.
@@ -351,19 +361,9 @@ class CommanderPlugin(Plugin):
         actions = self.failsafes.step(situation) + self.battery_failsafe.step(level, bool(flying))
         if nav is not None:  # the pilot's inputs are judged against the sensors' time
             rc, joystick = self.rc.get(), self.joystick.get()
-            receiver = self._receiver()
+            receiver = receiver_process(self.health.get())
             actions += self.pilot.step(int(nav.t_us), c.mode, bool(flying), rc, joystick, receiver)
         return self._act(now, actions)
-
-    def _receiver(self) -> ReceiverProcess | None:
-        """The RC receiver plug-in's process in the health table (None: none listed)."""
-        health = self.health.get()
-        if health is None:
-            return None
-        row = next((r for r in health.rows() if r.kind == RC_PLUGIN), None)
-        if row is None:
-            return None
-        return ReceiverProcess(row.state == PluginState.RUNNING, int(row.restarts))
 
     def _mode_switch(self, now: int) -> bool:
         """The pilot's switch wins over the ground station each time it moves."""
