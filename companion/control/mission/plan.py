@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from companion.control.mission.fence import CIRCLES, POLYGONS
-from companion.control.mission.items import MissionItem, check_mission
+from companion.control.mission.items import GLOBAL_FRAMES, MissionItem, check_mission
 from companion.params.atomic import atomic_write_text
 from mavlink_dialect import companion as d
 
@@ -52,6 +52,8 @@ def _simple(raw: dict[str, Any], seq: int) -> MissionItem:
 
 
 LANDING_PATTERN = "fwLandingPattern"
+RALLY_FRAMES = "companionFrames"  # rally points' frames, when one is not above home
+RELATIVE_FRAMES = (d.MAV_FRAME_GLOBAL_RELATIVE_ALT, d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT)
 
 
 def _landing(raw: dict[str, Any]) -> list[dict[str, Any]]:
@@ -168,10 +170,16 @@ def load_plan(path: str | Path) -> dict[int, list[MissionItem]]:
         raise PlanError(f"{path}: not a readable plan: {exc}") from None
     if plan.get("fileType") != "Plan":
         raise PlanError(f"{path}: fileType is not 'Plan'")
+    points = plan.get("rallyPoints", {})
+    frames = points.get(RALLY_FRAMES, []) if isinstance(points, dict) else None
+    if not isinstance(frames, list) or not all(
+        isinstance(f, int) and f in GLOBAL_FRAMES for f in frames
+    ):
+        raise PlanError(f"{path}: rallyPoints: {RALLY_FRAMES} must list global frames")
     rally = [
         MissionItem(
             i,
-            d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+            frames[i] if i < len(frames) else d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
             d.MAV_CMD_NAV_RALLY_POINT,
             0,
             1,
@@ -184,7 +192,7 @@ def load_plan(path: str | Path) -> dict[int, list[MissionItem]]:
             float(p[2]),
             2,
         )
-        for i, p in enumerate(plan.get("rallyPoints", {}).get("points", []))
+        for i, p in enumerate(points.get("points", []))
     ]
     try:
         fence = _fence_items(plan)
@@ -209,7 +217,13 @@ def plan_json(items: dict[int, list[MissionItem]]) -> dict[str, Any]:
     ]
     first = items.get(0, [None])[0] if items.get(0) else None
     home = [first.x / 1e7, first.y / 1e7, 0.0] if first else [0.0, 0.0, 0.0]
-    rally = [[it.x / 1e7, it.y / 1e7, it.z] for it in items.get(2, [])]
+    rally_items = items.get(2, [])
+    points = [[it.x / 1e7, it.y / 1e7, it.z] for it in rally_items]
+    rally: dict[str, Any] = {"version": 2, "points": points}
+    if any(it.frame not in RELATIVE_FRAMES for it in rally_items):
+        # A .plan's rally altitudes are above home: a point stored above sea level keeps
+        # its frame in a key of ours, which QGroundControl passes over.
+        rally[RALLY_FRAMES] = [it.frame for it in rally_items]
     return {
         "fileType": "Plan",
         "version": 1,
@@ -224,7 +238,7 @@ def plan_json(items: dict[int, list[MissionItem]]) -> dict[str, Any]:
             "items": mission,
         },
         "geoFence": _fence_json(items.get(1, [])),
-        "rallyPoints": {"version": 2, "points": rally},
+        "rallyPoints": rally,
     }
 
 

@@ -12,10 +12,13 @@ import json
 import shutil
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
+from companion.control.mission.mission_files import MissionStore
+from mavlink_dialect import companion as d
 from tests.support.configs import vehicle_config
 from tests.support.vehicle import REPO
 
@@ -98,3 +101,26 @@ def test_square_plan_saves_its_fence(tmp_path, config):
     plan = json.loads((tmp_path / "saved.plan").read_text())
     assert plan["geoFence"] == json.loads(SQUARE.read_text())["geoFence"]
     assert "breachReturn" not in plan["geoFence"]  # none stored: none written
+
+
+def test_a_rally_point_stored_above_sea_level_keeps_its_altitude_through_save_and_load(
+    tmp_path, config
+):
+    """A .plan's rally altitudes are above home: one uploaded above sea level is saved with
+    its frame (a key QGroundControl passes over) and loads back the same, not as 180 m
+    above home."""
+    _mission("load", SQUARE, "-c", config)
+    store = MissionStore(tmp_path / "state" / "missions")
+    relative = store.items[d.MAV_MISSION_TYPE_RALLY][0]
+    store.replace(
+        d.MAV_MISSION_TYPE_RALLY, [replace(relative, frame=d.MAV_FRAME_GLOBAL_INT, z=180.0)]
+    )
+    stored = _stored(tmp_path / "state")
+    saved = tmp_path / "saved.plan"
+    _mission("save", saved, "-c", config)
+    rally = json.loads(saved.read_text())["rallyPoints"]
+    assert rally["points"] == [[-37.9114009, 145.1442344, 180.0]]
+    assert rally["companionFrames"] == [d.MAV_FRAME_GLOBAL_INT]
+    shutil.rmtree(tmp_path / "state" / "missions")
+    _mission("load", saved, "-c", config)
+    assert _stored(tmp_path / "state") == stored
