@@ -94,6 +94,7 @@ class _FilePlan:
         self.store, self.path = store, path
         self.values = dict(store.values)  # the vehicle's, then the file's over them
         self.set_by: dict[str, _Line] = {}
+        self.unknown: list[str] = []  # names this config does not declare: skipped
 
     def error(self, line: _Line, text: str) -> ParamError:
         return ParamError(f"{self.path}:{line.lineno}: {text}")
@@ -102,7 +103,14 @@ class _FilePlan:
         """A parameter of the vehicle's own: its value, checked. One printed within its
         last digit of the vehicle's value is that value, not a rounding of it."""
         decl = self.store.decls.get(line.name)
-        if decl is not None and decl.min == decl.max and not same_value(decl.min, line.value):
+        if decl is None:
+            # A file from a vehicle with more plug-ins (or another version) is loaded as
+            # QGroundControl and MAVProxy load one: the rest of it, the name reported.
+            log.warning("%s:%d: %s not set: no such parameter here",
+                        self.path, line.lineno, line.name)  # fmt: skip
+            self.unknown.append(line.name)
+            return
+        if decl.min == decl.max and not same_value(decl.min, line.value):
             # A fact of the vehicle the file came from (its system id, a battery monitor
             # it had): not a setting, and this vehicle's stays.
             log.warning("%s:%d: %s %g not set: this vehicle's is %g (fixed)",
@@ -172,10 +180,11 @@ class _FilePlan:
 
 
 def load_params(store: ParamStore, path: Path) -> int:
-    """Apply a parameter file (any of the three formats); ParamError names the line and
-    parameter of the first bad line.
+    """Apply a parameter file (any of the three formats); how many of its lines name a
+    parameter of this config. ParamError names the line and parameter of the first bad line.
 
-    Nothing is applied unless every line is good. A line at the parameter's default stores
+    Nothing is applied unless every line is good; a name the config does not declare is
+    skipped, with a warning. A line at the parameter's default stores
     nothing (the parameter keeps following its default), so a whole file written by
     ``save_params`` stores only the values that differ. An alias's line that agrees with the
     file's values of the parameters it follows sets nothing; one that does not sets them
@@ -196,4 +205,4 @@ def load_params(store: ParamStore, path: Path) -> int:
         if not plan.agrees(line):
             raise plan.contradiction(line, store.aliases[line.name].sources)
     store.apply({own: plan.values[own] for own in plan.set_by})
-    return len(lines)
+    return len(lines) - len(plan.unknown)

@@ -102,6 +102,22 @@ def test_a_fact_of_the_vehicle_a_file_came_from_is_not_set_and_the_rest_loads(tm
     assert "MAV_SYS_ID 2 not set: this vehicle's is 1 (fixed)" in caplog.text
 
 
+def test_a_name_this_config_lacks_is_skipped_and_named_and_the_rest_loads(tmp_path, caplog):
+    """A whole vehicle's file loaded into a bench config without its controller: the
+    controller's lines are skipped with a warning each, as QGroundControl and MAVProxy skip
+    them; a bad value still refuses the file."""
+    store = ParamStore(DECLS)
+    path = tmp_path / "whole.params"
+    path.write_text("1\t1\tRTL_ALT_M\t150\t9\n1\t1\tFW_R_LIM\t50\t9\n")
+    assert load_params(store, path) == 1
+    assert store.get("FW_R_LIM") == 50.0
+    assert "whole.params:1: RTL_ALT_M not set: no such parameter here" in caplog.text
+    path.write_text("1\t1\tRTL_ALT_M\t150\t9\n1\t1\tFW_R_LIM\t95\t9\n")
+    with pytest.raises(ParamError, match=r"whole\.params:2: FW_R_LIM: 95 outside"):
+        load_params(store, path)
+    assert store.get("FW_R_LIM") == 50.0
+
+
 def test_only_what_the_user_set_is_stored_and_a_moved_default_reaches_the_rest(tmp_path):
     path = tmp_path / "p.json"
     ParamStore(DECLS, path).set("FW_R_LIM", 50.0)
