@@ -13,7 +13,6 @@ the last point (PX4).
 
 from __future__ import annotations
 
-import enum
 import math
 from dataclasses import dataclass, field
 
@@ -28,6 +27,7 @@ from companion.control.mission.items import (
 )
 from companion.control.mission.leg_geometry import CircleProgress, past_point, tangent_angle
 from companion.control.mission.leg_geometry import distance as _distance
+from companion.control.mission.setpoint import Kind, Point, Setpoint
 from companion.geodesy import LocalFrame, wrap_pi
 from mavlink_dialect import companion as d
 
@@ -39,31 +39,6 @@ TANGENT_WINDOW = math.radians(30.0)  # leave a LOITER_TO_ALT this soon past the 
 ESTABLISHED = math.radians(90.0)  # and once it has flown this far round it
 # Items a landing's final may start from (``leads_to_landing``).
 APPROACH_FROM = {d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_NAV_LOITER_TO_ALT}
-Point = tuple[float, float]
-
-
-class Kind(enum.IntEnum):
-    """What the controller is asked to fly."""
-
-    TAKEOFF = 1  # runway take-off, then climb along the runway heading
-    LINE = 2  # track a → b
-    CIRCLE = 3  # circle b
-    LAND = 4  # approach along a → b down to alt_msl at b, flare, roll out, stop
-
-
-@dataclass(frozen=True)
-class Setpoint:
-    """One guidance target in the home-centred north/east frame (metres, MSL altitude)."""
-
-    kind: Kind
-    a: Point
-    b: Point
-    alt_msl: float
-    radius: float = 0.0
-    clockwise: bool = True
-    speed: float = math.nan  # NaN: the cruise speed
-    from_alt: float = math.nan  # LAND: the height at a, where the glide path starts
-    approach: bool = False  # the leg or circle a landing's final starts from (leads_to_landing)
 
 
 @dataclass
