@@ -9,23 +9,33 @@ from __future__ import annotations
 
 import compileall
 import os
+import shutil
 import subprocess
 import sys
+import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 
+from companion.exec_control.config import STATE_ENV
 from tests.support.vehicle import REPO, Vehicle
 
 STRESS_ENV = "COMPANION_TEST_STRESS"
 _HOG = "while True:\n    pass\n"
 _hogs: list[subprocess.Popen[bytes]] = []
+_state_roots: list[str] = []  # the default state directories this process made
 
 
 def pytest_sessionstart(session: pytest.Session) -> None:
     """Compile the project's modules once; start the CPU hogs when asked for a busy machine."""
     _compile_project()
+    # A vehicle started without a state directory of its own makes one under the config's
+    # default, ~/.local/state/companion/NAME/NAMESPACE: a session's hundreds of them stayed
+    # in the home directory. Under a directory of the session's, removed at its end.
+    if not os.environ.get(STATE_ENV):
+        _state_roots.append(tempfile.mkdtemp(prefix="companion-test-state-"))
+        os.environ[STATE_ENV] = _state_roots[-1]
     # Under pytest-xdist the controller starts the hogs once; its workers start none.
     worker = "PYTEST_XDIST_WORKER" in os.environ
     if os.environ.get(STRESS_ENV, "") not in ("", "0") and not worker:
@@ -49,6 +59,9 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     for hog in _hogs:
         hog.wait()
     _hogs.clear()
+    for root in _state_roots:
+        shutil.rmtree(root, ignore_errors=True)
+    _state_roots.clear()
 
 
 def pytest_report_header(config: pytest.Config) -> str | None:

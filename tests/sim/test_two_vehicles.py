@@ -18,6 +18,7 @@ os.environ.setdefault("MAVLINK20", "1")
 from pymavlink import mavutil
 
 from companion.control.mission.plan import load_plan
+from companion.exec_control.config import STATE_ENV
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import SimRun, finish
@@ -33,6 +34,7 @@ def _start(tmp_path, name: str, port: int):
     namespace = unique_namespace(f"two{name}")
     env = companion_env(namespace)
     env["HOME"] = str(tmp_path)  # the default state directory lands here
+    env.pop(STATE_ENV, None)  # the session's own default (tests/conftest.py) left out
     cmd = [
         sys.executable, "-m", "companion", "sim", "--speed", "max", "--namespace", namespace,
         "--link", f"udpout://127.0.0.1:{port}", "--duration", "1500",

@@ -86,7 +86,7 @@ def test_the_vehicle_command_line_means_what_the_fleet_planned(tmp_path, monkeyp
 
 def test_the_fleet_table_is_checked_and_ignored_by_run(tmp_path):
     vehicle, fleet = load_sections(SIM_TOML, "fl")
-    assert vehicle["sysid"] == 1 and vehicle["state_dir"].endswith("companion/sim/fl")
+    assert vehicle["sysid"] == 1 and vehicle["state_dir"].endswith("/sim/fl")
     assert fleet == {"count": 1, "spacing_m": 50.0, "api_port_base": 14540}
     config = tmp_path / "v.toml"
     config.write_text('[vehicle]\nname = "v"\n\n[fleet]\ncount = 2\ncuont = 3\n')
