@@ -38,6 +38,12 @@ def frames(plan: Iterable[tuple[int, int]]) -> bytes:
     return bytes(out)
 
 
+def position_for_pulse(pulse_us: float) -> int:
+    """The position whose pulse is nearest ``pulse_us`` (clamped to the card's range)."""
+    position = round((pulse_us - PULSE_MIN_US) * POSITION_MAX / PULSE_SPAN_US)
+    return max(0, min(POSITION_MAX, position))
+
+
 def pulse_us(position: int) -> int:
     """The pulse width, in µs, the card puts out for a position (90° range)."""
     return PULSE_MIN_US + round(position * PULSE_SPAN_US / POSITION_MAX)

@@ -127,6 +127,12 @@ RULES: dict[int, tuple[Param, ...]] = {
     ),
     d.MAV_CMD_DO_PAUSE_CONTINUE: (Param(1, "continue", 0, 1, whole=True),),
     d.MAV_CMD_DO_FENCE_ENABLE: (Param(1, "enable", 0, 2, whole=True),),
+    # The Mini SSC's eight outputs, numbered from 1 as ArduPilot's SERVOn; the pulse the
+    # card can put out (its 90° range).
+    d.MAV_CMD_DO_SET_SERVO: (
+        Param(1, "instance", 1, 8, whole=True),
+        Param(2, "PWM", 1000, 2000, whole=True),
+    ),
     d.MAV_CMD_DO_GO_AROUND: (Param(1, "altitude", -MAX_ALT_M, MAX_ALT_M, optional=True),),
     d.MAV_CMD_DO_REPOSITION: (
         Param(1, "ground speed", -1, 1000, optional=True),

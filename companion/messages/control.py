@@ -54,6 +54,7 @@ class CommandId(enum.IntEnum):
     GO_AROUND = 13  # abort the landing in progress: climb out and come round again
     CHANGE_SPEED = 14  # param1 = airspeed_m_s to fly (NaN: back to the cruise airspeed)
     SET_MISSION_CURRENT = 15  # param1 = the mission item to fly to (or start at) now
+    SET_SERVO = 16  # param1 = output (1: the card's servo 0), param2 = pulse in µs
 
 
 class CommandResult(enum.IntEnum):
@@ -81,8 +82,8 @@ class VehicleCommand(Message):
 
 
 class CommandAck(Message):
-    """Outcome of a VehicleCommand. Producers: exec_control, commander, the simulator bridge.
-    Consumers: link."""
+    """Outcome of a VehicleCommand. Producers: exec_control, commander, the servo output,
+    the simulator bridge. Consumers: link."""
 
     _fields_ = [
         ("t_us", ctypes.c_int64),

@@ -9,7 +9,7 @@ import pytest
 
 from companion.actuators.airframe import load_airframe
 from companion.actuators.minissc import FrameDecoder, pulse_us
-from companion.messages import ActuatorCommand, CommandId, VehicleCommand
+from companion.messages import ActuatorCommand, CommandId, CommandResult, VehicleCommand
 from tests.support.configs import plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
@@ -130,3 +130,49 @@ def test_a_disarmed_command_means_safe_positions(vehicle_factory, tmp_path):
         return card.poll() == safe
 
     wait_for(disarmed, 5, "safe positions on a disarmed command")
+
+
+@pytest.mark.timeout(180)  # start-up takes up to a minute on a busy machine
+def test_set_servo_moves_a_spare_output_and_refuses_a_surfaces(vehicle_factory, tmp_path):
+    """DO_SET_SERVO as the link puts it on the bus: output 7 (the card's servo 6, which the
+    c172p leaves spare) goes to the pulse asked for and is refreshed with the surfaces;
+    output 2 (the elevator) is refused with the reason; STOP leaves the spare one as set."""
+    vehicle, card, commands = start_servos(vehicle_factory, tmp_path, "c172p")
+    c172 = load_airframe("c172p")
+    safe = {c.servo: c.safe for c in c172.channels}
+    wait_for(lambda: card.poll() == safe, 10, "safe positions at start")
+    acks = vehicle.bus.queue_reader("link/command_acks")
+
+    def answer(seq: int, output: int, pulse: int):
+        def answered():
+            cmd = VehicleCommand(t_us=0, seq=seq, command=int(CommandId.SET_SERVO))
+            cmd.param[0], cmd.param[1] = output, pulse
+            commands.publish(cmd)
+            return next((a for a in acks.pending() if a.seq == seq), None)
+
+        return wait_for(answered, 10, f"the answer to SET_SERVO {output} {pulse}", 0.5)
+
+    release = answer(10, 7, 1900)
+    assert release.result == CommandResult.ACCEPTED and release.source == b"servos"
+    wait_for(lambda: card.poll().get(6) == 229, 5, "servo 6 at 1900 us")  # (1900-1000)*254/1000
+    refused = answer(11, 2, 1500)
+    assert refused.result == CommandResult.DENIED
+    assert refused.reason == b"Set servo: output 2 drives the elevator"
+
+    actuators = vehicle.bus.writer("control/actuators")
+    servos = vehicle.bus.latest_reader("actuators/servos")
+    frames = card.frames
+    wait_for(
+        lambda: (
+            actuators.publish(command(aileron=0.2, throttle=0.5))
+            or (card.poll() and card.frames > frames + 40)
+        ),
+        10,
+        "refreshes while commands flow",
+    )
+    assert card.poll()[6] == 229 and card.poll()[1] == safe[1]
+    shown = wait_for(lambda: (s := servos.get()) and s.pulse_us[6] and s, 5, "SERVO_OUTPUT")
+    assert shown.pulse_us[6] == 1902  # the card's own step nearest 1900 us
+    commands.publish(VehicleCommand(t_us=0, seq=12, command=int(CommandId.STOP)))
+    wait_for(lambda: vehicle.row("servos").pid == 0, 10, "servo output stopped")
+    wait_for(lambda: card.poll() == {**safe, 6: 229}, 5, "surfaces safe, the release held")

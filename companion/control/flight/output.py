@@ -24,6 +24,7 @@ class ControlOutput:
     mission_seq: int = 0
     mission_finished: bool = False
     reached: list[int] = field(default_factory=list)
+    servo_sets: list[tuple[int, int]] = field(default_factory=list)  # a mission's DO_SET_SERVO
     landed: bool = True
     disarm: bool = False  # landed and stopped: the flight is over
     land_phase: int = 0  # LandPhase while landing, else 0

@@ -7,7 +7,8 @@ the leg (an overshoot never makes it circle back; the leg after a take-off start
 the climb ended, so a first waypoint the climb flew past is flown back to); loiters
 circle their point (radius param3, negative for counter-clockwise) forever, for param1
 seconds or param1 turns once on the circle; NAV_RETURN_TO_LAUNCH flies home and circles
-there; DO_CHANGE_SPEED and DO_JUMP act at once. After the last item the aircraft circles
+there; DO_CHANGE_SPEED, DO_SET_SERVO (``servo_sets``, for the servo output) and DO_JUMP
+act at once. After the last item the aircraft circles
 the last point (PX4).
 """
 
@@ -63,6 +64,7 @@ class MissionExecutor:
     speed: float = math.nan
     finished: bool = False
     reached: list[int] = field(default_factory=list)  # items reached since the last drain
+    servo_sets: list[tuple[int, int]] = field(default_factory=list)  # (output, µs) passed
     # (MAV_SEVERITY, text) for the operator; a controller's executors share its landing's.
     said: list[tuple[int, str]] = field(default_factory=list)
 
@@ -159,7 +161,9 @@ class MissionExecutor:
         if cmd == d.MAV_CMD_DO_JUMP:
             self._jump(item)
             return None
-        if cmd in SKIPPED:
+        if cmd in SKIPPED or cmd == d.MAV_CMD_DO_SET_SERVO:
+            if cmd == d.MAV_CMD_DO_SET_SERVO:  # the controller hands it to the servo output
+                self.servo_sets.append((round(item.param1), round(item.param2)))
             self._advance(False, self._prev, self._prev_alt)
             return None
         if cmd == d.MAV_CMD_NAV_LAND:

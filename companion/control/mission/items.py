@@ -35,10 +35,11 @@ CAMERA_STOPS = frozenset(
 # Markers and camera stops: nothing to fly (DO_LAND_START only marks where a landing begins).
 SKIPPED = CAMERA_STOPS | {d.MAV_CMD_DO_LAND_START}
 MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
-DO_COMMANDS = (
-    frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_JUMP, d.MAV_CMD_DO_LAND_START})
-    | CAMERA_STOPS
-)
+# DO items that act at once and fly nowhere: a speed, a servo output (a payload release).
+ACTIONS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_SET_SERVO})
+DO_COMMANDS = ACTIONS | frozenset({d.MAV_CMD_DO_JUMP, d.MAV_CMD_DO_LAND_START}) | CAMERA_STOPS
+SERVO_OUTPUTS = range(1, 9)  # DO_SET_SERVO's param1: the Mini SSC's eight, from 1
+SERVO_PULSES_US = (1000.0, 2000.0)  # and param2: what the card puts out (its 90° range)
 SUPPORTED = {
     d.MAV_MISSION_TYPE_MISSION: NAV_COMMANDS | DO_COMMANDS,
     d.MAV_MISSION_TYPE_FENCE: frozenset(
@@ -65,6 +66,7 @@ POSITIONLESS = (
         {
             d.MAV_CMD_NAV_RETURN_TO_LAUNCH,
             d.MAV_CMD_DO_CHANGE_SPEED,
+            d.MAV_CMD_DO_SET_SERVO,
             d.MAV_CMD_DO_JUMP,
             d.MAV_CMD_DO_LAND_START,
         }
@@ -77,6 +79,7 @@ POSITIONLESS = (
 # Elsewhere NaN means "not given" (yaw, unused parameters); infinity is refused everywhere.
 NEEDS_NUMBER = {
     d.MAV_CMD_DO_JUMP: (1, 2),
+    d.MAV_CMD_DO_SET_SERVO: (1, 2),
     d.MAV_CMD_NAV_LOITER_TURNS: (1,),
     d.MAV_CMD_NAV_LOITER_TIME: (1,),
     d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION: (1,),
@@ -158,6 +161,8 @@ def check_item(item: MissionItem, count: int) -> int:
     params = check_params(item)
     if params != d.MAV_MISSION_ACCEPTED:
         return params
+    if item.command == d.MAV_CMD_DO_SET_SERVO:
+        return _servo_refusal(item)
     if item.command == d.MAV_CMD_DO_JUMP:
         target = round(item.param1)
         if not 0 <= target < count or target == item.seq:
@@ -175,6 +180,16 @@ def check_item(item: MissionItem, count: int) -> int:
         return d.MAV_MISSION_INVALID_PARAM5_X
     if not abs(item.z) <= MAX_ALT_M:  # NaN fails too: every positional item needs a height
         return d.MAV_MISSION_INVALID_PARAM7
+    return d.MAV_MISSION_ACCEPTED
+
+
+def _servo_refusal(item: MissionItem) -> int:
+    """A DO_SET_SERVO's output must be one of the card's, its pulse one the card puts out."""
+    if item.param1 != round(item.param1) or round(item.param1) not in SERVO_OUTPUTS:
+        return d.MAV_MISSION_INVALID_PARAM1
+    low, high = SERVO_PULSES_US
+    if item.param2 != round(item.param2) or not low <= item.param2 <= high:
+        return d.MAV_MISSION_INVALID_PARAM2
     return d.MAV_MISSION_ACCEPTED
 
 
@@ -218,7 +233,7 @@ def next_flown(
             done, repeats = jumps.get(item.seq, 0), round(item.param2)
             jumps[item.seq] = done + 1
             seq = round(item.param1) if repeats < 0 or done < repeats else seq + 1
-        elif item.command in SKIPPED or item.command == d.MAV_CMD_DO_CHANGE_SPEED:
+        elif item.command in SKIPPED or item.command in ACTIONS:
             seq += 1
         else:
             return item

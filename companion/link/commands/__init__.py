@@ -18,6 +18,7 @@ from companion.link.commands.message_requests import MessageRequests
 from companion.link.commands.mission_commands import MissionCommands
 from companion.link.commands.mode_commands import ModeCommands
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort
+from companion.link.commands.servo_commands import ServoCommands
 from companion.link.commands.speed_commands import SpeedCommands
 from companion.link.commands.storage import StorageCommands
 from companion.link.identity import IdentityService
@@ -34,6 +35,7 @@ __all__ = [
     "MessageRequests",
     "MissionCommands",
     "ModeCommands",
+    "ServoCommands",
     "SpeedCommands",
     "StorageCommands",
     "VehiclePort",
@@ -58,6 +60,7 @@ def register_commands(
     ArmingCommands(port).register(service)
     ModeCommands(port, identity.autopilot).register(service)
     SpeedCommands(port, params).register(service)
+    ServoCommands(port).register(service)
     FenceCommands(port, params).register(service)
     MessageRequests(port, identity, router, metadata).register(service)
     if missions is not None:

@@ -14,6 +14,12 @@ whatever the controller was doing: killed while rolling into a turn with full ai
 aircraft rolled on at 40°/s and was inverted and in the ground 6 s later, before the
 vehicle was back; the card's centre positions rolled it 35° in a second.
 
+An output the airframe leaves spare (none of its surfaces' servos) is set by
+MAV_CMD_DO_SET_SERVO, a command or a mission item, which comes as SET_SERVO on
+``link/commands`` and is answered on ``link/command_acks``; one that drives a surface is
+refused with the reason. Armed, it is written and refreshed with the surfaces; stopped,
+it is not written again, and the card holds its pulse.
+
 Started in flight (this process restarted after a crash while the controller says the
 aircraft is not landed, or the vehicle restarted after its supervisor died and the card was
 left trimmed), nothing is written until the first command: the card keeps its last pulses,
@@ -29,9 +35,18 @@ from pathlib import Path
 from typing import Any
 
 from companion.actuators import minissc
-from companion.actuators.airframe import Airframe, load_airframe
+from companion.actuators.airframe import SERVO_IDS, Airframe, load_airframe
 from companion.actuators.flying_trim import FlyingTrim
-from companion.messages import ActuatorCommand, ServoOutput
+from companion.messages import (
+    NAME_LEN,
+    REASON_LEN,
+    ActuatorCommand,
+    CommandAck,
+    CommandId,
+    CommandResult,
+    ServoOutput,
+    VehicleCommand,
+)
 from companion.messages.base import packed_layout
 from companion.params.atomic import atomic_write_text
 from companion.plugin import FLIGHT_NICE, NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
@@ -86,8 +101,8 @@ class MiniSscOutput(Plugin):
             min=0.05,
         ),
     }
-    optional_inputs = ("control/actuators", "control/status")
-    outputs = ("actuators/servos",)
+    optional_inputs = ("control/actuators", "control/status", "link/commands")
+    outputs = ("actuators/servos", "link/command_acks")
 
     @classmethod
     def prearm(
@@ -116,6 +131,9 @@ class MiniSscOutput(Plugin):
         self.commands = ctx.bus.queue_reader("control/actuators")
         self.waiter = ctx.bus.waiter([self.commands])
         self.out = ctx.bus.writer("actuators/servos")
+        self.requests = ctx.bus.queue_reader("link/commands")  # DO_SET_SERVO's
+        self.acks = ctx.bus.writer("link/command_acks")
+        self.spare: dict[int, int] = {}  # spare outputs set by DO_SET_SERVO: servo, position
         self.safe = {c.servo: c.safe for c in self.airframe.channels}
         self.wanted = dict(self.safe)
         self.sent: dict[int, int] = {}
@@ -148,6 +166,9 @@ class MiniSscOutput(Plugin):
 
     def step(self) -> None:
         self.waiter.sleep(WAIT_S)  # the waiter counts its own idle time; the commands are read
+        for request in self.requests.pending():
+            if request.command == CommandId.SET_SERVO:
+                self._set_servo(request)
         received = self.commands.pending()
         # The wire runs on vehicle time: in a simulation, simulated seconds.
         now = self.ctx.clock.now_us() / 1e6
@@ -236,7 +257,29 @@ class MiniSscOutput(Plugin):
             else:  # a broken command: this surface holds its last good position
                 self.ctx.health.refused += 1
                 positions[c.servo] = self.wanted.get(c.servo, self.safe[c.servo])
+        positions.update(self.spare)
         return positions
+
+    def _set_servo(self, request: VehicleCommand) -> None:
+        """DO_SET_SERVO on a spare output (the link has checked the output and the pulse
+        are in range); answered, with the reason when refused."""
+        output, pulse = round(request.param[0]), round(request.param[1])
+        servo = output - 1
+        surface = next((c.surface for c in self.airframe.channels if c.servo == servo), None)
+        ack = CommandAck(t_us=self.ctx.clock.now_us(), seq=request.seq, command=request.command)
+        ack.source = self.ctx.name.encode()[: NAME_LEN - 1]
+        if surface is not None or servo not in SERVO_IDS:
+            ack.result = int(CommandResult.DENIED)
+            why = f"drives the {surface}" if surface else "is not one of the card's 8"
+            ack.reason = f"Set servo: output {output} {why}".encode()[:REASON_LEN]
+        else:
+            position = minissc.position_for_pulse(pulse)
+            self.spare[servo] = self.wanted[servo] = position
+            if servo not in self.refresh_order:
+                self.refresh_order.append(servo)
+            self.ctx.log.info("output %d (servo %d) set to %d us", output, servo, pulse)
+            ack.result = int(CommandResult.ACCEPTED)
+        self.acks.publish(ack)
 
     def _room(self) -> int:
         """Frames that fit in one cycle, less what is still queued for the wire."""

@@ -48,6 +48,7 @@ STATUS_WAIT_S = 5.0  # the commander's last status, once, when this process star
 OUTPUT_WAIT_S = 5.0  # ... and the servo output's process, started with this one, listening
 STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item is reached)
 FENCE = d.MAV_MISSION_TYPE_FENCE
+SERVO_SEQ = (1 << 31) - 2  # a mission's DO_SET_SERVO on link/commands, apart from the link's
 RECENT = 4  # receiver and rangefinder values kept between steps (100 Hz against 50 Hz)
 # The command made in one call from its packed fields (its native layout: t_us, the four
 # surfaces, aux[4], armed, padding), not field by field through ctypes, at every step.
@@ -107,6 +108,9 @@ class FixedWingPlugin(Plugin):
             flight_config(self.live_params.values), self.missions.items[0]
         )
         self.controller.jumps = JumpCounts(state_dir)
+        # Outputs (numbered from 1, as DO_SET_SERVO numbers them) a mission may not set.
+        channels = load_airframe(ctx.vehicle["airframe"]).channels
+        self.surface_outputs = {c.servo + 1: c.surface for c in channels}
         # The geofence the landing pattern Land builds keeps inside (landing_pattern.py).
         self.controller.lander.fence = Fence.from_items(self.missions.items[FENCE])
         bus = ctx.bus
@@ -174,6 +178,7 @@ class FixedWingPlugin(Plugin):
         self.surfaces.publish(ActuatorCommand.from_buffer_copy(packed))
         if out.disarm and not self.disarm_sent:
             self._disarm(now_us, out, status)
+        self._set_servos(now_us, out.servo_sets)
         for seq in out.reached:  # each told, however many in one step
             self.recent_reached[self.reached_count % ControlStatus.REACHED_KEPT] = seq
             self.reached_count += 1
@@ -181,6 +186,20 @@ class FixedWingPlugin(Plugin):
         if out.reached or now_us >= self.next_status_us:
             self.status_out.publish(self._status(now_us, out, status))
             self.next_status_us = now_us + STATUS_PERIOD_US
+
+    def _set_servos(self, now_us: int, sets: list[tuple[int, int]]) -> None:
+        """A mission's DO_SET_SERVO items, handed to the servo output as the link hands the
+        command; one on a surface's output is not, and the operator is told."""
+        for output, pulse in sets:
+            surface = self.surface_outputs.get(output)
+            if surface is not None:
+                text = f"Mission: servo output {output} drives the {surface}: not set"
+                self.ctx.log.warning("%s", text)
+                self.texts.publish(StatusText.of(now_us, d.MAV_SEVERITY_WARNING, text))
+                continue
+            cmd = VehicleCommand(t_us=now_us, seq=SERVO_SEQ, command=int(CommandId.SET_SERVO))
+            cmd.param[0], cmd.param[1] = output, pulse
+            self.commands.publish(cmd)
 
     def _say(self, now_us: int) -> None:
         """What the landing told the operator (the pattern it chose, or why none)."""

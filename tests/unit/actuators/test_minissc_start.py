@@ -28,10 +28,11 @@ class _Commands:
 
 class _Bus:
     """The ports the plug-in opens: its commands, its wait, its answers, the controller's
-    status."""
+    status, and ``link/commands`` (DO_SET_SERVO's), where nothing comes here."""
 
     def __init__(self, status: ControlStatus | None = None) -> None:
         self.commands = _Commands()
+        self.requests = _Commands()
         self.status = status
 
     def latest_reader(self, name: str) -> SimpleNamespace:
@@ -39,7 +40,7 @@ class _Bus:
         return SimpleNamespace(get=lambda: self.status)
 
     def queue_reader(self, name: str) -> _Commands:
-        return self.commands
+        return self.requests if name == "link/commands" else self.commands
 
     def waiter(self, readers) -> SimpleNamespace:
         return SimpleNamespace(sleep=lambda timeout_s: None, close=lambda: None)

@@ -47,11 +47,11 @@ def test_every_registered_command_has_a_rule_and_every_rule_a_command():
 
 def test_a_command_without_a_rule_cannot_be_registered():
     service = linked_service()
-    with pytest.raises(KeyError, match=r"DO_SET_SERVO: no parameter rule .*command_rules\.py"):
-        service.register(d.MAV_CMD_DO_SET_SERVO, lambda args: Outcome())
-    ack = service.dispatch(CommandArgs(d.MAV_CMD_DO_SET_SERVO, (1.0,) * 7, 0, GCS), 0.0)
+    with pytest.raises(KeyError, match=r"DO_SET_RELAY: no parameter rule .*command_rules\.py"):
+        service.register(d.MAV_CMD_DO_SET_RELAY, lambda args: Outcome())
+    ack = service.dispatch(CommandArgs(d.MAV_CMD_DO_SET_RELAY, (1.0,) * 7, 0, GCS), 0.0)
     assert ack[0].msg.result == d.MAV_RESULT_UNSUPPORTED  # as before: not answered blindly
     early = CommandService(new_encoder(1, 1), 1, 1)
-    early.register(d.MAV_CMD_DO_SET_SERVO, lambda args: Outcome())
-    with pytest.raises(KeyError, match="no parameter rule for DO_SET_SERVO"):
+    early.register(d.MAV_CMD_DO_SET_RELAY, lambda args: Outcome())
+    with pytest.raises(KeyError, match="no parameter rule for DO_SET_RELAY"):
         early.guard(refusal, RULES)  # registered before the rules were put in front

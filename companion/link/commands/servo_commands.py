@@ -1,0 +1,47 @@
+"""MAV_CMD_DO_SET_SERVO: one of the servo card's spare outputs to a pulse, as ArduPilot
+sets a payload release, a camera trigger or a light (MAVProxy's ``servo set N PWM``).
+
+param1 the output, numbered from 1 as ArduPilot's SERVOn (1 is the Mini SSC's servo 0),
+param2 the pulse in µs within what the card puts out (1000-2000: its 90° range); the
+command rules refuse anything else. The servo output plug-in answers: an output that
+drives a surface of the airframe is refused with the reason, as ArduPilot refuses an output
+with a function. It runs only while the vehicle is armed (its group is ``flight``): the
+command is refused at once before then, with the reason.
+"""
+
+from __future__ import annotations
+
+from companion.link.codec import dialect as d
+from companion.link.command_service import CommandArgs, CommandService, Outcome
+from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort, refuse
+from companion.messages import CommandId, PluginState
+
+SERVO_OUTPUT = b"actuators.minissc"  # the plug-in that answers
+
+
+class ServoCommands:
+    """DO_SET_SERVO."""
+
+    def __init__(self, port: VehiclePort) -> None:
+        self.port = port
+        self.service: CommandService | None = None
+
+    def register(self, service: CommandService) -> None:
+        self.service = service
+        service.register(d.MAV_CMD_DO_SET_SERVO, self.set_servo)
+
+    def output_running(self) -> bool:
+        """Whether the health table shows the servo output plug-in running."""
+        health = self.port.snapshot.health
+        rows = health.rows() if health is not None else []
+        return any(r.kind == SERVO_OUTPUT and r.state == PluginState.RUNNING for r in rows)
+
+    def set_servo(self, args: CommandArgs) -> Outcome:
+        """A spare output of the servo card to the pulse, answered by the servo output (an
+        output a surface uses DENIED); DENIED at once while disarmed."""
+        if not self.output_running():
+            text = "Set servo: the servo output runs only while armed"
+            return refuse(self.port, self.service, text)
+        output, pulse = (round(p) for p in args.params[:2])
+        seq = self.port.publish_command(CommandId.SET_SERVO, (output, pulse))
+        return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)
