@@ -358,7 +358,7 @@ class Commander:
         return FlightState(
             self.armed, int(self.mode), self.home, self.target, self.radius,
             self.mission_first, self.changes, self.go_arounds, self.mission_jumps,
-            self.mission_jump_to,
+            self.mission_jump_to, self.speed,
         )  # fmt: skip
 
     def restore(self, saved: FlightState) -> None:
@@ -370,7 +370,7 @@ class Commander:
         self.mission_first = saved.mission_seq
         self.changes, self.go_arounds = saved.changes, saved.go_arounds
         self.mission_jumps, self.mission_jump_to = saved.mission_jumps, saved.mission_jump_to
-        self.armed = True
+        self.armed, self.speed = True, saved.speed  # a DO_CHANGE_SPEED holds in its mode
 
     def status(self, t_us: int) -> VehicleStatus:
         """What the link and the controller are told."""

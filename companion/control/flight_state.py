@@ -1,4 +1,5 @@
-"""What a restarted commander needs to carry a flight on: armed, mode, home, target, item.
+"""What a restarted commander needs to carry a flight on: armed, mode, home, target, item
+and the airspeed a DO_CHANGE_SPEED asked for.
 
 The commander writes it (atomically) each time it changes, and reads it back when its
 process starts again. It is used only when the sensors agree that the flight is still on
@@ -44,12 +45,14 @@ class FlightState:
     go_arounds: int
     mission_jumps: int = 0  # set-currents accepted (an older file has none: 0)
     mission_jump_to: int = -1  # the item of the last (-1: none)
+    speed: float = math.nan  # DO_CHANGE_SPEED's airspeed, m/s (NaN: the cruise; older files)
 
     def to_json(self) -> str:
         """One JSON object; NaN written as null."""
         data = asdict(self)
         data["target"] = [_finite_or_none(v) for v in self.target]
         data["radius"] = _finite_or_none(self.radius)
+        data["speed"] = _finite_or_none(self.speed)
         return json.dumps(data)
 
     @classmethod
@@ -70,9 +73,12 @@ class FlightState:
                 go_arounds=max(0, int(data["go_arounds"])),
                 mission_jumps=max(0, int(data.get("mission_jumps", 0))),
                 mission_jump_to=max(-1, int(data.get("mission_jump_to", -1))),
+                speed=_nan_if_none(data.get("speed")),
             )
         except (KeyError, TypeError, ValueError, OverflowError) as exc:
             raise ValueError(f"not a flight state: {exc}") from None
+        if not (math.isnan(state.speed) or state.speed > 0):
+            raise ValueError(f"not a flight state: airspeed {state.speed:g}")
         if len(state.target) != 3:
             raise ValueError("not a flight state: target is not a point")
         return state

@@ -48,6 +48,28 @@ def test_no_file_or_a_damaged_one_resumes_nothing(tmp_path):
         assert load_flight_state(tmp_path) is None, bad
 
 
+def test_an_airspeed_asked_for_is_carried_through_a_restart_and_a_bad_one_is_not(tmp_path):
+    """DO_CHANGE_SPEED holds in its mode: a commander restarted in flight flies it on
+    (before, the restarted one flew the cruise airspeed). A file from an older version has
+    none: the cruise."""
+    before = Commander(lambda: 4)
+    before.home, before.armed, before.mode = HOME, True, FlightMode.MISSION
+    before.speed = 31.5
+    save_flight_state(tmp_path, before.snapshot())
+    saved = load_flight_state(tmp_path)
+    assert saved is not None and saved.speed == 31.5
+    after = Commander(lambda: 4)
+    after.restore(saved)
+    assert after.status(5).speed_m_s == 31.5
+    text = (tmp_path / FILE_NAME).read_text()
+    for bad in ('"speed": -3.0', '"speed": 0.0', '"speed": "fast"'):
+        (tmp_path / FILE_NAME).write_text(text.replace('"speed": 31.5', bad))
+        assert load_flight_state(tmp_path) is None, bad
+    (tmp_path / FILE_NAME).write_text(text.replace(', "speed": 31.5', ""))
+    older = load_flight_state(tmp_path)
+    assert older is not None and math.isnan(older.speed)
+
+
 def _nav(vn: float, alt: float, valid: bool = True) -> SimpleNamespace:
     flags = NavFlags.POSITION_VALID if valid else 0
     return SimpleNamespace(flags=flags, vn_m_s=vn, ve_m_s=0.0, alt_msl_m=alt)
