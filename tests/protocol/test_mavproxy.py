@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -12,10 +13,12 @@ from pathlib import Path
 
 import pytest
 
+from companion.actuators.minissc import FrameDecoder
 from companion.plugins.link.mavlink_link import MavlinkLink
 from companion.plugins.vehicle.commander import CommanderPlugin
 from tests.protocol.mav_client import free_udp_port
-from tests.support.configs import client_vehicle
+from tests.support.configs import client_vehicle, plugin
+from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
 
 WAYPOINTS = """QGC WPL 110
@@ -174,3 +177,40 @@ def test_mavproxy_wp_save_writes_the_items_from_seq_0_and_they_load_back(vehicle
         return int(row[0]), int(row[3]), *(round(float(v), 6) for v in row[8:11])
 
     assert [key(r) for r in rows] == [key(s) for s in sent]
+
+
+@pytest.mark.timeout(120)
+def test_mavproxy_servo_set_moves_a_spare_output_once_armed(vehicle_factory, tmp_path):
+    """``servo set 7 1900``, as an ArduPilot user releases a payload: refused with the
+    reason while disarmed (the servo output runs only armed), then on the card's wire."""
+    port, pty = free_udp_port(), Pty(tmp_path / "ttyServo")
+    servos = plugin("servos", "actuators.minissc", group="flight", device=pty.link)
+    vehicle = vehicle_factory(
+        client_vehicle(f"udpin://127.0.0.1:{port}", tmp_path / "state", flight=servos)
+    )
+    vehicle.wait_running("link")
+    os.set_blocking(pty.master, False)
+    decoder, card = FrameDecoder(), {}
+
+    def on_the_wire() -> bool:
+        try:
+            card.update(decoder.feed(os.read(pty.master, 4096)))
+        except BlockingIOError:
+            pass
+        return card.get(6) == 229  # the card's servo 6 at (1900 - 1000) * 254 / 1000
+
+    mavproxy = MavProxy(port, tmp_path)
+    try:
+        mavproxy.connected(vehicle)
+        mavproxy.type("servo set 7 1900")
+        refused = "Set servo: the servo output runs only while armed"
+        wait_for(lambda: any(refused in x for x in mavproxy.lines), 30, "the refusal said")
+        mavproxy.type("arm throttle")
+        vehicle.wait_running("servos")
+        mavproxy.type("servo set 7 1900")
+        wait_for(on_the_wire, 30, "output 7 at 1900 us on the card's wire")
+        acked = "DO_SET_SERVO: ACCEPTED"
+        wait_for(lambda: any(acked in x for x in mavproxy.lines), 30, "the command acknowledged")
+    finally:
+        output = mavproxy.close()
+    assert "DO_SET_SERVO: DENIED" in output, output
