@@ -20,12 +20,14 @@ pytestmark = pytest.mark.vehicle(airframe="c172p", duration=1500)
 
 
 def _with_release(tmp_path: Path) -> Path:
-    """short_leg.plan with a DO_SET_SERVO (output 8 to 1200 µs) after its first waypoint."""
+    """short_leg.plan with two DO_SET_SERVO items after its first waypoint: output 8 to
+    1200 µs, and output 1 (the aileron's) to 2000 µs, which is not set."""
     plan = json.loads(PLAN.read_text())
     items = plan["mission"]["items"]
-    release = {"type": "SimpleItem", "command": d.MAV_CMD_DO_SET_SERVO, "frame": 2,
-               "autoContinue": True, "params": [8, 1200, 0, 0, 0, 0, 0]}  # fmt: skip
-    items.insert(2, release)
+    for output, pulse in ((1, 2000), (8, 1200)):
+        release = {"type": "SimpleItem", "command": d.MAV_CMD_DO_SET_SERVO, "frame": 2,
+                   "autoContinue": True, "params": [output, pulse, 0, 0, 0, 0, 0]}  # fmt: skip
+        items.insert(2, release)
     for n, item in enumerate(items, start=1):
         item["doJumpId"] = n
     path = tmp_path / "release.plan"
@@ -73,6 +75,8 @@ def test_a_spare_output_is_set_by_command_and_by_mission_and_a_surface_is_refuse
     assert _answer(sim, 2, 1500, said) == d.MAV_RESULT_DENIED
     said = "param1 (instance) 9 outside"  # the card has eight
     assert _answer(sim, 9, 1500, said) == d.MAV_RESULT_DENIED
-    sim.run_until_item(3)  # past the release item, on to the last waypoint
+    sim.run_until_item(4)  # past the release items, on to the last waypoint
     _pulse_shown(sim, 8, 1200)
+    told = "Mission: output 1 drives the aileron: not set"
+    assert any(told in t for t in sim.watcher.texts), sim.watcher.texts[-8:]
     _pulse_shown(sim, 7, 1900)  # the command's output still held

@@ -193,7 +193,7 @@ class FixedWingPlugin(Plugin):
         for output, pulse in sets:
             surface = self.surface_outputs.get(output)
             if surface is not None:
-                text = f"Mission: servo output {output} drives the {surface}: not set"
+                text = f"Mission: output {output} drives the {surface}: not set"
                 self.ctx.log.warning("%s", text)
                 self.texts.publish(StatusText.of(now_us, d.MAV_SEVERITY_WARNING, text))
                 continue
