@@ -25,6 +25,11 @@ EVENT_WAIT_S = 0.05  # exact: longest sleep on a bus event before looking again
 # starve a healthy driver for seconds, most of all one of ten plug-ins sharing a process)
 SAMPLE_GRACE_S = EXACT_STALL_S
 FIRST_SAMPLE_GRACE_S = 0.3  # ... and this long on a further channel that has carried nothing
+# Exact: a sample published without waking its readers (the IMU's between two navigation
+# states, ``sensors.serial_imu``'s ``wake_hz``) wakes nobody, the simulator included, which
+# then looks for it this often instead of at the end of EVENT_WAIT_S: waited for that long,
+# every such sample held an exact lockstep flight to real time.
+SAMPLE_LOOK_S = 0.0005
 SPIN_POLLS = 50  # polls that only yield the CPU before sleeping between polls
 POLL_SLEEP_S = 50e-6
 START_FLIGHT_S = 20.0  # the flight plug-ins' start-up after START, at most
@@ -107,6 +112,7 @@ class _BusWait:
 
     def __init__(self, waiter: Waiter) -> None:
         self.waiter = waiter
+        self.look_s = EVENT_WAIT_S  # the longest sleep before looking again
         self.wait_s = 0.0
         self.cancelled = False  # the simulation is ending: wait for nothing more
         # Called every ``EVENT_WAIT_S`` while the simulation is held: the bridge hands its
@@ -124,7 +130,7 @@ class _BusWait:
                 waited = time.perf_counter() - started
                 if waited > limit_s:
                     return False
-                self.waiter.wait(min(limit_s - waited, EVENT_WAIT_S))
+                self.waiter.wait(min(limit_s - waited, self.look_s))
                 if self.on_hold is not None and waited >= EVENT_WAIT_S:
                     self.on_hold()
             return True
@@ -243,6 +249,7 @@ class SampleSync(_BusWait):
         first_grace_s: float = FIRST_SAMPLE_GRACE_S,
     ) -> None:
         super().__init__(waiter)
+        self.look_s = SAMPLE_LOOK_S
         self.channels = channels  # device → {channel: reader}, its first channel first
         self.newest_us = {c: -1 for readers in channels.values() for c in readers}
         self.grace_s, self.first_grace_s = grace_s, first_grace_s
