@@ -69,9 +69,7 @@ class ReceiverProcess:
 
 def receiver_process(health: SystemHealth | None) -> ReceiverProcess | None:
     """The RC receiver plug-in's process in the health table (None: none listed)."""
-    if health is None:
-        return None
-    row = next((r for r in health.rows() if r.kind == RC_PLUGIN), None)
+    row = health.row_of_kind(RC_PLUGIN) if health is not None else None
     if row is None:
         return None
     return ReceiverProcess(row.state == PluginState.RUNNING, int(row.restarts))

@@ -89,6 +89,10 @@ class SystemHealth(Message):
         """The filled rows of the table."""
         return [self.plugins[i] for i in range(self.count)]
 
+    def row_of_kind(self, kind: bytes) -> PluginHealth | None:
+        """The first row of a plug-in of this kind (``b"actuators.minissc"``); None: none."""
+        return next((r for r in self.rows() if r.kind == kind), None)
+
 
 class ParamChange(Message):
     """A parameter a ground station set. Producer: link. Consumers: the parameter's owner."""

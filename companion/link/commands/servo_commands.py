@@ -33,8 +33,8 @@ class ServoCommands:
     def output_running(self) -> bool:
         """Whether the health table shows the servo output plug-in running."""
         health = self.port.snapshot.health
-        rows = health.rows() if health is not None else []
-        return any(r.kind == SERVO_OUTPUT and r.state == PluginState.RUNNING for r in rows)
+        row = health.row_of_kind(SERVO_OUTPUT) if health is not None else None
+        return row is not None and row.state == PluginState.RUNNING
 
     def set_servo(self, args: CommandArgs) -> Outcome:
         """A spare output of the servo card to the pulse, answered by the servo output (an

@@ -351,8 +351,7 @@ class MavlinkLink(Plugin):
         if self.readers["status"].get() is not None:
             return True
         health = self.readers["health"].get()
-        rows = health.rows() if health is not None else []
-        return any(row.kind.decode() == COMMANDER for row in rows)
+        return health is not None and health.row_of_kind(COMMANDER.encode()) is not None
 
     def param(self, name: str) -> float:
         """One of the link's own parameters (VehiclePort)."""
