@@ -18,6 +18,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+from companion.control.mission.executor import RELATIVE_FRAMES
 from companion.control.mission.fence import CIRCLES, POLYGONS
 from companion.control.mission.items import GLOBAL_FRAMES, MissionItem, check_mission
 from companion.params.atomic import atomic_write_text
@@ -53,7 +54,6 @@ def _simple(raw: dict[str, Any], seq: int) -> MissionItem:
 
 LANDING_PATTERN = "fwLandingPattern"
 RALLY_FRAMES = "companionFrames"  # rally points' frames, when one is not above home
-RELATIVE_FRAMES = (d.MAV_FRAME_GLOBAL_RELATIVE_ALT, d.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT)
 
 
 def _landing(raw: dict[str, Any]) -> list[dict[str, Any]]:
