@@ -32,7 +32,7 @@ def test_a_roll_slower_than_tkoff_timeout_allows_is_aborted_and_disarmed(station
     station.conn.mav.param_set_send(1, 1, b"TKOFF_TIMEOUT", 1.0, d.MAV_PARAM_TYPE_REAL32)
     value = station.conn.recv_match(type="PARAM_VALUE", blocking=True, timeout=20)
     assert value is not None and value.param_id == "TKOFF_TIMEOUT" and value.param_value == 1.0
-    station.fly_mission()
+    station.fly_mission(stays=False)  # aborted a simulated second later
     station.until(lambda: station.said("Takeoff aborted"), 60, "told the take-off was aborted")
     disarmed = station.conn.recv_match(
         type="HEARTBEAT",
