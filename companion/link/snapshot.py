@@ -28,6 +28,7 @@ from companion.messages import (
     SystemHealth,
     VehicleStatus,
 )
+from companion.messages.channels import CHANNELS
 
 
 def _newest(channel: str) -> Any:
@@ -77,3 +78,14 @@ class Snapshot:
 SNAPSHOT_CHANNELS: dict[str, str] = {
     f.name: f.metadata["channel"] for f in fields(Snapshot) if "channel" in f.metadata
 }
+
+
+def snapshot_readers(bus: Any) -> dict[str, Any]:
+    """A reader per snapshot field. Telemetry shows a queue's newest sample: a buffer of
+    one, not ~1300 copies a second."""
+    return {
+        key: bus.newest_reader(name)
+        if CHANNELS[name].pattern == "queue"
+        else bus.latest_reader(name)
+        for key, name in SNAPSHOT_CHANNELS.items()
+    }

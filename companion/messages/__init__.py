@@ -9,7 +9,7 @@ The types are split by pipeline stage (sensors, navigation, control, actuators, 
 system, simulation); ``channels.py`` holds the one CHANNELS table. Import from here.
 """
 
-from companion.messages.actuators import ActuatorCommand, ServoOutput
+from companion.messages.actuators import ActuatorCommand, CameraCapture, ServoOutput
 from companion.messages.base import MAX_PLUGINS, NAME_LEN, NAN, Message
 from companion.messages.channels import CHANNELS, Channel, channel
 from companion.messages.control import (
@@ -60,6 +60,7 @@ __all__ = [
     "Baro",
     "Battery",
     "BatteryLevel",
+    "CameraCapture",
     "Channel",
     "CommandAck",
     "CommandId",

@@ -40,3 +40,26 @@ class ServoOutput(Message):
         # them to the simulator a moment after the write returns, which waits for them all.
         ("bytes_out", ctypes.c_uint64),
     ]
+
+
+class CameraCapture(Message):
+    """A photo the camera's shutter was worked for, where and how the aircraft was then.
+
+    The fields are PX4's ``camera_capture`` (names, units, types), not the registry's
+    unit-suffixed names: the flight log records this channel as that topic, and
+    QGroundControl's GeoTag Images reads exactly those fields from a ULog (its 4.4 parser
+    finds each by name in the format, adding up the sizes of the fields before it).
+    Producers: control. Consumers: link (CAMERA_TRIGGER), the flight log.
+    """
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),  # the navigation state's time the photo was taken at
+        ("timestamp_utc", ctypes.c_uint64),  # the same instant in UTC, µs (0: no GPS time)
+        ("lat", ctypes.c_double),  # degrees
+        ("lon", ctypes.c_double),  # degrees
+        ("alt", ctypes.c_float),  # m above mean sea level
+        ("ground_distance", ctypes.c_float),  # m above home
+        ("q", ctypes.c_float * 4),  # body → NED attitude, (w, x, y, z)
+        ("seq", ctypes.c_uint32),  # the photo's number, from 1 each flight
+        ("result", ctypes.c_int8),  # 1: the shutter was worked
+    ]

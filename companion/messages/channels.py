@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from companion.messages.actuators import ActuatorCommand, ServoOutput
+from companion.messages.actuators import ActuatorCommand, CameraCapture, ServoOutput
 from companion.messages.base import Message
 from companion.messages.control import CommandAck, ControlStatus, VehicleCommand, VehicleStatus
 from companion.messages.link import LinkStatus, MissionChanged, StatusText
@@ -94,6 +94,8 @@ CHANNELS: dict[str, Channel] = _channels(
     Channel("control/actuators", ActuatorCommand, "queue", 32, "normalised surfaces"),
     Channel("control/status", ControlStatus, "latest", KEEP, doc="guidance and mission progress"),
     Channel("actuators/servos", ServoOutput, "latest", KEEP, doc="servo outputs written"),
+    # Recorded as the flight log's topic camera_capture, which geotagging tools read.
+    Channel("camera/capture", CameraCapture, "queue", 16, "photos taken, with their position"),
     Channel("link/commands", VehicleCommand, "queue", 16, "commands for the vehicle", True),
     Channel("link/command_acks", CommandAck, "queue", 16, "command outcomes"),
     Channel(

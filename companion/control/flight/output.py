@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from companion.control.mission.items import MissionItem
+
 
 @dataclass
 class ControlOutput:
@@ -25,6 +27,7 @@ class ControlOutput:
     mission_finished: bool = False
     reached: list[int] = field(default_factory=list)
     servo_sets: list[tuple[int, int]] = field(default_factory=list)  # a mission's DO_SET_SERVO
+    camera_items: list[MissionItem] = field(default_factory=list)  # its camera items
     landed: bool = True
     disarm: bool = False  # landed and stopped: the flight is over
     land_phase: int = 0  # LandPhase while landing, else 0

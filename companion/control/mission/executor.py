@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from companion.control.laws.fillet import MIN_TURN_RAD, corner_arc
 from companion.control.mission.approach import circle_down, circle_note, final_height
 from companion.control.mission.items import (
+    CAMERA_ITEMS,
     MAX_JUMPS_PER_STEP,
     SKIPPED,
     MissionItem,
@@ -65,6 +66,7 @@ class MissionExecutor:
     finished: bool = False
     reached: list[int] = field(default_factory=list)  # items reached since the last drain
     servo_sets: list[tuple[int, int]] = field(default_factory=list)  # (output, µs) passed
+    camera_items: list[MissionItem] = field(default_factory=list)  # camera items passed
     # (MAV_SEVERITY, text) for the operator; a controller's executors share its landing's.
     said: list[tuple[int, str]] = field(default_factory=list)
 
@@ -99,6 +101,12 @@ class MissionExecutor:
     def drain_reached(self) -> list[int]:
         """Items reached since the last call (for MISSION_ITEM_REACHED)."""
         out, self.reached = self.reached, []
+        return out
+
+    def take_actions(self) -> tuple[list[tuple[int, int]], list[MissionItem]]:
+        """The servo sets and camera items passed since the last call."""
+        out = self.servo_sets, self.camera_items
+        self.servo_sets, self.camera_items = [], []
         return out
 
     def alt_of(self, item: MissionItem) -> float:
@@ -161,9 +169,11 @@ class MissionExecutor:
         if cmd == d.MAV_CMD_DO_JUMP:
             self._jump(item)
             return None
-        if cmd in SKIPPED or cmd == d.MAV_CMD_DO_SET_SERVO:
+        if cmd in SKIPPED or cmd == d.MAV_CMD_DO_SET_SERVO or cmd in CAMERA_ITEMS:
             if cmd == d.MAV_CMD_DO_SET_SERVO:  # the controller hands it to the servo output
                 self.servo_sets.append((round(item.param1), round(item.param2)))
+            elif cmd in CAMERA_ITEMS:  # and these to the camera (mission/camera.py)
+                self.camera_items.append(item)
             self._advance(False, self._prev, self._prev_alt)
             return None
         if cmd == d.MAV_CMD_NAV_LAND:

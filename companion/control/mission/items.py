@@ -29,14 +29,23 @@ NAV_COMMANDS = frozenset(
         d.MAV_CMD_NAV_LAND,
     }
 )
-CAMERA_STOPS = frozenset(
-    {d.MAV_CMD_IMAGE_STOP_CAPTURE, d.MAV_CMD_DO_SET_CAM_TRIGG_DIST, d.MAV_CMD_VIDEO_STOP_CAPTURE}
+# What a survey, a waypoint's camera section and a landing pattern's camera stop say to a
+# camera on a servo output (companion.control.mission.camera).
+CAMERA_ITEMS = frozenset(
+    {
+        d.MAV_CMD_DO_SET_CAM_TRIGG_DIST,
+        d.MAV_CMD_IMAGE_START_CAPTURE,
+        d.MAV_CMD_IMAGE_STOP_CAPTURE,
+        d.MAV_CMD_DO_DIGICAM_CONTROL,
+    }
 )
+CAMERA_STOPS = frozenset({d.MAV_CMD_VIDEO_STOP_CAPTURE})  # no video camera to stop
 # Markers and camera stops: nothing to fly (DO_LAND_START only marks where a landing begins).
 SKIPPED = CAMERA_STOPS | {d.MAV_CMD_DO_LAND_START}
 MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
-# DO items that act at once and fly nowhere: a speed, a servo output (a payload release).
-ACTIONS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_SET_SERVO})
+# DO items that act at once and fly nowhere: a speed, a servo output (a payload release),
+# a camera's photos.
+ACTIONS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_SET_SERVO}) | CAMERA_ITEMS
 DO_COMMANDS = ACTIONS | frozenset({d.MAV_CMD_DO_JUMP, d.MAV_CMD_DO_LAND_START}) | CAMERA_STOPS
 SERVO_OUTPUTS = range(1, 9)  # DO_SET_SERVO's param1: the Mini SSC's eight, from 1
 SERVO_PULSES_US = (1000.0, 2000.0)  # and param2: what the card puts out (its 90° range)
@@ -72,6 +81,7 @@ POSITIONLESS = (
         }
     )
     | CAMERA_STOPS
+    | CAMERA_ITEMS
 )
 
 
@@ -80,6 +90,8 @@ POSITIONLESS = (
 NEEDS_NUMBER = {
     d.MAV_CMD_DO_JUMP: (1, 2),
     d.MAV_CMD_DO_SET_SERVO: (1, 2),
+    d.MAV_CMD_DO_SET_CAM_TRIGG_DIST: (1,),
+    d.MAV_CMD_IMAGE_START_CAPTURE: (2, 3),
     d.MAV_CMD_NAV_LOITER_TURNS: (1,),
     d.MAV_CMD_NAV_LOITER_TIME: (1,),
     d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION: (1,),
@@ -163,6 +175,8 @@ def check_item(item: MissionItem, count: int) -> int:
         return params
     if item.command == d.MAV_CMD_DO_SET_SERVO:
         return _servo_refusal(item)
+    if item.command in CAMERA_ITEMS:
+        return _camera_refusal(item)
     if item.command == d.MAV_CMD_DO_JUMP:
         target = round(item.param1)
         if not 0 <= target < count or target == item.seq:
@@ -190,6 +204,18 @@ def _servo_refusal(item: MissionItem) -> int:
     low, high = SERVO_PULSES_US
     if item.param2 != round(item.param2) or not low <= item.param2 <= high:
         return d.MAV_MISSION_INVALID_PARAM2
+    return d.MAV_MISSION_ACCEPTED
+
+
+def _camera_refusal(item: MissionItem) -> int:
+    """A distance, an interval or a count of photos is not negative."""
+    if item.command == d.MAV_CMD_DO_SET_CAM_TRIGG_DIST and item.param1 < 0:
+        return d.MAV_MISSION_INVALID_PARAM1
+    if item.command == d.MAV_CMD_IMAGE_START_CAPTURE:
+        if item.param2 < 0:
+            return d.MAV_MISSION_INVALID_PARAM2
+        if item.param3 < 0 or item.param3 != round(item.param3):
+            return d.MAV_MISSION_INVALID_PARAM3
     return d.MAV_MISSION_ACCEPTED
 
 

@@ -24,6 +24,8 @@ from companion.actuators.airframe import AirframeError, load_airframe
 from companion.control.flight.attitude_modes import pilot_sticks
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.flight_params import control_params, flight_config
+from companion.control.mission.camera import CAMERA_PARAMS
+from companion.control.mission.camera_shots import CameraPorts, CameraShots
 from companion.control.mission.fence import Fence
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
@@ -75,8 +77,15 @@ class FixedWingPlugin(Plugin):
         "link/manual_control",
         "actuators/servos",
         "sensors/range",
+        "sensors/gps",
     )
-    outputs = ("control/actuators", "control/status", "link/commands", "vehicle/statustext")
+    outputs = (
+        "control/actuators",
+        "control/status",
+        "link/commands",
+        "vehicle/statustext",
+        "camera/capture",
+    )
 
     @classmethod
     def validate(
@@ -94,7 +103,8 @@ class FixedWingPlugin(Plugin):
         cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
     ) -> tuple[ParamDecl, ...]:
         airframe = load_airframe(vehicle["airframe"])
-        return control_params(airframe.control, f"airframe {Path(airframe.source).name}")
+        control = control_params(airframe.control, f"airframe {Path(airframe.source).name}")
+        return control + CAMERA_PARAMS
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
@@ -136,10 +146,16 @@ class FixedWingPlugin(Plugin):
         self.recent_reached = [-1] * ControlStatus.REACHED_KEPT
         self.next_status_us = 0
         self.default_status = VehicleStatus(mode=int(FlightMode.LOITER), armed=1)
+        gps = bus.newest_reader("sensors/gps")  # its UTC stamps the photos
+        photos = CameraPorts(bus.writer("camera/capture").publish, self.commands.publish,
+                             self._tell, gps.get, self._home_alt)  # fmt: skip
+        self.camera = CameraShots(photos, self.surface_outputs)
+        self.camera.configure(self.live_params.values)
 
     def _follow_changes(self, now_us: int) -> None:
         if self.live_params.poll():
             self.controller.set_config(flight_config(self.live_params.values))
+            self.camera.configure(self.live_params.values)
         # Only a different mission restarts it: the same list stored again changes nothing.
         changed = self.follower.follow(self.mission_changes.get())
         if d.MAV_MISSION_TYPE_MISSION in changed:
@@ -179,6 +195,9 @@ class FixedWingPlugin(Plugin):
         if out.disarm and not self.disarm_sent:
             self._disarm(now_us, out, status)
         self._set_servos(now_us, out.servo_sets)
+        frame = self.controller.frame
+        if frame is not None:
+            self.camera.step(nav, out.camera_items, frame.ne(nav.lat_deg, nav.lon_deg))
         for seq in out.reached:  # each told, however many in one step
             self.recent_reached[self.reached_count % ControlStatus.REACHED_KEPT] = seq
             self.reached_count += 1
@@ -200,6 +219,13 @@ class FixedWingPlugin(Plugin):
             cmd = VehicleCommand(t_us=now_us, seq=SERVO_SEQ, command=int(CommandId.SET_SERVO))
             cmd.param[0], cmd.param[1] = output, pulse
             self.commands.publish(cmd)
+
+    def _tell(self, t_us: int, severity: int, text: str) -> None:
+        self.ctx.log.warning("%s", text)
+        self.texts.publish(StatusText.of(t_us, severity, text))
+
+    def _home_alt(self) -> float:
+        return self.controller.home_alt
 
     def _say(self, now_us: int) -> None:
         """What the landing told the operator (the pattern it chose, or why none)."""

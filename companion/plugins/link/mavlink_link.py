@@ -19,6 +19,7 @@ from companion.control.mission.mission_files import MissionStore
 from companion.control.modes import INITIAL_MODE
 from companion.control.prearm import PREARM_PARAMS, Readiness, failures
 from companion.flight_log import LogDirectory
+from companion.link.camera_feedback import CAPTURES, CameraFeedback
 from companion.link.codec import MavlinkStream, new_encoder
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandService
@@ -40,16 +41,16 @@ from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
 from companion.link.shell_service import ShellService
 from companion.link.signing import configured_secret, key_file_problem, key_from
-from companion.link.snapshot import SNAPSHOT_CHANNELS, Snapshot
+from companion.link.snapshot import SNAPSHOT_CHANNELS, Snapshot, snapshot_readers
 from companion.link.statustext import StatusTexts
 from companion.link.timesync import TimesyncService
 from companion.messages import ControlStatus, FlightMode, LinkStatus, ParamChange, VehicleCommand
-from companion.messages.channels import CHANNELS
 from companion.params import ParamDecl, ParamStore
 from companion.plugin import NO_VEHICLE, DeviceProbe, Plugin, PluginContext, Setting
 
 MAX_WAIT_S = 1.0  # longest sleep: a stream or a timer falling due, or a trigger, ends it
 PREARM_PERIOD_S = 1.0  # SYS_STATUS's ready-to-arm bit is judged once a second
+RELAYED = ("link/command_acks", "vehicle/statustext", CAPTURES)
 COMMANDER = "vehicle.commander"
 STREAM_PARAMS = {
     "SR_ATTITUDE": (d.MAVLINK_MSG_ID_ATTITUDE,),
@@ -95,8 +96,8 @@ class MavlinkLink(Plugin):
         *PREARM_PARAMS,
         *PX4_PARAMS,
     )
-    # What telemetry shows (the snapshot's channels), and the acks and texts it relays.
-    optional_inputs = (*SNAPSHOT_CHANNELS.values(), "link/command_acks", "vehicle/statustext")
+    # What telemetry shows (the snapshot's channels), and the acks, texts and photos it relays.
+    optional_inputs = (*SNAPSHOT_CHANNELS.values(), *RELAYED)
     outputs = (
         "link/commands",
         "params/changes",
@@ -145,14 +146,14 @@ class MavlinkLink(Plugin):
         self.devices = DeviceWatch(ctx.plugins)  # silent or garbled devices refuse arming
         self.boot_us = ctx.clock.now_us()
         bus = ctx.bus
-        self.readers = self._readers(bus)
+        self.readers = snapshot_readers(bus)
         self.acks = bus.queue_reader("link/command_acks")
         self.to_vehicle = bus.writer("link/commands")
         self.param_changes = bus.writer("params/changes")
         self.link_status = bus.writer("link/status")
         self.texts = bus.queue_reader("vehicle/statustext")
-        self.next_prearm_s = 0.0
-        self.reached_count = -1  # items the controller said it reached (-1: not heard yet)
+        # SYS_STATUS's checks' next time; items the controller reached (-1: not heard yet).
+        self.next_prearm_s, self.reached_count = 0.0, -1
         self.timesync = TimesyncService(
             self.mav, lambda: ctx.clock.now_us() * 1000, sysid, ctx.settings["compid"]
         )
@@ -164,6 +165,7 @@ class MavlinkLink(Plugin):
         self.router = LinkRouter(self.mav, self.endpoints, services, key)
         self.gcs = GcsWatch()
         self.router.add_service(self.gcs)
+        self.router.add_service(CameraFeedback(self.mav, bus.queue_reader(CAPTURES).drain))
         self._serve_joystick(ctx, sysid)
         self._serve_params(ctx, sysid)
         self._serve_missions(ctx, sysid)
@@ -186,17 +188,6 @@ class MavlinkLink(Plugin):
             sysid, joystick.publish, ctx.clock.now_us, self.refusal_text
         )
         self.router.add_service(self.manual)
-
-    @staticmethod
-    def _readers(bus: Any) -> dict[str, Any]:
-        """A reader per snapshot field. Telemetry shows a queue's newest sample: a buffer of
-        one, not ~1300 copies a second."""
-        return {
-            key: bus.newest_reader(name)
-            if CHANNELS[name].pattern == "queue"
-            else bus.latest_reader(name)
-            for key, name in SNAPSHOT_CHANNELS.items()
-        }
 
     def _serve_missions(self, ctx: PluginContext, sysid: int) -> None:
         store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")

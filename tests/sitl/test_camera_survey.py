@@ -1,0 +1,124 @@
+"""A survey's photos, flown in lockstep JSBSim with the c172p: the camera's shutter on the
+Mini SSC's spare output 7 (CAM1_TYPE Servo), a photo every 50 m along a leg as
+QGroundControl's survey asks for it (DO_SET_CAM_TRIGG_DIST 50 with "trigger now" at the
+leg's start, 0 at its end). Each photo reaches the ground station as CAMERA_TRIGGER and
+the flight log as PX4's camera_capture, which QGroundControl's GeoTag Images reads."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+import struct
+from pathlib import Path
+
+import pytest
+from pyulog import ULog
+
+from companion.actuators.minissc import position_for_pulse
+from companion.geodesy import LocalFrame
+from mavlink_dialect import companion as d
+from tests.support.vehicle import REPO
+
+PLAN = REPO / "qgc_plans" / "short_leg.plan"
+SPACING_M = 50.0
+LEG_M = 1598.0  # short_leg.plan's second leg, east waypoint to north waypoint, straight
+pytestmark = pytest.mark.vehicle(airframe="c172p", duration=1500)
+
+
+def _survey(tmp_path: Path) -> Path:
+    """short_leg.plan with photos every SPACING_M on its second leg, as a survey's
+    transect: the distance set (and a photo at once) as the leg starts, 0 as it ends."""
+    plan = json.loads(PLAN.read_text())
+    items = plan["mission"]["items"]
+
+    def camera(metres: float, now: int) -> dict:
+        return {"type": "SimpleItem", "command": d.MAV_CMD_DO_SET_CAM_TRIGG_DIST, "frame": 2,
+                "autoContinue": True, "params": [metres, 0, now, 0, 0, 0, 0]}  # fmt: skip
+
+    items.insert(2, camera(SPACING_M, 1))
+    items.insert(4, camera(0.0, 0))
+    for n, item in enumerate(items, start=1):
+        item["doJumpId"] = n
+    path = tmp_path / "survey.plan"
+    path.write_text(json.dumps(plan))
+    return path
+
+
+def _set(sim, name: str, value: float) -> None:
+    w = sim.watcher
+    w.mav.param_set_send(1, 1, name.encode(), value, d.MAV_PARAM_TYPE_REAL32)
+    w.until(lambda m: m.get_type() == "PARAM_VALUE" and m.param_id == name
+            and m.param_value == value, 30, f"{name} = {value}")  # fmt: skip
+
+
+def _photos_until(sim, done) -> list:
+    """Every CAMERA_TRIGGER until ``done(msg)``."""
+    photos = []
+
+    def note(m):
+        if m.get_type() == "CAMERA_TRIGGER":
+            photos.append(m)
+        return done(m)
+
+    sim.watcher.until(note, 600, "the flight's end of the survey")
+    return photos
+
+
+def _subscribed_before_any_data(path: Path, topic: bytes) -> bool:
+    """QGroundControl 4.4's GeoTag parser gives up at the first DATA message if it has not
+    yet seen the topic's ADD_LOGGED_MSG."""
+    raw, at = path.read_bytes(), 16
+    while at + 3 <= len(raw):
+        size, kind = struct.unpack_from("<HB", raw, at)
+        if kind == ord("A") and raw[at + 6 : at + 3 + size] == topic:
+            return True
+        if kind == ord("D"):
+            return False
+        at += 3 + size
+    return False
+
+
+@pytest.mark.timeout(900)
+def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geotagging(
+    sim, tmp_path
+):
+    sim.wait_ready()
+    _set(sim, "CAM1_TYPE", 1.0)
+    _set(sim, "CAM1_OUTPUT", 7.0)
+    sim.upload_plan(_survey(tmp_path))
+    sim.arm_and_start()
+    leg_end = 3  # the waypoint ending the survey's leg; the stop item follows it
+    photos = _photos_until(sim, lambda m: m.get_type() == "MISSION_ITEM_REACHED"
+                           and m.seq >= leg_end)  # fmt: skip
+    seqs = [p.seq for p in photos]
+    assert seqs == list(range(1, len(seqs) + 1)), seqs
+    # A photo for every 50 m of the leg at least: the turn onto it is flown too (the gaps
+    # below are the photos' own spacing along the track).
+    assert len(seqs) >= LEG_M // SPACING_M, len(seqs)
+    w = sim.watcher
+    end_s = w.time_boot_s + 60.0  # a minute on, circling the last waypoint
+    later = _photos_until(sim, lambda _m: w.time_boot_s >= end_s)
+    assert later == []  # the stop item passed: no more photos
+    log = sim.disarm(force=True)[-1]
+    assert _subscribed_before_any_data(log, b"camera_capture")
+    ulog = ULog(str(log))
+    capture = ulog.get_dataset("camera_capture").data
+    assert list(capture["seq"]) == seqs and set(capture["result"]) == {1}
+    frame = LocalFrame(capture["lat"][0], capture["lon"][0])
+    where = [frame.ne(lat, lon) for lat, lon in zip(capture["lat"], capture["lon"], strict=True)]
+    gaps = [math.dist(a, b) for a, b in itertools.pairwise(where)]
+    assert all(SPACING_M - 1.0 <= g <= SPACING_M + 3.0 for g in gaps), gaps
+    heights = capture["ground_distance"]
+    assert all(70.0 <= h <= 90.0 for h in heights), heights  # the plan's 80 m
+    utc, t = capture["timestamp_utc"].astype(int), capture["timestamp"].astype(int)
+    assert all(utc > 0)  # the GPS's time: the photos' files can be matched by their clocks
+    # Each photo's UTC is the newest fix's moved on by the vehicle's clock: right to the
+    # jitter with which fixes arrive (a few tens of milliseconds), plenty for matching
+    # pictures whose own clocks count whole seconds.
+    assert all(abs((u - utc[0]) - (v - t[0])) < 250_000 for u, v in zip(utc, t, strict=True))
+    # Each photo a pulse on output 7 (the card's servo 6): pressed, then released.
+    servos = ulog.get_dataset("actuators_servos").data["position[6]"]
+    pressed, released = position_for_pulse(1300), position_for_pulse(1100)
+    moves = [b for a, b in itertools.pairwise(servos) if a != b]
+    assert moves.count(pressed) == len(seqs) and moves.count(released) == len(seqs)
