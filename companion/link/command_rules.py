@@ -133,6 +133,18 @@ RULES: dict[int, tuple[Param, ...]] = {
         Param(1, "instance", 1, 8, whole=True),
         Param(2, "PWM", 1000, 2000, whole=True),
     ),
+    # A camera on a servo output (companion.control.mission.camera): a distance between
+    # photos (0 stops), an interval and a count, one photo (DIGICAM_CONTROL's param5 1).
+    d.MAV_CMD_DO_SET_CAM_TRIGG_DIST: (
+        Param(1, "distance", 0, 1e4),
+        Param(3, "trigger now", 0, 1, optional=True, whole=True),
+    ),
+    d.MAV_CMD_IMAGE_START_CAPTURE: (
+        Param(2, "interval", 0, 3600, optional=True),
+        Param(3, "total images", 0, 1e6, optional=True, whole=True),
+    ),
+    d.MAV_CMD_IMAGE_STOP_CAPTURE: (),
+    d.MAV_CMD_DO_DIGICAM_CONTROL: (Param(5, "shoot", 0, 1, optional=True, whole=True),),
     d.MAV_CMD_DO_GO_AROUND: (Param(1, "altitude", -MAX_ALT_M, MAX_ALT_M, optional=True),),
     d.MAV_CMD_DO_REPOSITION: (
         Param(1, "ground speed", -1, 1000, optional=True),

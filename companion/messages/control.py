@@ -55,6 +55,9 @@ class CommandId(enum.IntEnum):
     CHANGE_SPEED = 14  # param1 = airspeed_m_s to fly (NaN: back to the cruise airspeed)
     SET_MISSION_CURRENT = 15  # param1 = the mission item to fly to (or start at) now
     SET_SERVO = 16  # param1 = output (1: the card's servo 0), param2 = pulse in µs
+    # param1 = the MAVLink camera command (DO_DIGICAM_CONTROL, DO_SET_CAM_TRIGG_DIST,
+    # IMAGE_START_CAPTURE, IMAGE_STOP_CAPTURE), param2..5 = its param1, 2, 3 and 5
+    CAMERA = 17
 
 
 class CommandResult(enum.IntEnum):

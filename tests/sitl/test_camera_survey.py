@@ -65,6 +65,22 @@ def _photos_until(sim, done) -> list:
     return photos
 
 
+def _photo_button(sim, said: str = "") -> int:
+    """QGroundControl's simple camera control: DO_DIGICAM_CONTROL with param5 1; its
+    COMMAND_ACK's result (with ``said``, the reason it comes with too)."""
+    w = sim.watcher
+    before = len(w.texts)
+    w.mav.command_long_send(1, 1, d.MAV_CMD_DO_DIGICAM_CONTROL, 0, 0, 0, 0, 0, 1, 0, 0)
+
+    def acked(m):
+        return m.get_type() == "COMMAND_ACK" and m.command == d.MAV_CMD_DO_DIGICAM_CONTROL and m
+
+    result = w.until(acked, 30, "DO_DIGICAM_CONTROL's ack").result
+    if said:
+        w.until(lambda _m: any(said in t for t in w.texts[before:]) or None, 30, repr(said))
+    return result
+
+
 def _subscribed_before_any_data(path: Path, topic: bytes) -> bool:
     """QGroundControl 4.4's GeoTag parser gives up at the first DATA message if it has not
     yet seen the topic's ADD_LOGGED_MSG."""
@@ -84,6 +100,8 @@ def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geota
     sim, tmp_path
 ):
     sim.wait_ready()
+    said = "Camera: photos only while armed"  # QGroundControl's photo button, disarmed
+    assert _photo_button(sim, said) == d.MAV_RESULT_DENIED
     _set(sim, "CAM1_TYPE", 1.0)
     _set(sim, "CAM1_OUTPUT", 7.0)
     sim.upload_plan(_survey(tmp_path))
@@ -97,9 +115,14 @@ def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geota
     # below are the photos' own spacing along the track).
     assert len(seqs) >= LEG_M // SPACING_M, len(seqs)
     w = sim.watcher
-    end_s = w.time_boot_s + 60.0  # a minute on, circling the last waypoint
+    end_s = w.time_boot_s + 30.0  # half a minute on, circling the last waypoint
     later = _photos_until(sim, lambda _m: w.time_boot_s >= end_s)
     assert later == []  # the stop item passed: no more photos
+    assert _photo_button(sim) == d.MAV_RESULT_ACCEPTED
+    end_s = w.time_boot_s + 5.0
+    button = _photos_until(sim, lambda _m: w.time_boot_s >= end_s)
+    assert [p.seq for p in button] == [len(seqs) + 1]  # one photo, numbered on
+    seqs.append(len(seqs) + 1)
     log = sim.disarm(force=True)[-1]
     assert _subscribed_before_any_data(log, b"camera_capture")
     ulog = ULog(str(log))
@@ -107,7 +130,7 @@ def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geota
     assert list(capture["seq"]) == seqs and set(capture["result"]) == {1}
     frame = LocalFrame(capture["lat"][0], capture["lon"][0])
     where = [frame.ne(lat, lon) for lat, lon in zip(capture["lat"], capture["lon"], strict=True)]
-    gaps = [math.dist(a, b) for a, b in itertools.pairwise(where)]
+    gaps = [math.dist(a, b) for a, b in itertools.pairwise(where[:-1])]  # the leg's
     assert all(SPACING_M - 1.0 <= g <= SPACING_M + 3.0 for g in gaps), gaps
     heights = capture["ground_distance"]
     assert all(70.0 <= h <= 90.0 for h in heights), heights  # the plan's 80 m

@@ -75,6 +75,14 @@ class CameraShots:
             self.ports.capture(self._capture(nav))
             log.info("photo %d at %.7f, %.7f", self.trigger.seq, nav.lat_deg, nav.lon_deg)
 
+    def command(self, command: int, params: tuple[float, ...]) -> str | None:
+        """A ground station's camera command (param1, 2, 3 and 5 of it) taken: None, or
+        why it is refused (no camera set up, or one on a surface's output)."""
+        problem = self._problem()
+        if problem is None:
+            self.trigger.apply(command, (params[0], params[1], params[2], 0.0, params[3]))
+        return problem
+
     def _problem(self) -> str | None:
         """Why no photo can be taken (a text for the operator), or None."""
         config = self.trigger.config

@@ -13,6 +13,7 @@ from companion.link.command_rules import RULES, refusal
 from companion.link.command_service import CommandService
 from companion.link.commands.arming import ArmingCommands
 from companion.link.commands.calibration import CalibrationCommands
+from companion.link.commands.camera_commands import CameraCommands
 from companion.link.commands.fence_commands import FenceCommands
 from companion.link.commands.message_requests import MessageRequests
 from companion.link.commands.mission_commands import MissionCommands
@@ -31,6 +32,7 @@ __all__ = [
     "BUS_ACK_TIMEOUT_S",
     "ArmingCommands",
     "CalibrationCommands",
+    "CameraCommands",
     "FenceCommands",
     "MessageRequests",
     "MissionCommands",
@@ -61,6 +63,7 @@ def register_commands(
     ModeCommands(port, identity.autopilot).register(service)
     SpeedCommands(port, params).register(service)
     ServoCommands(port).register(service)
+    CameraCommands(port).register(service)
     FenceCommands(port, params).register(service)
     MessageRequests(port, identity, router, metadata).register(service)
     if missions is not None:

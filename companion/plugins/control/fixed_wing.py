@@ -30,8 +30,12 @@ from companion.control.mission.fence import Fence
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.messages import (
+    NAME_LEN,
+    REASON_LEN,
     ActuatorCommand,
+    CommandAck,
     CommandId,
+    CommandResult,
     ControlStatus,
     FlightMode,
     MissionState,
@@ -78,6 +82,7 @@ class FixedWingPlugin(Plugin):
         "actuators/servos",
         "sensors/range",
         "sensors/gps",
+        "link/commands",
     )
     outputs = (
         "control/actuators",
@@ -85,6 +90,7 @@ class FixedWingPlugin(Plugin):
         "link/commands",
         "vehicle/statustext",
         "camera/capture",
+        "link/command_acks",
     )
 
     @classmethod
@@ -150,6 +156,8 @@ class FixedWingPlugin(Plugin):
         photos = CameraPorts(bus.writer("camera/capture").publish, self.commands.publish,
                              self._tell, gps.get, self._home_alt)  # fmt: skip
         self.camera = CameraShots(photos, self.surface_outputs)
+        self.requests = bus.queue_reader("link/commands")  # a ground station's camera's
+        self.acks = bus.writer("link/command_acks")
         self.camera.configure(self.live_params.values)
 
     def _follow_changes(self, now_us: int) -> None:
@@ -195,6 +203,7 @@ class FixedWingPlugin(Plugin):
         if out.disarm and not self.disarm_sent:
             self._disarm(now_us, out, status)
         self._set_servos(now_us, out.servo_sets)
+        self._answer_camera(nav.t_us)
         frame = self.controller.frame
         if frame is not None:
             self.camera.step(nav, out.camera_items, frame.ne(nav.lat_deg, nav.lon_deg))
@@ -219,6 +228,20 @@ class FixedWingPlugin(Plugin):
             cmd = VehicleCommand(t_us=now_us, seq=SERVO_SEQ, command=int(CommandId.SET_SERVO))
             cmd.param[0], cmd.param[1] = output, pulse
             self.commands.publish(cmd)
+
+    def _answer_camera(self, t_us: int) -> None:
+        """A ground station's camera commands (the link checked their parameters), each
+        answered; taken before this step's photos are judged."""
+        for request in self.requests.pending():
+            if request.command != CommandId.CAMERA:
+                continue
+            params = tuple(request.param[1:5])
+            problem = self.camera.command(round(request.param[0]), params)
+            ack = CommandAck(t_us=t_us, seq=request.seq, command=request.command)
+            ack.source = self.ctx.name.encode()[: NAME_LEN - 1]
+            ack.result = int(CommandResult.DENIED if problem else CommandResult.ACCEPTED)
+            ack.reason = (problem or "").encode()[:REASON_LEN]
+            self.acks.publish(ack)
 
     def _tell(self, t_us: int, severity: int, text: str) -> None:
         self.ctx.log.warning("%s", text)

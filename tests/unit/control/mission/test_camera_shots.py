@@ -77,6 +77,17 @@ def test_a_stop_item_with_no_camera_says_nothing():
     assert rec.texts == [] and rec.commands == []
 
 
+def test_a_ground_stations_photo_button_takes_one_or_says_why_not():
+    rec = Recorder()
+    shots = CameraShots(rec.ports(), SURFACES)
+    button = (d.MAV_CMD_DO_DIGICAM_CONTROL, (0.0, 0.0, 0.0, 1.0))  # param1, 2, 3, 5
+    assert shots.command(*button) == "Camera: CAM1_TYPE is None: no photos"
+    shots.configure(SERVO_CAMERA)
+    assert shots.command(*button) is None
+    fly(shots, [], 1.0)
+    assert [c.seq for c in rec.captures] == [1]
+
+
 def test_a_shutter_on_a_surfaces_output_is_refused_with_the_reason():
     rec = Recorder()
     shots = CameraShots(rec.ports(), SURFACES)
