@@ -97,6 +97,13 @@ class CameraTrigger:
         self._last_s = -math.inf  # when the last photo was taken
         self._release_s: float | None = None  # when the held shutter is let go
 
+    @property
+    def busy(self) -> bool:
+        """Whether a photo may fall due or the shutter is held (else ``step`` does nothing)."""
+        return bool(
+            self._wanted or self.distance_m or self.interval_s or self._release_s is not None
+        )
+
     def apply_item(self, item: MissionItem) -> None:
         """A mission's camera item (param5 is the item's x: a count, not a latitude)."""
         if item.command in CAMERA_ITEMS:

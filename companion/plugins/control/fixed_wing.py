@@ -204,8 +204,8 @@ class FixedWingPlugin(Plugin):
             self._disarm(now_us, out, status)
         self._set_servos(now_us, out.servo_sets)
         self._answer_camera(nav.t_us)
-        frame = self.controller.frame
-        if frame is not None:
+        frame = self.controller.frame  # an idle camera costs the step nothing
+        if frame is not None and (out.camera_items or self.camera.trigger.busy):
             self.camera.step(nav, out.camera_items, frame.ne(nav.lat_deg, nav.lon_deg))
         for seq in out.reached:  # each told, however many in one step
             self.recent_reached[self.reached_count % ControlStatus.REACHED_KEPT] = seq

@@ -80,6 +80,15 @@ def test_photos_never_come_closer_than_the_cameras_shortest_interval():
     assert len(times) == 10  # each as soon as the camera can
 
 
+def test_an_idle_camera_says_so_and_a_busy_one_until_its_shutter_is_released():
+    trigger = CameraTrigger(SERVO)
+    assert not trigger.busy
+    trigger.apply(d.MAV_CMD_DO_DIGICAM_CONTROL, (0.0, 0.0, 0.0, 0.0, 1.0))
+    assert trigger.busy
+    assert trigger.step(0.0, (0.0, 0.0)).photo and trigger.busy  # the shutter held
+    assert trigger.step(0.1, (0.0, 0.0)).pulses == [(7, 1100)] and not trigger.busy
+
+
 def test_a_stop_item_ends_the_photos_and_a_distance_of_zero_too():
     for stop in ((d.MAV_CMD_IMAGE_STOP_CAPTURE, ()), distance(0.0)):
         trigger = CameraTrigger(SERVO)
