@@ -9,7 +9,6 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import struct
 from pathlib import Path
 
 import pytest
@@ -18,6 +17,7 @@ from pyulog import ULog
 from companion.actuators.minissc import position_for_pulse
 from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
+from tests.support.geotag import camera_feedback
 from tests.support.vehicle import REPO
 
 PLAN = REPO / "qgc_plans" / "short_leg.plan"
@@ -81,20 +81,6 @@ def _photo_button(sim, said: str = "") -> int:
     return result
 
 
-def _subscribed_before_any_data(path: Path, topic: bytes) -> bool:
-    """QGroundControl 4.4's GeoTag parser gives up at the first DATA message if it has not
-    yet seen the topic's ADD_LOGGED_MSG."""
-    raw, at = path.read_bytes(), 16
-    while at + 3 <= len(raw):
-        size, kind = struct.unpack_from("<HB", raw, at)
-        if kind == ord("A") and raw[at + 6 : at + 3 + size] == topic:
-            return True
-        if kind == ord("D"):
-            return False
-        at += 3 + size
-    return False
-
-
 @pytest.mark.timeout(900)
 def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geotagging(
     sim, tmp_path
@@ -124,12 +110,16 @@ def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geota
     assert [p.seq for p in button] == [len(seqs) + 1]  # one photo, numbered on
     seqs.append(len(seqs) + 1)
     log = sim.disarm(force=True)[-1]
-    assert _subscribed_before_any_data(log, b"camera_capture")
     ulog = ULog(str(log))
     capture = ulog.get_dataset("camera_capture").data
     assert list(capture["seq"]) == seqs and set(capture["result"]) == {1}
-    frame = LocalFrame(capture["lat"][0], capture["lon"][0])
-    where = [frame.ne(lat, lon) for lat, lon in zip(capture["lat"], capture["lon"], strict=True)]
+    # QGroundControl 4.4's GeoTag Images finds the same photos in the same places.
+    tags = camera_feedback(log)
+    assert [t["seq"] for t in tags] == seqs
+    places = list(zip(capture["lat"], capture["lon"], strict=True))
+    assert [(t["lat"], t["lon"]) for t in tags] == places
+    frame = LocalFrame(*places[0])
+    where = [frame.ne(lat, lon) for lat, lon in places]
     gaps = [math.dist(a, b) for a, b in itertools.pairwise(where[:-1])]  # the leg's
     assert all(SPACING_M - 1.0 <= g <= SPACING_M + 3.0 for g in gaps), gaps
     heights = capture["ground_distance"]
