@@ -14,6 +14,7 @@ script's own link loss is the vehicle's, whatever the helpers do meanwhile.
 from __future__ import annotations
 
 import os
+import socket
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -30,6 +31,18 @@ from mavlink_dialect import companion as d
 
 SYSID, COMPID = 253, d.MAV_COMP_ID_ONBOARD_COMPUTER
 PREARM = d.MAV_SYS_STATUS_PREARM_CHECK
+# A lockstep simulation sends its telemetry several times faster than real time: the
+# default receive buffer (208 KiB, some 270 datagrams) holds a fraction of a second of it,
+# and a test process not scheduled for longer on a busy machine lost messages (the kernel
+# caps this at net.core.rmem_max, 4 MiB here).
+RECEIVE_BUFFER = 4 << 20
+
+
+def widen_receive_buffer(conn: Any) -> None:
+    """Let a pymavlink UDP connection's socket hold seconds of telemetry, not a fraction."""
+    sock = getattr(conn, "port", None)
+    if isinstance(sock, socket.socket):
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, RECEIVE_BUFFER)
 
 
 class VehicleError(AssertionError):
@@ -46,6 +59,7 @@ class Watcher:
         # The vehicle's own dialect, so its own messages decode.
         self.conn.mav = d.MAVLink(self.conn, srcSystem=SYSID, srcComponent=COMPID)
         self.conn.mav.robust_parsing = True
+        widen_receive_buffer(self.conn)
         self.mav = self.conn.mav
         self.sysid = sysid
         self.texts: list[str] = []  # every STATUSTEXT seen, for the failure messages

@@ -18,6 +18,7 @@ from pymavlink import mavutil
 
 from companion.control.modes import BY_MODE
 from companion.messages import FlightMode
+from companion.testing.watcher import widen_receive_buffer
 from mavlink_dialect import companion as d
 from tests.support.vehicle import REPO
 
@@ -31,6 +32,7 @@ class Station:
 
     def __init__(self, url: str) -> None:
         self.conn = mavutil.mavlink_connection(url, source_system=255)
+        widen_receive_buffer(self.conn)
         self.beating = True
         self.texts: list[str] = []
         self.mode = -1
