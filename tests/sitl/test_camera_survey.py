@@ -81,7 +81,16 @@ def _photo_button(sim, said: str = "") -> int:
     return result
 
 
+COMPOSED = REPO / "companion" / "configs" / "sim_composed.toml"
+
+
 @pytest.mark.timeout(900)
+@pytest.mark.parametrize(
+    "sim",
+    [{}, {"sim_args": ["--config", str(COMPOSED)]}],
+    ids=["one_process_per_plugin", "composed"],
+    indirect=True,
+)
 def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geotagging(
     sim, tmp_path
 ):
