@@ -13,6 +13,8 @@ from companion.messages.actuators import ActuatorCommand, CameraCapture, ServoOu
 from companion.messages.base import MAX_PLUGINS, NAME_LEN, NAN, Message
 from companion.messages.channels import CHANNELS, Channel, channel
 from companion.messages.control import (
+    CAMERA_SEQ,
+    MISSION_SERVO_SEQ,
     REASON_LEN,
     CommandAck,
     CommandId,
@@ -50,8 +52,10 @@ from companion.messages.system import (
 )
 
 __all__ = [
+    "CAMERA_SEQ",
     "CHANNELS",
     "MAX_PLUGINS",
+    "MISSION_SERVO_SEQ",
     "NAME_LEN",
     "NAN",
     "RC_MAX_CHANNELS",

@@ -60,6 +60,12 @@ class CommandId(enum.IntEnum):
     CAMERA = 17
 
 
+# Sequence numbers of commands the flight controller sends the servo output on its own
+# (the link counts its own from 1): a mission's DO_SET_SERVO, the camera's shutter pulses.
+MISSION_SERVO_SEQ = (1 << 31) - 2
+CAMERA_SEQ = (1 << 31) - 3
+
+
 class CommandResult(enum.IntEnum):
     """Same numbering as MAVLink's MAV_RESULT."""
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from companion.control.mission.camera import CameraConfig, CameraTrigger, asks_for_photos
 from companion.control.mission.items import MissionItem
 from companion.messages import (
+    CAMERA_SEQ,
     CameraCapture,
     CommandId,
     GpsFix,
@@ -23,8 +24,6 @@ from companion.messages import (
     VehicleCommand,
 )
 from mavlink_dialect import companion as d
-
-CAMERA_SEQ = (1 << 31) - 3  # the shutter's DO_SET_SERVO on link/commands, apart from others
 
 log = logging.getLogger("companion.camera")
 

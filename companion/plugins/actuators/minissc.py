@@ -38,6 +38,7 @@ from companion.actuators import minissc
 from companion.actuators.airframe import SERVO_IDS, Airframe, load_airframe
 from companion.actuators.flying_trim import FlyingTrim
 from companion.messages import (
+    CAMERA_SEQ,
     NAME_LEN,
     REASON_LEN,
     ActuatorCommand,
@@ -277,7 +278,9 @@ class MiniSscOutput(Plugin):
             self.spare[servo] = self.wanted[servo] = position
             if servo not in self.refresh_order:
                 self.refresh_order.append(servo)
-            self.ctx.log.info("output %d (servo %d) set to %d us", output, servo, pulse)
+            # A camera's pulses, two a photo, are the controller's to tell ("photo N at").
+            say = self.ctx.log.debug if request.seq == CAMERA_SEQ else self.ctx.log.info
+            say("output %d (servo %d) set to %d us", output, servo, pulse)
             ack.result = int(CommandResult.ACCEPTED)
         self.acks.publish(ack)
 

@@ -30,6 +30,7 @@ from companion.control.mission.fence import Fence
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.messages import (
+    MISSION_SERVO_SEQ,
     NAME_LEN,
     REASON_LEN,
     ActuatorCommand,
@@ -54,7 +55,6 @@ STATUS_WAIT_S = 5.0  # the commander's last status, once, when this process star
 OUTPUT_WAIT_S = 5.0  # ... and the servo output's process, started with this one, listening
 STATUS_PERIOD_US = 100_000  # control/status at 10 Hz (and at once when an item is reached)
 FENCE = d.MAV_MISSION_TYPE_FENCE
-SERVO_SEQ = (1 << 31) - 2  # a mission's DO_SET_SERVO on link/commands, apart from the link's
 RECENT = 4  # receiver and rangefinder values kept between steps (100 Hz against 50 Hz)
 # The command made in one call from its packed fields (its native layout: t_us, the four
 # surfaces, aux[4], armed, padding), not field by field through ctypes, at every step.
@@ -225,7 +225,9 @@ class FixedWingPlugin(Plugin):
                 self.ctx.log.warning("%s", text)
                 self.texts.publish(StatusText.of(now_us, d.MAV_SEVERITY_WARNING, text))
                 continue
-            cmd = VehicleCommand(t_us=now_us, seq=SERVO_SEQ, command=int(CommandId.SET_SERVO))
+            cmd = VehicleCommand(
+                t_us=now_us, seq=MISSION_SERVO_SEQ, command=int(CommandId.SET_SERVO)
+            )
             cmd.param[0], cmd.param[1] = output, pulse
             self.commands.publish(cmd)
 
