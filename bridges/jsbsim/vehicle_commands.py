@@ -114,10 +114,8 @@ class VehicleCommands:
 
     def _inject(self, cmd: VehicleCommand, t_us: int) -> None:
         unit, failure_type, instance = (round(v) for v in cmd.param[:3])
-        ack = CommandAck(t_us=t_us, seq=cmd.seq, command=cmd.command)
-        ack.result = int(self.failures.inject(unit, failure_type, instance))
-        ack.source = b"sim_bridge"
-        self.acks.publish(ack)
+        result = self.failures.inject(unit, failure_type, instance)
+        self.acks.publish(CommandAck.answer(cmd, t_us, b"sim_bridge", result))
 
     def _take_acks(self) -> None:
         for ack in self.acks_in.drain():

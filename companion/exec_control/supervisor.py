@@ -25,8 +25,6 @@ from companion.exec_control.priority import note_refused_raises
 from companion.exec_control.registry import load
 from companion.exec_control.zygote import READY_TIMEOUT_S, ForkServer, become_subreaper
 from companion.messages import (
-    NAME_LEN,
-    REASON_LEN,
     CommandAck,
     CommandId,
     CommandResult,
@@ -267,8 +265,5 @@ class Supervisor:
         waiter.close()
 
     def _ack(self, cmd: VehicleCommand, result: CommandResult) -> CommandAck:
-        ack = CommandAck(t_us=self.clock.now_us(), seq=cmd.seq, command=cmd.command)
-        ack.result = int(result)
-        ack.source = b"exec_control"[: NAME_LEN - 1]
-        ack.reason = self.reason.encode()[:REASON_LEN]  # whole: the field fits a PreArm text
-        return ack
+        # The reason whole: the field fits a PreArm text.
+        return CommandAck.answer(cmd, self.clock.now_us(), b"exec_control", result, self.reason)

@@ -89,6 +89,13 @@ class VehicleCommand(Message):
         ("param", ctypes.c_double * 7),
     ]
 
+    @classmethod
+    def set_servo(cls, t_us: int, seq: int, output: int, pulse_us: int) -> VehicleCommand:
+        """SET_SERVO: the servo card's ``output`` (from 1) to ``pulse_us``."""
+        cmd = cls(t_us=t_us, seq=seq, command=int(CommandId.SET_SERVO))
+        cmd.param[0], cmd.param[1] = output, pulse_us
+        return cmd
+
 
 class CommandAck(Message):
     """Outcome of a VehicleCommand. Producers: exec_control, commander, the servo output,
@@ -102,6 +109,17 @@ class CommandAck(Message):
         ("source", ctypes.c_char * NAME_LEN),  # who answered
         ("reason", ctypes.c_char * REASON_LEN),  # why it was refused (told to the ground station)
     ]
+
+    @classmethod
+    def answer(
+        cls, cmd: VehicleCommand, t_us: int, source: bytes, result: int, reason: str = ""
+    ) -> CommandAck:
+        """The ack of ``cmd`` from plug-in ``source``, with the reason it was refused (both
+        cut to what their fields hold)."""
+        ack = cls(t_us=t_us, seq=cmd.seq, command=cmd.command, result=int(result))
+        ack.source = source[: NAME_LEN - 1]
+        ack.reason = reason.encode()[:REASON_LEN]
+        return ack
 
 
 class FlightMode(enum.IntEnum):

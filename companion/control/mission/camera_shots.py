@@ -18,7 +18,6 @@ from companion.control.mission.items import MissionItem
 from companion.messages import (
     CAMERA_SEQ,
     CameraCapture,
-    CommandId,
     GpsFix,
     NavState,
     VehicleCommand,
@@ -67,9 +66,7 @@ class CameraShots:
             self.trigger.apply_item(item)
         shot = self.trigger.step(nav.t_us / 1e6, pos)
         for output, pulse in shot.pulses:
-            cmd = VehicleCommand(t_us=nav.t_us, seq=CAMERA_SEQ, command=int(CommandId.SET_SERVO))
-            cmd.param[0], cmd.param[1] = output, pulse
-            self.ports.command(cmd)
+            self.ports.command(VehicleCommand.set_servo(nav.t_us, CAMERA_SEQ, output, pulse))
         if shot.photo:
             self.ports.capture(self._capture(nav))
             log.info("photo %d at %.7f, %.7f", self.trigger.seq, nav.lat_deg, nav.lon_deg)

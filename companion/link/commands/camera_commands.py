@@ -15,8 +15,8 @@ import math
 
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandArgs, CommandService, Outcome
-from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort, refuse
-from companion.messages import CommandId, PluginState
+from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort, plugin_running, refuse
+from companion.messages import CommandId
 
 CONTROLLER = b"control.fixed_wing"  # the plug-in that answers
 
@@ -36,15 +36,10 @@ class CameraCommands:
         service.register(d.MAV_CMD_IMAGE_START_CAPTURE, self.camera)
         service.register(d.MAV_CMD_IMAGE_STOP_CAPTURE, self.camera)
 
-    def controller_running(self) -> bool:
-        health = self.port.snapshot.health
-        row = health.row_of_kind(CONTROLLER) if health is not None else None
-        return row is not None and row.state == PluginState.RUNNING
-
     def camera(self, args: CommandArgs) -> Outcome:
         """A photo, a distance or an interval between photos, or none, for the camera on a
         servo output (the flight controller answers); DENIED while disarmed."""
-        if not self.controller_running():
+        if not plugin_running(self.port, CONTROLLER):
             return refuse(self.port, self.service, "Camera: photos only while armed")
         p = [0.0 if math.isnan(v) else v for v in args.params]
         seq = self.port.publish_command(CommandId.CAMERA, (args.command, p[0], p[1], p[2], p[4]))

@@ -7,6 +7,7 @@ from typing import Any, Protocol
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandService, Outcome
 from companion.link.snapshot import Snapshot
+from companion.messages import PluginState
 
 # How long a command handed to another plug-in waits for its answer: a busy machine may
 # take seconds to start the flight group.
@@ -70,3 +71,11 @@ def armed(port: VehiclePort) -> bool:
     """Whether the flight plug-ins run, as the newest health table says."""
     health = port.snapshot.health
     return health is not None and bool(health.flight_running)
+
+
+def plugin_running(port: VehiclePort, kind: bytes) -> bool:
+    """Whether the health table shows a plug-in of ``kind`` (``b"actuators.minissc"``)
+    running: one of the flight group runs only while armed."""
+    health = port.snapshot.health
+    row = health.row_of_kind(kind) if health is not None else None
+    return row is not None and row.state == PluginState.RUNNING

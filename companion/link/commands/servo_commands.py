@@ -13,8 +13,8 @@ from __future__ import annotations
 
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandArgs, CommandService, Outcome
-from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort, refuse
-from companion.messages import CommandId, PluginState
+from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort, plugin_running, refuse
+from companion.messages import CommandId
 
 SERVO_OUTPUT = b"actuators.minissc"  # the plug-in that answers
 
@@ -30,16 +30,10 @@ class ServoCommands:
         self.service = service
         service.register(d.MAV_CMD_DO_SET_SERVO, self.set_servo)
 
-    def output_running(self) -> bool:
-        """Whether the health table shows the servo output plug-in running."""
-        health = self.port.snapshot.health
-        row = health.row_of_kind(SERVO_OUTPUT) if health is not None else None
-        return row is not None and row.state == PluginState.RUNNING
-
     def set_servo(self, args: CommandArgs) -> Outcome:
         """A spare output of the servo card to the pulse, answered by the servo output (an
         output a surface uses DENIED); DENIED at once while disarmed."""
-        if not self.output_running():
+        if not plugin_running(self.port, SERVO_OUTPUT):
             text = "Set servo: the servo output runs only while armed"
             return refuse(self.port, self.service, text)
         output, pulse = (round(p) for p in args.params[:2])

@@ -39,8 +39,6 @@ from companion.actuators.airframe import SERVO_IDS, Airframe, load_airframe
 from companion.actuators.flying_trim import FlyingTrim
 from companion.messages import (
     CAMERA_SEQ,
-    NAME_LEN,
-    REASON_LEN,
     ActuatorCommand,
     CommandAck,
     CommandId,
@@ -267,12 +265,10 @@ class MiniSscOutput(Plugin):
         output, pulse = round(request.param[0]), round(request.param[1])
         servo = output - 1
         surface = next((c.surface for c in self.airframe.channels if c.servo == servo), None)
-        ack = CommandAck(t_us=self.ctx.clock.now_us(), seq=request.seq, command=request.command)
-        ack.source = self.ctx.name.encode()[: NAME_LEN - 1]
+        result, reason = CommandResult.ACCEPTED, ""
         if surface is not None or servo not in SERVO_IDS:
-            ack.result = int(CommandResult.DENIED)
             why = f"drives the {surface}" if surface else "is not one of the card's 8"
-            ack.reason = f"Set servo: output {output} {why}".encode()[:REASON_LEN]
+            result, reason = CommandResult.DENIED, f"Set servo: output {output} {why}"
         else:
             position = minissc.position_for_pulse(pulse)
             self.spare[servo] = self.wanted[servo] = position
@@ -281,8 +277,8 @@ class MiniSscOutput(Plugin):
             # A camera's pulses, two a photo, are the controller's to tell ("photo N at").
             say = self.ctx.log.debug if request.seq == CAMERA_SEQ else self.ctx.log.info
             say("output %d (servo %d) set to %d us", output, servo, pulse)
-            ack.result = int(CommandResult.ACCEPTED)
-        self.acks.publish(ack)
+        source, now = self.ctx.name.encode(), self.ctx.clock.now_us()
+        self.acks.publish(CommandAck.answer(request, now, source, result, reason))
 
     def _room(self) -> int:
         """Frames that fit in one cycle, less what is still queued for the wire."""

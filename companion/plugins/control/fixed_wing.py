@@ -31,8 +31,6 @@ from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.messages import (
     MISSION_SERVO_SEQ,
-    NAME_LEN,
-    REASON_LEN,
     ActuatorCommand,
     CommandAck,
     CommandId,
@@ -225,11 +223,9 @@ class FixedWingPlugin(Plugin):
                 self.ctx.log.warning("%s", text)
                 self.texts.publish(StatusText.of(now_us, d.MAV_SEVERITY_WARNING, text))
                 continue
-            cmd = VehicleCommand(
-                t_us=now_us, seq=MISSION_SERVO_SEQ, command=int(CommandId.SET_SERVO)
+            self.commands.publish(
+                VehicleCommand.set_servo(now_us, MISSION_SERVO_SEQ, output, pulse)
             )
-            cmd.param[0], cmd.param[1] = output, pulse
-            self.commands.publish(cmd)
 
     def _answer_camera(self, t_us: int) -> None:
         """A ground station's camera commands (the link checked their parameters), each
@@ -239,11 +235,9 @@ class FixedWingPlugin(Plugin):
                 continue
             params = tuple(request.param[1:5])
             problem = self.camera.command(round(request.param[0]), params)
-            ack = CommandAck(t_us=t_us, seq=request.seq, command=request.command)
-            ack.source = self.ctx.name.encode()[: NAME_LEN - 1]
-            ack.result = int(CommandResult.DENIED if problem else CommandResult.ACCEPTED)
-            ack.reason = (problem or "").encode()[:REASON_LEN]
-            self.acks.publish(ack)
+            result = CommandResult.DENIED if problem else CommandResult.ACCEPTED
+            source = self.ctx.name.encode()
+            self.acks.publish(CommandAck.answer(request, t_us, source, result, problem or ""))
 
     def _tell(self, t_us: int, severity: int, text: str) -> None:
         self.ctx.log.warning("%s", text)

@@ -34,8 +34,6 @@ from companion.control.mission.rally import RALLY_PARAMS, RallyPoints
 from companion.control.mission.set_current import first_takeoff
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch, receiver_process
 from companion.messages import (
-    NAME_LEN,
-    REASON_LEN,
     CommandAck,
     CommandId,
     FlightMode,
@@ -330,11 +328,8 @@ class CommanderPlugin(Plugin):
             decision = self.commander.handle(cmd)
             if decision is None:
                 continue
-            ack = CommandAck(t_us=self.ctx.clock.now_us(), seq=cmd.seq, command=cmd.command)
-            ack.result = int(decision.result)
-            ack.source = self.ctx.name.encode()[: NAME_LEN - 1]
-            ack.reason = decision.reason.encode()[:REASON_LEN]
-            acks.append(ack)
+            source, now = self.ctx.name.encode(), self.ctx.clock.now_us()
+            acks.append(CommandAck.answer(cmd, now, source, decision.result, decision.reason))
             if decision.result == 0 and cmd.command in rules.MODE_CHOICES:
                 self.failsafes.operator_chose(self.commander.mode)
             if decision.reason:
