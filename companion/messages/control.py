@@ -177,11 +177,13 @@ class MissionState(enum.IntEnum):
 
 
 class ControlStatus(Message):
-    """What the flight controller is doing. Producer: control.fixed_wing. Consumer: link.
+    """What the flight controller is doing. Producer: control.fixed_wing. Consumers: link,
+    vehicle.commander.
 
     Feeds NAV_CONTROLLER_OUTPUT, MISSION_CURRENT, MISSION_ITEM_REACHED (one for each item
     ``reached_count`` grew by, from ``recent_reached``) and EXTENDED_SYS_STATE's landed
-    state (from ``landed``, ``takeoff_phase`` and ``land_phase``).
+    state (from ``landed``, ``takeoff_phase`` and ``land_phase``); the commander reads the
+    landed state and a mission's NAV_RETURN_TO_LAUNCH (``control.mission_return``).
     """
 
     REACHED_KEPT = 8  # items reached kept in ``recent_reached``
@@ -209,6 +211,9 @@ class ControlStatus(Message):
         # The last REACHED_KEPT items reached, the n-th (from 0) at [n % REACHED_KEPT]: two
         # in one step (a loiter, then the take-off a DO_JUMP returns to) are both told.
         ("recent_reached", ctypes.c_int32 * REACHED_KEPT),
+        # The vehicle status's ``changes`` this step flew: the commander knows which entry
+        # of a mode the controller's mission state belongs to (a mission's Return).
+        ("mode_changes", ctypes.c_uint32),
     ]
 
     STALE_US = 2_000_000  # no newer status for this long: the controller has stopped

@@ -1,5 +1,6 @@
 """Return flies to the plan's rally point when it is nearer than home, and circles it at its
-own height, as an ArduPlane or PX4 user expects; home when home is nearer.
+own height, as an ArduPlane or PX4 user expects; home when home is nearer. A mission's own
+NAV_RETURN_TO_LAUNCH item enters Return too.
 
 The square plan's rally point is 900 m east and 100 m south of home, 80 m above it. From
 the square's north-east corner (1.8 km east of home) the rally point is the nearer; from
@@ -77,3 +78,24 @@ def test_return_from_the_last_leg_goes_home_nearer_than_the_rally_point(sim):
     wait_for(lambda: sim.truth()["t"][-1] >= end - 1.0, 120, "the truth file written")
     north, east, _ = _track(sim, end - CIRCLING_S)
     assert math.hypot(float(np.median(north)), float(np.median(east))) < 300.0
+
+
+@pytest.mark.timeout(900)
+def test_the_missions_own_return_item_enters_return_and_goes_where_return_goes(sim):
+    """The square ends on NAV_RETURN_TO_LAUNCH: reached as it begins, then the mode is
+    Return (as ArduPlane and PX4 switch to theirs), said with why and where. Home is the
+    nearer from the last waypoint, so the aircraft circles home, in Return."""
+    sim.wait_ready()
+    sim.arm_and_start()
+    sim.run_until_item(5)
+    sim.run_until_mode("RTL", timeout_s=60.0)
+    w = sim.watcher
+    w.until(lambda _m: "Mission: item 5 returns to launch" in w.texts, 30, "why Return")
+    assert _told(sim) == "Return: home, nearer than any rally point"
+    t0 = sim.run_until_time(0.0)
+    end = sim.run_until_time(t0 + 60.0 + CIRCLING_S)
+    assert sim.mode() == "RTL"
+    wait_for(lambda: sim.truth()["t"][-1] >= end - 1.0, 120, "the truth file written")
+    north, east, height = _track(sim, end - CIRCLING_S)
+    assert math.hypot(float(np.median(north)), float(np.median(east))) < 300.0
+    assert abs(float(np.median(height)) - 100.0) < 15.0  # RTL_ALT_M

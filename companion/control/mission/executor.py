@@ -6,10 +6,12 @@ acceptance radius or when the aircraft crosses the line through the waypoint squ
 the leg (an overshoot never makes it circle back; the leg after a take-off starts where
 the climb ended, so a first waypoint the climb flew past is flown back to); loiters
 circle their point (radius param3, negative for counter-clockwise) forever, for param1
-seconds or param1 turns once on the circle; NAV_RETURN_TO_LAUNCH flies home and circles
-there; DO_CHANGE_SPEED, DO_SET_SERVO (``servo_sets``, for the servo output) and DO_JUMP
-act at once. After the last item the aircraft circles
-the last point (PX4).
+seconds or param1 turns once on the circle; NAV_RETURN_TO_LAUNCH ends the mission, reached
+as it is begun, and hands the flight to Return (the commander enters that mode, as ArduPlane
+and PX4 do: ``control.mission_return``; until it does, or flown without a commander, it
+flies home and circles there); DO_CHANGE_SPEED, DO_SET_SERVO (``servo_sets``, for the servo
+output) and DO_JUMP act at once. After the last item the aircraft circles the last point
+(PX4).
 """
 
 from __future__ import annotations
@@ -77,6 +79,7 @@ class MissionExecutor:
         self._prev: Point = (0.0, 0.0)
         self._prev_alt = self.home_alt_msl
         self._hold: Setpoint | None = None
+        self._home_circled = False  # NAV_RETURN_TO_LAUNCH flown without Return: home reached
         self._turn_radius = 0.0
         self._told: set[int] = set()  # LOITER_TO_ALT items whose circle was said
         # An implicit take-off's height (take_off_first); the waypoint the climb flew past.
@@ -89,7 +92,7 @@ class MissionExecutor:
         self._prev, self._prev_alt = leg_from or pos, alt_msl
         self.jumps_done.clear()
         self.finished = False
-        self._hold = None
+        self._hold, self._home_circled = None, False
         self._loiter, self._descending = CircleProgress(), None
         self.climb_to, self._flown_back = math.nan, False
 
@@ -285,15 +288,18 @@ class MissionExecutor:
         return next_flown(self.items, self.current + 1, self.jumps_done)
 
     def _return(self, item: MissionItem, pos: Point, alt: float) -> Setpoint:
+        """NAV_RETURN_TO_LAUNCH: the mission ends here (the item reached as it is begun);
+        home at the return height is what is flown until Return takes over."""
+        if not self.finished:
+            self.finished = True
+            self.reached.append(item.seq)
         home = (0.0, 0.0)
         rtl_alt = self.home_alt_msl + self.config.rtl_alt_rel
         radius = self.config.loiter_radius
         reach = max(radius, self._turn_radius) * 1.5
-        there = _distance(pos, home) <= reach or past_point(self._prev, home, pos)
-        if not self.finished and there:
-            self.finished = True
-            self.reached.append(item.seq)
-        if self.finished:
+        if not self._home_circled:
+            self._home_circled = _distance(pos, home) <= reach or past_point(self._prev, home, pos)
+        if self._home_circled:
             return Setpoint(Kind.CIRCLE, home, home, rtl_alt, radius, speed=self.speed)
         return Setpoint(Kind.LINE, self._prev, home, rtl_alt, speed=self.speed)
 

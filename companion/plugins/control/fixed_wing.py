@@ -314,4 +314,5 @@ class FixedWingPlugin(Plugin):
         msg.land_phase, msg.takeoff_phase = out.land_phase, out.takeoff_phase
         msg.reached_count, msg.last_reached = self.reached_count, self.last_reached
         msg.recent_reached[:] = self.recent_reached
+        msg.mode_changes = status.changes
         return msg

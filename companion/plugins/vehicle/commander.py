@@ -3,9 +3,10 @@
 Takes the mode commands off ``link/commands`` (SET_MODE, MISSION_START, RTL, REPOSITION,
 LOITER, SET_HOME), answers each on ``link/command_acks`` (with the reason when refused),
 applies the failsafes (ground-station link, GPS, geofence; ``companion.control.failsafe``),
-the pilot's mode switch and the RC and joystick failsafes (``companion.control.pilot_watch``), the
-low-battery failsafe (``companion.control.battery_failsafe``), and
-publishes ``vehicle/status`` on every change and four times a second, and what the
+the pilot's mode switch and the RC and joystick failsafes (``companion.control.pilot_watch``),
+the low-battery failsafe (``companion.control.battery_failsafe``), enters Return when a
+mission ends on its NAV_RETURN_TO_LAUNCH (``companion.control.mission_return``), publishes
+``vehicle/status`` on every change and every 0.3 s armed (1 s disarmed), and what the
 operator should read on ``vehicle/statustext``.
 """
 
@@ -32,6 +33,7 @@ from companion.control.mission.fence import Fence
 from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.control.mission.rally import RALLY_PARAMS, RallyPoints
 from companion.control.mission.set_current import first_takeoff
+from companion.control.mission_return import returning_item
 from companion.control.pilot_watch import PILOT_PARAMS, PilotWatch, receiver_process
 from companion.messages import (
     CommandAck,
@@ -167,11 +169,11 @@ class CommanderPlugin(Plugin):
         landed = bool(control.landed) if control is not None else standing(nav, home_alt)
         c.landed = bool(c.armed and landed)
         acks = self._commands()
-        changed = bool(acks) | self._mode_switch(now)
+        changed = bool(acks) | self._mode_switch(now) | self._mission_return(now, control)
         self._ground_notice(now, landed is not None)
         if now >= self.next_failsafe_us or now < self.next_failsafe_us - FAILSAFE_PERIOD_US:
             self.next_failsafe_us = now + FAILSAFE_PERIOD_US
-            changed |= self._failsafes(now, nav)
+            changed |= self._failsafes(now, nav, control)
         for text in c.take_notices():  # where Return goes, after what sent it there
             self._say(now, text, d.MAV_SEVERITY_INFO)
         if changed or now >= self.next_status_us:
@@ -183,7 +185,7 @@ class CommanderPlugin(Plugin):
         # the old mode, when this process was preempted between the two).
         for ack in acks:
             self.acks.publish(ack)
-        self._keep_flight_state(now)
+        self._keep_flight_state(control)
         self.pause_s = self._pause(now)
 
     def _pause(self, now: int) -> float:
@@ -246,17 +248,15 @@ class CommanderPlugin(Plugin):
         )
         self.rearm_until_us = now + REARM_WAIT_US
 
-    def _keep_flight_state(self, now: int) -> None:
+    def _keep_flight_state(self, control: Any) -> None:
         """Write the flight state when it changed (the mission's item, from the controller)."""
         c = self.commander
-        control = self.control.get()
         flying_mission = c.armed and c.mode == FlightMode.MISSION
         # A controller with no mission running (restarted, its first steps refused) says
         # item 0: the item to resume from is still the one saved.
         if (
             flying_mission
             and control is not None
-            and control.fresh(now)
             and control.mission_state != MissionState.NOT_STARTED
         ):
             c.mission_first = max(0, int(control.mission_seq))
@@ -336,10 +336,9 @@ class CommanderPlugin(Plugin):
                 self.ctx.log.info("refused: %s", decision.reason)
         return acks
 
-    def _failsafes(self, now: int, nav: Any) -> bool:
+    def _failsafes(self, now: int, nav: Any, control: Any) -> bool:
         c = self.commander
-        control = self.control.get()
-        flying = c.armed and control is not None and control.fresh(now) and not control.landed
+        flying = c.armed and control is not None and not control.landed  # control: fresh
         link = self.link.get()
         valid = nav is not None and nav.flags & NavFlags.POSITION_VALID
         situation = Situation(
@@ -359,6 +358,14 @@ class CommanderPlugin(Plugin):
             receiver = receiver_process(self.health.get())
             actions += self.pilot.step(int(nav.t_us), c.mode, bool(flying), rc, joystick, receiver)
         return self._act(now, actions)
+
+    def _mission_return(self, now: int, control: Any) -> bool:
+        c, items = self.commander, self.store.items[d.MAV_MISSION_TYPE_MISSION]
+        seq = returning_item(items, control, c.mode, c.changes, c.landed)
+        if seq is None or c.failsafe(FlightMode.RTL).result != 0:
+            return False
+        self._say(now, f"Mission: item {seq} returns to launch", d.MAV_SEVERITY_INFO)
+        return True
 
     def _mode_switch(self, now: int) -> bool:
         """The pilot's switch wins over the ground station each time it moves."""

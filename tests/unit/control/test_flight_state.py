@@ -103,14 +103,13 @@ def test_the_item_to_resume_from_is_not_a_restarted_controllers_item_0(tmp_path)
     commander.home, commander.armed, commander.mode = HOME, True, FlightMode.MISSION
     status = ControlStatus(t_us=1_000_000, mission_seq=4, mission_state=MissionState.ACTIVE)
     plugin = SimpleNamespace(
-        commander=commander, control=SimpleNamespace(get=lambda: status), judged=None,
-        written="", written_armed=False, state_dir=tmp_path,
+        commander=commander, judged=None, written="", written_armed=False, state_dir=tmp_path
     )  # fmt: skip
-    CommanderPlugin._keep_flight_state(plugin, 1_100_000)  # type: ignore[arg-type]
+    CommanderPlugin._keep_flight_state(plugin, status)  # type: ignore[arg-type]
     assert commander.mission_first == 4 and load_flight_state(tmp_path).mission_seq == 4
     status = ControlStatus(t_us=2_000_000, mission_seq=0, mission_state=MissionState.NOT_STARTED)
-    CommanderPlugin._keep_flight_state(plugin, 2_100_000)  # type: ignore[arg-type]
+    CommanderPlugin._keep_flight_state(plugin, status)  # type: ignore[arg-type]
     assert commander.mission_first == 4 and load_flight_state(tmp_path).mission_seq == 4
     status = ControlStatus(t_us=3_000_000, mission_seq=5, mission_state=MissionState.ACTIVE)
-    CommanderPlugin._keep_flight_state(plugin, 3_100_000)  # type: ignore[arg-type]
+    CommanderPlugin._keep_flight_state(plugin, status)  # type: ignore[arg-type]
     assert commander.mission_first == 5 and load_flight_state(tmp_path).mission_seq == 5

@@ -20,6 +20,7 @@ from tests.unit.control.mission.executor_flying import (
     item,
     jump,
     on_circle,
+    towards,
     wp,
 )
 
@@ -152,20 +153,29 @@ def test_loiter_unlimited_never_ends():
 # --- RTL and the end of the mission ---------------------------------------------------------
 
 
-def test_rtl_flies_home_at_rtl_altitude_then_circles_home():
+def test_rtl_ends_the_mission_as_it_begins_then_flies_home_at_rtl_altitude_and_circles():
+    """The item is reached, and the mission finished, as it is begun: the commander enters
+    Return on it. Flown without Return, home at the return height, then circled."""
     config = ExecutorConfig(rtl_alt_rel=60.0, loiter_radius=80.0)
     items = [wp(0, (1_500.0, 0.0), z=120.0), item(1, d.MAV_CMD_NAV_RETURN_TO_LAUNCH)]
     ex = executor(items, config=config)
     reached, setpoints, pos = fly_lines(ex, step_m=10.0)
-    assert reached == [0, 1]
-    home_legs = [sp for sp in setpoints if sp.kind == Kind.LINE and sp.b == (0.0, 0.0)]
+    assert reached == [0, 1] and ex.finished
+    assert dist(pos, (1_500.0, 0.0)) < 50.0  # at the last waypoint, not home
+    final, home_legs = setpoints[-1], []
+    for t in range(1_000):
+        if final.kind != Kind.LINE:
+            break
+        home_legs.append(final)
+        pos = towards(pos, final.b, 10.0)
+        final = ex.step(pos, final.alt_msl, 1e3 + t)
+        assert ex.drain_reached() == []  # reached once, as it began
     assert home_legs
     for sp in home_legs:
+        assert sp.b == (0.0, 0.0)
         assert sp.a == pytest.approx((1_500.0, 0.0), abs=0.05)  # from the last waypoint
         assert sp.alt_msl == pytest.approx(HOME_ALT + 60.0)
         assert not math.isfinite(sp.speed)
-    final = setpoints[-1]
-    assert ex.finished
     assert final.kind == Kind.CIRCLE
     assert final.b == (0.0, 0.0) and final.radius == 80.0
     assert final.alt_msl == pytest.approx(HOME_ALT + 60.0)
