@@ -59,11 +59,12 @@ def mission_current(
     paused: bool = False,
 ) -> Any:
     """MISSION_CURRENT: the executor's item and state while it runs, else the stored one
-    (complete at its last item once it was flown to the end; paused at the item it was
-    at once it was flown and left, as PX4 and ArduPilot keep it)."""
+    (complete at its last item once it was flown to the end, also in the Return its
+    NAV_RETURN_TO_LAUNCH entered; paused at the item it was at once it was flown and left,
+    as PX4 and ArduPilot keep it)."""
     if total == 0:
         return mav.mission_current_encode(stored_seq, 0, d.MISSION_STATE_NO_MISSION)
-    if c is None and completed:
+    if completed and (c is None or c.mission_state == MissionState.NOT_STARTED):
         return mav.mission_current_encode(total - 1, total, d.MISSION_STATE_COMPLETE)
     if c is None or c.mission_state == MissionState.NOT_STARTED:
         state = d.MISSION_STATE_PAUSED if paused else d.MISSION_STATE_NOT_STARTED

@@ -286,6 +286,31 @@ def test_leaving_the_mission_keeps_its_item_as_px4_and_ardupilot_do(bench):
     assert state(None) == (0, d.MISSION_STATE_NOT_STARTED)
 
 
+def test_a_mission_ended_by_its_return_item_stays_complete_in_return(bench):
+    """A mission's NAV_RETURN_TO_LAUNCH ends it and enters Return: the controller then runs
+    outside Mission, and the plan still shows complete (MAVSDK's is_mission_finished and
+    QGroundControl read it so), as after a mission flown to its end in Mission."""
+    bench.upload([bench.item(i) for i in range(4)])
+    service = bench.service
+
+    def state(control: ControlStatus | None) -> tuple[int, int]:
+        msg = mission_current(bench.vehicle, service.current, 4, control, service.completed,
+                              service.paused)  # fmt: skip
+        return msg.seq, msg.mission_state
+
+    service.follow(MissionState.ACTIVE, 2)
+    ended = ControlStatus(mission_seq=3, mission_state=MissionState.COMPLETE)
+    service.follow(ended.mission_state, ended.mission_seq)
+    assert state(ended) == (3, d.MISSION_STATE_COMPLETE)
+    returning = ControlStatus(mission_seq=0, mission_state=MissionState.NOT_STARTED)
+    service.follow(returning.mission_state, returning.mission_seq)
+    assert state(returning) == (3, d.MISSION_STATE_COMPLETE)
+    service.follow(MissionState.ACTIVE, 1)  # flown again from item 1
+    assert state(ControlStatus(mission_seq=1, mission_state=MissionState.ACTIVE)) == (
+        1, d.MISSION_STATE_ACTIVE,
+    )  # fmt: skip
+
+
 def _status(jumps: int, item: int):
     return VehicleStatus(mission_jumps=jumps, mission_jump_to=item)
 
