@@ -30,7 +30,7 @@ class Magnetometer(Message):
     """Magnetic field, body FRD, in gauss.
 
     Producers: sensors.serial_imu, sensors.os3000 (when M fields present), sensors.replay.
-    Consumers: nav.ins_ekf, link.
+    Consumers: nav.ins_ekf, link, sensors.os3000 (whether another magnetometer speaks).
     """
 
     _fields_ = [

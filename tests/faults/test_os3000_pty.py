@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import itertools
 import math
+from types import SimpleNamespace
 
 import pytest
 
+from companion.bus.clock import MonotonicClock
+from companion.messages import Magnetometer, VehicleStatus
+from companion.plugins.sensors.os3000 import Os3000Compass
 from tests.support.configs import plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
@@ -35,3 +40,40 @@ def test_compass_and_magnetometer_from_a_pty(vehicle_factory, tmp_path):
     assert fields[0].mz_gauss == pytest.approx(0.4)
     wait_for(lambda: vehicle.row("compass").frames_bad >= 1, 5, "the bad sentence counted")
     pty.vanish()
+
+
+@pytest.mark.timeout(90)
+def test_beside_a_speaking_magnetometer_the_compass_is_read_in_batches_every_frame_kept(
+    vehicle_factory, tmp_path
+):
+    """batch_s: while another magnetometer speaks, the compass is read once a batch (0.2 s)
+    rather than once a sentence, and still publishes every sentence, in order, each with a
+    time of its own; silent, or the compass itself the magnetometer, its heading is read as
+    it comes (``per_frame``)."""
+    pty = Pty(tmp_path / "ttyCompass")
+    entry = plugin("compass", "sensors.os3000", device=pty.link, rate_hz=20.0, batch_s=0.2)
+    vehicle = vehicle_factory(vehicle_config("compass", entry))
+    bus = vehicle.bus
+    compass = bus.queue_reader("sensors/compass")
+    mag, status = bus.writer("sensors/mag"), bus.writer("vehicle/status")
+    vehicle.wait_running("compass")
+    now_us = MonotonicClock().now_us
+    status.publish(VehicleStatus(t_us=now_us(), armed=1))
+    sent, got = 40, []
+    for k in range(sent):  # 2 s of sentences at 20 Hz, the magnetometer speaking throughout
+        mag.publish(Magnetometer(now_us(), 0.2, 0.0, 0.4))
+        pty.write(sentence(f"C{k:.1f}P0.0R0.0") + "\r\n")
+        got += compass.take(0.05)  # taken as they come: the test's queue holds 32
+    wait_for(lambda: got.extend(compass.take(0.2)) or len(got) >= sent, 20, "every sentence")
+    headings = [round(math.degrees(c.heading_rad)) for c in got]
+    assert headings == list(range(sent))  # none lost, none out of order
+    stamps = [c.t_us for c in got]
+    assert all(b > a for a, b in itertools.pairwise(stamps)), stamps
+    sensor = Os3000Compass()
+    sensor.own_mag, sensor.ctx = False, SimpleNamespace(clock=SimpleNamespace(now_us=lambda: 0))
+    sensor.other_mag = SimpleNamespace(get=lambda: Magnetometer(-600_000, 0.2, 0.0, 0.4))
+    assert sensor.per_frame(VehicleStatus())  # silent for 0.6 s: the navigator's heading
+    sensor.other_mag = SimpleNamespace(get=lambda: Magnetometer(-100_000, 0.2, 0.0, 0.4))
+    assert not sensor.per_frame(VehicleStatus())
+    sensor.own_mag = True  # the compass's own field: it is the magnetometer, read as it comes
+    assert sensor.per_frame(VehicleStatus())
