@@ -42,6 +42,15 @@ def test_compass_and_magnetometer_from_a_pty(vehicle_factory, tmp_path):
     pty.vanish()
 
 
+def _newest_steps(stats, name: bytes) -> int | None:
+    """The plug-in's newest step count on system/plugin_stats (once a second), if any came."""
+    steps = None
+    for s in stats.drain():
+        if s.name == name:
+            steps = int(s.steps)
+    return steps
+
+
 @pytest.mark.timeout(90)
 def test_beside_a_speaking_magnetometer_the_compass_is_read_in_batches_every_frame_kept(
     vehicle_factory, tmp_path
@@ -54,11 +63,13 @@ def test_beside_a_speaking_magnetometer_the_compass_is_read_in_batches_every_fra
     entry = plugin("compass", "sensors.os3000", device=pty.link, rate_hz=20.0, batch_s=0.2)
     vehicle = vehicle_factory(vehicle_config("compass", entry))
     bus = vehicle.bus
-    compass = bus.queue_reader("sensors/compass")
+    compass, stats = bus.queue_reader("sensors/compass"), bus.queue_reader("system/plugin_stats")
     mag, status = bus.writer("sensors/mag"), bus.writer("vehicle/status")
     vehicle.wait_running("compass")
     now_us = MonotonicClock().now_us
     status.publish(VehicleStatus(t_us=now_us(), armed=1))
+    mag.publish(Magnetometer(now_us(), 0.2, 0.0, 0.4))
+    before = wait_for(lambda: _newest_steps(stats, b"compass"), 15, "the compass's counters")
     sent, got = 40, []
     for k in range(sent):  # 2 s of sentences at 20 Hz, the magnetometer speaking throughout
         mag.publish(Magnetometer(now_us(), 0.2, 0.0, 0.4))
@@ -69,6 +80,11 @@ def test_beside_a_speaking_magnetometer_the_compass_is_read_in_batches_every_fra
     assert headings == list(range(sent))  # none lost, none out of order
     stamps = [c.t_us for c in got]
     assert all(b > a for a, b in itertools.pairwise(stamps)), stamps
+    # Its counters a second later cover the last batch: a wake-up a batch, not one a
+    # sentence (40 over the 2 s; a busy machine only makes them fewer).
+    after = wait_for(lambda: _newest_steps(stats, b"compass"), 15, "the compass's counters")
+    after = wait_for(lambda: _newest_steps(stats, b"compass"), 15, "the compass's counters")
+    assert after - before <= 2.0 / 0.2 + 8, (before, after)
     sensor = Os3000Compass()
     sensor.own_mag, sensor.ctx = False, SimpleNamespace(clock=SimpleNamespace(now_us=lambda: 0))
     sensor.other_mag = SimpleNamespace(get=lambda: Magnetometer(-600_000, 0.2, 0.0, 0.4))
