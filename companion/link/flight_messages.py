@@ -64,9 +64,9 @@ def mission_current(
     as PX4 and ArduPilot keep it)."""
     if total == 0:
         return mav.mission_current_encode(stored_seq, 0, d.MISSION_STATE_NO_MISSION)
-    if completed and (c is None or c.mission_state == MissionState.NOT_STARTED):
-        return mav.mission_current_encode(total - 1, total, d.MISSION_STATE_COMPLETE)
     if c is None or c.mission_state == MissionState.NOT_STARTED:
+        if completed:
+            return mav.mission_current_encode(total - 1, total, d.MISSION_STATE_COMPLETE)
         state = d.MISSION_STATE_PAUSED if paused else d.MISSION_STATE_NOT_STARTED
         return mav.mission_current_encode(stored_seq, total, state)
     seq = max(0, min(int(c.mission_seq), total - 1))

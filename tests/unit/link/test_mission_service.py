@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from functools import partial
+
 import pytest
 from pymavlink import mavwp
 
@@ -262,16 +264,20 @@ def test_a_flown_mission_stays_complete_after_the_controller_stops_until_it_chan
     assert state() == (0, d.MISSION_STATE_NOT_STARTED)
 
 
+def _current_of_four(bench, control: ControlStatus | None) -> tuple[int, int]:
+    """MISSION_CURRENT's item and state for a stored plan of four, as the link sends it."""
+    service = bench.service
+    msg = mission_current(bench.vehicle, service.current, 4, control, service.completed,
+                          service.paused)  # fmt: skip
+    return msg.seq, msg.mission_state
+
+
 def test_leaving_the_mission_keeps_its_item_as_px4_and_ardupilot_do(bench):
     """MISSION_CURRENT had fallen back to item 0 whenever the aircraft left Mission (Pause,
     Return, a failsafe), and QGroundControl then showed the plan as not started."""
     bench.upload([bench.item(i) for i in range(4)])
     service = bench.service
-
-    def state(control: ControlStatus | None) -> tuple[int, int]:
-        msg = mission_current(bench.vehicle, service.current, 4, control, service.completed,
-                              service.paused)  # fmt: skip
-        return msg.seq, msg.mission_state
+    state = partial(_current_of_four, bench)
 
     flying = ControlStatus(mission_seq=2, mission_state=MissionState.ACTIVE)
     service.follow(flying.mission_state, flying.mission_seq)
@@ -292,11 +298,7 @@ def test_a_mission_ended_by_its_return_item_stays_complete_in_return(bench):
     QGroundControl read it so), as after a mission flown to its end in Mission."""
     bench.upload([bench.item(i) for i in range(4)])
     service = bench.service
-
-    def state(control: ControlStatus | None) -> tuple[int, int]:
-        msg = mission_current(bench.vehicle, service.current, 4, control, service.completed,
-                              service.paused)  # fmt: skip
-        return msg.seq, msg.mission_state
+    state = partial(_current_of_four, bench)
 
     service.follow(MissionState.ACTIVE, 2)
     ended = ControlStatus(mission_seq=3, mission_state=MissionState.COMPLETE)
