@@ -43,11 +43,6 @@ CLIMB_OUT_CHECK_M = 200.0  # the roll and the wings-level climb-out follow the r
 SAID = re.compile(r"Land: course (\d+), (\d+) m final, loiter (right|left)")
 
 
-def _accepted(qgc: GroundStation, command: int, *params: float) -> None:
-    qgc.command(command, *params)
-    assert qgc.ack(command).result == d.MAV_RESULT_ACCEPTED
-
-
 class Heard:
     """What QGroundControl's Fly view shows: the modes in turn, the messages, the position.
     ``pump`` beats once a second meanwhile, as QGroundControl does."""
@@ -71,6 +66,23 @@ class Heard:
             if msg is not None and msg.get_srcSystem() == 1 and msg.get_srcComponent() == 1:
                 self._take(msg)
         assert done(), f"never {what}; modes {self.modes}, texts {self.texts[-10:]}"
+
+    def accepted(self, command: int, *params: float, timeout_s: float = 15.0) -> None:
+        """Send a command and see it accepted, taking in what comes meanwhile: the vehicle
+        may say where Return goes before the ack reaches the station."""
+        self.qgc.command(command, *params)
+        end = time.monotonic() + timeout_s
+        kinds = ["COMMAND_ACK", "HEARTBEAT", "STATUSTEXT", "GLOBAL_POSITION_INT"]
+        while time.monotonic() < end:
+            msg = self.qgc.conn.recv_match(type=kinds, blocking=True, timeout=0.2)
+            if msg is None or msg.get_srcSystem() != 1 or msg.get_srcComponent() != 1:
+                continue
+            if msg.get_type() != "COMMAND_ACK":
+                self._take(msg)
+            elif msg.command == command:
+                assert msg.result == d.MAV_RESULT_ACCEPTED, (command, msg.result, self.texts)
+                return
+        raise AssertionError(f"no COMMAND_ACK for {command} within {timeout_s} s")
 
     def _take(self, msg) -> None:
         kind = msg.get_type()
@@ -100,9 +112,9 @@ def test_qgc_land_with_the_square_plans_fence_lands_inside_it(sim):
     try:
         qgc.connect()
         flag = d.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
-        _accepted(qgc, d.MAV_CMD_DO_SET_MODE, flag, BY_MODE[FlightMode.RTL].px4)  # Return
+        heard.accepted(d.MAV_CMD_DO_SET_MODE, flag, BY_MODE[FlightMode.RTL].px4)  # Return
         heard.pump(lambda: heard.rally_m < NEAR_M, "near the rally point")
-        _accepted(qgc, d.MAV_CMD_NAV_LAND, 0, 0, 0, 0, 0, 0, 0)  # the custom action Land
+        heard.accepted(d.MAV_CMD_NAV_LAND, 0, 0, 0, 0, 0, 0, 0)  # the custom action Land
         heard.pump(lambda: not heard.armed, "disarmed")
     finally:
         qgc.close()
