@@ -94,6 +94,17 @@ class LineFramer:
             return 0
         return max(0, min(self._recent) - len(self._line)) + 1
 
+    def bytes_until(self, sentences: int) -> int:
+        """Bytes still to come before ``sentences`` more are whole (the one in progress
+        the first of them), at least: each as long as the shortest of the last few and its
+        line ending's first byte, less what has come of the one in progress (0: none asked,
+        or no sentence seen yet). A reader with nothing to do before then may sleep until
+        that many bytes are waiting (``ReopeningSerial.wake_after``)."""
+        if sentences <= 0 or not self._recent:
+            return 0
+        begun = len(self._line) if self._line is not None else 0
+        return max(0, sentences * (min(self._recent) + 1) - begun)
+
     def _one_whole_sentence(self, data: bytes) -> bytes | None:
         """``data`` as one sentence when it is exactly one, from its ``$`` to its line
         ending, between sentences: what a device's read nearly always finds. The loop in

@@ -35,6 +35,7 @@ import serial
 
 from companion.fd_wait import drain
 from companion.sensors.termios2_serial import port_class
+from companion.sensors.tty_wake import WakeBytes
 
 log = logging.getLogger(__name__)
 FIRST_RETRY_S = 0.1
@@ -150,6 +151,7 @@ class ReopeningSerial:
         self._port: SerialPort | None = None
         self._fd: int | None = None  # a device's descriptor, read and written directly
         self._poll: select.poll | None = None  # on _fd (and stop_fd)
+        self._wake: WakeBytes | None = None  # _fd's VMIN, when a reader asked for one
         self._timeout_ms = max(0, round(read_timeout_s * 1000))
         self._retry_s = FIRST_RETRY_S
         self._next_try = 0.0  # time.monotonic() of the next open attempt
@@ -159,6 +161,19 @@ class ReopeningSerial:
     def is_open(self) -> bool:
         """Whether the device is open now."""
         return self._port is not None
+
+    def wake_after(self, n_bytes: int) -> None:
+        """Let the next reads wait until ``n_bytes`` have come (1 to 255, termios VMIN;
+        ``companion.sensors.tty_wake``), not only the first: for a caller with work only
+        every few frames. A port without a descriptor, or reopened and not asked again,
+        wakes at the first byte."""
+        if self._fd is None:
+            return
+        if self._wake is None:
+            if n_bytes <= 1:
+                return
+            self._wake = WakeBytes(self._fd)
+        self._wake.set(n_bytes)
 
     def read(self, size: int = 4096) -> bytes:
         """What has arrived, up to ``size`` bytes; waits at most the read timeout for the
@@ -207,6 +222,8 @@ class ReopeningSerial:
             return b"", t_us  # readable a moment ago, taken by nobody else: try again
         if not data:  # pyserial's own verdict on a readable device with nothing to read
             raise serial.SerialException("device reports readiness to read but returned no data")
+        if self._wake is not None:
+            data = self._wake.read_rest(data, size)
         return data, t_us
 
     def write(self, data: bytes) -> int:
@@ -294,6 +311,7 @@ class ReopeningSerial:
 
     def _drop_port(self) -> None:
         port, self._port, self._fd, self._poll = self._port, None, None, None
+        self._wake = None  # a reopened port starts at pyserial's VMIN of 1
         if port is not None:
             try:
                 port.close()

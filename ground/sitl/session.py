@@ -115,6 +115,8 @@ def vehicle_config(req: SimRequest, opts: BridgeOptions, devices: dict[str, str]
             # Lockstep: the simulator waits for each driver to read its frame (exact: to
             # publish its sample) before the next step, so a batching driver would hold it.
             spec.settings["batch_s"] = 0.0
+        if spec.settings.get("read_on_wake") and opts.speed is None:
+            spec.settings["read_on_wake"] = False  # the same: each sample must be read
     if req.state_dir:
         cfg.vehicle["state_dir"] = req.state_dir
     if req.sysid is not None:

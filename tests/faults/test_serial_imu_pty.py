@@ -7,6 +7,7 @@ import time
 
 import pytest
 
+from companion.exec_control.config import ConfigError, load_config
 from tests.support.configs import plugin, vehicle_config
 from tests.support.pty import Pty
 from tests.support.vehicle import wait_for
@@ -192,3 +193,62 @@ def test_a_sentence_handed_over_in_pieces_does_not_wake_the_driver_for_each(
     assert frames == sent
     # Woken by its first piece, once more after the wait, then by the last piece or two.
     assert steps <= len(pieces) // 2 * frames, f"{steps} reads, {frames} sentences"
+
+
+def _imu_steps(stats) -> int | None:
+    """The IMU driver's newest step count on system/plugin_stats (once a second), if any."""
+    steps = None
+    for s in stats.drain():
+        if s.name == b"imu":
+            steps = int(s.steps)
+    return steps
+
+
+@pytest.mark.timeout(90)
+def test_read_on_wake_wakes_the_driver_once_a_state_and_keeps_every_sample(
+    vehicle_factory, tmp_path
+):
+    """read_on_wake: the port holds a navigation period's first sample until its last has
+    come (VMIN), so the driver wakes once a state (50 Hz), not once a sample (100 Hz), and
+    still publishes every sample, in order, each a period after the one before."""
+    pty = Pty(tmp_path / "ttyImu")
+    config = plugin(
+        "imu", "sensors.serial_imu", device=pty.link, rate_hz=100.0, wake_hz=50.0,
+        read_on_wake=True,
+    )  # fmt: skip
+    vehicle = vehicle_factory(vehicle_config("imu", config))
+    imu, stats = (
+        vehicle.bus.queue_reader("sensors/imu"),
+        vehicle.bus.queue_reader("system/plugin_stats"),
+    )
+    vehicle.wait_running("imu")
+    wait_for(lambda: pty.write(GOOD) or imu.take(0.05), 15, "the IMU heard")
+    time.sleep(0.3)
+    list(imu.drain())
+    before = wait_for(lambda: _imu_steps(stats), 15, "the IMU's counters")
+    start, sent, got = time.monotonic(), 200, []
+    for n in range(sent):  # 2 s of samples at 100 Hz, on the device's schedule
+        time.sleep(max(0.0, start + n / 100 - time.monotonic()))
+        pty.write(GOOD)
+        got += imu.drain()
+    got += imu.take(1.5)  # the last may wait for its partner until the read timeout (1 s)
+    assert len(got) == sent, f"{len(got)} of {sent} samples"
+    stamps = [s.t_us for s in got]
+    gaps = [b - a for a, b in itertools.pairwise(stamps)]
+    assert min(gaps) > 0, "two samples stamped alike, or out of order"
+    assert sorted(gaps)[len(gaps) // 2] == pytest.approx(10_000, abs=2_000)
+    after = wait_for(lambda: _imu_steps(stats), 5, "the IMU's counters")
+    steps = after - before
+    # Once a state and a second's counters: about 100 reads for 200 samples (200 without).
+    assert steps <= 0.65 * sent, f"{steps} reads for {sent} samples"
+    # A lone sample whose partner never comes is still read, at the read timeout at worst.
+    pty.write(GOOD)
+    assert len(imu.take(2.5)) == 1
+
+
+def test_read_on_wake_without_the_navigators_grid_is_refused(tmp_path):
+    config = plugin("imu", "sensors.serial_imu", device="/dev/null", read_on_wake=True)
+    path = tmp_path / "imu.toml"
+    path.write_text(vehicle_config("imu", config))
+    with pytest.raises(ConfigError, match="read_on_wake needs wake_hz and an IMU at least twice"):
+        load_config(path)

@@ -66,10 +66,13 @@ def _first_difference(a: Path, b: Path) -> str:
 def _woken_every_sample(tmp_path: Path) -> str:
     """sim.toml with the navigator woken on every IMU sample, not once a state."""
     text = (REPO / "companion" / "configs" / "sim.toml").read_text()
-    shipped = 'device = "sim://imu", baud = 115200, wake_hz = 50.0'
+    shipped = (
+        'device = "sim://imu", baud = 115200, rate_hz = 100.0, wake_hz = 50.0, read_on_wake = true'
+    )
     assert shipped in text, "sim.toml's IMU line changed: update this test"
     path = tmp_path / "every_sample.toml"
-    path.write_text(text.replace(shipped, 'device = "sim://imu", baud = 115200, wake_hz = 0.0'))
+    every = 'device = "sim://imu", baud = 115200, rate_hz = 100.0, wake_hz = 0.0'
+    path.write_text(text.replace(shipped, every))
     return str(path)
 
 

@@ -17,10 +17,11 @@ from typing import TYPE_CHECKING, Any
 
 from companion.messages import Baro
 from companion.params.live import LiveParams
-from companion.plugin import FLIGHT_NICE, PluginContext, Ports, Setting
+from companion.plugin import FLIGHT_NICE, NO_VEHICLE, PluginContext, Ports, Setting
 from companion.plugins.sensors.serial_sensor import SerialSensor, serial_settings
 from companion.sensors.barometer import pressure_altitude_m
 from companion.sensors.imu_calibration import IMU_CAL_PARAMS, ImuCalibration
+from companion.sensors.line_framer import LineFramer
 from companion.sensors.vectornav import VectorNavDecoder, VectorNavReading
 from companion.time_grid import TimeGrid
 
@@ -28,6 +29,10 @@ if TYPE_CHECKING:
     from companion.bus.patterns import Writer
 
 PARAMS_EVERY_US = 100_000  # a calibration's new values are looked for this often
+# read_on_wake: the reader's wait ends this many bytes before the sentences it waits for
+# are whole, at the least: a number in the next may be a digit or a sign shorter than in
+# any of the last few, and woken that little early the reader takes the rest as it comes.
+SENTENCE_SLACK = 8
 
 
 class SerialImu(SerialSensor[VectorNavReading]):
@@ -61,9 +66,31 @@ class SerialImu(SerialSensor[VectorNavReading]):
             min=0.0,
             max=1000.0,
         ),
+        "read_on_wake": Setting(
+            bool,
+            False,
+            "with wake_hz: the driver itself sleeps until the sample that wakes the navigator"
+            " has come, not at every sample (the port's driver holds the ones before it:"
+            " termios VMIN), a wake-up a state; not in a lockstep simulation, which waits"
+            " for every sample to be read",
+        ),
     }
 
     params = IMU_CAL_PARAMS
+
+    @classmethod
+    def validate(
+        cls, settings: Mapping[str, Any], vehicle: Mapping[str, Any] = NO_VEHICLE
+    ) -> list[str]:
+        """read_on_wake needs the navigator's grid (wake_hz) and a device at least twice as
+        fast (rate_hz): slower, every sample wakes the navigator anyway."""
+        wake_hz, rate_hz = settings["wake_hz"], settings["rate_hz"]
+        if settings.get("read_on_wake") and not (wake_hz > 0 and rate_hz >= 2 * wake_hz):
+            return [
+                f"read_on_wake needs wake_hz and an IMU at least twice as fast (rate_hz"
+                f" {rate_hz:g}, wake_hz {wake_hz:g})"
+            ]
+        return []
 
     @classmethod
     def ports(cls, settings: Mapping[str, Any]) -> Ports:
@@ -85,6 +112,13 @@ class SerialImu(SerialSensor[VectorNavReading]):
         self.wake_grid = TimeGrid(wake_hz) if wake_hz > 0 else None
         aiding_hz = ctx.settings["aiding_hz"]
         self.aiding_grid = TimeGrid(aiding_hz) if aiding_hz > 0 else None
+        # read_on_wake: the samples a navigation period brought, and those since its end.
+        self.read_on_wake = bool(ctx.settings["read_on_wake"] and wake_hz > 0)
+        # At most the samples every period has: a period of 2.5 has 2 or 3, and a wait for
+        # 3 would hold a state back by a sample where 2 made it.
+        self.most_per_wake = int(ctx.settings["rate_hz"] / wake_hz + 1e-9) if wake_hz else 1
+        self.period_samples = 0
+        self.since_wake = 0
 
     def make_decoder(self, settings: Mapping[str, Any]) -> VectorNavDecoder:
         return VectorNavDecoder()
@@ -104,6 +138,10 @@ class SerialImu(SerialSensor[VectorNavReading]):
         # The sample that completes a navigation period wakes the navigator (and takes
         # the ones before it along): a wake-up costs the navigator its whole step.
         wake = self.wake_grid is None or self.wake_grid.passed(t_us)
+        if wake:
+            self.period_samples, self.since_wake = self.since_wake + 1, 0
+        else:
+            self.since_wake += 1
         # Its heading and height first: woken, the navigator finds them there. Not with
         # every sample: each one costs its readers (the navigator, the logger) a receive,
         # and the navigator would drop all but one in five of them.
@@ -113,6 +151,22 @@ class SerialImu(SerialSensor[VectorNavReading]):
             if self.baro is not None:
                 self._publish_baro(self.baro, t_us, reading.pressure_pa, wake)
         self.imu.publish(reading.imu, wake)
+
+    def step(self) -> None:
+        bytes_before = self.port.bytes_in
+        super().step()
+        if not self.read_on_wake or not isinstance(self.framer, LineFramer):
+            return
+        if self.port.bytes_in == bytes_before:
+            # A wait that ended with nothing read (a second's silence, a stop): what the
+            # port may hold back under its count is taken at the next wait, as it is.
+            self.port.wake_after(1)
+            return
+        # Sleep until the sample that completes the navigation period has come: as many as
+        # the last period brought (the device's rate may not be the setting's), less those
+        # already here.
+        due = min(self.period_samples, self.most_per_wake) - self.since_wake
+        self.port.wake_after(self.framer.bytes_until(due) - SENTENCE_SLACK)
 
     def _publish_baro(
         self, baro: Writer[Baro], t_us: int, pressure_pa: float, wake: bool = True

@@ -111,3 +111,16 @@ def test_every_sentence_embedded_in_junk_comes_out_intact(pairs, tail, size):
     stream = b"".join(junk + sentence + b"\r\n" for junk, sentence in pairs) + tail
     framer = LineFramer()
     assert feed_in_pieces(framer, stream, size) == [sentence for _, sentence in pairs]
+
+
+def test_bytes_until_counts_the_shortest_recent_sentence_less_what_has_come():
+    framer = LineFramer()
+    assert framer.bytes_until(2) == 0  # no sentence seen: its length is unknown
+    framer.feed(GGA + b"\r\n" + RMC + b"\r\n")
+    shortest = min(len(GGA), len(RMC))
+    # Each sentence is whole at its line ending's first byte.
+    assert framer.bytes_until(1) == shortest + 1
+    assert framer.bytes_until(2) == 2 * (shortest + 1)
+    assert framer.bytes_until(0) == 0
+    framer.feed(GGA[:10])  # a sentence begun: it is the first of those waited for
+    assert framer.bytes_until(2) == 2 * (shortest + 1) - 10
