@@ -15,7 +15,10 @@ import pytest
 from mavlink_dialect import companion as d
 from tests.sitl.test_failsafes import PLAN, Station
 
-pytestmark = pytest.mark.vehicle(plan=PLAN, duration=600)
+# 1500 simulated seconds, as the other failsafe flights: lockstep on an idle machine runs 20-30
+# times faster than the wall, and 600 s ended the simulation before a slow start had armed
+# (CI twice: every pre-arm check then said the sensors were not fresh).
+pytestmark = pytest.mark.vehicle(plan=PLAN, duration=1500)
 
 
 @pytest.fixture
