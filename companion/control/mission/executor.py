@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass, field
 
 from companion.control.laws.fillet import MIN_TURN_RAD, corner_arc
-from companion.control.mission.approach import circle_down, circle_note, final_height
+from companion.control.mission import approach
 from companion.control.mission.items import (
     CAMERA_ITEMS,
     MAX_JUMPS_PER_STEP,
@@ -237,13 +237,19 @@ class MissionExecutor:
         if not self._flown_back:
             radius = max(radius, self._turn_lead(self._prev, b))
         if _distance(pos, b) <= radius or past_point(self._prev, b, pos):
-            # Reached too high to start the final there: circle down to it first (PX4 and
-            # pilots do), else the final began 24 m above its path and the Cub floated 40 m.
+            # Reached too high for the final, or the final turning back on the leg in (a
+            # loop's corner): circle down to it first (PX4 and pilots do), else the Cub
+            # floated 40 m (the C172 in the loop: 350 m short, 134 m aside).
             land = self._next_point(b) if self.leads_to_landing() else None
             top = self._final_from(b, self.alt_of(item)) + LOITER_ALT_MARGIN_M
-            if land is not None and alt > top:
+            back = approach.turns_back_onto
+            turns_back = land is not None and back(self._prev, b, land, self._turn_radius)
+            if land is not None and (alt > top or turns_back):
                 size = max(self.config.loiter_radius, self._turn_radius)
-                self._descending = circle_down(item, b, land, pos, size, self.frame)
+                self._descending = approach.circle_down(item, b, land, pos, size, self.frame)
+                if turns_back:
+                    text = f"Land: circling at item {item.seq} to line up with the final"
+                    self.said.append((d.MAV_SEVERITY_NOTICE, text))
                 return self._loiter_to_alt(self._descending, pos, alt)
             self._advance(True, b, self.alt_of(item))
             return None
@@ -338,7 +344,7 @@ class MissionExecutor:
         if item.seq not in self._told and self._turn_radius > 0.0:  # once, on the circle
             self._told.add(item.seq)
             home, planned_alt = self.home_alt_msl, self.alt_of(item)
-            note = circle_note((nominal, planned_alt - home), (radius, target_alt - home))
+            note = approach.circle_note((nominal, planned_alt - home), (radius, target_alt - home))
             self.said += [(d.MAV_SEVERITY_NOTICE, note)] if note else []
         circle = Setpoint(Kind.CIRCLE, centre, centre, target_alt, radius, clockwise, self.speed)
         on_circle = abs(_distance(pos, centre) - radius) <= radius * ON_CIRCLE
@@ -363,7 +369,8 @@ class MissionExecutor:
         if land is None or land.command != d.MAV_CMD_NAV_LAND:
             return alt
         point = self.point_of(land, start)
-        return final_height(alt, start, point, self.alt_of(land), self.config.final_slope_max)
+        steepest = self.config.final_slope_max
+        return approach.final_height(alt, start, point, self.alt_of(land), steepest)
 
     def _loiter_item(
         self, item: MissionItem, pos: Point, alt: float, t_s: float

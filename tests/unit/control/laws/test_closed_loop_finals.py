@@ -18,7 +18,7 @@ import pytest
 from bridges.jsbsim.fdm import Home
 from companion.control.mission.items import MissionItem
 from companion.control.mission.plan import checked_plan
-from companion.geodesy import LocalFrame
+from companion.geodesy import LocalFrame, wrap_pi
 from companion.messages import LandPhase
 from ground.campaign.landing_score import landing_score_for_plan
 from mavlink_dialect import companion as d
@@ -124,5 +124,39 @@ def test_a_turn_back_onto_the_final_at_approach_speed_does_not_stall_the_c172() 
     approach = [s for s in loop.samples if s.out.land_phase == LandPhase.APPROACH]
     slowest = min(s.airspeed for s in approach)
     assert slowest > 27.0, f"slowed to {slowest:.1f} m/s on the final"
+    score = landing_score_for_plan(loop.truth(), items)
+    assert score.passed(), score
+
+
+def test_a_short_final_turning_back_on_the_leg_in_is_begun_from_a_circle_lined_up() -> None:
+    """A random plan's shape (benchmarks/varied_landings.py, plan 30): the leg into the
+    final's waypoint runs east-north-east, the 336 m final from 25 m back west, a 152° turn
+    on a final shorter than the loop onto it needs. Flown as a loop corner, the C172 began
+    its glide in the loop, flared heading away from the runway and landed 350 m short and
+    134 m beside it; it now circles at the waypoint, leaves the circle there lined up,
+    says so, and lands on target."""
+    home = Home()
+    frame = LocalFrame(home.lat_deg, home.lon_deg)
+
+    def at(seq: int, command: int, ne: tuple[float, float], alt: float, p1: float = 0.0):
+        lat, lon = frame.latlon(*ne)
+        return MissionItem(seq, d.MAV_FRAME_GLOBAL_RELATIVE_ALT, command, 0, 1, p1, 0.0, 0.0,
+                           0.0, round(lat * 1e7), round(lon * 1e7), alt)  # fmt: skip
+
+    items = [
+        at(0, d.MAV_CMD_NAV_TAKEOFF, (0.0, 600.0), 100.0, p1=15.0),
+        at(1, d.MAV_CMD_NAV_WAYPOINT, (-600.0, -700.0), 80.0),
+        at(2, d.MAV_CMD_NAV_WAYPOINT, (0.0, 436.0), 25.0),
+        at(3, d.MAV_CMD_NAV_LAND, (0.0, 100.0), 0.0),
+    ]
+    loop = ClosedLoop("c172p", items, range_max_m=12.0)
+    assert loop.fly_until_disarmed(900.0)
+    said = [text for _, text in loop.controller.lander.said]
+    assert "Land: circling at item 2 to line up with the final" in said, said
+    glide = [s for s in loop.samples if s.out.land_phase == LandPhase.APPROACH]
+    first = glide[0]  # the glide begins lined up: on the centreline, heading west
+    north, _ = frame.ne(first.lat, first.lon)
+    assert abs(north) < 10.0, f"{north:.1f} m off the centreline as the glide began"
+    assert abs(math.degrees(wrap_pi(first.yaw - math.radians(270.0)))) < 20.0
     score = landing_score_for_plan(loop.truth(), items)
     assert score.passed(), score
