@@ -39,7 +39,7 @@ RELATIVE_FRAMES = (d.MAV_FRAME_GLOBAL_RELATIVE_ALT, d.MAV_FRAME_GLOBAL_RELATIVE_
 ON_CIRCLE = 0.25  # within this fraction of the radius the aircraft counts as circling
 TAKEOFF_MARGIN_M = 5.0
 LOITER_ALT_MARGIN_M = 5.0  # LOITER_TO_ALT: this close to its height counts as there
-TANGENT_WINDOW = math.radians(30.0)  # leave a LOITER_TO_ALT this soon past the tangent point
+TANGENT_WINDOW = math.radians(10.0)  # leave a LOITER_TO_ALT this soon past the tangent point
 ESTABLISHED = math.radians(90.0)  # and once it has flown this far round it
 # Items a landing's final may start from (``leads_to_landing``).
 APPROACH_FROM = {d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_NAV_LOITER_TO_ALT}
