@@ -29,6 +29,7 @@ from companion.control.mission.camera_shots import CameraPorts, CameraShots
 from companion.control.mission.fence import Fence
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
+from companion.control.mission_return import reported_state
 from companion.messages import (
     MISSION_SERVO_SEQ,
     ActuatorCommand,
@@ -37,7 +38,6 @@ from companion.messages import (
     CommandResult,
     ControlStatus,
     FlightMode,
-    MissionState,
     StatusText,
     TakeoffPhase,
     VehicleCommand,
@@ -304,12 +304,12 @@ class FixedWingPlugin(Plugin):
         executor = self.controller.executor
         running = executor is not None
         msg.mission_seq = executor.current if executor is not None else 0
-        if out.mission_finished:
-            msg.mission_state = MissionState.COMPLETE
-        elif running and status.mode == FlightMode.MISSION:
-            msg.mission_state = MissionState.ACTIVE
-        else:
-            msg.mission_state = MissionState.NOT_STARTED
+        finished = executor is not None and executor.finished
+        pending = self.controller.set_currents.pending is not None
+        flying_it = running and status.mode == FlightMode.MISSION
+        msg.mission_state = reported_state(
+            flying_it, out.mission_finished, finished, status.mode == FlightMode.RTL, pending
+        )
         msg.landed = int(out.landed)
         msg.land_phase, msg.takeoff_phase = out.land_phase, out.takeoff_phase
         msg.reached_count, msg.last_reached = self.reached_count, self.last_reached

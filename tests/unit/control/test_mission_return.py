@@ -8,7 +8,7 @@ from types import SimpleNamespace
 import pytest
 
 from companion.control.commander import Commander
-from companion.control.mission_return import returning_item
+from companion.control.mission_return import reported_state, returning_item
 from companion.messages import ControlStatus, FlightMode, MissionState
 from companion.plugins.vehicle.commander import CommanderPlugin
 from mavlink_dialect import companion as d
@@ -60,3 +60,16 @@ def test_the_commander_enters_return_once_and_says_why():
     # The controller's next status still says the mission ended there, in the old entry.
     assert not CommanderPlugin._mission_return(plugin, 0, _control())  # type: ignore[arg-type]
     assert commander.changes == 8 and said == ["Mission: item 2 returns to launch"]
+
+
+def test_the_status_says_complete_through_the_return_the_mission_ended_in():
+    """The commander enters Return within a step of the first COMPLETE; a link that reads
+    the newest status missed it at lockstep speed. COMPLETE holds through that Return,
+    until a set-current is waiting to take the mission up again."""
+    state = reported_state
+    assert state(True, False, False, False, False) == MissionState.ACTIVE
+    assert state(True, True, True, False, False) == MissionState.COMPLETE  # its end, in Mission
+    assert state(False, False, True, True, False) == MissionState.COMPLETE  # the Return after
+    assert state(False, False, True, True, True) == MissionState.NOT_STARTED  # set elsewhere
+    assert state(False, False, True, False, False) == MissionState.NOT_STARTED  # Loiter after
+    assert state(False, False, False, True, False) == MissionState.NOT_STARTED  # a failsafe RTL
