@@ -10,8 +10,8 @@ from dataclasses import replace
 
 from companion.control.laws.fillet import LOOP_TURN_RAD
 from companion.control.mission.items import MissionItem
-from companion.control.mission.leg_geometry import distance
-from companion.geodesy import LocalFrame, wrap_pi
+from companion.control.mission.leg_geometry import corner_turn, distance
+from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
 
 Point = tuple[float, float]
@@ -20,6 +20,7 @@ NOTE_LOWER_M = 2.0  # and one left this much lower
 # A final shorter than this many turn radii after a loop's corner is begun from a circle:
 # the loop takes up to two radii of it, and the glide needs the rest lined up.
 LINE_UP_RADII = 3.0
+LINE_UP_TEXT = "Land: circling at item %d to line up with the final"  # said as it begins
 
 
 def circle_down(
@@ -36,16 +37,17 @@ def circle_down(
                    param2=side * radius, x=round(lat * 1e7), y=round(lon * 1e7))  # fmt: skip
 
 
-def turns_back_onto(a: Point, b: Point, land: Point, turn_radius: float) -> bool:
+def turns_back_onto(a: Point, b: Point, land: Point | None, turn_radius: float) -> bool:
     """Whether the final from ``b`` to ``land`` turns back on the leg ``a`` → ``b`` more than
     a corner's arc turns (``LOOP_TURN_RAD``) and is too short (``LINE_UP_RADII`` turn
     radii) for the loop that turns onto it to leave the aircraft lined up on it before the
-    flare: the aircraft would glide in the loop and meet the final across it."""
-    if distance(a, b) < 1.0 or distance(b, land) >= LINE_UP_RADII * turn_radius:
+    flare: the aircraft would glide in the loop and meet the final across it (False with
+    no final: ``land`` None)."""
+    if land is None or distance(a, b) < 1.0:
         return False
-    leg_in = math.atan2(b[1] - a[1], b[0] - a[0])
-    leg_out = math.atan2(land[1] - b[1], land[0] - b[0])
-    return abs(wrap_pi(leg_out - leg_in)) > LOOP_TURN_RAD
+    if distance(b, land) >= LINE_UP_RADII * turn_radius:
+        return False
+    return abs(corner_turn(a, b, land)) > LOOP_TURN_RAD
 
 
 def final_height(alt: float, start: Point, land: Point, land_alt: float, steepest: float) -> float:

@@ -29,7 +29,12 @@ from companion.control.mission.items import (
     change_speed,
     next_flown,
 )
-from companion.control.mission.leg_geometry import CircleProgress, past_point, tangent_angle
+from companion.control.mission.leg_geometry import (
+    CircleProgress,
+    corner_turn,
+    past_point,
+    tangent_angle,
+)
 from companion.control.mission.leg_geometry import distance as _distance
 from companion.control.mission.setpoint import Kind, Point, Setpoint
 from companion.geodesy import LocalFrame, wrap_pi
@@ -237,19 +242,16 @@ class MissionExecutor:
         if not self._flown_back:
             radius = max(radius, self._turn_lead(self._prev, b))
         if _distance(pos, b) <= radius or past_point(self._prev, b, pos):
-            # Reached too high for the final, or the final turning back on the leg in (a
-            # loop's corner): circle down to it first (PX4 and pilots do), else the Cub
-            # floated 40 m (the C172 in the loop: 350 m short, 134 m aside).
+            # Too high for the final, or the final turns back on the leg in (a loop): circle down
+            # to it first (PX4 and pilots do), else the Cub floated 40 m (the C172: 350 m short).
             land = self._next_point(b) if self.leads_to_landing() else None
             top = self._final_from(b, self.alt_of(item)) + LOITER_ALT_MARGIN_M
-            back = approach.turns_back_onto
-            turns_back = land is not None and back(self._prev, b, land, self._turn_radius)
+            turns_back = approach.turns_back_onto(self._prev, b, land, self._turn_radius)
             if land is not None and (alt > top or turns_back):
                 size = max(self.config.loiter_radius, self._turn_radius)
                 self._descending = approach.circle_down(item, b, land, pos, size, self.frame)
                 if turns_back:
-                    text = f"Land: circling at item {item.seq} to line up with the final"
-                    self.said.append((d.MAV_SEVERITY_NOTICE, text))
+                    self.said.append((d.MAV_SEVERITY_NOTICE, approach.LINE_UP_TEXT % item.seq))
                 return self._loiter_to_alt(self._descending, pos, alt)
             self._advance(True, b, self.alt_of(item))
             return None
@@ -260,9 +262,7 @@ class MissionExecutor:
         nxt = self._next_point(b)
         if nxt is None or self._turn_radius <= 0.0:
             return 0.0
-        leg_in = math.atan2(b[1] - a[1], b[0] - a[0])
-        leg_out = math.atan2(nxt[1] - b[1], nxt[0] - b[0])
-        turn = wrap_pi(leg_out - leg_in)
+        turn = corner_turn(a, b, nxt)
         if abs(turn) < MIN_TURN_RAD:
             return 0.0
         return corner_arc(turn, self._turn_radius, _distance(a, b), _distance(b, nxt))[0]

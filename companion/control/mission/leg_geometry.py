@@ -26,6 +26,13 @@ def distance(a: Point, b: Point) -> float:
     return math.hypot(b[0] - a[0], b[1] - a[1])
 
 
+def corner_turn(a: Point, b: Point, c: Point) -> float:
+    """The turn (rad, -π..π, positive to the right) at ``b`` from the leg a→b onto b→c."""
+    leg_in = math.atan2(b[1] - a[1], b[0] - a[0])
+    leg_out = math.atan2(c[1] - b[1], c[0] - b[0])
+    return wrap_pi(leg_out - leg_in)
+
+
 def past_point(a: Point, b: Point, pos: Point) -> bool:
     """True once ``pos`` is beyond the line through ``b`` square to the leg a→b."""
     leg = (b[0] - a[0], b[1] - a[1])

@@ -112,8 +112,10 @@ class SerialImu(SerialSensor[VectorNavReading]):
         self.wake_grid = TimeGrid(wake_hz) if wake_hz > 0 else None
         aiding_hz = ctx.settings["aiding_hz"]
         self.aiding_grid = TimeGrid(aiding_hz) if aiding_hz > 0 else None
-        # read_on_wake: the samples a navigation period brought, and those since its end.
-        self.read_on_wake = bool(ctx.settings["read_on_wake"] and wake_hz > 0)
+        # read_on_wake: the sentences' framer (their lengths), the samples a navigation
+        # period brought, and those since its end.
+        framer = self.framer if isinstance(self.framer, LineFramer) else None
+        self.line_framer = framer if ctx.settings["read_on_wake"] and wake_hz > 0 else None
         # At most the samples every period has: a period of 2.5 has 2 or 3, and a wait for
         # 3 would hold a state back by a sample where 2 made it.
         self.most_per_wake = int(ctx.settings["rate_hz"] / wake_hz + 1e-9) if wake_hz else 1
@@ -155,7 +157,7 @@ class SerialImu(SerialSensor[VectorNavReading]):
     def step(self) -> None:
         bytes_before = self.port.bytes_in
         super().step()
-        if not self.read_on_wake or not isinstance(self.framer, LineFramer):
+        if self.line_framer is None:
             return
         if self.port.bytes_in == bytes_before:
             # A wait that ended with nothing read (a second's silence, a stop): what the
@@ -166,7 +168,7 @@ class SerialImu(SerialSensor[VectorNavReading]):
         # the last period brought (the device's rate may not be the setting's), less those
         # already here.
         due = min(self.period_samples, self.most_per_wake) - self.since_wake
-        self.port.wake_after(self.framer.bytes_until(due) - SENTENCE_SLACK)
+        self.port.wake_after(self.line_framer.bytes_until(due) - SENTENCE_SLACK)
 
     def _publish_baro(
         self, baro: Writer[Baro], t_us: int, pressure_pa: float, wake: bool = True
