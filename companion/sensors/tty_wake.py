@@ -26,7 +26,7 @@ TTY_READ_PIECE = 64  # what one read of such a tty hands over at most (Linux 5.1
 
 
 class WakeBytes:
-    """The VMIN of one open tty: set when it changes, back to 1 when the tty refuses it."""
+    """The VMIN of one open tty: set when it changes, left at 1 when the tty refuses it."""
 
     def __init__(self, fd: int) -> None:
         self.fd = fd
