@@ -112,3 +112,22 @@ class DecelEstimate:
             self.decel += k * (min(max(raw, -MAX_DECEL), MAX_DECEL) - self.decel)
         self._last = speed_along
         return max(self.decel, 0.0)
+
+
+def flare_run(ground_speed: float, slope: float, v: Mapping[str, float]) -> tuple[float, float]:
+    """The flare from a glide of ``slope`` (rise over run) at ``ground_speed``: how far
+    before touchdown it begins (m) and at what height (m).
+
+    The exponential flare ḣ = -(s + h/τ) from height H at the glide's sink rate s0 has
+    τ = H / (s0 - s) and lasts τ·ln(s0 / s). It begins where the landing begins it: at
+    ``LAND_FLARE_ALT``, or higher on a path steep enough that ``LAND_FLARE_SEC`` of its
+    sink comes first (the Cub at 4-5 m). The model's flare holds its speed and follows its
+    demand at once; a real one slows with the throttle cut and lags the demand, so it
+    flies a share of this distance, the airframe's ``LAND_FLARE_AIM`` (as ArduPlane's
+    flare aim point)."""
+    s_t = max(v["TECS_LAND_SINK"], 0.05)
+    gs = max(ground_speed, 5.0)
+    s0 = max(gs * slope, s_t * 1.5)
+    h_f = max(v["LAND_FLARE_ALT"], v["LAND_FLARE_SEC"] * s0)
+    tau = h_f / (s0 - s_t)
+    return v["LAND_FLARE_AIM"] / 100.0 * gs * tau * math.log(s0 / s_t), h_f

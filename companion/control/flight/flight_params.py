@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from functools import cached_property
 
+from companion.control.flight.flare_aim import flare_run
 from companion.control.laws.attitude import AttitudeGains
 from companion.control.laws.tecs import TecsGains
 from companion.control.mission.executor import ExecutorConfig
@@ -54,7 +55,7 @@ LANDING_PARAMS = (
     ParamDecl("LAND_SLOPE_MIN", 3.0, 1.0, 10.0, "deg", "landing: the least slope of the glide "
               "path; from a lower approach the height is held until the path is met"),
     ParamDecl("LAND_SLOPE_MAX", 0.0, 0.0, 20.0, "deg", "landing: a landing circle (LOITER_TO_ALT) "
-              "descends below its height until the final is no steeper (0: off)"),
+              "descends below its height until the glide to the flare is no steeper (0: off)"),
     ParamDecl("TECS_APPR_SMAX", 0.0, 0.0, 20.0, "m/s", "landing: most sink on the approach, "
               "for a steep final or a tailwind (0: TECS_SINK_MAX)"),
     ParamDecl("TECS_LAND_SPDWGT", 0.0, 0.0, 2.0, "", "landing: TECS speed weight on the approach "
@@ -214,7 +215,7 @@ def flight_config(values: Mapping[str, float]) -> FlightConfig:
         pitch_min=math.radians(v["PTCH_LIM_MIN_DEG"]),
         speed_weight=v["TECS_SPDWEIGHT"],
     )
-    executor = ExecutorConfig(
-        v["WP_RADIUS"], v["WP_LOITER_RAD"], v["RTL_ALT_M"], math.radians(v["LAND_SLOPE_MAX"])
-    )
+    steepest = math.radians(v["LAND_SLOPE_MAX"])
+    flare = flare_run(v["TECS_LAND_ARSPD"], math.tan(steepest), v)
+    executor = ExecutorConfig(v["WP_RADIUS"], v["WP_LOITER_RAD"], v["RTL_ALT_M"], steepest, flare)
     return FlightConfig(attitude, tecs, executor, v)

@@ -39,7 +39,13 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from companion.control.flight.flare_aim import DecelEstimate, aimed_sink, flare_pitch, time_to_point
+from companion.control.flight.flare_aim import (
+    DecelEstimate,
+    aimed_sink,
+    flare_pitch,
+    flare_run,
+    time_to_point,
+)
 from companion.control.laws.limits import clamp
 from companion.geodesy import wrap_pi
 from companion.messages.control import LandPhase
@@ -162,28 +168,14 @@ class Landing:
         )
 
     def flare_distance(self, ground_speed: float, v: Mapping[str, float]) -> float:
-        """How far before touchdown the flare begins at this ground speed.
-
-        The exponential flare ḣ = -(s + h/τ) from height H at the glide's sink rate s0
-        has τ = H / (s0 - s) and lasts τ·ln(s0 / s); the glide's sink rate is the ground
-        speed times the slope, which itself depends on where the flare begins, so the
-        two are solved together by a few fixed-point steps.
+        """How far before touchdown the flare begins at this ground speed (``flare_run``):
+        the glide's sink rate is the ground speed times the slope, which itself depends on
+        where the flare begins, so the two are solved together by a few fixed-point steps.
         """
-        s_t = max(v["TECS_LAND_SINK"], 0.05)
-        gs = max(ground_speed, 5.0)
         dist, h_f = 0.0, v["LAND_FLARE_ALT"]
         for _ in range(4):
-            slope = self._slope(dist, h_f, v)
-            s0 = max(gs * slope, s_t * 1.5)
-            # The flare begins where _flare_due will begin it: on a path steep enough that
-            # LAND_FLARE_SEC comes first, higher than LAND_FLARE_ALT (the Cub at 4-5 m).
-            h_f = max(v["LAND_FLARE_ALT"], v["LAND_FLARE_SEC"] * s0)
-            tau = h_f / (s0 - s_t)
-            # The model's flare holds its speed and follows its demand at once; a real one
-            # slows with the throttle cut and lags the demand, so it flies a share of this
-            # distance, the airframe's LAND_FLARE_AIM (as ArduPlane's flare aim point).
-            share = v["LAND_FLARE_AIM"] / 100.0
-            dist = min(share * gs * tau * math.log(s0 / s_t), 0.5 * self.length)
+            run, h_f = flare_run(ground_speed, self._slope(dist, h_f, v), v)
+            dist = min(run, 0.5 * self.length)
         self.flare_alt = h_f
         return dist
 
@@ -305,6 +297,13 @@ class Landing:
         # of path angle is the pitch change to first order (the feedback does the rest).
         speed = max(math.hypot(*s.vel), 5.0)
         path_change = (self._flare_sink - sink_dem) / speed
+        if low and error > 0.0:
+            # Sinking too fast low in the flare, it pitches up from its least pitch, not from
+            # a fast steep glide's far below it: from a tailwind final's -10° its demand
+            # stayed under the least pitch down to 1 m, the sink at 1.3 m/s, and a C172
+            # touched down 19.7 m short.
+            least = flare_pitch(-math.pi / 2, s.airspeed, v)
+            self._flare_pitch = max(self._flare_pitch, least - path_change)
         pitch = self._flare_pitch + path_change + SINK_P * error + self._flare_integ
         return LandingDemand(
             self.phase,

@@ -50,13 +50,21 @@ def turns_back_onto(a: Point, b: Point, land: Point | None, turn_radius: float) 
     return abs(corner_turn(a, b, land)) > LOOP_TURN_RAD
 
 
-def final_height(alt: float, start: Point, land: Point, land_alt: float, steepest: float) -> float:
+def final_height(
+    alt: float, start: Point, land: Point, land_alt: float, steepest: float, flare: Point
+) -> float:
     """The height to leave a landing circle at, at ``start``, for a final no steeper than
     ``steepest`` (rad; 0: the plan's ``alt``): a Cub idling down a 6° final gained 6 m/s
-    and floated 34 m long."""
+    and floated 34 m long. The glide ends where the flare begins, ``flare`` (its run before
+    the touchdown point, at most half the final, and its height): counted to the
+    touchdown point instead, a C172's 227 m final from 20 m was glided at 8°, dived at
+    its least pitch to 34 m/s, flared from 13 m and touched down 42 m long."""
     if steepest <= 0.0:
         return alt
-    return min(alt, land_alt + distance(start, land) * math.tan(steepest))
+    length = distance(start, land)
+    run, flare_alt = flare
+    glide = length - min(run, 0.5 * length)
+    return min(alt, land_alt + flare_alt + glide * math.tan(steepest))
 
 
 def circle_note(planned: tuple[float, float], flown: tuple[float, float]) -> str | None:

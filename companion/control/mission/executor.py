@@ -10,8 +10,7 @@ seconds or param1 turns once on the circle; NAV_RETURN_TO_LAUNCH ends the missio
 as it is begun, and hands the flight to Return (the commander enters that mode, as ArduPlane
 and PX4 do: ``control.mission_return``; until it does, or flown without a commander, it
 flies home and circles there); DO_CHANGE_SPEED, DO_SET_SERVO (``servo_sets``, for the servo
-output) and DO_JUMP act at once. After the last item the aircraft circles the last point
-(PX4).
+output) and DO_JUMP act at once. After the last item the aircraft circles its last point (PX4).
 """
 
 from __future__ import annotations
@@ -58,6 +57,7 @@ class ExecutorConfig:
     loiter_radius: float = 80.0
     rtl_alt_rel: float = 100.0
     final_slope_max: float = 0.0  # rad: a landing circle descends until its final is no steeper
+    final_flare: tuple[float, float] = (0.0, 0.0)  # (run, height) of that final's flare (m)
 
 
 @dataclass
@@ -369,8 +369,8 @@ class MissionExecutor:
         if land is None or land.command != d.MAV_CMD_NAV_LAND:
             return alt
         point = self.point_of(land, start)
-        steepest = self.config.final_slope_max
-        return approach.final_height(alt, start, point, self.alt_of(land), steepest)
+        steepest, flare = self.config.final_slope_max, self.config.final_flare
+        return approach.final_height(alt, start, point, self.alt_of(land), steepest, flare)
 
     def _loiter_item(
         self, item: MissionItem, pos: Point, alt: float, t_s: float

@@ -201,3 +201,20 @@ def test_a_flare_begun_as_a_gust_pitches_the_nose_starts_from_the_glides_pitch()
 
     gust = first_flare_pitch(math.radians(-4.0))
     assert gust == pytest.approx(first_flare_pitch(math.radians(1.0)), abs=math.radians(0.2))
+
+
+def test_low_in_a_flare_from_a_fast_steep_glide_a_sink_too_fast_pitches_up_at_once():
+    """Down a steep final with a tailwind the C172 glided nose 10° down, and its flare,
+    pitching from there, asked for less than its least pitch (LAND_PITCH_CD, 0°) down to
+    1 m: the sink stayed at 1.3 m/s and it touched down 19.7 m short. Low in the flare and
+    sinking faster than the flare asks, the pitch now rises from the least pitch at once."""
+    flare_at = TOUCHDOWN[1] - Landing(START, 150.0, TOUCHDOWN, 100.0).flare_distance(28.0, V)
+    land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+    glide = replace(_state(flare_at - 100.0, 12.0, sink=4.0), pitch=math.radians(-10.0))
+    for k in range(150):  # three seconds on the glide
+        land.step(replace(glide, pos=(0.0, flare_at - 100.0 + k * 0.56)), V, 0.02)
+    high = land.step(replace(_state(flare_at, 6.0, sink=4.0), pitch=math.radians(-8.0)), V, 0.02)
+    assert high.phase == LandPhase.FLARE
+    assert high.pitch == pytest.approx(0.0)  # high in the flare: held at the least pitch
+    low = land.step(_state(flare_at + 80.0, 0.8, sink=1.3), V, 0.02)
+    assert low.pitch > math.radians(1.0)

@@ -80,17 +80,19 @@ def _gusty_landings(
 def test_power_in_the_flare_holds_up_a_flare_begun_in_a_gusts_dive():
     """In JSBSim's own gust sequence (its seed 1, the one the simulated vehicle meets) the
     C172's flare on land_east begins in a gust's dive, nose 4° down and sinking 2 m/s, and
-    its pitch lags the demand all the way down: at idle it touched down 26 m short. Power
+    its pitch lags the demand all the way down: at idle it touched down 26 m short (15 m
+    since the flare pitches up from its least pitch when low and sinking too fast). Power
     against the sink that would land short of the point puts it on target."""
     idle, powered = _gusty_landings("c172p", PLAN, 1, {"LAND_FLARE_PWR": 0.0})
-    assert idle.along_m < -20.0, idle
     assert powered.passed(), powered
+    assert powered.along_m > idle.along_m + 10.0, (idle, powered)
 
 
 def test_full_power_in_the_flare_holds_the_c172_up_through_a_lull():
     """In JSBSim's gust sequence 47 a lull meets the C172's flare in the crosswind: at
-    TRIM_THROTTLE it sank 15.5 m short of the point. With the airframe's LAND_FLARE_THR
-    (full power, as a pilot gives in gusts) it touched down 8.4 m short, on target."""
+    TRIM_THROTTLE it sank 15.5 m short of the point (12.5 m since the flare pitches up from
+    its least pitch when low and sinking too fast). With the airframe's LAND_FLARE_THR (full
+    power, as a pilot gives in gusts) it touches down 6.5 m short."""
     items = checked_plan(PLAN)[0]
     scores = []
     for overrides in ({"LAND_FLARE_THR": 0.0}, {}):
@@ -102,8 +104,7 @@ def test_full_power_in_the_flare_holds_the_c172_up_through_a_lull():
         loop.fly_until_disarmed(640.0)
         scores.append(landing_score_for_plan(loop.truth(), items))
     trim, full = scores
-    assert not trim.passed() and trim.along_m < -15.0, trim
-    assert full.passed() and full.along_m > trim.along_m + 5.0, full
+    assert full.passed() and full.along_m > trim.along_m + 5.0, (trim, full)
 
 
 def test_a_cub_fast_after_gusts_at_idle_flares_lower_and_lands_on_the_point():

@@ -174,6 +174,23 @@ def test_a_landing_circle_descends_below_its_height_for_a_final_no_steeper_than_
     assert sp.kind == Kind.LAND and sp.from_alt == pytest.approx(low, abs=0.1)
 
 
+def test_a_landing_circle_descends_for_a_glide_no_steeper_than_allowed_down_to_the_flare():
+    """The glide path ends where the flare begins, before the point: the C172's flare from
+    a 5° glide begins about 110 m out at 5 m, so a 227 m final from the 20 m that 5° to the
+    point allows was glided at 8°; it dived at its least pitch to 34 m/s and floated 42 m
+    long. The circle now goes down until the glide to the flare is the steepest allowed."""
+    items = [
+        item(0, d.MAV_CMD_NAV_LOITER_TO_ALT, CENTRE, z=50.0, p1=1.0, p2=RADIUS),
+        item(1, d.MAV_CMD_NAV_LAND, LAND, z=0.0),
+    ]
+    ex = executor(items, pos=(-250.0, -900.0), alt=HOME_ALT + 50.0)
+    ex.config.final_slope_max = math.radians(2.0)
+    ex.config.final_flare = (100.0, 5.0)
+    low = HOME_ALT + 5.0 + 700.0 * math.tan(math.radians(2.0))
+    sp = ex.step((-250.0, -900.0), HOME_ALT + 50.0, 0.0)
+    assert sp.kind == Kind.CIRCLE and sp.alt_msl == pytest.approx(low, abs=0.1)
+
+
 def test_a_landing_circle_flown_wider_or_lower_than_planned_is_said_once():
     """QGroundControl draws the plan's circle and height: the operator is told, once, what
     is flown instead (QGroundControl 5 showed a 75 m circle at 40 m; the C172 flew 230 m
