@@ -135,6 +135,33 @@ def test_a_short_final_turning_back_on_the_leg_in_is_begun_from_a_circle_lined_u
     its glide in the loop, flared heading away from the runway and landed 350 m short and
     134 m beside it; it now circles at the waypoint, leaves the circle there lined up,
     says so, and lands on target."""
+    _turn_back_flown_from_a_circle(
+        [((-600.0, -700.0), 80.0), ((0.0, 436.0), 25.0)], (0.0, 100.0), heading_deg=270.0
+    )
+
+
+def test_a_final_under_four_turn_radii_turning_back_180_degrees_is_begun_from_a_circle():
+    """A random jump plan's landing (benchmarks/jump_landings.py, plan 31): the aircraft
+    flies down the runway's line to the final's waypoint, 813 m before the point, and the
+    final turns back on it: 3.7 turn radii (218 m at its DO_CHANGE_SPEED's 31.6 m/s). Flown
+    as a loop corner, begun 375 m before the waypoint, the loop left the C172 250 m beside
+    the final heading back; it met the centreline only in the flare and touched down 12.8 m
+    beside the point (8.5 m short)."""
+    _turn_back_flown_from_a_circle(
+        [((0.0, 2500.0), 87.0), ((0.0, -300.0), 50.0)], (0.0, 500.0), 90.0, speed=31.6
+    )
+
+
+def _turn_back_flown_from_a_circle(
+    waypoints: list[tuple[tuple[float, float], float]],
+    land: tuple[float, float],
+    heading_deg: float,
+    speed: float = 0.0,
+) -> None:
+    """Take off east, fly ``waypoints`` ((north, east), height; at ``speed`` m/s, 0: the
+    cruise), land at ``land`` on the runway line through home: the final's waypoint is
+    circled, the glide begins lined up on the centreline heading ``heading_deg``, and the
+    landing is on target."""
     home = Home()
     frame = LocalFrame(home.lat_deg, home.lon_deg)
 
@@ -143,21 +170,24 @@ def test_a_short_final_turning_back_on_the_leg_in_is_begun_from_a_circle_lined_u
         return MissionItem(seq, d.MAV_FRAME_GLOBAL_RELATIVE_ALT, command, 0, 1, p1, 0.0, 0.0,
                            0.0, round(lat * 1e7), round(lon * 1e7), alt)  # fmt: skip
 
-    items = [
-        at(0, d.MAV_CMD_NAV_TAKEOFF, (0.0, 600.0), 100.0, p1=15.0),
-        at(1, d.MAV_CMD_NAV_WAYPOINT, (-600.0, -700.0), 80.0),
-        at(2, d.MAV_CMD_NAV_WAYPOINT, (0.0, 436.0), 25.0),
-        at(3, d.MAV_CMD_NAV_LAND, (0.0, 100.0), 0.0),
+    items = [at(0, d.MAV_CMD_NAV_TAKEOFF, (0.0, 600.0), 100.0, p1=15.0)]
+    if speed:  # DO_CHANGE_SPEED: airspeed, param2
+        items.append(replace(at(1, d.MAV_CMD_DO_CHANGE_SPEED, (0.0, 0.0), 0.0), param2=speed))
+    first = len(items)
+    items += [
+        at(first + k, d.MAV_CMD_NAV_WAYPOINT, ne, alt) for k, (ne, alt) in enumerate(waypoints)
     ]
+    items.append(at(len(items), d.MAV_CMD_NAV_LAND, land, 0.0))
     loop = ClosedLoop("c172p", items, range_max_m=12.0)
     assert loop.fly_until_disarmed(900.0)
     said = [text for _, text in loop.controller.lander.said]
-    assert "Land: circling at item 2 to line up with the final" in said, said
+    text = f"Land: circling at item {len(items) - 2} to line up with the final"
+    assert text in said, said
     glide = [s for s in loop.samples if s.out.land_phase == LandPhase.APPROACH]
-    first = glide[0]  # the glide begins lined up: on the centreline, heading west
+    first = glide[0]  # the glide begins lined up: on the centreline, down the runway
     north, _ = frame.ne(first.lat, first.lon)
     assert abs(north) < 10.0, f"{north:.1f} m off the centreline as the glide began"
-    assert abs(math.degrees(wrap_pi(first.yaw - math.radians(270.0)))) < 20.0
+    assert abs(math.degrees(wrap_pi(first.yaw - math.radians(heading_deg)))) < 20.0
     score = landing_score_for_plan(loop.truth(), items)
     assert score.passed(), score
 
