@@ -36,6 +36,7 @@ from companion.control.laws.limits import clamp
 MAX_DECEL = 3.0  # m/s²: more than any glider-like flare loses; a gust's spike is not speed lost
 DECEL_TAU_S = 1.0  # the measured deceleration's smoothing
 _ITERATIONS = 40
+FLARE_SHARE_MAX = 0.5  # of a final: the glide before the flare keeps the rest
 # Lift counted at most this many times the approach's: a faster reading is a gust's spike.
 FAST_LIFT_MAX = 2.0
 
@@ -88,14 +89,19 @@ def fast_pitch_drop(airspeed: float, approach_speed: float, aoa_deg: float) -> f
     return math.radians(aoa_deg) * (1.0 - 1.0 / lift)
 
 
+def least_flare_pitch(airspeed: float, v: Mapping[str, float]) -> float:
+    """The flare's least pitch (rad) at ``airspeed``: ``LAND_PITCH_CD``, less
+    ``fast_pitch_drop`` when faster than ``TECS_LAND_ARSPD`` (a floor set for the approach
+    speed held a Cub 6 m/s fast at its least pitch, its nose above its glide's, and it
+    floated 48 m long)."""
+    drop = fast_pitch_drop(airspeed, v["TECS_LAND_ARSPD"], v["LAND_FLARE_AOA"])
+    return math.radians(v["LAND_PITCH_CD"] / 100.0) - drop
+
+
 def flare_pitch(pitch: float, airspeed: float, v: Mapping[str, float]) -> float:
     """``pitch`` (rad) within the flare's limits at ``airspeed``: ``TECS_LAND_PMAX`` above,
-    ``LAND_PITCH_CD`` below, less ``fast_pitch_drop`` when faster than ``TECS_LAND_ARSPD``
-    (a floor set for the approach speed held a Cub 6 m/s fast at its least pitch, its nose
-    above its glide's, and it floated 48 m long)."""
-    drop = fast_pitch_drop(airspeed, v["TECS_LAND_ARSPD"], v["LAND_FLARE_AOA"])
-    least = math.radians(v["LAND_PITCH_CD"] / 100.0) - drop
-    return clamp(pitch, least, math.radians(v["TECS_LAND_PMAX"]))
+    ``least_flare_pitch`` below."""
+    return clamp(pitch, least_flare_pitch(airspeed, v), math.radians(v["TECS_LAND_PMAX"]))
 
 
 class DecelEstimate:
@@ -116,7 +122,8 @@ class DecelEstimate:
 
 def flare_run(ground_speed: float, slope: float, v: Mapping[str, float]) -> tuple[float, float]:
     """The flare from a glide of ``slope`` (rise over run) at ``ground_speed``: how far
-    before touchdown it begins (m) and at what height (m).
+    before touchdown it begins (m; on a final, at most ``FLARE_SHARE_MAX`` of it) and at
+    what height (m).
 
     The exponential flare ḣ = -(s + h/τ) from height H at the glide's sink rate s0 has
     τ = H / (s0 - s) and lasts τ·ln(s0 / s). It begins where the landing begins it: at

@@ -40,10 +40,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from companion.control.flight.flare_aim import (
+    FLARE_SHARE_MAX,
     DecelEstimate,
     aimed_sink,
     flare_pitch,
     flare_run,
+    least_flare_pitch,
     time_to_point,
 )
 from companion.control.laws.limits import clamp
@@ -175,7 +177,7 @@ class Landing:
         dist, h_f = 0.0, v["LAND_FLARE_ALT"]
         for _ in range(4):
             run, h_f = flare_run(ground_speed, self._slope(dist, h_f, v), v)
-            dist = min(run, 0.5 * self.length)
+            dist = min(run, FLARE_SHARE_MAX * self.length)
         self.flare_alt = h_f
         return dist
 
@@ -302,7 +304,7 @@ class Landing:
             # a fast steep glide's far below it: from a tailwind final's -10° its demand
             # stayed under the least pitch down to 1 m, the sink at 1.3 m/s, and a C172
             # touched down 19.7 m short.
-            least = flare_pitch(-math.pi / 2, s.airspeed, v)
+            least = least_flare_pitch(s.airspeed, v)
             self._flare_pitch = max(self._flare_pitch, least - path_change)
         pitch = self._flare_pitch + path_change + SINK_P * error + self._flare_integ
         return LandingDemand(

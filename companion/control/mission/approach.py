@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+from companion.control.flight.flare_aim import FLARE_SHARE_MAX
 from companion.control.laws.fillet import LOOP_TURN_RAD
 from companion.control.mission.items import MissionItem
 from companion.control.mission.leg_geometry import corner_turn, distance
@@ -58,14 +59,14 @@ def final_height(
     """The height to leave a landing circle at, at ``start``, for a final no steeper than
     ``steepest`` (rad; 0: the plan's ``alt``): a Cub idling down a 6° final gained 6 m/s
     and floated 34 m long. The glide ends where the flare begins, ``flare`` (its run before
-    the touchdown point, at most half the final, and its height): counted to the
-    touchdown point instead, a C172's 227 m final from 20 m was glided at 8°, dived at
-    its least pitch to 34 m/s, flared from 13 m and touched down 42 m long."""
+    the touchdown point, at most ``FLARE_SHARE_MAX`` of the final, and its height):
+    counted to the touchdown point instead, a C172's 227 m final from 20 m was glided at
+    8°, dived at its least pitch to 34 m/s, flared from 13 m and touched down 42 m long."""
     if steepest <= 0.0:
         return alt
     length = distance(start, land)
     run, flare_alt = flare
-    glide = length - min(run, 0.5 * length)
+    glide = length - min(run, FLARE_SHARE_MAX * length)
     return min(alt, land_alt + flare_alt + glide * math.tan(steepest))
 
 
