@@ -56,7 +56,7 @@ class ExecutorConfig:
     wp_radius: float = 30.0
     loiter_radius: float = 80.0
     rtl_alt_rel: float = 100.0
-    final_slope_max: float = 0.0  # rad: a landing circle descends until its final is no steeper
+    final_slope_max: float = 0.0  # rad: a landing circle descends until its glide is no steeper
     final_flare: tuple[float, float] = (0.0, 0.0)  # (run, height) of that final's flare (m)
 
 
