@@ -37,6 +37,10 @@ ACRO_PARAMS = (
 LANDING_PARAMS = (
     ParamDecl("LAND_FLARE_ALT", 3.0, 0.5, 20.0, "m", "landing: flare below this height"),
     ParamDecl("LAND_FLARE_SEC", 2.0, 0.5, 10.0, "s", "landing: flare this long before ground"),
+    ParamDecl("LAND_GA_HGT", 2.0, 0.0, 20.0, "m", "landing: go around when the flare is due "
+              "this far above the glide path, and fly the approach again (0: off)"),
+    ParamDecl("LAND_GA_MAX", 2.0, 0.0, 10.0, "", "landing: most go-arounds of LAND_GA_HGT "
+              "for one landing; then it lands from where it is"),
     ParamDecl("LAND_FLARE_AIM", 90.0, 50.0, 150.0, "%", "landing: the glide ends this share of "
               "the modelled flare's distance before the point (lower it if the airframe lands "
               "short: its flare then begins nearer the point)"),

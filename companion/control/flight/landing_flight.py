@@ -94,6 +94,8 @@ class LandingFlight:
         self.fence: Fence | None = None  # the stored geofence: Land's own pattern keeps inside
         self.refused = False  # no pattern fits in the fence: this Land circles instead
         self.said: list[tuple[int, str]] = []  # (MAV_SEVERITY, text) for the operator
+        # The landing's own go-arounds (LAND_GA_HGT) so far, and the touchdown they count for.
+        self.own_go_arounds: tuple[tuple[float, float, float], int] = ((0.0, 0.0, 0.0), 0)
 
     def fly(
         self,
@@ -114,6 +116,7 @@ class LandingFlight:
             land = self.landing = Landing(sp.a, from_alt, sp.b, sp.alt_msl)
         if go_around:
             land.abort()
+        land.may_go_around = self._own_go_arounds_left(sp, config)
         vel = (nav.vn_m_s, nav.ve_m_s)
         agl = range_height(self.range_reading, nav.t_us, nav.roll_rad, nav.pitch_rad,
                            config["RNGFND_LANDING"])  # fmt: skip
@@ -121,6 +124,9 @@ class LandingFlight:
         state = AircraftState(pos, vel, nav.alt_msl_m, -nav.vd_m_s, nav.pitch_rad, nav.yaw_rad,
                               nav.yaw_rate_rad_s, agl, airspeed)  # fmt: skip
         dem = land.step(state, config.values, dt)
+        if math.isfinite(land.high_at_flare):  # it went around of itself: said once
+            self._went_around_high(land.high_at_flare, config)
+            land.high_at_flare = math.nan
         out.land_phase = int(dem.phase)
         out.flaps, out.brakes = dem.flaps, dem.brakes
         if dem.phase == LandPhase.GO_AROUND and nav.alt_msl_m >= dem.alt_msl - GO_AROUND_MARGIN_M:
@@ -138,6 +144,22 @@ class LandingFlight:
             out.reached += executor.drain_reached()
         out.disarm = dem.disarm
         return self._fly_attitude(dem, (pos, vel, nav, airspeed, dt), out, config, lateral)
+
+    def _own_go_arounds_left(self, sp: Setpoint, config: FlightConfig) -> bool:
+        """Whether this landing may still go around of itself (LAND_GA_MAX): counted per
+        touchdown point, so a second approach to it counts on."""
+        key = (sp.b[0], sp.b[1], sp.alt_msl)
+        if key != self.own_go_arounds[0]:
+            self.own_go_arounds = (key, 0)
+        return self.own_go_arounds[1] < config["LAND_GA_MAX"]
+
+    def _went_around_high(self, high: float, config: FlightConfig) -> None:
+        key, count = self.own_go_arounds
+        self.own_go_arounds = (key, count + 1)
+        # One STATUSTEXT (50 characters): "Land: 3.9 m high at the flare: going around 1/2".
+        most = config["LAND_GA_MAX"]
+        text = f"Land: {high:.1f} m high at the flare: going around {count + 1}/{most:.0f}"
+        self.said.append((d.MAV_SEVERITY_WARNING, text))
 
     def _come_round(self, ex: MissionExecutor | None, pos: tuple[float, float], alt: float) -> None:
         """Climbed out after a go-around: fly the landing's approach again. The DO_JUMPs

@@ -218,3 +218,31 @@ def test_low_in_a_flare_from_a_fast_steep_glide_a_sink_too_fast_pitches_up_at_on
     assert high.pitch == pytest.approx(0.0)  # high in the flare: held at the least pitch
     low = land.step(_state(flare_at + 80.0, 0.8, sink=1.3), V, 0.02)
     assert low.pitch > math.radians(1.0)
+
+
+def test_a_flare_due_far_above_the_glide_path_goes_around_when_allowed():
+    """An approach a gust has left high reaches the flare's height past the point where
+    the flare should begin: going on, it floats far past the point; allowed to (the
+    flight's LAND_GA_MAX not used up), it goes around."""
+    flare_at = TOUCHDOWN[1] - Landing(START, 150.0, TOUCHDOWN, 100.0).flare_distance(28.0, V)
+    late = flare_at + 60.0  # 60 m past it at LAND_FLARE_ALT: some 4 m above the path there
+    for allowed, limit, phase in [
+        (True, V["LAND_GA_HGT"], LandPhase.GO_AROUND),
+        (False, V["LAND_GA_HGT"], LandPhase.FLARE),  # no go-arounds left: it lands
+        (True, 0.0, LandPhase.FLARE),  # LAND_GA_HGT 0: off
+    ]:
+        land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+        land.may_go_around = allowed
+        dem = land.step(_state(late, V["LAND_FLARE_ALT"] - 0.1), V | {"LAND_GA_HGT": limit}, 0.02)
+        assert dem.phase == phase
+        if phase == LandPhase.GO_AROUND:  # how high, for the operator's text
+            assert limit < land.high_at_flare < 6.0
+            assert dem.alt_msl >= 150.0 and dem.speed == V["AIRSPEED_CRUISE"]
+        else:
+            assert math.isnan(land.high_at_flare)
+    # On the path at the flare's start it flares, allowed or not.
+    land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+    land.may_go_around = True
+    land.step(_state(flare_at - 50.0, 40.0), V, 0.02)  # the flare's height planned
+    dem = land.step(_state(flare_at + 1.0, land.flare_alt - 0.1), V, 0.02)
+    assert dem.phase == LandPhase.FLARE and math.isnan(land.high_at_flare)

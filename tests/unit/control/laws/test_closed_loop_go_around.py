@@ -1,0 +1,59 @@
+"""A landing that goes around of itself, flown against JSBSim on the true state.
+
+``benchmarks/plans/gusty_steep_final.plan`` is random plan 53 of
+``benchmarks/varied_landings.py``: a Cub circles down from 85 m to a 848 m final across
+a 5 m/s crosswind with light turbulence (JSBSim's gust sequence 55). A gust leaves it
+3.2 m above the glide path where the flare is due, and flaring from there it touched
+down 19.8 m past the point (the issue's target: 15 m).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from companion.control.mission.plan import checked_plan
+from companion.messages import LandPhase
+from ground.campaign.landing_score import landing_score_for_plan
+from mavlink_dialect import companion as d
+from tests.support.closed_loop import ClosedLoop
+
+PLAN = Path(__file__).resolve().parents[4] / "benchmarks" / "plans" / "gusty_steep_final.plan"
+CROSSWIND = (3.356723318148176, -3.705726455824863, 0.0)  # 5 m/s across its 222° runway
+GUSTS = 55
+
+
+def _fly(overrides: dict[str, float]) -> ClosedLoop:
+    items = checked_plan(PLAN)[0]
+    loop = ClosedLoop("J3Cub", items, wind_ned=CROSSWIND, turbulence="light",
+                      overrides=overrides, range_max_m=12.0)  # fmt: skip
+    loop.flight.fdm["atmosphere/randomseed"] = GUSTS
+    assert loop.fly_until_disarmed(1500.0)
+    return loop
+
+
+def test_an_approach_left_high_by_a_gust_goes_around_and_lands_on_target_the_second_time():
+    items = checked_plan(PLAN)[0]
+    loop = _fly({})
+    phases = [s.out.land_phase for s in loop.samples]
+    went_around = [k for k in range(1, len(phases)) if phases[k] == LandPhase.GO_AROUND
+                   and phases[k - 1] != LandPhase.GO_AROUND]  # fmt: skip
+    assert len(went_around) == 1
+    # From the flare's height, never on the wheels, then round to the approach again.
+    k = went_around[0]
+    assert not any(s.on_wheels for s in loop.samples[k - 500 : k + 500])  # 10 s about it
+    assert LandPhase.FLARE in phases[went_around[0] :]
+    texts = [t for sev, t in loop.controller.lander.said if "going around" in t]
+    assert texts == [texts[0]] and texts[0].startswith("Land: 3.")
+    assert texts[0].endswith("going around 1/2") and len(texts[0]) <= 50
+    assert (d.MAV_SEVERITY_WARNING, texts[0]) in loop.controller.lander.said
+    score = landing_score_for_plan(loop.truth(), items)
+    assert score.passed(), score
+    # Flared from up there instead (LAND_GA_HGT 0: off), it touches down too far along.
+    stayed = landing_score_for_plan(_fly({"LAND_GA_HGT": 0.0}).truth(), items)
+    assert stayed.along_m > 15.0, stayed
+
+
+def test_with_no_go_arounds_left_the_landing_flares_from_where_it_is():
+    loop = _fly({"LAND_GA_MAX": 0.0})
+    assert LandPhase.GO_AROUND not in {s.out.land_phase for s in loop.samples}
+    assert not [t for _, t in loop.controller.lander.said if "going around" in t]
