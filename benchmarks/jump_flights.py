@@ -15,6 +15,7 @@ import psutil
 
 from companion.bus.namespace import cleanup_namespace
 from companion.bus.node import BusNode
+from companion.control.flight.landing_flight import approach_start
 from companion.control.mission.plan import checked_plan
 from ground.campaign.landing_score import landing_score_for_plan
 from mavlink_dialect import companion as d
@@ -100,7 +101,7 @@ def fly_closed_loop(plan: Path, airframe: str, weather: tuple, seed: int) -> tup
     seqs = [s.out.mission_seq for s in loop.samples]
     score = landing_score_for_plan(loop.truth(), items)
     faults = []
-    if loop.reached != order:  # the link tells each (control/status keeps the last 8)
+    if not reached_as_planned(loop.reached, order, items):  # the link tells each
         faults.append(f"reached {loop.reached} != {order}")
     if back_to_zero(seqs, order):
         faults.append("MISSION_CURRENT back to 0")
@@ -117,10 +118,46 @@ def fly_closed_loop(plan: Path, airframe: str, weather: tuple, seed: int) -> tup
 
 
 def _lowest(loop: ClosedLoop, items: list, order: list, seqs: list, landing: int) -> float:
-    if order[1] not in seqs or landing not in seqs:
+    began = landing_began(seqs, landing, last_land(items, order))
+    if order[1] not in seqs or began is None:
         return math.nan
     climbed = seqs.index(order[1]) + 50 * 20  # 20 s after the take-off item
-    began = len(seqs) - 1 - seqs[::-1].index(landing)
-    began = next(k for k in range(began, -1, -1) if seqs[k] != landing) + 1
     heights = [s.alt_agl for s in loop.samples[climbed:began]]
     return min(heights) if heights else math.nan
+
+
+def last_land(items: list, order: list[int]) -> int:
+    """The seq of the last NAV_LAND the plan flies (-1: none)."""
+    lands = [s for s in order if items[s].command == d.MAV_CMD_NAV_LAND]
+    return lands[-1] if lands else -1
+
+
+def reached_as_planned(reached: list[int], order: list[int], items: list) -> bool:
+    """Whether the items reached are the plan's order, a go-around allowed for: it flies the
+    landing's approach again (from DO_LAND_START, else the item before the NAV_LAND:
+    ``approach_start``), whose items are then reached once more."""
+    if reached == order:
+        return True
+    land = last_land(items, order)
+    if land < 0:
+        return False
+    j = len(order) - 1 - order[::-1].index(land)
+    restart, k = approach_start(items, land), j
+    while k > 0 and order[k - 1] >= restart:
+        k -= 1
+    again = order[k:j]
+    return any(reached == order[:k] + again * (1 + n) + order[j:] for n in range(1, 4))
+
+
+def landing_began(seqs: list[int], landing: int, land: int) -> int | None:
+    """Where in ``seqs`` (the current item, in order) the landing began: the last stretch
+    of ``landing`` (the item flown before the NAV_LAND ``land``) before the NAV_LAND is
+    first current. A go-around's climb and second approach come after it."""
+    end = seqs.index(land) if land in seqs else len(seqs)
+    runs = [k for k in range(end) if seqs[k] == landing]
+    if not runs:
+        return None
+    k = runs[-1]
+    while k > 0 and seqs[k - 1] == landing:
+        k -= 1
+    return k

@@ -38,7 +38,13 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.jump_flights import ControlKiller, fly_closed_loop
+from benchmarks.jump_flights import (
+    ControlKiller,
+    fly_closed_loop,
+    landing_began,
+    last_land,
+    reached_as_planned,
+)
 from benchmarks.varied_landings import HOME, _crosswind, landing_pattern, random_runway
 from companion.control.mission.plan import checked_plan
 from ground.campaign.flight_run import FlightJob, fly_flight
@@ -169,17 +175,17 @@ def judge(plan: Path, folder: Path, row: dict) -> tuple[bool, str]:
     truth = read_truth(folder / "truth.csv") if (folder / "truth.csv").exists() else None
     score = landing_score_for_plan(truth, items) if truth is not None else LandingScore(False)
     faults = []
-    if tl["reached"] != order:
+    if not reached_as_planned(tl["reached"], order, items):
         faults.append(f"reached {tl['reached']} != {order}")
     seqs = tl["seqs"]
     if back_to_zero(seqs, order):
         faults.append("MISSION_CURRENT back to 0")
     landing = _landing_first(items, order)
     low = math.nan
-    if truth is not None and landing in seqs and order[1] in seqs:
+    began = landing_began(seqs, landing, last_land(items, order))
+    if truth is not None and began is not None and order[1] in seqs:
         climbed = tl["seq_ms"][seqs.index(order[1])] / 1000.0
-        began = tl["seq_ms"][len(seqs) - 1 - seqs[::-1].index(landing)] / 1000.0
-        low = lowest_between(truth, climbed + 20.0, began)
+        low = lowest_between(truth, climbed + 20.0, tl["seq_ms"][began] / 1000.0)
     if not low >= SAFE_SHARE * least_planned(items, order):
         faults.append(f"down to {low:.0f} m before the landing")
     if not score.passed():
