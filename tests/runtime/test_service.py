@@ -118,6 +118,10 @@ def test_the_units_command_runs_the_vehicle_and_sigterm_closes_the_log_within_a_
 
 def _armed_log_and_sigterm(vehicle: Vehicle, logs: Path) -> None:
     logger_pid = vehicle.wait_running("logger")
+    # Armed only once the logger reads (its first step done), as the flight-log tests do:
+    # a logger still subscribing missed the replay's first samples (CI on c4fa64d: the log
+    # began at sample 4).
+    wait_for(lambda: (r := vehicle.row("logger")) is not None and r.step_p50_us > 0, 30, "logger")
     vehicle.bus.writer("link/commands").publish(
         VehicleCommand(t_us=0, seq=1, command=int(CommandId.START))
     )
