@@ -282,8 +282,10 @@ class Landing:
         two Cubs in gusts, 2.8 and 3.2 m above it, which touched down 15 and 20 m long;
         the whole vehicle's Cub on random plan 3, 3.9 m above it, 37.6 m long."""
         limit = v["LAND_GA_HGT"]
+        if not self.may_go_around or limit <= 0.0:
+            return  # the path's height is not worked out: it would land either way
         path = self.glide_alt(pos, self.flare_distance(ground_speed, v), v) - self.ground_alt
-        if self.may_go_around and limit > 0.0 and height - path > limit:
+        if height - path > limit:
             self.high_at_flare = height - path
             self.phase = LandPhase.GO_AROUND
 
