@@ -126,10 +126,16 @@ def _lowest(loop: ClosedLoop, items: list, order: list, seqs: list, landing: int
     return min(heights) if heights else math.nan
 
 
+def last_land_at(items: list, order: list[int]) -> int:
+    """Where in ``order`` the plan flies its last NAV_LAND (-1: none)."""
+    lands = [k for k, s in enumerate(order) if items[s].command == d.MAV_CMD_NAV_LAND]
+    return lands[-1] if lands else -1
+
+
 def last_land(items: list, order: list[int]) -> int:
     """The seq of the last NAV_LAND the plan flies (-1: none)."""
-    lands = [s for s in order if items[s].command == d.MAV_CMD_NAV_LAND]
-    return lands[-1] if lands else -1
+    at = last_land_at(items, order)
+    return order[at] if at >= 0 else -1
 
 
 def reached_as_planned(reached: list[int], order: list[int], items: list) -> bool:
@@ -138,11 +144,10 @@ def reached_as_planned(reached: list[int], order: list[int], items: list) -> boo
     ``approach_start``), whose items are then reached once more."""
     if reached == order:
         return True
-    land = last_land(items, order)
-    if land < 0:
+    j = last_land_at(items, order)
+    if j < 0:
         return False
-    j = len(order) - 1 - order[::-1].index(land)
-    restart, k = approach_start(items, land), j
+    restart, k = approach_start(items, order[j]), j
     while k > 0 and order[k - 1] >= restart:
         k -= 1
     again = order[k:j]

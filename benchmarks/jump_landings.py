@@ -43,6 +43,7 @@ from benchmarks.jump_flights import (
     fly_closed_loop,
     landing_began,
     last_land,
+    last_land_at,
     reached_as_planned,
 )
 from benchmarks.varied_landings import HOME, _crosswind, landing_pattern, random_runway
@@ -214,8 +215,8 @@ def least_planned(items: list, order: list[int]) -> float:
 
 def _landing_first(items: list, order: list[int]) -> int:
     """The first item of the landing: the one flown before the last NAV_LAND."""
-    lands = [k for k, s in enumerate(order) if items[s].command == d.MAV_CMD_NAV_LAND]
-    return order[lands[-1] - 1] if lands else -1
+    at = last_land_at(items, order)
+    return order[at - 1] if at >= 0 else -1
 
 
 def fly_whole(plan: Path, airframe: str, weather: tuple, out: Path, restart: bool) -> tuple:
