@@ -48,6 +48,9 @@ LANDING_PARAMS = (
               "sunk beyond what reaches the point, at most TRIM_THROTTLE (0: idle all flare)"),
     ParamDecl("LAND_FLARE_THR", 0.0, 0.0, 1.0, "", "landing: most throttle in the flare's "
               "lower half against a sink that lands short, as a lull gives (0: TRIM_THROTTLE)"),
+    ParamDecl("LAND_FLOAT_SINK", 1.2, 0.0, 3.0, "m/s", "landing: a flare that would touch down "
+              "over 10 m past the point keeps sinking at up to this, no faster than its glide "
+              "(0: off, the flare's sink falls to TECS_LAND_SINK whatever)"),
     ParamDecl("LAND_PITCH_CD", 0.0, -500.0, 1500.0, "cdeg", "landing: least pitch in the flare"),
     ParamDecl("LAND_FLARE_AOA", 0.0, 0.0, 15.0, "deg", "landing: wing's angle of attack over zero "
               "lift at TECS_LAND_ARSPD; faster, the flare's least pitch is lower (0: off)"),

@@ -216,7 +216,9 @@ def test_low_in_a_flare_from_a_fast_steep_glide_a_sink_too_fast_pitches_up_at_on
     high = land.step(replace(_state(flare_at, 6.0, sink=4.0), pitch=math.radians(-8.0)), V, 0.02)
     assert high.phase == LandPhase.FLARE
     assert high.pitch == pytest.approx(0.0)  # high in the flare: held at the least pitch
-    low = land.step(_state(flare_at + 80.0, 0.8, sink=1.3), V, 0.02)
+    # Sinking faster than any flare here asks (20 m before the point, 0.8 m up: the flare
+    # that would float past it asks for LAND_FLOAT_SINK, 1.2 m/s).
+    low = land.step(_state(flare_at + 80.0, 0.8, sink=2.0), V, 0.02)
     assert low.pitch > math.radians(1.0)
 
 
@@ -246,3 +248,39 @@ def test_a_flare_due_far_above_the_glide_path_goes_around_when_allowed():
     land.step(_state(flare_at - 50.0, 40.0), V, 0.02)  # the flare's height planned
     dem = land.step(_state(flare_at + 1.0, land.flare_alt - 0.1), V, 0.02)
     assert dem.phase == LandPhase.FLARE and math.isnan(land.high_at_flare)
+
+
+def test_a_flare_that_would_float_long_keeps_sinking_but_no_faster_than_its_glide():
+    """Gusts held Cubs up at idle; following the nominal flare, whose sink demand falls to
+    TECS_LAND_SINK as the height does, they floated 16-32 m past the point. A flare that
+    would touch down more than 10 m past it asks for up to LAND_FLOAT_SINK instead, and never
+    for more than the sink rate it began from; one sinking faster than that already (a lull)
+    is asked less, down to the nominal."""
+    v = V | {"LAND_PITCH_CD": -500.0}
+    flare_at = TOUCHDOWN[1] - Landing(START, 150.0, TOUCHDOWN, 100.0).flare_distance(28.0, v)
+
+    def pitch(
+        e: float, float_sink: float, approached: bool = True, sink0: float = 1.7, sink: float = 0.6
+    ) -> float:
+        w = v | {"LAND_FLOAT_SINK": float_sink}
+        land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+        if approached:  # the glide's sink: 28 m/s down 50 m over 800 m, 1.75 m/s
+            land.step(_state(flare_at - 30.0, 8.0), w, 0.02)
+        assert land.step(_state(flare_at, 2.9, sink=sink0), w, 0.02).phase == LandPhase.FLARE
+        dem = land.step(_state(e, 1.0, sink=sink), w, 0.02)
+        assert dem.phase == LandPhase.FLARE
+        return dem.pitch
+
+    past = TOUCHDOWN[1] + 10.0  # 1 m up, 10 m past the point: the nominal asks ~0.85 m/s
+    assert pitch(past, 1.2) < pitch(past, 0.0) - math.radians(2.0)  # asks 1.2 m/s
+    assert pitch(past, 1.7) < pitch(past, 1.2) - math.radians(2.0)  # up to the glide's
+    assert pitch(past, 3.0) == pytest.approx(pitch(past, 1.7))  # and no faster
+    # Begun from a sink of 0.8 m/s (no glide before it), it asks no more than that.
+    slow = pitch(past, 3.0, approached=False, sink0=0.8)
+    assert slow == pytest.approx(pitch(past, 0.8, approached=False, sink0=0.8))
+    # Sinking twice as fast as it would ask (a lull), it asks the nominal: the full pitch-up.
+    assert pitch(past, 1.2, sink=2.4) == pytest.approx(pitch(past, 0.0, sink=2.4))
+    assert pitch(past, 1.2, sink=1.4) < pitch(past, 0.0, sink=1.4) - math.radians(0.5)
+    # Where the nominal flare touches down in time, nothing changes.
+    early = TOUCHDOWN[1] - 100.0
+    assert pitch(early, 1.2) == pytest.approx(pitch(early, 0.0))
