@@ -209,7 +209,9 @@ def back_to_zero(seqs: list[int], order: list[int]) -> bool:
 
 def least_planned(items: list, order: list[int]) -> float:
     """The lowest height the plan flies at before its landing begins (m above home)."""
-    last = len(order) - 1 - [items[s].command for s in order][::-1].index(d.MAV_CMD_NAV_LAND)
+    last = last_land_at(items, order)
+    if last < 0:
+        raise ValueError("the plan flies no NAV_LAND")
     return min(items[s].z for s in order[1 : last - 1])
 
 
