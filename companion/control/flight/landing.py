@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 from companion.control.flight.flare_aim import (
     FLARE_SHARE_MAX,
@@ -53,11 +52,10 @@ from companion.control.flight.flare_aim import (
     least_flare_pitch,
     time_to_point,
 )
+from companion.control.flight.landing_io import AircraftState, LandingDemand, Point
 from companion.control.laws.limits import clamp
 from companion.geodesy import wrap_pi
 from companion.messages.control import LandPhase
-
-Point = tuple[float, float]
 
 # On the wheels: this low and no longer sinking for a moment. The flare sinks at least at
 # TECS_LAND_SINK until then, so a navigator a few decimetres out still touches down
@@ -96,46 +94,6 @@ SINK_I = 0.05  # rad per (m/s·s)
 # moment's: a gust that had just pitched the nose down or changed the sink is not the trim.
 GLIDE_TRIM_TAU_S = 2.0
 FLARE_THR_SHARE = 0.5  # LAND_FLARE_THR below this share of the flare's planned height
-
-
-@dataclass(frozen=True)
-class LandingDemand:
-    """What to fly now.
-
-    APPROACH and GO_AROUND: track ``line`` at ``alt_msl`` and ``speed`` with normal
-    energy control (``pitch`` and ``throttle`` are NaN). FLARE and ROLLOUT: ``pitch``,
-    ``throttle`` and the bank limit are given; ``rudder`` (NaN: the yaw damper) steers
-    on the ground.
-    """
-
-    phase: LandPhase
-    line: tuple[Point, Point]
-    alt_msl: float
-    speed: float
-    pitch: float = math.nan
-    throttle: float = math.nan
-    rudder: float = math.nan
-    elevator: float = math.nan  # ROLLOUT: held directly when given
-    brakes: float = 0.0  # 0 off .. 1 full
-    roll_limit: float = math.nan
-    disarm: bool = False
-    flaps: float = 0.0
-    climb_ff: float = 0.0  # m/s: how fast the glide path descends under the aircraft
-
-
-@dataclass(frozen=True)
-class AircraftState:
-    """The navigator's view: local north/east position and velocity, MSL height."""
-
-    pos: Point
-    vel: Point
-    alt_msl: float
-    climb_rate: float  # m/s, + up
-    pitch: float
-    yaw: float
-    yaw_rate: float
-    range_height: float = math.nan  # m above the ground by the rangefinder; NaN: none usable
-    airspeed: float = math.nan  # m/s; NaN: unknown
 
 
 class Landing:

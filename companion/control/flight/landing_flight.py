@@ -14,7 +14,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
-from companion.control.flight.landing import AircraftState, Landing, LandingDemand
+from companion.control.flight.landing import Landing
+from companion.control.flight.landing_io import AircraftState, LandingDemand
 from companion.control.flight.landing_pattern import (
     HOME_TOUCHDOWN_M,
     Approach,

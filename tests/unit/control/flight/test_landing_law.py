@@ -14,7 +14,8 @@ from dataclasses import replace
 import pytest
 
 from companion.control.flight.flight_params import CONTROL_PARAMS
-from companion.control.flight.landing import AircraftState, Landing
+from companion.control.flight.landing import Landing
+from companion.control.flight.landing_io import AircraftState
 from companion.messages import LandPhase
 
 V = {p.name: p.default for p in CONTROL_PARAMS}

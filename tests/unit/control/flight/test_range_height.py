@@ -8,7 +8,8 @@ import math
 import pytest
 
 from companion.control.flight.flight_params import CONTROL_PARAMS
-from companion.control.flight.landing import AircraftState, Landing
+from companion.control.flight.landing import Landing
+from companion.control.flight.landing_io import AircraftState
 from companion.control.flight.range_height import range_height
 from companion.messages import LandPhase, RangeReading
 
