@@ -39,7 +39,9 @@ LANDING_PARAMS = (
     ParamDecl("LAND_FLARE_SEC", 2.0, 0.5, 10.0, "s", "landing: flare this long before ground"),
     ParamDecl("LAND_GA_HGT", 2.0, 0.0, 20.0, "m", "landing: go around when the flare is due "
               "this far above the glide path, and fly the approach again (0: off)"),
-    ParamDecl("LAND_GA_MAX", 2.0, 0.0, 10.0, "", "landing: most go-arounds of LAND_GA_HGT "
+    ParamDecl("LAND_GA_LONG", 15.0, 0.0, 200.0, "m", "landing: go around from the flare's upper "
+              "half when it would touch down over this far past the point (0: off)"),
+    ParamDecl("LAND_GA_MAX", 2.0, 0.0, 10.0, "", "landing: most go-arounds of its own "
               "for one landing; then it lands from where it is"),
     ParamDecl("LAND_FLARE_AIM", 90.0, 50.0, 150.0, "%", "landing: the glide ends this share of "
               "the modelled flare's distance before the point (lower it if the airframe lands "

@@ -26,6 +26,8 @@ PX4 publish for their fixed-wing landings, written here from their descriptions:
   Also of itself, while ``may_go_around``, when the flare is due with the aircraft more
   than ``LAND_GA_HGT`` above the glide path: an approach that a gust has left that high
   floats far past the point (a pilot's unstabilized approach), so it is flown again.
+  And in the flare's upper half, when even sinking at the most the flare asks for it would
+  touch down more than ``LAND_GA_LONG`` past the point (a balloon in rising air).
 
 Heights are above the touchdown point's altitude, from the navigator's altitude (which
 fuses the barometer and GPS); the flare (when to begin it, its sink demand, the touchdown)
@@ -94,6 +96,7 @@ SINK_I = 0.05  # rad per (m/s·s)
 # moment's: a gust that had just pitched the nose down or changed the sink is not the trim.
 GLIDE_TRIM_TAU_S = 2.0
 FLARE_THR_SHARE = 0.5  # LAND_FLARE_THR below this share of the flare's planned height
+COMMITTED = 0.5  # below this share of the flare's planned height it lands, floating or not
 
 
 class Landing:
@@ -123,6 +126,7 @@ class Landing:
         self._decel = DecelEstimate()
         self.may_go_around = False  # the caller allows a go-around of the landing's own
         self.high_at_flare = math.nan  # m above the glide path when it went around so
+        self.long_at_flare = math.nan  # m past the point it would have touched down, so
 
     # -- geometry --------------------------------------------------------------------
 
@@ -200,16 +204,7 @@ class Landing:
         if due:
             self._go_around_if_high(s.pos, height, ground_speed, v)
         if due and self.phase == LandPhase.APPROACH:
-            self.phase = LandPhase.FLARE
-            self._flare_integ = 0.0
-            self._decel = DecelEstimate()
-            # The flare's time constant makes its first sink demand the sink rate now, or
-            # the glide's when a gust has just slowed the sink: a flare slower than the one
-            # planned (flare_distance) floated, and a C172 touched down 47 m long.
-            s_t = max(v["TECS_LAND_SINK"], 0.05)
-            sink0 = max(-s.climb_rate, self._glide_sink)
-            self._tau = max(height, 0.5) / max(sink0 - s_t, 0.3)
-            self._sink0 = sink0
+            self._begin_flare(height, s.climb_rate, v)
         # On the wheels: low and no longer sinking, or slower than anything that flies.
         slow = ground_speed < 0.5 * v["TECS_LAND_ARSPD"]
         level = height < TOUCHDOWN_AGL_M and s.climb_rate > TOUCHDOWN_CLIMB
@@ -219,6 +214,8 @@ class Landing:
             self._touchdown_pitch = s.pitch - WHEELS_DOWN_PITCH
         if self.phase in (LandPhase.ROLLOUT, LandPhase.STOPPED):
             return self._rollout(s, ground_speed, v, dt)
+        if self.phase == LandPhase.FLARE:
+            self._go_around_if_long(s, height, v)  # it may go around instead
         if self.phase == LandPhase.FLARE:
             return self._flare(s, height, v, dt)
         line = (self.start, self.point(1e4))
@@ -237,6 +234,17 @@ class Landing:
         return LandingDemand(
             self.phase, line, alt, v["TECS_LAND_ARSPD"], flaps=landing_flaps(v), climb_ff=ff
         )
+
+    def _begin_flare(self, height: float, climb_rate: float, v: Mapping[str, float]) -> None:
+        self.phase = LandPhase.FLARE
+        self._flare_integ = 0.0
+        self._decel = DecelEstimate()
+        # The flare's time constant makes its first sink demand the sink rate now, or the
+        # glide's when a gust has just slowed the sink: a flare slower than the one planned
+        # (flare_distance) floated, and a C172 touched down 47 m long.
+        s_t = max(v["TECS_LAND_SINK"], 0.05)
+        self._sink0 = max(-climb_rate, self._glide_sink)
+        self._tau = max(height, 0.5) / max(self._sink0 - s_t, 0.3)
 
     def _smooth_trim(self, s: AircraftState, dt: float) -> None:
         if not math.isfinite(self._flare_pitch):
@@ -258,6 +266,22 @@ class Landing:
         path = self.glide_alt(pos, self.flare_distance(ground_speed, v), v) - self.ground_alt
         if height - path > limit:
             self.high_at_flare = height - path
+            self.phase = LandPhase.GO_AROUND
+
+    def _go_around_if_long(self, s: AircraftState, height: float, v: Mapping[str, float]) -> None:
+        """Go around from the flare's upper half when, even sinking at the most the flare
+        asks for (its starting sink, ``LAND_FLOAT_SINK``), the aircraft would touch down
+        more than ``LAND_GA_LONG`` past the point: rising air held a C172's flare at 4 m
+        for 50 m (its least pitch above its glide's), and it touched down 41.8 m long."""
+        limit = v["LAND_GA_LONG"]
+        if not self.may_go_around or limit <= 0.0 or not height >= COMMITTED * self.flare_alt:
+            return  # lower, it lands whatever: a climb begun there could touch down first
+        speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
+        most = min(self._sink0, v["LAND_FLOAT_SINK"] or self._sink0)
+        sink = max(most, -s.climb_rate, 0.1)
+        along = self.along(s.pos)
+        if height > sink * time_to_point(limit - along, speed_along, self._decel.decel):
+            self.long_at_flare = along + max(speed_along, 0.0) * height / sink
             self.phase = LandPhase.GO_AROUND
 
     def _flare_due(self, height: float, climb_rate: float, v: Mapping[str, float]) -> bool:

@@ -95,7 +95,8 @@ class LandingFlight:
         self.fence: Fence | None = None  # the stored geofence: Land's own pattern keeps inside
         self.refused = False  # no pattern fits in the fence: this Land circles instead
         self.said: list[tuple[int, str]] = []  # (MAV_SEVERITY, text) for the operator
-        # The landing's own go-arounds (LAND_GA_HGT) so far, and the touchdown they count for.
+        # The landing's own go-arounds (LAND_GA_HGT, LAND_GA_LONG) so far, and the touchdown
+        # they count for.
         self.own_go_arounds: tuple[tuple[float, float, float], int] = ((0.0, 0.0, 0.0), 0)
 
     def fly(
@@ -125,9 +126,8 @@ class LandingFlight:
         state = AircraftState(pos, vel, nav.alt_msl_m, -nav.vd_m_s, nav.pitch_rad, nav.yaw_rad,
                               nav.yaw_rate_rad_s, agl, airspeed)  # fmt: skip
         dem = land.step(state, config.values, dt)
-        if math.isfinite(land.high_at_flare):  # it went around of itself: said once
-            self._went_around_high(land.high_at_flare, config)
-            land.high_at_flare = math.nan
+        if math.isfinite(land.high_at_flare) or math.isfinite(land.long_at_flare):
+            self._went_around(land, config)  # of itself: said once
         out.land_phase = int(dem.phase)
         out.flaps, out.brakes = dem.flaps, dem.brakes
         if dem.phase == LandPhase.GO_AROUND and nav.alt_msl_m >= dem.alt_msl - GO_AROUND_MARGIN_M:
@@ -154,12 +154,17 @@ class LandingFlight:
             self.own_go_arounds = (key, 0)
         return self.own_go_arounds[1] < config["LAND_GA_MAX"]
 
-    def _went_around_high(self, high: float, config: FlightConfig) -> None:
+    def _went_around(self, land: Landing, config: FlightConfig) -> None:
         key, count = self.own_go_arounds
         self.own_go_arounds = (key, count + 1)
-        # One STATUSTEXT (50 characters): "Land: 3.9 m high at the flare: going around 1/2".
-        most = config["LAND_GA_MAX"]
-        text = f"Land: {high:.1f} m high at the flare: going around {count + 1}/{most:.0f}"
+        # One STATUSTEXT (50 characters): "Land: 3.9 m high at the flare: going around 1/2",
+        # "Land: would land 42 m long: going around 1/2".
+        if math.isfinite(land.high_at_flare):
+            why = f"{land.high_at_flare:.1f} m high at the flare"
+        else:
+            why = f"would land {min(land.long_at_flare, 999.0):.0f} m long"
+        land.high_at_flare = land.long_at_flare = math.nan
+        text = f"Land: {why}: going around {count + 1}/{config['LAND_GA_MAX']:.0f}"
         self.said.append((d.MAV_SEVERITY_WARNING, text))
 
     def _come_round(self, ex: MissionExecutor | None, pos: tuple[float, float], alt: float) -> None:

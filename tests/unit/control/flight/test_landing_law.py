@@ -285,3 +285,35 @@ def test_a_flare_that_would_float_long_keeps_sinking_but_no_faster_than_its_glid
     # Where the nominal flare touches down in time, nothing changes.
     early = TOUCHDOWN[1] - 100.0
     assert pitch(early, 1.2) == pytest.approx(pitch(early, 0.0))
+
+
+def test_a_flare_held_up_in_its_upper_half_goes_around_when_it_would_land_far_long():
+    """Rising air held a C172's flare at 4 m for 50 m, and it touched down 41.8 m long. A
+    flare that would touch down more than LAND_GA_LONG past the point even sinking at the
+    most it asks for (LAND_FLOAT_SINK, 1.2 m/s, here under its glide's sink) goes around
+    while in its upper half, if allowed; lower down, or on its way to the point, it lands."""
+    flare_at = TOUCHDOWN[1] - Landing(START, 150.0, TOUCHDOWN, 100.0).flare_distance(28.0, V)
+
+    def flown(e: float, height: float, sink: float, allowed: bool = True, **w: float):
+        land = Landing(START, 150.0, TOUCHDOWN, 100.0)
+        land.may_go_around = allowed
+        land.step(_state(flare_at - 30.0, 8.0), V | w, 0.02)  # the flare's height planned
+        flare = land.step(_state(flare_at, land.flare_alt - 0.1), V | w, 0.02)
+        assert flare.phase == LandPhase.FLARE
+        return land.step(_state(e, height, sink=sink), V | w, 0.02), land
+
+    # 58 m before the point, 3.5 m up and climbing: at 1.2 m/s it lands 24 m past it.
+    held_up = flare_at + 40.0
+    dem, land = flown(held_up, 3.5, sink=-0.2)
+    assert dem.phase == LandPhase.GO_AROUND and dem.speed == V["AIRSPEED_CRUISE"]
+    assert V["LAND_GA_LONG"] < land.long_at_flare < 30.0
+    assert math.isnan(land.high_at_flare)
+    assert flown(held_up, 3.5, sink=-0.2, allowed=False)[0].phase == LandPhase.FLARE
+    assert flown(held_up, 3.5, sink=-0.2, LAND_GA_LONG=0.0)[0].phase == LandPhase.FLARE
+    assert flown(held_up, 3.5, sink=-0.2, LAND_GA_LONG=40.0)[0].phase == LandPhase.FLARE
+    # Sinking as a flare does on its way to the point, it flares on.
+    dem, land = flown(held_up, 2.2, sink=1.5)
+    assert dem.phase == LandPhase.FLARE and math.isnan(land.long_at_flare)
+    # In the flare's lower half it lands, however long.
+    assert flown(TOUCHDOWN[1] - 5.0, 1.7, sink=0.0)[0].phase == LandPhase.FLARE
+    assert flown(TOUCHDOWN[1] - 5.0, 2.0, sink=0.0)[0].phase == LandPhase.GO_AROUND

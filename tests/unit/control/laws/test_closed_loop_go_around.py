@@ -1,5 +1,6 @@
 """A landing that goes around of itself, or flares on and keeps sinking, flown against
-JSBSim on the true state.
+JSBSim on the true state: an approach a gust has left high at the flare, and a flare that
+rising air holds up (below).
 
 ``benchmarks/plans/gusty_steep_final.plan`` is random plan 53 of
 ``benchmarks/varied_landings.py``: a Cub circles down from 85 m to a 848 m final across
@@ -73,3 +74,40 @@ def test_with_no_go_arounds_left_the_landing_flares_from_where_it_is():
     loop = _fly({"LAND_GA_MAX": 0.0})
     assert LandPhase.GO_AROUND not in {s.out.land_phase for s in loop.samples}
     assert not [t for _, t in loop.controller.lander.said if "going around" in t]
+
+
+# Random jump plan 22 of benchmarks/jump_landings.py (take-off, a loop flown twice, a
+# landing on a 345° runway) with JSBSim's gust sequence 24 across it: the C172 flares from
+# 5 m, 125 m before the point, and rising air holds it at 4 m for the next 50 m, its least
+# pitch (LAND_PITCH_CD 0°) 2-3° above its glide's. It touched down 41.8 m long.
+BALLOON = PLAN.parent / "jump_balloon.plan"
+BALLOON_WIND = (1.29785625847449, 4.828619795794508, 0.0)  # 5 m/s across its runway
+
+
+def _fly_balloon(overrides: dict[str, float]) -> ClosedLoop:
+    items = checked_plan(BALLOON)[0]
+    loop = ClosedLoop("c172p", items, wind_ned=BALLOON_WIND, turbulence="light",
+                      overrides=overrides, range_max_m=12.0)  # fmt: skip
+    loop.flight.fdm["atmosphere/randomseed"] = 24
+    assert loop.fly_until_disarmed(2000.0)
+    return loop
+
+
+def test_a_flare_held_up_by_rising_air_goes_around_and_lands_on_target_the_second_time():
+    items = checked_plan(BALLOON)[0]
+    loop = _fly_balloon({})
+    phases = [s.out.land_phase for s in loop.samples]
+    went_around = [k for k in range(1, len(phases)) if phases[k] == LandPhase.GO_AROUND
+                   and phases[k - 1] != LandPhase.GO_AROUND]  # fmt: skip
+    assert len(went_around) == 1
+    k = went_around[0]
+    assert phases[k - 1] == LandPhase.FLARE  # from the flare itself, in the air
+    assert not any(s.on_wheels for s in loop.samples[k - 500 : k + 500])
+    texts = [t for sev, t in loop.controller.lander.said if "going around" in t]
+    assert len(texts) == 1 and texts[0].startswith("Land: would land ")
+    assert texts[0].endswith("m long: going around 1/2") and len(texts[0]) <= 50
+    score = landing_score_for_plan(loop.truth(), items)
+    assert score.passed(), score
+    # Flared on (LAND_GA_LONG 0: off), it touches down far past the point.
+    stayed = landing_score_for_plan(_fly_balloon({"LAND_GA_LONG": 0.0}).truth(), items)
+    assert stayed.along_m > 30.0, stayed
