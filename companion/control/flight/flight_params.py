@@ -37,6 +37,8 @@ ACRO_PARAMS = (
 LANDING_PARAMS = (
     ParamDecl("LAND_FLARE_ALT", 3.0, 0.5, 20.0, "m", "landing: flare below this height"),
     ParamDecl("LAND_FLARE_SEC", 2.0, 0.5, 10.0, "s", "landing: flare this long before ground"),
+    ParamDecl("LAND_TD_ALT", 0.0, 0.0, 2.0, "m", "landing: how far above where it rests the "
+              "aircraft is when its wheels meet the runway in the flare (a tail dragger, tail up)"),
     ParamDecl("LAND_GA_HGT", 2.0, 0.0, 20.0, "m", "landing: go around when the flare is due "
               "this far above the glide path, and fly the approach again (0: off)"),
     ParamDecl("LAND_GA_LONG", 15.0, 0.0, 200.0, "m", "landing: go around from the flare's upper "
@@ -51,8 +53,10 @@ LANDING_PARAMS = (
     ParamDecl("LAND_FLARE_THR", 0.0, 0.0, 1.0, "", "landing: most throttle in the flare's "
               "lower half against a sink that lands short, as a lull gives (0: TRIM_THROTTLE)"),
     ParamDecl("LAND_FLOAT_SINK", 1.2, 0.0, 3.0, "m/s", "landing: a flare that would touch down "
-              "over 10 m past the point keeps sinking at up to this, no faster than its glide "
-              "(0: off, the flare's sink falls to TECS_LAND_SINK whatever)"),
+              "over LAND_FLOAT_DIST past the point keeps sinking at up to this, no faster than "
+              "its glide (0: off, the flare's sink falls to TECS_LAND_SINK whatever)"),
+    ParamDecl("LAND_FLOAT_DIST", 10.0, 0.0, 50.0, "m", "landing: how far past the point a flare "
+              "may float before it keeps sinking (LAND_FLOAT_SINK)"),
     ParamDecl("LAND_PITCH_CD", 0.0, -500.0, 1500.0, "cdeg", "landing: least pitch in the flare"),
     ParamDecl("LAND_FLARE_AOA", 0.0, 0.0, 15.0, "deg", "landing: wing's angle of attack over zero "
               "lift at TECS_LAND_ARSPD; faster, the flare's least pitch is lower (0: off)"),

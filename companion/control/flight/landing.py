@@ -30,9 +30,11 @@ PX4 publish for their fixed-wing landings, written here from their descriptions:
   touch down more than ``LAND_GA_LONG`` past the point (a balloon in rising air).
 
 Heights are above the touchdown point's altitude, from the navigator's altitude (which
-fuses the barometer and GPS); the flare (when to begin it, its sink demand, the touchdown)
-takes the rangefinder's height instead whenever the state carries one
-(``range_height.py``: valid, fresh, wings near level), as ArduPlane's ``RNGFND_LANDING``.
+fuses the barometer and GPS), less ``LAND_TD_ALT`` (a tail dragger's wheels meet the runway
+tail up, its centre higher than where it rested at arming); the flare (when to begin it,
+its sink demand, the touchdown) takes the rangefinder's height instead whenever the state
+carries one (``range_height.py``: valid, fresh, wings near level), as ArduPlane's
+``RNGFND_LANDING``.
 Once the rangefinder reaches the ground on the approach, it also corrects where the
 navigator's altitude puts the runway (``ground_alt``), as ArduPlane's rangefinder
 correction does: the touchdown point's altitude is home's, taken from the navigator at
@@ -77,15 +79,11 @@ NOT_FLYING = 0.6  # below this fraction of the approach speed the wings cannot l
 # Never more than the nominal: a flare that dives for a point it would float past reaches
 # the ground before its pitch has caught up (short and hard); long is the lesser harm.
 AIM_LOW, AIM_HIGH = 0.6, 1.0
-# But a flare whose nominal shape would touch down more than FLOAT_MARGIN_M past the point
+# But a flare whose nominal shape would touch down more than LAND_FLOAT_DIST past the point
 # asks for the sink of the flare that touches down there, at most the sink it began from
 # (never steeper than the glide it came from, so the pitch has nothing to catch up) and
 # LAND_FLOAT_SINK (a firm touchdown, not a hard one): Cubs that gusts held up at idle
-# followed the nominal flare's falling demand and floated 16-32 m long. The model's flare
-# ends at the ground, a real one on the wheels a little earlier: aimed 5 m past the point,
-# the Cub's touchdowns came 6.7 m short of it on average (96 random plans, calm); at 10 m,
-# 2.8 m short.
-FLOAT_MARGIN_M = 10.0
+# followed the nominal flare's falling demand and floated 16-32 m long.
 # The runway's altitude follows the rangefinder's ground with this time constant: a few
 # readings' noise is smoothed, and the glide path moves down no faster than it can be flown.
 GROUND_TAU_S = 1.5
@@ -165,7 +163,7 @@ class Landing:
         # little sink that it is planned long, and a C172 at idle in it sank short of the
         # point (15-50 m on 1.3-2.2° finals). The path then starts below the approach's
         # height, which the aircraft holds until it meets the path, as on a glide slope.
-        drop = self.start_alt - self.ground_alt - flare_alt
+        drop = self.start_alt - self._wheels_alt(v) - flare_alt
         least = math.tan(math.radians(v["LAND_SLOPE_MIN"]))
         return max(drop / max(self.length - flare_dist, 1.0), least)
 
@@ -173,8 +171,14 @@ class Landing:
         """The glide path's height (MSL) abeam ``pos``."""
         h_f = self.flare_alt if math.isfinite(self.flare_alt) else v["LAND_FLARE_ALT"]
         to_flare = -self.along(pos) - flare_dist
-        alt = self.ground_alt + h_f + to_flare * self._slope(flare_dist, h_f, v)
-        return min(alt, max(self.start_alt, self.ground_alt + h_f))
+        alt = self._wheels_alt(v) + h_f + to_flare * self._slope(flare_dist, h_f, v)
+        return min(alt, max(self.start_alt, self._wheels_alt(v) + h_f))
+
+    def _wheels_alt(self, v: Mapping[str, float]) -> float:
+        """The height (MSL) the navigator reads when the wheels meet the runway in the
+        flare's attitude: the runway's, plus ``LAND_TD_ALT`` (a tail dragger lands tail up,
+        its centre higher than where it rests on its tail wheel)."""
+        return self.ground_alt + v["LAND_TD_ALT"]
 
     def _correct_ground(self, s: AircraftState, dt: float) -> None:
         """Move ``ground_alt`` towards the ground the rangefinder finds under the aircraft."""
@@ -198,7 +202,8 @@ class Landing:
             self._correct_ground(s, dt)
             ground_rate = (self.ground_alt - ground_before) / dt if dt > 0 else 0.0
             self._smooth_trim(s, dt)
-        height = s.range_height if math.isfinite(s.range_height) else s.alt_msl - self.ground_alt
+        raw = s.range_height if math.isfinite(s.range_height) else s.alt_msl - self.ground_alt
+        height = raw - v["LAND_TD_ALT"]  # above the wheels' touchdown
         ground_speed = math.hypot(*s.vel)
         due = self.phase == LandPhase.APPROACH and self._flare_due(height, s.climb_rate, v)
         if due:
@@ -263,7 +268,7 @@ class Landing:
         limit = v["LAND_GA_HGT"]
         if not self.may_go_around or limit <= 0.0:
             return  # the path's height is not worked out: it would land either way
-        path = self.glide_alt(pos, self.flare_distance(ground_speed, v), v) - self.ground_alt
+        path = self.glide_alt(pos, self.flare_distance(ground_speed, v), v) - self._wheels_alt(v)
         if height - path > limit:
             self.high_at_flare = height - path
             self.phase = LandPhase.GO_AROUND
@@ -300,7 +305,7 @@ class Landing:
         decel = self._decel.update(speed_along, dt)
         t_go = time_to_point(-self.along(s.pos), speed_along, decel)
         aim = aimed_sink(height, t_go, s_t)
-        t_float = time_to_point(FLOAT_MARGIN_M - self.along(s.pos), speed_along, decel)
+        t_float = time_to_point(v["LAND_FLOAT_DIST"] - self.along(s.pos), speed_along, decel)
         floating = min(aimed_sink(height, t_float, s_t), self._sink0, v["LAND_FLOAT_SINK"])
         # Already sinking faster than that (a lull), it is asked less, down to the nominal
         # flare's sink at twice it: a C172 asked to keep 1.2 m/s as a lull sank it at 2 m/s

@@ -317,3 +317,35 @@ def test_a_flare_held_up_in_its_upper_half_goes_around_when_it_would_land_far_lo
     # In the flare's lower half it lands, however long.
     assert flown(TOUCHDOWN[1] - 5.0, 1.7, sink=0.0)[0].phase == LandPhase.FLARE
     assert flown(TOUCHDOWN[1] - 5.0, 2.0, sink=0.0)[0].phase == LandPhase.GO_AROUND
+
+
+def test_the_flare_ends_where_the_wheels_meet_the_runway_land_td_alt_above_rest():
+    """Heights are the navigator's above where the aircraft rested at arming. A tail dragger
+    rests on its tail wheel and lands tail up, its centre 0.2 m higher: its wheels met the
+    runway with 0.2 m of the flare left, and it touched down 10 m short. With LAND_TD_ALT
+    the glide path and the flare are flown that much higher, all else alike."""
+    flare_at = TOUCHDOWN[1] - Landing(START, 150.0, TOUCHDOWN, 100.0).flare_distance(28.0, V)
+
+    def flown(td: float) -> list[tuple[LandPhase, float, float]]:
+        w = V | {"LAND_TD_ALT": td}
+        land = Landing(START, 150.0 + td, TOUCHDOWN, 100.0)
+        out = []
+        for e, height, sink in [(flare_at - 300.0, 20.0, 2.0), (flare_at - 30.0, 4.5, 1.8),
+                                (flare_at, 2.9, 1.7), (flare_at + 40.0, 1.8, 1.2),
+                                (flare_at + 80.0, 0.6, 0.7)]:  # fmt: skip
+            dem = land.step(_state(e, height + td, sink=sink), w, 0.02)
+            flown_at = td if dem.phase == LandPhase.APPROACH else 0.0  # the glide path's
+            out.append((dem.phase, dem.alt_msl - flown_at, dem.pitch))
+        return out
+
+    raised = flown(0.3)
+    assert [p for p, _, _ in raised] == [LandPhase.APPROACH] * 2 + [LandPhase.FLARE] * 3
+    for got, want in zip(raised, flown(0.0), strict=True):
+        assert got[0] == want[0] and got[1:] == pytest.approx(want[1:], nan_ok=True)
+    # Without it, the same heights read 0.3 m higher: a flare asking for more sink.
+    w = V | {"LAND_TD_ALT": 0.0}
+    land = Landing(START, 150.3, TOUCHDOWN, 100.0)
+    for e, height, sink in [(flare_at - 30.0, 4.8, 1.8), (flare_at, 3.2, 1.7)]:
+        land.step(_state(e, height, sink=sink), w, 0.02)
+    late = land.step(_state(flare_at + 80.0, 0.9, sink=0.7), w, 0.02)
+    assert late.pitch < raised[-1][2] - math.radians(0.3)
