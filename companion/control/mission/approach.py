@@ -23,6 +23,12 @@ NOTE_LOWER_M = 2.0  # and one left this much lower
 # 180° on a final of 3.7 radii, a C172 came out of the loop 250 m beside the final and met
 # its line only in the flare, 12.8 m beside the point.
 LINE_UP_RADII = 4.0
+# And so is any final the aircraft comes to back along its own line (a go-around's second
+# approach, climbed out past the runway): the 180° loop at its start leaves it two radii
+# beside the final. After a go-around in a 5 m/s crosswind a Cub turned so onto a 700 m
+# final (6 radii), drifted 150 m beside it, lined up only at 12 m and 29 m/s, and touched
+# down 19 m aside.
+REVERSAL_RAD = math.radians(150.0)
 LINE_UP_TEXT = "Land: circling at item %d to line up with the final"  # said as it begins
 
 
@@ -44,13 +50,23 @@ def turns_back_onto(a: Point, b: Point, land: Point | None, turn_radius: float) 
     """Whether the final from ``b`` to ``land`` turns back on the leg ``a`` → ``b`` more than
     a corner's arc turns (``LOOP_TURN_RAD``) and is too short (``LINE_UP_RADII`` turn
     radii) for the loop that turns onto it to leave the aircraft lined up on it before the
-    flare: the aircraft would glide in the loop and meet the final across it (False with
-    no final: ``land`` None)."""
+    flare: the aircraft would glide in the loop and meet the final across it; or turns
+    back more than ``REVERSAL_RAD`` from within a turn radius of the final's line,
+    whatever its length (False with no final: ``land`` None)."""
     if land is None or distance(a, b) < 1.0:
         return False
-    if distance(b, land) >= LINE_UP_RADII * turn_radius:
+    turn = abs(corner_turn(a, b, land))
+    if turn <= LOOP_TURN_RAD:
         return False
-    return abs(corner_turn(a, b, land)) > LOOP_TURN_RAD
+    if distance(b, land) < LINE_UP_RADII * turn_radius:
+        return True
+    return turn > REVERSAL_RAD and abs(_beside(a, b, land)) < turn_radius
+
+
+def _beside(pos: Point, b: Point, land: Point) -> float:
+    """How far ``pos`` is beside the line through ``b`` and ``land`` (m, + right)."""
+    length = max(distance(b, land), 1.0)
+    return ((pos[1] - b[1]) * (land[0] - b[0]) - (pos[0] - b[0]) * (land[1] - b[1])) / length
 
 
 def final_height(
