@@ -134,6 +134,10 @@ class Landing:
             pos[1] - self.touchdown[1]
         ) * self.unit[1]
 
+    def speed_along(self, vel: Point) -> float:
+        """The ground speed along the approach (m/s, negative when flying back)."""
+        return vel[0] * self.unit[0] + vel[1] * self.unit[1]
+
     def xtrack(self, pos: Point) -> float:
         """Metres right of the centreline."""
         dn, de = pos[0] - self.touchdown[0], pos[1] - self.touchdown[1]
@@ -230,7 +234,7 @@ class Landing:
         flare_dist = self.flare_distance(ground_speed, v)
         alt = self.glide_alt(s.pos, flare_dist, v)
         on_slope = alt < self.start_alt
-        speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
+        speed_along = self.speed_along(s.vel)
         slope = self._slope(flare_dist, self.flare_alt, v)
         self._glide_sink = max(speed_along, 0.0) * slope
         # The path moves with the runway's height as the rangefinder corrects it, and the
@@ -281,7 +285,7 @@ class Landing:
         limit = v["LAND_GA_LONG"]
         if not self.may_go_around or limit <= 0.0 or not height >= COMMITTED * self.flare_alt:
             return  # lower, it lands whatever: a climb begun there could touch down first
-        speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
+        speed_along = self.speed_along(s.vel)
         most = min(self._sink0, v["LAND_FLOAT_SINK"] or self._sink0)
         sink = max(most, -s.climb_rate, 0.1)
         along = self.along(s.pos)
@@ -301,7 +305,7 @@ class Landing:
         # Steer the touchdown onto the point: the flare that ends there (flare_aim.py),
         # counting the speed it loses, kept near the nominal flare's so the touchdown
         # stays gentle either way.
-        speed_along = s.vel[0] * self.unit[0] + s.vel[1] * self.unit[1]
+        speed_along = self.speed_along(s.vel)
         decel = self._decel.update(speed_along, dt)
         t_go = time_to_point(-self.along(s.pos), speed_along, decel)
         aim = aimed_sink(height, t_go, s_t)

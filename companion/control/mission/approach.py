@@ -40,7 +40,7 @@ def circle_down(
     side the aircraft is on, so it is left at the waypoint on the final's course."""
     length = max(distance(wp, land), 1.0)
     right = (-(land[1] - wp[1]) / length, (land[0] - wp[0]) / length)
-    side = 1.0 if (pos[0] - wp[0]) * right[0] + (pos[1] - wp[1]) * right[1] >= 0.0 else -1.0
+    side = 1.0 if _beside(pos, wp, land) >= 0.0 else -1.0
     lat, lon = frame.latlon(wp[0] + side * radius * right[0], wp[1] + side * radius * right[1])
     return replace(item, command=d.MAV_CMD_NAV_LOITER_TO_ALT, param1=1.0,
                    param2=side * radius, x=round(lat * 1e7), y=round(lon * 1e7))  # fmt: skip

@@ -12,6 +12,7 @@ flare it touched down 19.8 m past the point (the issue's target: 15 m).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import NamedTuple
 
 from companion.control.mission.plan import checked_plan
 from companion.messages import LandPhase
@@ -19,26 +20,44 @@ from ground.campaign.landing_score import landing_score_for_plan
 from mavlink_dialect import companion as d
 from tests.support.closed_loop import ClosedLoop
 
-PLAN = Path(__file__).resolve().parents[4] / "benchmarks" / "plans" / "gusty_steep_final.plan"
-CROSSWIND = (3.356723318148176, -3.705726455824863, 0.0)  # 5 m/s across its 222° runway
-GUSTS = 55
+PLANS = Path(__file__).resolve().parents[4] / "benchmarks" / "plans"
 
 
-def _fly(overrides: dict[str, float]) -> ClosedLoop:
-    items = checked_plan(PLAN)[0]
-    loop = ClosedLoop("J3Cub", items, wind_ned=CROSSWIND, turbulence="light",
+class Case(NamedTuple):
+    """A plan flown by one airframe across its runway in light turbulence."""
+
+    plan: Path
+    airframe: str
+    wind_ned: tuple[float, float, float]  # 5 m/s across the runway
+    gusts: int  # JSBSim's turbulence seed
+    longest_s: float
+
+
+STEEP = Case(PLANS / "gusty_steep_final.plan", "J3Cub",
+             (3.356723318148176, -3.705726455824863, 0.0), 55, 1500.0)  # fmt: skip
+
+
+def _fly(overrides: dict[str, float], case: Case = STEEP) -> ClosedLoop:
+    items = checked_plan(case.plan)[0]
+    loop = ClosedLoop(case.airframe, items, wind_ned=case.wind_ned, turbulence="light",
                       overrides=overrides, range_max_m=12.0)  # fmt: skip
-    loop.flight.fdm["atmosphere/randomseed"] = GUSTS
-    assert loop.fly_until_disarmed(1500.0)
+    loop.flight.fdm["atmosphere/randomseed"] = case.gusts
+    assert loop.fly_until_disarmed(case.longest_s)
     return loop
 
 
-def test_an_approach_left_high_by_a_gust_goes_around_and_lands_on_target_the_second_time():
-    items = checked_plan(PLAN)[0]
-    loop = _fly({})
+def _went_around(loop: ClosedLoop) -> tuple[list[int], list[int]]:
+    """The landing phase of every sample, and the samples where a go-around began."""
     phases = [s.out.land_phase for s in loop.samples]
-    went_around = [k for k in range(1, len(phases)) if phases[k] == LandPhase.GO_AROUND
-                   and phases[k - 1] != LandPhase.GO_AROUND]  # fmt: skip
+    began = [k for k in range(1, len(phases)) if phases[k] == LandPhase.GO_AROUND
+             and phases[k - 1] != LandPhase.GO_AROUND]  # fmt: skip
+    return phases, began
+
+
+def test_an_approach_left_high_by_a_gust_goes_around_and_lands_on_target_the_second_time():
+    items = checked_plan(STEEP.plan)[0]
+    loop = _fly({})
+    phases, went_around = _went_around(loop)
     assert len(went_around) == 1
     # From the flare's height, never on the wheels, then round to the approach again.
     k = went_around[0]
@@ -62,7 +81,7 @@ def test_flared_from_high_a_flare_that_would_float_long_keeps_sinking_onto_the_t
     would float far past the point, so its sink demand stays at up to LAND_FLOAT_SINK
     (1.2 m/s) until the flare that touches down near the point asks less: on target,
     firmly but under the issue's 1.5 m/s."""
-    items = checked_plan(PLAN)[0]
+    items = checked_plan(STEEP.plan)[0]
     loop = _fly({"LAND_GA_HGT": 0.0})
     assert LandPhase.GO_AROUND not in {s.out.land_phase for s in loop.samples}
     score = landing_score_for_plan(loop.truth(), items)
@@ -80,25 +99,14 @@ def test_with_no_go_arounds_left_the_landing_flares_from_where_it_is():
 # landing on a 345° runway) with JSBSim's gust sequence 24 across it: the C172 flares from
 # 5 m, 125 m before the point, and rising air holds it at 4 m for the next 50 m, its least
 # pitch (LAND_PITCH_CD 0°) 2-3° above its glide's. It touched down 41.8 m long.
-BALLOON = PLAN.parent / "jump_balloon.plan"
-BALLOON_WIND = (1.29785625847449, 4.828619795794508, 0.0)  # 5 m/s across its runway
-
-
-def _fly_balloon(overrides: dict[str, float]) -> ClosedLoop:
-    items = checked_plan(BALLOON)[0]
-    loop = ClosedLoop("c172p", items, wind_ned=BALLOON_WIND, turbulence="light",
-                      overrides=overrides, range_max_m=12.0)  # fmt: skip
-    loop.flight.fdm["atmosphere/randomseed"] = 24
-    assert loop.fly_until_disarmed(2000.0)
-    return loop
+BALLOON = Case(PLANS / "jump_balloon.plan", "c172p",
+               (1.29785625847449, 4.828619795794508, 0.0), 24, 2000.0)  # fmt: skip
 
 
 def test_a_flare_held_up_by_rising_air_goes_around_and_lands_on_target_the_second_time():
-    items = checked_plan(BALLOON)[0]
-    loop = _fly_balloon({})
-    phases = [s.out.land_phase for s in loop.samples]
-    went_around = [k for k in range(1, len(phases)) if phases[k] == LandPhase.GO_AROUND
-                   and phases[k - 1] != LandPhase.GO_AROUND]  # fmt: skip
+    items = checked_plan(BALLOON.plan)[0]
+    loop = _fly({}, BALLOON)
+    phases, went_around = _went_around(loop)
     assert len(went_around) == 1
     k = went_around[0]
     assert phases[k - 1] == LandPhase.FLARE  # from the flare itself, in the air
@@ -109,5 +117,5 @@ def test_a_flare_held_up_by_rising_air_goes_around_and_lands_on_target_the_secon
     score = landing_score_for_plan(loop.truth(), items)
     assert score.passed(), score
     # Flared on (LAND_GA_LONG 0: off), it touches down far past the point.
-    stayed = landing_score_for_plan(_fly_balloon({"LAND_GA_LONG": 0.0}).truth(), items)
+    stayed = landing_score_for_plan(_fly({"LAND_GA_LONG": 0.0}, BALLOON).truth(), items)
     assert stayed.along_m > 30.0, stayed
