@@ -93,6 +93,10 @@ def mission_load(
     for mission_type, items in lists.items():
         store.replace(mission_type, items)
     out.print(f"stored {_counts({t: len(items) for t, items in lists.items()})} items from {plan}")
+    from companion.control.mission.items import not_carried_note
+
+    if (note := not_carried_note([it for items in lists.values() for it in items])) is not None:
+        out.print(note)
 
 
 @mission_app.command("save")

@@ -21,6 +21,7 @@ from companion.control.mission.items import (
     TAKEOFF_NOT_FIRST,
     MissionItem,
     first_refusal,
+    not_carried_note,
 )
 from companion.control.mission.mission_files import MissionStore
 from companion.control.prearm import PlanVerdicts
@@ -181,6 +182,8 @@ class MissionService:
         notes: list[str] = []
         if mission_type == d.MAV_MISSION_TYPE_FENCE:  # zones that enclose nothing: left out
             items, notes = honoured(items)
+        elif (note := not_carried_note(items)) is not None:  # a gimbal's angles, say
+            notes = [note]
         result, bad = first_refusal(items)
         if result == d.MAV_MISSION_ACCEPTED:
             self.store.replace(mission_type, items)

@@ -26,7 +26,7 @@ from companion.control.flight.landing_pattern import (
 from companion.control.flight.range_height import range_height
 from companion.control.laws.l1_guidance import bank_for
 from companion.control.mission.executor import Kind, MissionExecutor, Setpoint
-from companion.control.mission.items import MissionItem
+from companion.control.mission.items import NAV_COMMANDS, MissionItem
 from companion.messages import FlightMode, LandPhase, NavState, RangeReading
 from mavlink_dialect import companion as d
 
@@ -51,12 +51,12 @@ def land_start(items: list[MissionItem]) -> int | None:
 
 def approach_start(items: list[MissionItem], land_index: int) -> int:
     """Where a second approach to the NAV_LAND at ``land_index`` begins: its DO_LAND_START,
-    else the positional item before it."""
+    else the item flown to before it (not a region of interest's place)."""
     for k in range(land_index - 1, -1, -1):
         if items[k].command == d.MAV_CMD_DO_LAND_START:
             return k
     for k in range(land_index - 1, -1, -1):
-        if items[k].x or items[k].y:
+        if items[k].command in NAV_COMMANDS and (items[k].x or items[k].y):
             return k
     return land_index
 

@@ -2,8 +2,10 @@
 
 Only what the executor flies is accepted: no terrain frames (it has no terrain data), so
 such a plan is refused at upload with the matching MAV_MISSION_RESULT instead of being
-skipped in flight. The camera stops that QGroundControl's landing pattern puts before the
-approach are accepted and do nothing: there is no camera on board to stop.
+skipped in flight. Items that aim or set up what the vehicle does not carry (a gimbal, a
+video or MAVLink camera) and a multicopter's yaw are accepted and passed over, as PX4 takes
+them from QGroundControl's Plan view: the plan flies, and the operator is told at upload
+(``not_carried_note``).
 """
 
 from __future__ import annotations
@@ -40,13 +42,36 @@ CAMERA_ITEMS = frozenset(
     }
 )
 CAMERA_STOPS = frozenset({d.MAV_CMD_VIDEO_STOP_CAPTURE})  # no video camera to stop
-# Markers and camera stops: nothing to fly (DO_LAND_START only marks where a landing begins).
-SKIPPED = CAMERA_STOPS | {d.MAV_CMD_DO_LAND_START}
+# What QGroundControl's Plan view offers a PX4 plane for a gimbal (regions of interest, mount
+# and gimbal-manager angles), a video or MAVLink camera (its mode, zoom, focus, video) and a
+# multicopter's yaw: nothing on board acts on them (photos go through CAM1_*).
+NOT_CARRIED = frozenset(
+    {
+        d.MAV_CMD_DO_SET_ROI_LOCATION,
+        d.MAV_CMD_DO_SET_ROI_WPNEXT_OFFSET,
+        d.MAV_CMD_DO_SET_ROI_NONE,
+        d.MAV_CMD_DO_SET_ROI,
+        d.MAV_CMD_DO_MOUNT_CONFIGURE,
+        d.MAV_CMD_DO_MOUNT_CONTROL,
+        d.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW,
+        d.MAV_CMD_DO_GIMBAL_MANAGER_CONFIGURE,
+        d.MAV_CMD_SET_CAMERA_MODE,
+        d.MAV_CMD_SET_CAMERA_ZOOM,
+        d.MAV_CMD_SET_CAMERA_FOCUS,
+        d.MAV_CMD_VIDEO_START_CAPTURE,
+        d.MAV_CMD_CONDITION_YAW,
+    }
+)
+# Markers, camera stops and the above: nothing to fly (DO_LAND_START only marks where a
+# landing begins).
+SKIPPED = CAMERA_STOPS | NOT_CARRIED | {d.MAV_CMD_DO_LAND_START}
 MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
 # DO items that act at once and fly nowhere: a speed, a servo output (a payload release),
 # a camera's photos.
 ACTIONS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_SET_SERVO}) | CAMERA_ITEMS
-DO_COMMANDS = ACTIONS | frozenset({d.MAV_CMD_DO_JUMP, d.MAV_CMD_DO_LAND_START}) | CAMERA_STOPS
+DO_COMMANDS = (
+    ACTIONS | frozenset({d.MAV_CMD_DO_JUMP, d.MAV_CMD_DO_LAND_START}) | CAMERA_STOPS | NOT_CARRIED
+)
 SERVO_OUTPUTS = range(1, 9)  # DO_SET_SERVO's param1: the Mini SSC's eight, from 1
 SERVO_PULSES_US = (1000.0, 2000.0)  # and param2: what the card puts out (its 90° range)
 SUPPORTED = {
@@ -82,6 +107,7 @@ POSITIONLESS = (
     )
     | CAMERA_STOPS
     | CAMERA_ITEMS
+    | NOT_CARRIED  # a region of interest's position is never flown to
 )
 
 
@@ -142,6 +168,15 @@ class MissionItem:
     def acceptance_m(self, default_m: float) -> float:
         """A waypoint's acceptance radius (param2, m), or ``default_m`` when it gives none."""
         return self.param2 if self.param2 > 0 else default_m
+
+
+def not_carried_note(items: Sequence[MissionItem]) -> str | None:
+    """What to tell the operator of a stored mission whose items aim or set up what the
+    vehicle does not carry (STATUSTEXT's 50 bytes); None when it has none."""
+    count = sum(1 for item in items if item.command in NOT_CARRIED)
+    if not count:
+        return None
+    return f"Mission: {count} gimbal/video/yaw item{'s' * (count > 1)} ignored"
 
 
 def change_speed(item: MissionItem, speed: float) -> float:

@@ -87,6 +87,37 @@ def test_an_item_the_vehicle_cannot_fly_is_refused_and_the_old_mission_stays(ben
     ]  # fmt: skip
 
 
+# What QGroundControl's Plan view offers a PX4 plane for a gimbal, a video camera and a
+# multicopter's yaw: PX4 takes a plan with them, and so does this vehicle, which has none.
+NOT_CARRIED = (
+    d.MAV_CMD_DO_SET_ROI_LOCATION,
+    d.MAV_CMD_DO_MOUNT_CONTROL,
+    d.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW,
+    d.MAV_CMD_SET_CAMERA_MODE,
+    d.MAV_CMD_VIDEO_START_CAPTURE,
+    d.MAV_CMD_CONDITION_YAW,
+    d.MAV_CMD_DO_SET_ROI_NONE,
+)
+
+
+def test_a_gimbal_video_or_yaw_item_is_taken_and_the_operator_told_it_is_ignored(bench):
+    said = []
+    bench.service.say = lambda text, severity: said.append((text, severity))
+    items = [bench.item(0)]
+    items += [bench.item(i + 1, command=c, p1=1.0) for i, c in enumerate(NOT_CARRIED)]
+    items.append(bench.item(len(items)))
+    ack = bench.upload(items)
+    assert ack.type == d.MAV_MISSION_ACCEPTED
+    assert said == [("Mission: 7 gimbal/video/yaw items ignored", d.MAV_SEVERITY_WARNING)]
+    stored = bench.service.store.items[0]
+    assert [it.command for it in stored] == [d.MAV_CMD_NAV_WAYPOINT, *NOT_CARRIED,
+                                             d.MAV_CMD_NAV_WAYPOINT]  # fmt: skip
+    # A plan without them says nothing; a VTOL take-off is still refused (test above).
+    said.clear()
+    assert bench.upload([bench.item(0), bench.item(1)]).type == d.MAV_MISSION_ACCEPTED
+    assert said == []
+
+
 # An ArduPilot .waypoints file as Mission Planner saves one: line 0 is home (at ground level,
 # absolute), then the take-off and the waypoints. MAVProxy's `wp load` sends every line.
 WAYPOINTS_FILE = """QGC WPL 110

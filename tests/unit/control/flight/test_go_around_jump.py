@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import pytest
 
-from companion.control.flight.landing_flight import LandingFlight
+from companion.control.flight.landing_flight import LandingFlight, approach_start
 from companion.control.mission.executor import Kind
 from mavlink_dialect import companion as d
 from tests.unit.control.mission.executor_flying import (
@@ -47,3 +47,14 @@ def test_a_go_around_after_the_loop_comes_round_to_the_landing(jump_after_approa
     again, setpoints, _ = fly_lines(ex, pos)
     assert setpoints[-1].kind == Kind.LAND  # the second approach ...
     assert again == [items[-3].seq]  # ... from its start, on to the landing
+
+
+def test_a_go_around_comes_round_to_the_last_waypoint_not_a_region_of_interest():
+    """A region of interest set between the approach's waypoint and NAV_LAND has a place of
+    its own, 2 km off to the side; the second approach begins at the waypoint."""
+    items = [
+        wp(0, (0.0, 1_500.0)),
+        item(1, d.MAV_CMD_DO_SET_ROI_LOCATION, (2_000.0, 2_000.0), z=10.0),
+        item(2, d.MAV_CMD_NAV_LAND, LAND, z=0.0),
+    ]
+    assert approach_start(items, 2) == 0

@@ -3,7 +3,8 @@
 No dynamics: the aircraft is teleported along the path (or round a circle) and the
 executor is stepped at each position, so what is tested is only the executor's logic —
 take-off, waypoint acceptance (radius, the square line, the turn lead), DO_CHANGE_SPEED,
-DO_JUMP, the loiters, RTL and what happens after the last item.
+DO_JUMP, items for what the vehicle does not carry, the loiters, RTL and what happens after
+the last item.
 """
 
 from __future__ import annotations
@@ -247,6 +248,27 @@ def test_changed_speed_carries_into_a_loiter():
     ex = executor(items)
     sp = ex.step((0.0, 0.0), 180.0, 0.0)
     assert sp.kind == Kind.CIRCLE and sp.speed == 19.0
+
+
+def test_gimbal_video_and_yaw_items_are_passed_over_and_the_legs_flown_as_without_them():
+    """A region of interest 2 km off, a gimbal's angles, a video start and a yaw: nothing on
+    board acts on them, so the aircraft flies the waypoints either side as if they were not
+    there, never towards the region of interest."""
+    a, b = (500.0, 0.0), (500.0, 500.0)
+    aims = [
+        item(1, d.MAV_CMD_DO_SET_ROI_LOCATION, (2_000.0, -2_000.0), z=10.0),
+        item(2, d.MAV_CMD_DO_MOUNT_CONTROL, p1=-45.0),
+        item(3, d.MAV_CMD_VIDEO_START_CAPTURE),
+        item(4, d.MAV_CMD_CONDITION_YAW, p1=90.0),
+    ]
+    with_aims = executor([wp(0, a), *aims, wp(5, b)])
+    reached, setpoints, end = fly_lines(with_aims)
+    plain_reached, plain_setpoints, plain_end = fly_lines(executor([wp(0, a), wp(1, b)]))
+    assert reached == [0, 5] and plain_reached == [0, 1] and with_aims.finished
+    assert [sp.b for sp in setpoints if sp.kind == Kind.LINE] == [
+        sp.b for sp in plain_setpoints if sp.kind == Kind.LINE
+    ]
+    assert end == plain_end
 
 
 def test_do_jump_repeats_the_loop_twice_more_then_continues():
