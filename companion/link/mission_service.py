@@ -337,4 +337,6 @@ def _refusal_text(result: int, item: MissionItem) -> str:
     """What a ground station is told of a refused upload: the item, its command, why."""
     name = d.enums["MAV_MISSION_RESULT"][result].name
     why = _WHY.get(result) or name.removeprefix("MAV_MISSION_").lower().replace("_", " ")
+    if item.command == d.MAV_CMD_NAV_DELAY and result == d.MAV_MISSION_INVALID_PARAM1:
+        why = "seconds to wait, not a time of day"
     return f"Mission refused: item {item.seq} ({command_name(item.command)}): {why}"

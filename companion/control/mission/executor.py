@@ -6,7 +6,8 @@ acceptance radius or when the aircraft crosses the line through the waypoint squ
 the leg (an overshoot never makes it circle back; the leg after a take-off starts where
 the climb ended, so a first waypoint the climb flew past is flown back to); loiters
 circle their point (radius param3, negative for counter-clockwise) forever, for param1
-seconds or param1 turns once on the circle; NAV_RETURN_TO_LAUNCH ends the mission, reached
+seconds or param1 turns once on the circle; NAV_DELAY circles the last point flown to, at
+its height, for param1 seconds from its start; NAV_RETURN_TO_LAUNCH ends the mission, reached
 as it is begun, and hands the flight to Return (the commander enters that mode, as ArduPlane
 and PX4 do: ``control.mission_return``; until it does, or flown without a commander, it
 flies home and circles there); DO_CHANGE_SPEED, DO_SET_SERVO (``servo_sets``, for the servo
@@ -21,11 +22,14 @@ from dataclasses import dataclass, field
 from companion.control.laws.fillet import MIN_TURN_RAD, corner_arc
 from companion.control.mission import approach
 from companion.control.mission.items import (
+    ACTIONS,
     CAMERA_ITEMS,
     MAX_JUMPS_PER_STEP,
     SKIPPED,
     MissionItem,
     change_speed,
+    delay_loiter,
+    jump_target,
     next_flown,
 )
 from companion.control.mission.leg_geometry import (
@@ -170,20 +174,22 @@ class MissionExecutor:
     def _item(self, item: MissionItem, pos: Point, alt: float, t_s: float) -> Setpoint | None:
         """The setpoint of ``item``, or None when it is done (and the next is current)."""
         cmd = item.command
-        if cmd == d.MAV_CMD_DO_CHANGE_SPEED:  # an airspeed or ground speed; -1: no change
-            self.speed = change_speed(item, self.speed)
-            self._advance(False, self._prev, self._prev_alt)
-            return None
         if cmd == d.MAV_CMD_DO_JUMP:
-            self._jump(item)
+            self.current = jump_target(item, self.current, self.jumps_done, len(self.items))
             return None
-        if cmd in SKIPPED or cmd == d.MAV_CMD_DO_SET_SERVO or cmd in CAMERA_ITEMS:
-            if cmd == d.MAV_CMD_DO_SET_SERVO:  # the controller hands it to the servo output
+        if cmd in SKIPPED or cmd in ACTIONS:
+            if cmd == d.MAV_CMD_DO_CHANGE_SPEED:  # an airspeed or ground speed; -1: no change
+                self.speed = change_speed(item, self.speed)
+            elif cmd == d.MAV_CMD_DO_SET_SERVO:  # the controller hands it to the servo output
                 self.servo_sets.append((round(item.param1), round(item.param2)))
             elif cmd in CAMERA_ITEMS:  # and these to the camera (mission/camera.py)
                 self.camera_items.append(item)
             self._advance(False, self._prev, self._prev_alt)
             return None
+        if cmd == d.MAV_CMD_NAV_DELAY:  # its seconds count from its start, on the circle or not
+            if self._loiter.started_s is None:
+                self._loiter.started_s = t_s
+            return self._loiter_item(delay_loiter(item, self._prev_alt), pos, alt, t_s)
         if cmd == d.MAV_CMD_NAV_LAND:
             return self._land(item, pos)
         if cmd == d.MAV_CMD_NAV_LOITER_TO_ALT:
@@ -195,16 +201,6 @@ class MissionExecutor:
         if cmd == d.MAV_CMD_NAV_RETURN_TO_LAUNCH:
             return self._return(item, pos, alt)
         return self._loiter_item(item, pos, alt, t_s)
-
-    def _jump(self, item: MissionItem) -> None:
-        repeats = round(item.param2)
-        done = self.jumps_done.get(item.seq, 0)
-        if repeats < 0 or done < repeats:
-            if repeats >= 0:  # an endless jump keeps no count (see the loop check in step)
-                self.jumps_done[item.seq] = done + 1
-            self.current = max(0, min(round(item.param1), len(self.items)))
-        else:
-            self.current += 1
 
     def _takeoff(self, item: MissionItem, pos: Point, alt: float) -> Setpoint | None:
         target = self.alt_of(item)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 from mavlink_dialect import companion as d
@@ -29,6 +29,7 @@ NAV_COMMANDS = frozenset(
         d.MAV_CMD_NAV_TAKEOFF,
         d.MAV_CMD_NAV_LOITER_TO_ALT,
         d.MAV_CMD_NAV_LAND,
+        d.MAV_CMD_NAV_DELAY,
     }
 )
 # What a survey, a waypoint's camera section and a landing pattern's camera stop say to a
@@ -103,6 +104,7 @@ POSITIONLESS = (
             d.MAV_CMD_DO_SET_SERVO,
             d.MAV_CMD_DO_JUMP,
             d.MAV_CMD_DO_LAND_START,
+            d.MAV_CMD_NAV_DELAY,  # circles the last point flown to (``delay_loiter``)
         }
     )
     | CAMERA_STOPS
@@ -120,6 +122,7 @@ NEEDS_NUMBER = {
     d.MAV_CMD_IMAGE_START_CAPTURE: (2, 3),
     d.MAV_CMD_NAV_LOITER_TURNS: (1,),
     d.MAV_CMD_NAV_LOITER_TIME: (1,),
+    d.MAV_CMD_NAV_DELAY: (1,),
     d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION: (1,),
     d.MAV_CMD_NAV_FENCE_POLYGON_VERTEX_EXCLUSION: (1,),
     d.MAV_CMD_NAV_FENCE_CIRCLE_INCLUSION: (1,),
@@ -179,6 +182,14 @@ def not_carried_note(items: Sequence[MissionItem]) -> str | None:
     return f"Mission: {count} gimbal/video/yaw item{'s' * (count > 1)} ignored"
 
 
+def delay_loiter(item: MissionItem, alt_msl: float) -> MissionItem:
+    """A NAV_DELAY as the executor flies it, as PX4 and ArduPlane hold a plane: a LOITER_TIME
+    of its seconds round the last point flown to (it has no place of its own), at that
+    point's height ``alt_msl``, on the default radius, clockwise."""
+    return replace(item, command=d.MAV_CMD_NAV_LOITER_TIME, frame=d.MAV_FRAME_GLOBAL,
+                   param2=0.0, param3=0.0, param4=0.0, x=0, y=0, z=alt_msl)  # fmt: skip
+
+
 def change_speed(item: MissionItem, speed: float) -> float:
     """The speed flown after a DO_CHANGE_SPEED item (NaN: the default): param2 m/s for an
     airspeed or a ground speed (param1 0 or 1, both flown as the airspeed, as PX4 does),
@@ -217,6 +228,8 @@ def check_item(item: MissionItem, count: int) -> int:
         if not 0 <= target < count or target == item.seq:
             return d.MAV_MISSION_INVALID_PARAM1
         return d.MAV_MISSION_ACCEPTED
+    if item.command == d.MAV_CMD_NAV_DELAY and item.param1 < 0:  # until a time of day
+        return d.MAV_MISSION_INVALID_PARAM1
     if item.command in POSITIONLESS:
         return d.MAV_MISSION_ACCEPTED
     if item.frame not in GLOBAL_FRAMES:
@@ -280,6 +293,18 @@ def first_refusal(items: list[MissionItem]) -> tuple[int, MissionItem | None]:
     return d.MAV_MISSION_ACCEPTED, None
 
 
+def jump_target(item: MissionItem, index: int, jumps_done: dict[int, int], count: int) -> int:
+    """Where the DO_JUMP at ``index`` of ``count`` items sends the mission, its count in
+    ``jumps_done`` (by seq) taken: its target while repeats remain (for ever when param2 is
+    negative), else the next item."""
+    repeats, done = round(item.param2), jumps_done.get(item.seq, 0)
+    if 0 <= repeats <= done:
+        return index + 1
+    if repeats >= 0:  # an endless jump keeps no count (the executor's loop check needs that)
+        jumps_done[item.seq] = done + 1
+    return max(0, min(round(item.param1), count))
+
+
 def next_flown(
     items: Sequence[MissionItem], seq: int, jumps_done: Mapping[int, int]
 ) -> MissionItem | None:
@@ -291,9 +316,7 @@ def next_flown(
             return None
         item = items[seq]
         if item.command == d.MAV_CMD_DO_JUMP:
-            done, repeats = jumps.get(item.seq, 0), round(item.param2)
-            jumps[item.seq] = done + 1
-            seq = round(item.param1) if repeats < 0 or done < repeats else seq + 1
+            seq = jump_target(item, seq, jumps, len(items))
         elif item.command in SKIPPED or item.command in ACTIONS:
             seq += 1
         else:

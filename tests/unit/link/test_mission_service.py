@@ -100,7 +100,7 @@ NOT_CARRIED = (
 )
 
 
-def test_a_gimbal_video_or_yaw_item_is_taken_and_the_operator_told_it_is_ignored(bench):
+def test_gimbal_video_yaw_and_delay_items_are_taken_the_operator_told_of_the_ignored(bench):
     said = []
     bench.service.say = lambda text, severity: said.append((text, severity))
     items = [bench.item(0)]
@@ -112,6 +112,15 @@ def test_a_gimbal_video_or_yaw_item_is_taken_and_the_operator_told_it_is_ignored
     stored = bench.service.store.items[0]
     assert [it.command for it in stored] == [d.MAV_CMD_NAV_WAYPOINT, *NOT_CARRIED,
                                              d.MAV_CMD_NAV_WAYPOINT]  # fmt: skip
+    # A delay is flown (test_executor_loiter.py); one until a time of day is refused.
+    said.clear()
+    bench.service.refusal.period_s = 0.0
+    delay = [bench.item(0), bench.item(1, command=d.MAV_CMD_NAV_DELAY, x=0, y=0, p1=-1.0)]
+    assert bench.upload(delay).type == d.MAV_MISSION_INVALID_PARAM1
+    assert said == [("Mission refused: item 1 (NAV_DELAY): seconds to wait, not a time of day",
+                     d.MAV_SEVERITY_WARNING)]  # fmt: skip
+    delay[1] = bench.item(1, command=d.MAV_CMD_NAV_DELAY, x=0, y=0, p1=30.0)
+    assert bench.upload(delay).type == d.MAV_MISSION_ACCEPTED
     # A plan without them says nothing; a VTOL take-off is still refused (test above).
     said.clear()
     assert bench.upload([bench.item(0), bench.item(1)]).type == d.MAV_MISSION_ACCEPTED

@@ -1,4 +1,4 @@
-"""The mission executor's loiters, RTL, the end of the mission and starting part way.
+"""The mission executor's loiters and delays, RTL, the end of the mission and starting part way.
 
 As in test_executor.py: the aircraft is teleported and the executor stepped at each point.
 """
@@ -6,10 +6,12 @@ As in test_executor.py: the aircraft is teleported and the executor stepped at e
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import pytest
 
 from companion.control.mission.executor import ExecutorConfig, Kind, MissionExecutor
+from companion.control.mission.items import check_mission
 from mavlink_dialect import companion as d
 from tests.unit.control.mission.executor_flying import (
     HOME,
@@ -58,6 +60,39 @@ def test_loiter_time_starts_counting_within_a_quarter_radius_of_the_circle():
     assert not ex.finished
     ex.step((880.0, 0.0), 180.0, 15.0)
     assert ex.finished and ex.drain_reached() == [0]
+
+
+def test_a_delay_circles_the_last_waypoint_at_its_height_for_its_seconds_from_its_start():
+    """NAV_DELAY as QGroundControl sends it (no place, no height, the time-of-day fields -1)
+    holds the aircraft round the waypoint before it, counted from its start as PX4 and
+    ArduPlane count it, then the mission goes on from that waypoint."""
+    a, b = (500.0, 0.0), (1_500.0, 0.0)
+    delay = item(1, d.MAV_CMD_NAV_DELAY, p1=30.0, p2=-1.0, p3=-1.0)
+    delay = replace(delay, frame=d.MAV_FRAME_MISSION)
+    ex = executor([wp(0, a, z=120.0), delay, wp(2, b, z=120.0)])
+    reached, setpoints, pos = fly_lines(ex)  # to the waypoint; the delay began there
+    assert reached == [0]
+    began = float(len(setpoints) - 1)  # fly_lines steps once a second
+    for t in range(1, 30):  # from the waypoint out to the circle and round: not done
+        sp = ex.step(towards(pos, (500.0, 200.0), 6.0 * t), HOME_ALT + 120.0, began + t)
+        assert sp.kind == Kind.CIRCLE and ex.drain_reached() == [], t
+        assert sp.b == pytest.approx(a, abs=0.05) and sp.alt_msl == HOME_ALT + 120.0
+        assert sp.radius == ExecutorConfig().loiter_radius and sp.clockwise
+    sp = ex.step((500.0, 80.0), HOME_ALT + 120.0, began + 30.0)
+    assert ex.drain_reached() == [1]
+    assert (
+        sp.kind == Kind.LINE
+        and sp.a == pytest.approx(a, abs=0.05)
+        and sp.b == pytest.approx(b, abs=0.05)
+    )
+
+
+def test_a_delay_until_a_time_of_day_is_refused_at_upload():
+    ok = replace(item(1, d.MAV_CMD_NAV_DELAY, p1=30.0), frame=d.MAV_FRAME_MISSION)
+    assert check_mission([wp(0, (500.0, 0.0)), ok]) == d.MAV_MISSION_ACCEPTED
+    for p1 in (-1.0, math.nan):
+        bad = replace(ok, param1=p1, param2=12.0)
+        assert check_mission([wp(0, (500.0, 0.0)), bad]) == d.MAV_MISSION_INVALID_PARAM1
 
 
 @pytest.mark.parametrize("direction", [+1, -1])
