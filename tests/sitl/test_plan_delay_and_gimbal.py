@@ -4,6 +4,7 @@ QGroundControl's PX4 plug-in offers these items and PX4 flies such a plan: the d
 the aircraft round the waypoint before it, the gimbal items aim what a PX4 plane may carry.
 This vehicle carries no gimbal: the plan must still upload and fly, the aircraft circling
 the waypoint for the delay and never turning towards the region of interest 2.5 km off.
+MAVSDK's mission plug-in makes the same items of a waypoint's gimbal pitch and loiter time.
 """
 
 from __future__ import annotations
@@ -14,9 +15,16 @@ import math
 
 import numpy as np
 import pytest
+from mavsdk.asyncio import Configuration, Mavsdk
+from mavsdk.asyncio.plugins.mission import MissionAsync
+from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
+from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
+from mavsdk.component_type import ComponentType
+from mavsdk.plugins.mission import MissionItem, MissionPlan
 
 from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate as read_truth
+from mavlink_dialect import companion as d
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
 from tests.support.mavsdk_flight import fly_plan
@@ -87,3 +95,42 @@ def test_a_delay_holds_the_aircraft_round_its_waypoint_and_gimbal_items_change_n
     held, passed = seconds_within(A, 350.0), seconds_within(B, 350.0)
     assert held >= DELAY_S + 10.0 and held >= passed + 20.0, (held, passed)
     assert min(math.dist(p, ROI) for p in ne) > 1_800.0  # never turned towards it
+
+
+async def _upload_as_mavsdk_mission(port: int) -> list[int]:
+    """MAVSDK's own mission plug-in, a script's way: a waypoint with a gimbal pitch and a
+    loiter time, then one without. The commands the vehicle stored, downloaded."""
+    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
+    async with Mavsdk(config) as mavsdk:
+        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
+        system = await mavsdk.first_autopilot(timeout_s=60.0)
+        home = await anext(aiter(TelemetryAsync(system).subscribe_home()))
+        frame, nan = LocalFrame(home.latitude_deg, home.longitude_deg), math.nan
+        a, b = frame.latlon(*A), frame.latlon(*B)
+        none, fly = MissionItem.CameraAction.NONE, MissionItem.VehicleAction.NONE
+        items = [
+            MissionItem(*a, 60.0, 25.0, False, -45.0, 0.0, none, 20.0, nan, nan, nan, nan, fly),
+            MissionItem(*b, 60.0, 25.0, True, nan, nan, none, nan, nan, nan, nan, nan, fly),
+        ]
+        await MissionAsync(system).upload_mission(MissionPlan(items))  # raises if refused
+        stored = await MissionRawAsync(system).download_mission()
+    return [item.command for item in stored]
+
+
+@pytest.mark.timeout(300)
+def test_a_mavsdk_mission_with_a_gimbal_pitch_and_a_loiter_time_is_taken(tmp_path):
+    """MAVSDK turns a gimbal pitch into gimbal-manager items and a loiter time into
+    NAV_DELAY: the upload used to be refused whole."""
+    port = free_udp_port()
+    proc, namespace, _ = start_sim(
+        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "60"
+    )
+    try:
+        commands = asyncio.run(_upload_as_mavsdk_mission(port))
+    finally:
+        out = finish(proc, namespace, 240)
+    gimbal = {d.MAV_CMD_DO_GIMBAL_MANAGER_CONFIGURE, d.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW}
+    assert gimbal <= set(commands) and d.MAV_CMD_NAV_DELAY in commands, commands
+    assert commands.count(d.MAV_CMD_NAV_WAYPOINT) == 2
+    ignored = sum(c in gimbal for c in commands)
+    assert f"Mission: {ignored} gimbal/video/yaw items ignored" in out
