@@ -12,6 +12,9 @@ from __future__ import annotations
 import asyncio
 import json
 import math
+from collections.abc import Awaitable, Callable
+from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 import pytest
@@ -33,6 +36,7 @@ HOME = LocalFrame(-37.9105, 145.1340)
 TAKEOFF, A, B, C = (0.0, 600.0), (900.0, 900.0), (900.0, -300.0), (0.0, -300.0)
 ROI = (2_500.0, 3_000.0)  # 2.4 km or more from every leg
 DELAY_S = 30.0
+T = TypeVar("T")
 
 
 def _item(command: int, frame: int, params: list, seq: int) -> dict:
@@ -66,20 +70,27 @@ def _plan() -> dict:
             "rallyPoints": {"version": 2, "points": []}}  # fmt: skip
 
 
+def _with_sim(tmp_path, sim_s: int, script: Callable[[int], Awaitable[T]]) -> tuple[T, str, Path]:
+    """Run ``script(port)`` against a lockstep c172p flying ``sim_s`` simulated seconds;
+    its result, the vehicle's output and the truth file."""
+    port = free_udp_port()
+    proc, namespace, truth_path = start_sim(
+        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", str(sim_s)
+    )
+    try:
+        result = asyncio.run(script(port))
+    finally:
+        out = finish(proc, namespace, 240)
+    return result, out, truth_path
+
+
 @pytest.mark.timeout(300)
 def test_a_delay_holds_the_aircraft_round_its_waypoint_and_gimbal_items_change_nothing(
     tmp_path,
 ):
     plan = tmp_path / "delay_gimbal.plan"
     plan.write_text(json.dumps(_plan()))
-    port = free_udp_port()
-    proc, namespace, truth_path = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "330"
-    )
-    try:
-        seen = asyncio.run(fly_plan(port, str(plan), 240.0))
-    finally:
-        out = finish(proc, namespace, 240)
+    seen, out, truth_path = _with_sim(tmp_path, 330, lambda port: fly_plan(port, str(plan), 240.0))
     assert seen["finished"], out[-3000:]
     assert "Mission: 2 gimbal/video/yaw items ignored" in out
     truth = read_truth(truth_path)
@@ -121,14 +132,7 @@ async def _upload_as_mavsdk_mission(port: int) -> list[int]:
 def test_a_mavsdk_mission_with_a_gimbal_pitch_and_a_loiter_time_is_taken(tmp_path):
     """MAVSDK turns a gimbal pitch into gimbal-manager items and a loiter time into
     NAV_DELAY: the upload used to be refused whole."""
-    port = free_udp_port()
-    proc, namespace, _ = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "60"
-    )
-    try:
-        commands = asyncio.run(_upload_as_mavsdk_mission(port))
-    finally:
-        out = finish(proc, namespace, 240)
+    commands, out, _ = _with_sim(tmp_path, 60, _upload_as_mavsdk_mission)
     gimbal = {d.MAV_CMD_DO_GIMBAL_MANAGER_CONFIGURE, d.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW}
     assert gimbal <= set(commands) and d.MAV_CMD_NAV_DELAY in commands, commands
     assert commands.count(d.MAV_CMD_NAV_WAYPOINT) == 2

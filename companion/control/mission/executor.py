@@ -22,10 +22,9 @@ from dataclasses import dataclass, field
 from companion.control.laws.fillet import MIN_TURN_RAD, corner_arc
 from companion.control.mission import approach
 from companion.control.mission.items import (
-    ACTIONS,
     CAMERA_ITEMS,
     MAX_JUMPS_PER_STEP,
-    SKIPPED,
+    PASSED_OVER,
     MissionItem,
     change_speed,
     delay_loiter,
@@ -177,7 +176,7 @@ class MissionExecutor:
         if cmd == d.MAV_CMD_DO_JUMP:
             self.current = jump_target(item, self.current, self.jumps_done, len(self.items))
             return None
-        if cmd in SKIPPED or cmd in ACTIONS:
+        if cmd in PASSED_OVER:
             if cmd == d.MAV_CMD_DO_CHANGE_SPEED:  # an airspeed or ground speed; -1: no change
                 self.speed = change_speed(item, self.speed)
             elif cmd == d.MAV_CMD_DO_SET_SERVO:  # the controller hands it to the servo output

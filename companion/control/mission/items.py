@@ -70,9 +70,8 @@ MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO it
 # DO items that act at once and fly nowhere: a speed, a servo output (a payload release),
 # a camera's photos.
 ACTIONS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_SET_SERVO}) | CAMERA_ITEMS
-DO_COMMANDS = (
-    ACTIONS | frozenset({d.MAV_CMD_DO_JUMP, d.MAV_CMD_DO_LAND_START}) | CAMERA_STOPS | NOT_CARRIED
-)
+PASSED_OVER = SKIPPED | ACTIONS  # done as they are reached: the next item is current at once
+DO_COMMANDS = PASSED_OVER | {d.MAV_CMD_DO_JUMP}
 SERVO_OUTPUTS = range(1, 9)  # DO_SET_SERVO's param1: the Mini SSC's eight, from 1
 SERVO_PULSES_US = (1000.0, 2000.0)  # and param2: what the card puts out (its 90° range)
 SUPPORTED = {
@@ -317,7 +316,7 @@ def next_flown(
         item = items[seq]
         if item.command == d.MAV_CMD_DO_JUMP:
             seq = jump_target(item, seq, jumps, len(items))
-        elif item.command in SKIPPED or item.command in ACTIONS:
+        elif item.command in PASSED_OVER:
             seq += 1
         else:
             return item

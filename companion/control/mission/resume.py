@@ -15,8 +15,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from companion.control.mission.executor import SKIPPED, Kind, MissionExecutor, Setpoint
-from companion.control.mission.items import ACTIONS, change_speed
+from companion.control.mission.executor import Kind, MissionExecutor, Setpoint
+from companion.control.mission.items import PASSED_OVER, change_speed
 from companion.control.mission.zones import point_to_segment
 from mavlink_dialect import companion as d
 
@@ -95,7 +95,7 @@ def _previous_place(ex: MissionExecutor, seq: int) -> int | None:
     place of its own; None when it is anything else."""
     for i in range(seq - 1, -1, -1):
         item = ex.items[i]
-        if item.command in ACTIONS or item.command in SKIPPED:
+        if item.command in PASSED_OVER:
             continue
         has_place = item.x != 0 or item.y != 0
         takeoff_or_wp = item.command in (d.MAV_CMD_NAV_WAYPOINT, d.MAV_CMD_NAV_TAKEOFF)
