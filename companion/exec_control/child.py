@@ -44,6 +44,7 @@ class Child:
         self.cpu_pct = 0.0
         self.rss_kib = 0
         self.stats = PluginStats()
+        self.first_report = False  # the counters last absorbed were its first since start
         self._ps: psutil.Process | None = None
 
     @property
@@ -133,6 +134,7 @@ class Child:
         """Keep the plug-in's counters when they are this process's; True when kept."""
         if stats.name.decode(errors="replace") != self.spec.name or stats.pid != self.pid:
             return False
+        self.first_report = stats.steps == 0  # sent after init, before any step
         self.stats = stats
         return True
 

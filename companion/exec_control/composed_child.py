@@ -63,6 +63,7 @@ class ComposedChild(Child):
         name = stats.name.decode(errors="replace")
         if name not in self.carried or stats.pid != self.pid:
             return False
+        self.first_report = stats.steps == 0  # sent after init, before any step
         self.member_stats[name] = stats
         return True
 

@@ -163,7 +163,9 @@ class PluginHost:
     def request_stop(self, signum: int, _frame: object) -> None:
         self.stopping = True
 
-    def publish_stats(self) -> None:
+    def publish_stats(self, wake: bool = False) -> None:
+        """The counters, for the health table; ``wake``: the supervisor puts them in at
+        once (the first after ``init``: the link holds commands until then)."""
         msg = PluginStats(t_us=self.clock.now_us(), pid=os.getpid(), steps=self.timer.steps)
         msg.name = self.spec["name"].encode()[: NAME_LEN - 1]
         health = self.ctx.health
@@ -180,7 +182,7 @@ class PluginHost:
             self._cpu_mark = (cpu, wall)
             msg.restarts = self.restarts + int(self.failed)
             msg.state = PluginState.BACKOFF if self.failed else PluginState.RUNNING
-        self.stats.publish(msg)
+        self.stats.publish(msg, wake=wake)
         health.reported_us = msg.t_us
 
     def start(self, plugin: Plugin) -> bool:
@@ -199,7 +201,7 @@ class PluginHost:
             self.initialised.set()
         # Up: the health table has the new process's own counters before its first step,
         # which waits for its device (a silent one: the read timeout, a second).
-        self.publish_stats()
+        self.publish_stats(wake=True)
         self._next_stats = self._next_connections = time.monotonic()
         return True
 

@@ -160,11 +160,16 @@ class Supervisor:
         writer.publish(msg, wake=shape != self._health_shape)
         self._health_shape = shape
 
-    def absorb_stats(self, stats: Reader[PluginStats]) -> None:
+    def absorb_stats(self, stats: Reader[PluginStats]) -> bool:
+        """Every plug-in's counters kept; True when one reported for the first time since
+        it started (the table goes out at once)."""
+        first = False
         for msg in stats.drain():
             for child in self.children:
                 if child.absorb(msg):
+                    first |= child.first_report
                     break
+        return first
 
     def supervise_forker(self) -> None:
         """Restart a dead fork server (plug-ins are spawned meanwhile, and never lost)."""
@@ -234,9 +239,9 @@ class Supervisor:
         acks = bus.writer("link/command_acks")
         commands = bus.queue_reader("link/commands")
         stats = bus.queue_reader("system/plugin_stats")
-        # Commands wake it; the plug-ins' counters (each plug-in's once a second) wait for
-        # the health table they go into.
-        waiter = bus.waiter([commands, stats], triggers=[commands])
+        # Commands wake it, and a plug-in's first counters (it is up: ``commands.held``);
+        # the others (each plug-in's once a second) wait for the table they go into.
+        waiter = bus.waiter([commands, stats], triggers=[commands, stats])
         if self.forker.proc is not None:
             if self.forker.wait_ready(READY_TIMEOUT_S):
                 log.info("fork server ready")
@@ -256,7 +261,8 @@ class Supervisor:
                     self.publish_health(health)
                     next_health = time.monotonic() + HEALTH_PERIOD_S
                     acks.publish(self._ack(cmd, result))
-            self.absorb_stats(stats)
+            if self.absorb_stats(stats):
+                next_health = time.monotonic()
             self.restart_dead()
             bus.update_connections()
             if time.monotonic() >= next_health:

@@ -3,7 +3,11 @@
 Handlers are registered per MAV_CMD. A handler answers at once, or defers: the command
 went onto the bus for another plug-in and the ack follows when that plug-in answers (or
 FAILED when nobody does in time). Unknown commands get UNSUPPORTED at once, and a
-retransmission (confirmation > 0) is never executed twice.
+retransmission is never executed twice: one with confirmation > 0, and the same command
+with the same parameters from the same sender while the first is still in progress
+(MAVSDK resends an unanswered command every 0.5 s with confirmation 0). A retransmission
+of a command in progress gets no answer of its own: the first's final ack answers both
+(MAVSDK's Gripper plug-in, among others, takes an IN_PROGRESS for the final result).
 """
 
 from __future__ import annotations
@@ -144,11 +148,12 @@ class CommandService:
         peer = args.peer
         key = (peer.sysid, peer.compid, args.command)
         previous = self._done.get(key)
+        if previous and previous[1] is None and self._in_progress(args):
+            return []  # a resend of a command in progress: its final ack is on its way
         if args.confirmation > 0 and previous and now_s - previous[0] < RETRY_MEMORY_S:
-            # A retransmission: answer again with the first result, never act twice.
-            if previous[1] is None:
-                return []  # still in progress: the final ack is on its way
-            return [self.ack(args, previous[1])]
+            result = previous[1]
+            if result is not None:  # a retransmission: answered again, never acted twice
+                return [self.ack(args, result)]
         handler = self.handlers.get(args.command)
         if handler is None:
             self._done[key] = (now_s, d.MAV_RESULT_UNSUPPORTED)
@@ -161,6 +166,18 @@ class CommandService:
         self._done[key] = (now_s, outcome.result)
         extra = [m if isinstance(m, Outgoing) else Outgoing(m, peer) for m in outcome.extra]
         return [self.ack(args, outcome.result), *extra]
+
+    def _in_progress(self, args: CommandArgs) -> bool:
+        """Whether ``args`` resends a command still in progress (a confirmation > 0, or
+        the same parameters, NaN matching NaN)."""
+        for pending in self.pending.values():
+            first = pending.args
+            if first.peer == args.peer and first.command == args.command:
+                return args.confirmation > 0 or all(
+                    a == b or (math.isnan(a) and math.isnan(b))
+                    for a, b in zip(first.params, args.params, strict=True)
+                )
+        return False
 
     def _run(self, handler: Handler, args: CommandArgs) -> Outcome:
         reason = self.check(args) if self.check is not None else None

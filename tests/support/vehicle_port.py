@@ -35,12 +35,16 @@ class RecordingVehicle:
     )
     simulated: bool = True
     published: list[tuple[int, tuple[float, ...]]] = field(default_factory=list)
+    published_to: list[bytes | None] = field(default_factory=list)  # each one's plug-in
     texts: list[str] = field(default_factory=list)
     feeds: list[SampleFeed] = field(default_factory=list)  # one per open_imu
     prearm: list[str] = field(default_factory=list)  # what prearm_failures reports
 
-    def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
+    def publish_command(
+        self, command: int, params: tuple[float, ...] = (), to: bytes | None = None
+    ) -> int:
         self.published.append((command, tuple(params)))
+        self.published_to.append(to)
         return len(self.published)
 
     def statustext(self, text: str, severity: int = 4) -> None:

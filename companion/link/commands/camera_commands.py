@@ -42,5 +42,6 @@ class CameraCommands:
         if not plugin_running(self.port, CONTROLLER):
             return refuse(self.port, self.service, "Camera: photos only while armed")
         p = [0.0 if math.isnan(v) else v for v in args.params]
-        seq = self.port.publish_command(CommandId.CAMERA, (args.command, p[0], p[1], p[2], p[4]))
+        params = (args.command, p[0], p[1], p[2], p[4])
+        seq = self.port.publish_command(CommandId.CAMERA, params, to=CONTROLLER)
         return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)

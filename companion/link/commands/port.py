@@ -19,8 +19,11 @@ class VehiclePort(Protocol):
 
     snapshot: Snapshot  # the newest bus values, refreshed every step
 
-    def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
-        """Put a VehicleCommand on the bus; returns the sequence its ack will carry."""
+    def publish_command(
+        self, command: int, params: tuple[float, ...] = (), to: bytes | None = None
+    ) -> int:
+        """Put a VehicleCommand on the bus (for the flight plug-in of kind ``to``: once it
+        listens, ``commands.held``); returns the sequence its ack will carry."""
         ...
 
     def statustext(self, text: str, severity: int = d.MAV_SEVERITY_WARNING) -> None:

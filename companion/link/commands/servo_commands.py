@@ -37,5 +37,5 @@ class ServoCommands:
             text = "Set servo: the servo output runs only while armed"
             return refuse(self.port, self.service, text)
         output, pulse = (round(p) for p in args.params[:2])
-        seq = self.port.publish_command(CommandId.SET_SERVO, (output, pulse))
+        seq = self.port.publish_command(CommandId.SET_SERVO, (output, pulse), to=SERVO_OUTPUT)
         return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)

@@ -23,7 +23,8 @@ from companion.link.camera_feedback import CAPTURES, CameraFeedback
 from companion.link.codec import MavlinkStream, new_encoder
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandService
-from companion.link.commands import register_commands
+from companion.link.commands import BUS_ACK_TIMEOUT_S, register_commands
+from companion.link.commands.held import HeldCommands
 from companion.link.endpoints import endpoint_problems, open_endpoints, serial_endpoints
 from companion.link.flight_messages import mission_items_reached
 from companion.link.gcs_watch import GcsWatch
@@ -149,6 +150,7 @@ class MavlinkLink(Plugin):
         self.readers = snapshot_readers(bus)
         self.acks = bus.queue_reader("link/command_acks")
         self.to_vehicle = bus.writer("link/commands")
+        self.held = HeldCommands()  # commands for a flight plug-in not yet listening
         self.param_changes = bus.writer("params/changes")
         self.link_status = bus.writer("link/status")
         self.texts = bus.queue_reader("vehicle/statustext")
@@ -260,6 +262,8 @@ class MavlinkLink(Plugin):
         for key, reader in self.readers.items():
             setattr(s, key, reader.get())
         self.devices.update(s.health)
+        self.held.follow(s.health, self.ctx.clock.now_us())
+        self.held.release(s.health, time.monotonic(), self.to_vehicle.publish)
         s.control = self._fresh_control(s.control)
         s.now_us = self.ctx.clock.now_us()
         if s.status is not None and s.status.home_valid:  # home is the commander's alone
@@ -374,13 +378,19 @@ class MavlinkLink(Plugin):
         """Whether the vehicle runs on the simulator's clock (VehiclePort)."""
         return self.ctx.vehicle.get("clock") == "sim"
 
-    def publish_command(self, command: int, params: tuple[float, ...] = ()) -> int:
-        """Put a VehicleCommand on the bus; returns its sequence number for the ack."""
+    def publish_command(
+        self, command: int, params: tuple[float, ...] = (), to: bytes | None = None
+    ) -> int:
+        """Put a VehicleCommand on the bus (for the flight plug-in of kind ``to``, once it
+        listens: ``HeldCommands``); returns its sequence number for the ack."""
         self._seq += 1
         msg = VehicleCommand(t_us=self.ctx.clock.now_us(), seq=self._seq, command=command)
         for i, value in enumerate(params[:7]):
             msg.param[i] = value
-        self.to_vehicle.publish(msg)
+        if to is not None and not self.held.listening(self.snapshot.health, to):
+            self.held.hold(to, time.monotonic() + BUS_ACK_TIMEOUT_S, msg)
+        else:
+            self.to_vehicle.publish(msg)
         return self._seq
 
     def close(self) -> None:
