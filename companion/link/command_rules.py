@@ -133,6 +133,12 @@ RULES: dict[int, tuple[Param, ...]] = {
         Param(1, "instance", 1, 8, whole=True),
         Param(2, "PWM", 1000, 2000, whole=True),
     ),
+    # A payload gripper on a servo output (companion.control.mission.gripper): one, so
+    # which (param1, MAVSDK's instance) is not read.
+    d.MAV_CMD_DO_GRIPPER: (
+        Param(1, "instance", 0, 255, optional=True, whole=True),
+        Param(2, "action", 0, 1, whole=True),
+    ),
     # A camera on a servo output (companion.control.mission.camera): a distance between
     # photos (0 stops), an interval and a count, one photo (DIGICAM_CONTROL's param5 1).
     d.MAV_CMD_DO_SET_CAM_TRIGG_DIST: (

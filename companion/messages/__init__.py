@@ -14,6 +14,7 @@ from companion.messages.base import MAX_PLUGINS, NAME_LEN, NAN, Message
 from companion.messages.channels import CHANNELS, Channel, channel
 from companion.messages.control import (
     CAMERA_SEQ,
+    GRIPPER_SEQ,
     MISSION_SERVO_SEQ,
     REASON_LEN,
     CommandAck,
@@ -54,6 +55,7 @@ from companion.messages.system import (
 __all__ = [
     "CAMERA_SEQ",
     "CHANNELS",
+    "GRIPPER_SEQ",
     "MAX_PLUGINS",
     "MISSION_SERVO_SEQ",
     "NAME_LEN",

@@ -58,12 +58,15 @@ class CommandId(enum.IntEnum):
     # param1 = the MAVLink camera command (DO_DIGICAM_CONTROL, DO_SET_CAM_TRIGG_DIST,
     # IMAGE_START_CAPTURE, IMAGE_STOP_CAPTURE), param2..5 = its param1, 2, 3 and 5
     CAMERA = 17
+    GRIPPER = 18  # param1 = the action: 0 release, 1 grab (DO_GRIPPER's param2)
 
 
 # Sequence numbers of commands the flight controller sends the servo output on its own
-# (the link counts its own from 1): a mission's DO_SET_SERVO, the camera's shutter pulses.
+# (the link counts its own from 1): a mission's DO_SET_SERVO, the camera's shutter pulses,
+# the gripper's.
 MISSION_SERVO_SEQ = (1 << 31) - 2
 CAMERA_SEQ = (1 << 31) - 3
+GRIPPER_SEQ = (1 << 31) - 4
 
 
 class CommandResult(enum.IntEnum):

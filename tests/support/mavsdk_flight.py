@@ -25,6 +25,7 @@ class PlanSession:
     action: ActionAsync
     mission: MissionRawAsync
     items: int = 0
+    system: Any = None  # for the plug-ins a test adds (MAVSDK's System: untyped)
 
 
 @asynccontextmanager
@@ -39,6 +40,7 @@ async def plan_uploaded(
         await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
         system = await mavsdk.first_autopilot(timeout_s=connect_s)
         flight = PlanSession(TelemetryAsync(system), ActionAsync(system), MissionRawAsync(system))
+        flight.system = system
         async for _home in flight.telemetry.subscribe_home():
             break
         await until(flight.telemetry.subscribe_health(), lambda h: h.is_armable, "armable", 120)

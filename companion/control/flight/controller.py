@@ -119,7 +119,7 @@ class FlightController:
         usable = math.isfinite(t_s) and nav_usable(nav) and status_usable(status)
         if not (usable and sticks_usable(sticks)):
             self.rejected += 1
-            return replace(self._last_out, reached=[], servo_sets=[], camera_items=[], disarm=False)
+            return self._last_out.held()
         self._last_out = self._step(rates_or_zero(nav), status, t_s, sticks)
         return self._last_out
 
@@ -289,7 +289,7 @@ class FlightController:
         out.mission_seq = ex.current
         out.mission_finished = ex.finished
         out.reached = ex.drain_reached()
-        out.servo_sets, out.camera_items = ex.take_actions()
+        out.servo_sets, out.payload_items = ex.take_actions()
         return setpoint
 
     def _fly_takeoff(

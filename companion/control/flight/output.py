@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from companion.control.mission.items import MissionItem
 
@@ -27,10 +27,15 @@ class ControlOutput:
     mission_finished: bool = False
     reached: list[int] = field(default_factory=list)
     servo_sets: list[tuple[int, int]] = field(default_factory=list)  # a mission's DO_SET_SERVO
-    camera_items: list[MissionItem] = field(default_factory=list)  # its camera items
+    payload_items: list[MissionItem] = field(default_factory=list)  # camera, gripper items
     landed: bool = True
     disarm: bool = False  # landed and stopped: the flight is over
     land_phase: int = 0  # LandPhase while landing, else 0
     takeoff_phase: int = 0  # TakeoffPhase from the roll until the take-off height, else 0
     flaps: float = 0.0  # 0 up .. 1 fully down
     brakes: float = 1.0  # 0 off .. 1 full: held while parked
+
+    def held(self) -> ControlOutput:
+        """The same commands without this step's events (items reached, servo sets, payload
+        items, a disarm): what an unusable input keeps, so none is done twice."""
+        return replace(self, reached=[], servo_sets=[], payload_items=[], disarm=False)

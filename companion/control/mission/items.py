@@ -67,9 +67,11 @@ NOT_CARRIED = frozenset(
 # landing begins).
 SKIPPED = CAMERA_STOPS | NOT_CARRIED | {d.MAV_CMD_DO_LAND_START}
 MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
+# What the controller's plug-in works: the camera and a payload gripper (mission/gripper.py).
+PAYLOAD_ITEMS = CAMERA_ITEMS | {d.MAV_CMD_DO_GRIPPER}
 # DO items that act at once and fly nowhere: a speed, a servo output (a payload release),
-# a camera's photos.
-ACTIONS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_SET_SERVO}) | CAMERA_ITEMS
+# a camera's photos, a gripper.
+ACTIONS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_SET_SERVO}) | PAYLOAD_ITEMS
 PASSED_OVER = SKIPPED | ACTIONS  # done as they are reached: the next item is current at once
 DO_COMMANDS = PASSED_OVER | {d.MAV_CMD_DO_JUMP}
 SERVO_OUTPUTS = range(1, 9)  # DO_SET_SERVO's param1: the Mini SSC's eight, from 1
@@ -101,6 +103,7 @@ POSITIONLESS = (
             d.MAV_CMD_NAV_RETURN_TO_LAUNCH,
             d.MAV_CMD_DO_CHANGE_SPEED,
             d.MAV_CMD_DO_SET_SERVO,
+            d.MAV_CMD_DO_GRIPPER,
             d.MAV_CMD_DO_JUMP,
             d.MAV_CMD_DO_LAND_START,
             d.MAV_CMD_NAV_DELAY,  # circles the last point flown to (``delay_loiter``)
@@ -117,6 +120,7 @@ POSITIONLESS = (
 NEEDS_NUMBER = {
     d.MAV_CMD_DO_JUMP: (1, 2),
     d.MAV_CMD_DO_SET_SERVO: (1, 2),
+    d.MAV_CMD_DO_GRIPPER: (2,),
     d.MAV_CMD_DO_SET_CAM_TRIGG_DIST: (1,),
     d.MAV_CMD_IMAGE_START_CAPTURE: (2, 3),
     d.MAV_CMD_NAV_LOITER_TURNS: (1,),
@@ -222,6 +226,8 @@ def check_item(item: MissionItem, count: int) -> int:
         return _servo_refusal(item)
     if item.command in CAMERA_ITEMS:
         return _camera_refusal(item)
+    if item.command == d.MAV_CMD_DO_GRIPPER and item.param2 not in (0.0, 1.0):  # release, grab
+        return d.MAV_MISSION_INVALID_PARAM2
     if item.command == d.MAV_CMD_DO_JUMP:
         target = round(item.param1)
         if not 0 <= target < count or target == item.seq:

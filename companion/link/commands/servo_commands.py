@@ -7,6 +7,10 @@ command rules refuse anything else. The servo output plug-in answers: an output 
 drives a surface of the airframe is refused with the reason, as ArduPilot refuses an output
 with a function. It runs only while the vehicle is armed (its group is ``flight``): the
 command is refused at once before then, with the reason.
+
+MAV_CMD_DO_GRIPPER (MAVSDK's Gripper plug-in): param2 0 releases, 1 grabs, the gripper on
+the output ``GRIP_OUTPUT`` (``companion.control.mission.gripper``). The flight controller
+works it and answers, as it does the camera; refused at once while disarmed too.
 """
 
 from __future__ import annotations
@@ -16,11 +20,12 @@ from companion.link.command_service import CommandArgs, CommandService, Outcome
 from companion.link.commands.port import BUS_ACK_TIMEOUT_S, VehiclePort, plugin_running, refuse
 from companion.messages import CommandId
 
-SERVO_OUTPUT = b"actuators.minissc"  # the plug-in that answers
+SERVO_OUTPUT = b"actuators.minissc"  # the plug-in that answers DO_SET_SERVO
+CONTROLLER = b"control.fixed_wing"  # and DO_GRIPPER
 
 
 class ServoCommands:
-    """DO_SET_SERVO."""
+    """DO_SET_SERVO and DO_GRIPPER."""
 
     def __init__(self, port: VehiclePort) -> None:
         self.port = port
@@ -28,7 +33,9 @@ class ServoCommands:
 
     def register(self, service: CommandService) -> None:
         self.service = service
+        # One line each: the reference page (docs/gen_reference_commands.py) reads them.
         service.register(d.MAV_CMD_DO_SET_SERVO, self.set_servo)
+        service.register(d.MAV_CMD_DO_GRIPPER, self.gripper)
 
     def set_servo(self, args: CommandArgs) -> Outcome:
         """A spare output of the servo card to the pulse, answered by the servo output (an
@@ -38,4 +45,13 @@ class ServoCommands:
             return refuse(self.port, self.service, text)
         output, pulse = (round(p) for p in args.params[:2])
         seq = self.port.publish_command(CommandId.SET_SERVO, (output, pulse), to=SERVO_OUTPUT)
+        return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)
+
+    def gripper(self, args: CommandArgs) -> Outcome:
+        """Grab or release the payload, answered by the flight controller (a gripper not
+        set up DENIED, with the reason); DENIED at once while disarmed."""
+        if not plugin_running(self.port, CONTROLLER):
+            return refuse(self.port, self.service, "Gripper: works only while armed")
+        action = (round(args.params[1]),)
+        seq = self.port.publish_command(CommandId.GRIPPER, action, to=CONTROLLER)
         return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)

@@ -27,6 +27,7 @@ from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.mission.camera import CAMERA_PARAMS
 from companion.control.mission.camera_shots import CameraPorts, CameraShots
 from companion.control.mission.fence import Fence
+from companion.control.mission.gripper import GRIPPER_PARAMS, Gripper
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.control.mission_return import reported_state
@@ -108,7 +109,7 @@ class FixedWingPlugin(Plugin):
     ) -> tuple[ParamDecl, ...]:
         airframe = load_airframe(vehicle["airframe"])
         control = control_params(airframe.control, f"airframe {Path(airframe.source).name}")
-        return control + CAMERA_PARAMS
+        return control + CAMERA_PARAMS + GRIPPER_PARAMS
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
@@ -154,14 +155,17 @@ class FixedWingPlugin(Plugin):
         photos = CameraPorts(bus.writer("camera/capture").publish, self.commands.publish,
                              self._tell, gps.get, self._home_alt)  # fmt: skip
         self.camera = CameraShots(photos, self.surface_outputs)
-        self.requests = bus.queue_reader("link/commands")  # a ground station's camera's
+        self.gripper = Gripper(self.commands.publish, self._tell, self.surface_outputs)
+        self.requests = bus.queue_reader("link/commands")  # a ground station's payload's
         self.acks = bus.writer("link/command_acks")
         self.camera.configure(self.live_params.values)
+        self.gripper.configure(self.live_params.values)
 
     def _follow_changes(self, now_us: int) -> None:
         if self.live_params.poll():
             self.controller.set_config(flight_config(self.live_params.values))
             self.camera.configure(self.live_params.values)
+            self.gripper.configure(self.live_params.values)
         # Only a different mission restarts it: the same list stored again changes nothing.
         changed = self.follower.follow(self.mission_changes.get())
         if d.MAV_MISSION_TYPE_MISSION in changed:
@@ -201,10 +205,12 @@ class FixedWingPlugin(Plugin):
         if out.disarm and not self.disarm_sent:
             self._disarm(now_us, out, status)
         self._set_servos(now_us, out.servo_sets)
-        self._answer_camera(nav.t_us)
+        self._answer_payloads(nav.t_us)
+        if out.payload_items:
+            self.gripper.items(nav.t_us, out.payload_items)
         frame = self.controller.frame  # an idle camera costs the step nothing
-        if frame is not None and (out.camera_items or self.camera.trigger.busy):
-            self.camera.step(nav, out.camera_items, frame.ne(nav.lat_deg, nav.lon_deg))
+        if frame is not None and (out.payload_items or self.camera.trigger.busy):
+            self.camera.step(nav, out.payload_items, frame.ne(nav.lat_deg, nav.lon_deg))
         for seq in out.reached:  # each told, however many in one step
             self.recent_reached[self.reached_count % ControlStatus.REACHED_KEPT] = seq
             self.reached_count += 1
@@ -227,20 +233,24 @@ class FixedWingPlugin(Plugin):
                 VehicleCommand.set_servo(now_us, MISSION_SERVO_SEQ, output, pulse)
             )
 
-    def _answer_camera(self, t_us: int) -> None:
-        """A ground station's camera commands (the link checked their parameters), each
-        answered; taken before this step's photos are judged."""
+    def _answer_payloads(self, t_us: int) -> None:
+        """A ground station's camera and gripper commands (the link checked their
+        parameters), each answered; taken before this step's photos are judged."""
         for request in self.requests.pending():
-            if request.command != CommandId.CAMERA:
+            if request.command == CommandId.CAMERA:
+                params = tuple(request.param[1:5])
+                problem = self.camera.command(round(request.param[0]), params)
+            elif request.command == CommandId.GRIPPER:
+                problem = self.gripper.act(t_us, round(request.param[0]))
+            else:
                 continue
-            params = tuple(request.param[1:5])
-            problem = self.camera.command(round(request.param[0]), params)
             result = CommandResult.DENIED if problem else CommandResult.ACCEPTED
             source = self.ctx.name.encode()
             self.acks.publish(CommandAck.answer(request, t_us, source, result, problem or ""))
 
     def _tell(self, t_us: int, severity: int, text: str) -> None:
-        self.ctx.log.warning("%s", text)
+        if severity <= d.MAV_SEVERITY_WARNING:
+            self.ctx.log.warning("%s", text)
         self.texts.publish(StatusText.of(t_us, severity, text))
 
     def _home_alt(self) -> float:

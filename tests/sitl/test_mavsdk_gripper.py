@@ -1,0 +1,111 @@
+"""A payload dropped from a gripper, as a MAVSDK script and a QGroundControl plan drop it.
+
+MAVSDK's Gripper plug-in sends DO_GRIPPER (param1 the instance, param2 0 release or 1
+grab); QGroundControl's Plan view offers the same command as "Gripper Mechanism". With
+``GRIP_ENABLE`` set (by MAVSDK's Param plug-in, as a user sets it in QGroundControl) the
+gripper on output 8 of the c172p's Mini SSC (its spare servo 7) grabs at ``GRIP_GRAB`` and
+releases at ``GRIP_RELEASE``; the pulse is read back from SERVO_OUTPUT_RAW, which the servo
+output sends after writing the card. Disarmed (the servo output runs only armed) the
+command is refused, and MAVSDK says so.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import math
+from pathlib import Path
+
+import pytest
+from mavsdk.asyncio.plugins.gripper import GripperAsync
+from mavsdk.asyncio.plugins.mavlink_direct import MavlinkDirectAsync
+from mavsdk.asyncio.plugins.param import ParamAsync
+from mavsdk.plugins.gripper import GripperError
+
+from companion.actuators.minissc import position_for_pulse, pulse_us
+from companion.geodesy import LocalFrame
+from mavlink_dialect import companion as d
+from tests.protocol.mav_client import free_udp_port
+from tests.sim.sim_run import finish, start_sim
+from tests.support.mavsdk_flight import plan_uploaded, until
+
+HOME = LocalFrame(-37.9105, 145.1340)
+TAKEOFF, A, B = (0.0, 600.0), (0.0, 3000.0), (1500.0, 3000.0)
+GRAB_US, RELEASE_US = 1900, 1100  # GRIP_GRAB and GRIP_RELEASE as shipped
+
+
+def _plan() -> dict:
+    """Take-off, waypoint A, "Gripper Mechanism" release (as QGroundControl 4.4.5 saves it:
+    frame MISSION, param1 the gripper, 1), waypoint B."""
+
+    def item(command: int, frame: int, params: list, seq: int) -> dict:
+        return {"type": "SimpleItem", "autoContinue": True, "command": command,
+                "doJumpId": seq, "frame": frame, "params": params}  # fmt: skip
+
+    def at(ne: tuple[float, float], alt: float) -> list:
+        return [*HOME.latlon(*ne), alt]
+
+    items = [
+        item(d.MAV_CMD_NAV_TAKEOFF, 3, [15, 0, 0, None, *at(TAKEOFF, 60.0)], 1),
+        item(d.MAV_CMD_NAV_WAYPOINT, 3, [0, 0, 0, None, *at(A, 100.0)], 2),
+        item(d.MAV_CMD_DO_GRIPPER, 2, [1, 0, 0, 0, 0, 0, 0], 3),
+        item(d.MAV_CMD_NAV_WAYPOINT, 3, [0, 0, 0, None, *at(B, 100.0)], 4),
+    ]
+    mission = {"version": 2, "firmwareType": 12, "vehicleType": 1, "cruiseSpeed": 15,
+               "hoverSpeed": 5, "plannedHomePosition": [-37.9105, 145.134, 126],
+               "items": items}  # fmt: skip
+    return {"fileType": "Plan", "version": 1, "groundStation": "QGroundControl",
+            "mission": mission, "geoFence": {"version": 2, "polygons": [], "circles": []},
+            "rallyPoints": {"version": 2, "points": []}}  # fmt: skip
+
+
+async def _drop(port: int, plan: str) -> dict:
+    """Refused disarmed; set up, armed and flying: grabbed by command, released by the
+    plan at A. What MAVSDK saw."""
+    seen: dict = {}
+    async with plan_uploaded(port, plan) as flight:
+        gripper = GripperAsync(flight.system)
+        try:
+            await gripper.grab(1)
+            seen["disarmed"] = "accepted"
+        except GripperError as exc:
+            seen["disarmed"] = exc.result.name
+        await ParamAsync(flight.system).set_param_float("GRIP_ENABLE", 1.0)
+        raw = MavlinkDirectAsync(flight.system).subscribe_message("SERVO_OUTPUT_RAW")
+
+        def output_8_at(pulse: int):
+            shown = pulse_us(position_for_pulse(pulse))
+            return lambda m: json.loads(m.fields_json)["servo8_raw"] == shown
+
+        await flight.action.arm()
+        await flight.mission.start_mission()
+        await gripper.grab(1)  # on the runway or climbing out, kilometres before A
+        await until(raw, output_8_at(GRAB_US), "output 8 at GRIP_GRAB", 60)
+        progress = flight.mission.subscribe_mission_progress()
+        seen["grabbed_before"] = (await anext(aiter(progress))).current
+        await until(raw, output_8_at(RELEASE_US), "output 8 at GRIP_RELEASE", 120)
+        at = await anext(aiter(flight.telemetry.subscribe_position()))
+        seen["released_from_a_m"] = math.dist(HOME.ne(at.latitude_deg, at.longitude_deg), A)
+    return seen
+
+
+@pytest.mark.timeout(300)
+def test_a_mavsdk_script_grabs_and_a_plans_gripper_item_releases_the_payload(tmp_path: Path):
+    plan = tmp_path / "drop.plan"
+    plan.write_text(json.dumps(_plan()))
+    port = free_udp_port()
+    proc, namespace, _truth = start_sim(
+        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "260"
+    )
+    try:
+        seen = asyncio.run(_drop(port, str(plan)))
+    finally:
+        out = finish(proc, namespace, 240)
+    assert seen["disarmed"] == "FAILED", seen  # MAVSDK's name for DENIED
+    assert seen["grabbed_before"] <= 1, seen  # still on the way to A
+    # Over A (the c172p flies some 40 m a second; a turn's lead is some 150 m)
+    assert seen["released_from_a_m"] < 400.0, seen
+    # Sent right after arming, before the controller listens, and resent by MAVSDK while
+    # it waits: done once.
+    assert out.count("gripper: grab (output 8 to 1900 us)") == 1, out[-3000:]
+    assert "gripper: release (output 8 to 1100 us)" in out
