@@ -28,35 +28,27 @@ from mavlink_dialect import companion as d
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
 from tests.support.mavsdk_flight import plan_uploaded, until
+from tests.support.qgc_plan import simple_item, write_plan
 
 HOME = LocalFrame(-37.9105, 145.1340)
 TAKEOFF, A, B = (0.0, 600.0), (0.0, 3000.0), (1500.0, 3000.0)
 GRAB_US, RELEASE_US = 1900, 1100  # GRIP_GRAB and GRIP_RELEASE as shipped
 
 
-def _plan() -> dict:
+def _plan(path: Path) -> Path:
     """Take-off, waypoint A, "Gripper Mechanism" release (as QGroundControl 4.4.5 saves it:
     frame MISSION, param1 the gripper, 1), waypoint B."""
-
-    def item(command: int, frame: int, params: list, seq: int) -> dict:
-        return {"type": "SimpleItem", "autoContinue": True, "command": command,
-                "doJumpId": seq, "frame": frame, "params": params}  # fmt: skip
 
     def at(ne: tuple[float, float], alt: float) -> list:
         return [*HOME.latlon(*ne), alt]
 
     items = [
-        item(d.MAV_CMD_NAV_TAKEOFF, 3, [15, 0, 0, None, *at(TAKEOFF, 60.0)], 1),
-        item(d.MAV_CMD_NAV_WAYPOINT, 3, [0, 0, 0, None, *at(A, 100.0)], 2),
-        item(d.MAV_CMD_DO_GRIPPER, 2, [1, 0, 0, 0, 0, 0, 0], 3),
-        item(d.MAV_CMD_NAV_WAYPOINT, 3, [0, 0, 0, None, *at(B, 100.0)], 4),
+        simple_item(d.MAV_CMD_NAV_TAKEOFF, 3, [15, 0, 0, None, *at(TAKEOFF, 60.0)], 1),
+        simple_item(d.MAV_CMD_NAV_WAYPOINT, 3, [0, 0, 0, None, *at(A, 100.0)], 2),
+        simple_item(d.MAV_CMD_DO_GRIPPER, 2, [1, 0, 0, 0, 0, 0, 0], 3),
+        simple_item(d.MAV_CMD_NAV_WAYPOINT, 3, [0, 0, 0, None, *at(B, 100.0)], 4),
     ]
-    mission = {"version": 2, "firmwareType": 12, "vehicleType": 1, "cruiseSpeed": 15,
-               "hoverSpeed": 5, "plannedHomePosition": [-37.9105, 145.134, 126],
-               "items": items}  # fmt: skip
-    return {"fileType": "Plan", "version": 1, "groundStation": "QGroundControl",
-            "mission": mission, "geoFence": {"version": 2, "polygons": [], "circles": []},
-            "rallyPoints": {"version": 2, "points": []}}  # fmt: skip
+    return write_plan(path, items, (-37.9105, 145.134, 126))
 
 
 async def _drop(port: int, plan: str) -> dict:
@@ -91,8 +83,7 @@ async def _drop(port: int, plan: str) -> dict:
 
 @pytest.mark.timeout(300)
 def test_a_mavsdk_script_grabs_and_a_plans_gripper_item_releases_the_payload(tmp_path: Path):
-    plan = tmp_path / "drop.plan"
-    plan.write_text(json.dumps(_plan()))
+    plan = _plan(tmp_path / "drop.plan")
     port = free_udp_port()
     proc, namespace, _truth = start_sim(
         tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "260"

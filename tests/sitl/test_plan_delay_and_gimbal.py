@@ -10,7 +10,6 @@ MAVSDK's mission plug-in makes the same items of a waypoint's gimbal pitch and l
 from __future__ import annotations
 
 import asyncio
-import json
 import math
 from collections.abc import Awaitable, Callable
 from pathlib import Path
@@ -31,6 +30,7 @@ from mavlink_dialect import companion as d
 from tests.protocol.mav_client import free_udp_port
 from tests.sim.sim_run import finish, start_sim
 from tests.support.mavsdk_flight import fly_plan
+from tests.support.qgc_plan import simple_item, write_plan
 
 HOME = LocalFrame(-37.9105, 145.1340)
 TAKEOFF, A, B, C = (0.0, 600.0), (900.0, 900.0), (900.0, -300.0), (0.0, -300.0)
@@ -39,35 +39,25 @@ DELAY_S = 30.0
 T = TypeVar("T")
 
 
-def _item(command: int, frame: int, params: list, seq: int) -> dict:
-    return {"type": "SimpleItem", "autoContinue": True, "command": command,
-            "doJumpId": seq, "frame": frame, "params": params}  # fmt: skip
-
-
 def _at(ne: tuple[float, float], alt: float) -> list:
     lat, lon = HOME.latlon(*ne)
     return [lat, lon, alt]
 
 
-def _plan() -> dict:
+def _plan(path: Path) -> Path:
     """As QGroundControl 4.4 saves them: NAV_DELAY with its time-of-day fields -1 and no
     place (frame 2, MISSION), DO_SET_ROI_LOCATION, DO_MOUNT_CONTROL (a waypoint's camera
     section's gimbal pitch), then two more waypoints."""
     items = [
-        _item(22, 3, [15, 0, 0, None, *_at(TAKEOFF, 60.0)], 1),
-        _item(16, 3, [0, 0, 0, None, *_at(A, 100.0)], 2),
-        _item(93, 2, [DELAY_S, -1, -1, -1, 0, 0, 0], 3),
-        _item(195, 3, [0, 0, 0, 0, *_at(ROI, 0.0)], 4),
-        _item(205, 2, [-45, 0, 0, 0, 0, 0, 2], 5),
-        _item(16, 3, [0, 0, 0, None, *_at(B, 100.0)], 6),
-        _item(16, 3, [0, 0, 0, None, *_at(C, 100.0)], 7),
+        simple_item(22, 3, [15, 0, 0, None, *_at(TAKEOFF, 60.0)], 1),
+        simple_item(16, 3, [0, 0, 0, None, *_at(A, 100.0)], 2),
+        simple_item(93, 2, [DELAY_S, -1, -1, -1, 0, 0, 0], 3),
+        simple_item(195, 3, [0, 0, 0, 0, *_at(ROI, 0.0)], 4),
+        simple_item(205, 2, [-45, 0, 0, 0, 0, 0, 2], 5),
+        simple_item(16, 3, [0, 0, 0, None, *_at(B, 100.0)], 6),
+        simple_item(16, 3, [0, 0, 0, None, *_at(C, 100.0)], 7),
     ]
-    mission = {"version": 2, "firmwareType": 12, "vehicleType": 1, "cruiseSpeed": 15,
-               "hoverSpeed": 5, "plannedHomePosition": [-37.9105, 145.134, 126],
-               "items": items}  # fmt: skip
-    return {"fileType": "Plan", "version": 1, "groundStation": "QGroundControl",
-            "mission": mission, "geoFence": {"version": 2, "polygons": [], "circles": []},
-            "rallyPoints": {"version": 2, "points": []}}  # fmt: skip
+    return write_plan(path, items, (-37.9105, 145.134, 126))
 
 
 def _with_sim(tmp_path, sim_s: int, script: Callable[[int], Awaitable[T]]) -> tuple[T, str, Path]:
@@ -88,8 +78,7 @@ def _with_sim(tmp_path, sim_s: int, script: Callable[[int], Awaitable[T]]) -> tu
 def test_a_delay_holds_the_aircraft_round_its_waypoint_and_gimbal_items_change_nothing(
     tmp_path,
 ):
-    plan = tmp_path / "delay_gimbal.plan"
-    plan.write_text(json.dumps(_plan()))
+    plan = _plan(tmp_path / "delay_gimbal.plan")
     seen, out, truth_path = _with_sim(tmp_path, 330, lambda port: fly_plan(port, str(plan), 240.0))
     assert seen["finished"], out[-3000:]
     assert "Mission: 2 gimbal/video/yaw items ignored" in out

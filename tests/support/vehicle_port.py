@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from companion.link.codec import new_encoder
+from companion.link.command_rules import RULES, refusal
+from companion.link.command_service import CommandService
 from companion.link.snapshot import Snapshot
+from companion.messages import PluginState, SystemHealth
 
 
 @dataclass
@@ -62,3 +67,21 @@ class RecordingVehicle:
     def open_imu(self) -> SampleFeed:
         self.feeds.append(SampleFeed())
         return self.feeds[-1]
+
+
+def command_bench(
+    register: Callable[[RecordingVehicle], Any], kind: bytes, running: bool
+) -> tuple[CommandService, RecordingVehicle]:
+    """A command service behind the parameter rules, with the command group ``register``
+    makes of the vehicle (``lambda v: CameraCommands(v)``) registered; the health table
+    shows the plug-in of ``kind`` running (armed) or stopped."""
+    service = CommandService(new_encoder(1, 1), 1, 1)
+    service.guard(refusal, RULES)
+    vehicle = RecordingVehicle()
+    service.on_refusal = vehicle.statustext
+    health = SystemHealth(count=1, flight_running=int(running))
+    health.plugins[0].kind = kind
+    health.plugins[0].state = int(PluginState.RUNNING if running else PluginState.STOPPED)
+    vehicle.snapshot.health = health
+    register(vehicle).register(service)
+    return service, vehicle

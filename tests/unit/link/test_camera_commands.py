@@ -8,29 +8,18 @@ import math
 
 import pytest
 
-from companion.link.codec import new_encoder
-from companion.link.command_rules import RULES, refusal
 from companion.link.command_service import CommandArgs, CommandService
 from companion.link.commands import CameraCommands
 from companion.link.microservice import Peer
-from companion.messages import CommandId, PluginState, SystemHealth
+from companion.messages import CommandId
 from mavlink_dialect import companion as d
-from tests.support.vehicle_port import RecordingVehicle
+from tests.support.vehicle_port import RecordingVehicle, command_bench
 
 GCS = Peer(255, 190, 0)
 
 
 def bench(armed: bool) -> tuple[CommandService, RecordingVehicle]:
-    service = CommandService(new_encoder(1, 1), 1, 1)
-    service.guard(refusal, RULES)
-    vehicle = RecordingVehicle()
-    service.on_refusal = vehicle.statustext
-    health = SystemHealth(count=1)
-    health.plugins[0].kind = b"control.fixed_wing"
-    health.plugins[0].state = int(PluginState.RUNNING if armed else PluginState.STOPPED)
-    vehicle.snapshot.health = health
-    CameraCommands(vehicle).register(service)
-    return service, vehicle
+    return command_bench(CameraCommands, b"control.fixed_wing", armed)
 
 
 def send(service: CommandService, command: int, *params: float) -> int | None:
