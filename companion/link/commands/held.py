@@ -38,15 +38,14 @@ class HeldCommands:
             self.flight_since_us = now_us
 
     def listening(self, health: SystemHealth | None, kind: bytes) -> bool:
-        """Whether the plug-in of ``kind`` runs and has reported since the flight started."""
+        """Whether the plug-in of ``kind`` runs and has reported since the flight group
+        started (one a config puts in the core group: since it started)."""
         row = health.row_of_kind(kind) if health is not None else None
-        since = self.flight_since_us
-        return (
-            row is not None
-            and row.state == PluginState.RUNNING
-            and since is not None
-            and row.counted_us >= since
-        )
+        if row is None or row.state != PluginState.RUNNING:
+            return False
+        if row.group != b"flight":
+            return row.counted_us > 0
+        return self.flight_since_us is not None and row.counted_us >= self.flight_since_us
 
     def hold(self, kind: bytes, deadline_s: float, command: VehicleCommand) -> None:
         self.held.append((kind, deadline_s, command))

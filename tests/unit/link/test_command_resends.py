@@ -70,7 +70,7 @@ def test_another_command_of_the_same_kind_is_not_a_resend():
 def health(running: bool, counted_us: int) -> SystemHealth:
     table = SystemHealth(count=1, flight_running=int(running))
     row = table.plugins[0]
-    row.kind, row.counted_us = CONTROLLER, counted_us
+    row.kind, row.counted_us, row.group = CONTROLLER, counted_us, b"flight"
     row.state = int(PluginState.RUNNING if running else PluginState.STOPPED)
     return table
 
@@ -101,3 +101,11 @@ def test_a_command_never_heard_is_dropped_when_its_wait_ends():
     assert held.held != []
     held.release(table, 10.0, sent.append)
     assert sent == [] and held.held == []
+
+
+def test_a_plugin_a_config_runs_from_the_start_listens_once_it_has_reported():
+    table = health(False, counted_us=0)
+    table.plugins[0].group, table.plugins[0].state = b"core", int(PluginState.RUNNING)
+    assert not HeldCommands().listening(table, CONTROLLER)  # started, not yet reported
+    table.plugins[0].counted_us = 2_000_000
+    assert HeldCommands().listening(table, CONTROLLER)  # disarmed, and not held for ever
