@@ -17,7 +17,7 @@ from pyulog import ULog
 from companion.actuators.minissc import position_for_pulse
 from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
-from tests.support.geotag import camera_feedback
+from tests.support.geotag import camera_feedback, images_tagged
 from tests.support.vehicle import REPO
 
 PLAN = REPO / "qgc_plans" / "short_leg.plan"
@@ -113,7 +113,7 @@ def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geota
     grace_s = w.time_boot_s + 1.0
     photos += _photos_until(sim, lambda _m: w.time_boot_s >= grace_s)
     seqs = [p.seq for p in photos]
-    assert seqs == list(range(1, len(seqs) + 1)), seqs
+    assert seqs == list(range(len(seqs))), seqs  # from 0, as PX4 numbers them
     # A photo for every 50 m of the leg at least: the turn onto it is flown too (the gaps
     # below are the photos' own spacing along the track).
     assert len(seqs) >= LEG_M // SPACING_M, len(seqs)
@@ -124,8 +124,8 @@ def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geota
     assert _photo_button(sim, seen=button) == d.MAV_RESULT_ACCEPTED
     end_s = w.time_boot_s + 5.0
     button += _photos_until(sim, lambda _m: w.time_boot_s >= end_s)
-    assert [p.seq for p in button] == [len(seqs) + 1]  # one photo, numbered on
-    seqs.append(len(seqs) + 1)
+    assert [p.seq for p in button] == [len(seqs)]  # one photo, numbered on
+    seqs.append(len(seqs))
     log = sim.disarm(force=True)[-1]
     ulog = ULog(str(log))
     capture = ulog.get_dataset("camera_capture").data
@@ -133,6 +133,8 @@ def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geota
     # QGroundControl 4.4's GeoTag Images finds the same photos in the same places.
     tags = camera_feedback(log)
     assert [t["seq"] for t in tags] == seqs
+    # One picture a photo: each tagged with its own photo's place, none left out.
+    assert images_tagged(tags, len(seqs)) == [(i, i) for i in range(len(seqs))]
     places = list(zip(capture["lat"], capture["lon"], strict=True))
     assert [(t["lat"], t["lon"]) for t in tags] == places
     frame = LocalFrame(*places[0])

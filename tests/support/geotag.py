@@ -3,7 +3,9 @@ same way here (QGroundControl is not built on the test machine): walk the messag
 byte 16; take each field's offset from the topic's FORMAT by adding up the sizes of the
 fields before it (fields named ``_padding`` left out); give up at the first DATA message
 if no ADD_LOGGED_MSG for the topic came before it; read the named fields of each DATA
-sample of that subscription at those offsets."""
+sample of that subscription at those offsets. Then, as its GeoTagWorker does, tag the
+images (sorted by name) in trigger order: the i-th trigger's ``seq`` is the index of the
+image it tags, and an index past the last image fails the whole run."""
 
 from __future__ import annotations
 
@@ -53,3 +55,14 @@ def camera_feedback(path: Path) -> list[dict[str, float]]:
                 found.append({k: struct.unpack_from(READ[k], sample, offsets[k])[0] for k in READ})
         index += 3 + size
     return found
+
+
+def images_tagged(tags: list[dict[str, float]], images: int) -> list[tuple[int, int]]:
+    """(image index, trigger index) for each image GeoTag Images writes, given ``images``
+    images; AssertionError with its message where it gives up."""
+    out = []
+    for i in range(min(images, len(tags))):
+        image = int(tags[i]["seq"])
+        assert image < images, f"Requesting image #{image}, but only {images} images present."
+        out.append((image, i))
+    return out

@@ -77,7 +77,7 @@ class CameraConfig:
 class CameraStep:
     """What one control step asks of the camera's output."""
 
-    photo: bool = False  # a photo was taken (its number is ``CameraTrigger.seq``)
+    photo: bool = False  # a photo was taken (its number is ``CameraTrigger.seq``, from 0)
     pulses: list[tuple[int, int]] = field(default_factory=list)  # (output, µs) to set now
 
 
@@ -86,7 +86,7 @@ class CameraTrigger:
     """When photos are due, from the camera items passed and the positions flown."""
 
     config: CameraConfig = field(default_factory=CameraConfig)
-    seq: int = 0  # photos taken so far
+    taken: int = 0  # photos taken so far
     distance_m: float = 0.0  # a photo every this many metres (0: not by distance)
     interval_s: float = 0.0  # a photo every this many seconds (0: not by time)
     left: int = 0  # photos still to take by time (0: no end)
@@ -96,6 +96,12 @@ class CameraTrigger:
         self._last_at: Point | None = None  # where the last photo (or the count) started
         self._last_s = -math.inf  # when the last photo was taken
         self._release_s: float | None = None  # when the held shutter is let go
+
+    @property
+    def seq(self) -> int:
+        """The last photo's number: the first is 0, as PX4's camera trigger numbers them,
+        and QGroundControl's GeoTag Images tags the image of that index (by name) with it."""
+        return self.taken - 1
 
     @property
     def busy(self) -> bool:
@@ -141,7 +147,7 @@ class CameraTrigger:
             self._wanted = True  # taken when the shutter is free again
             return out
         self._wanted = False
-        self.seq += 1
+        self.taken += 1
         self._last_s, self._last_at = t_s, pos
         if self.interval_s > 0 and self.left > 0:
             self.left -= 1

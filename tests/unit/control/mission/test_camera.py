@@ -47,7 +47,7 @@ def test_a_survey_distance_takes_a_photo_every_so_many_metres_flown():
     photos, _ = fly(trigger, 20.0)  # 500 m
     norths = [n for _, n in photos]
     assert norths[0] == 0.0  # the first at once (param3 1)
-    assert len(norths) == 10 and trigger.seq == 10
+    assert len(norths) == 10 and trigger.taken == 10 and trigger.seq == 9
     gaps = [b - a for a, b in itertools.pairwise(norths)]
     assert all(50.0 <= g <= 50.0 + SPEED * STEP_S for g in gaps), gaps
 
@@ -94,10 +94,10 @@ def test_a_stop_item_ends_the_photos_and_a_distance_of_zero_too():
         trigger = CameraTrigger(SERVO)
         trigger.apply(*distance(50.0))
         fly(trigger, 5.0)
-        taken = trigger.seq
+        taken = trigger.taken
         trigger.apply(*stop)
         photos, _ = fly(trigger, 10.0, start_s=5.0)
-        assert photos == [] and trigger.seq == taken
+        assert photos == [] and trigger.taken == taken
 
 
 def test_image_capture_takes_its_count_at_its_interval_or_one_photo():
