@@ -15,6 +15,7 @@ from companion.messages.channels import CHANNELS, Channel, channel
 from companion.messages.control import (
     CAMERA_SEQ,
     GRIPPER_SEQ,
+    MISSION_HOME_SEQ,
     MISSION_SERVO_SEQ,
     REASON_LEN,
     CommandAck,
@@ -57,6 +58,7 @@ __all__ = [
     "CHANNELS",
     "GRIPPER_SEQ",
     "MAX_PLUGINS",
+    "MISSION_HOME_SEQ",
     "MISSION_SERVO_SEQ",
     "NAME_LEN",
     "NAN",

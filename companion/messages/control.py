@@ -63,10 +63,11 @@ class CommandId(enum.IntEnum):
 
 # Sequence numbers of commands the flight controller sends the servo output on its own
 # (the link counts its own from 1): a mission's DO_SET_SERVO, the camera's shutter pulses,
-# the gripper's.
+# the gripper's; and the one it sends the commander for a mission's DO_SET_HOME.
 MISSION_SERVO_SEQ = (1 << 31) - 2
 CAMERA_SEQ = (1 << 31) - 3
 GRIPPER_SEQ = (1 << 31) - 4
+MISSION_HOME_SEQ = (1 << 31) - 5  # a mission's DO_SET_HOME, for the commander
 
 
 class CommandResult(enum.IntEnum):

@@ -103,8 +103,9 @@ class FlightController:
             home = (nav.lat_deg, nav.lon_deg, nav.alt_msl_m)
         if self.frame is None or (self.frame.lat0, self.frame.lon0) != home[:2]:
             self.frame = LocalFrame(home[0], home[1])
-            self.executor = None
-            self._mode_key = None
+            if self.executor is not None and not self.executor.finished:  # DO_SET_HOME's
+                self.set_currents.pending = self.executor.current  # on from its own item
+            self.executor, self._mode_key = None, None
         self.home_alt = home[2]
         return self.frame
 
@@ -289,7 +290,7 @@ class FlightController:
         out.mission_seq = ex.current
         out.mission_finished = ex.finished
         out.reached = ex.drain_reached()
-        out.servo_sets, out.payload_items = ex.take_actions()
+        out.servo_sets, out.passed_items = ex.take_actions()
         return setpoint
 
     def _fly_takeoff(

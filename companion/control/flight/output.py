@@ -27,7 +27,7 @@ class ControlOutput:
     mission_finished: bool = False
     reached: list[int] = field(default_factory=list)
     servo_sets: list[tuple[int, int]] = field(default_factory=list)  # a mission's DO_SET_SERVO
-    payload_items: list[MissionItem] = field(default_factory=list)  # camera, gripper items
+    passed_items: list[MissionItem] = field(default_factory=list)  # camera, gripper, home
     landed: bool = True
     disarm: bool = False  # landed and stopped: the flight is over
     land_phase: int = 0  # LandPhase while landing, else 0
@@ -38,4 +38,4 @@ class ControlOutput:
     def held(self) -> ControlOutput:
         """The same commands without this step's events (items reached, servo sets, payload
         items, a disarm): what an unusable input keeps, so none is done twice."""
-        return replace(self, reached=[], servo_sets=[], payload_items=[], disarm=False)
+        return replace(self, reached=[], servo_sets=[], passed_items=[], disarm=False)

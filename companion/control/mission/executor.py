@@ -11,8 +11,8 @@ its height, for param1 seconds from its start; NAV_RETURN_TO_LAUNCH ends the mis
 as it is begun, and hands the flight to Return (the commander enters that mode, as ArduPlane
 and PX4 do: ``control.mission_return``; until it does, or flown without a commander, it
 flies home and circles there); DO_CHANGE_SPEED, DO_SET_SERVO (``servo_sets``, for the servo
-output), the camera's items and DO_GRIPPER (``payload_items``) and DO_JUMP act at once.
-After the last item the aircraft circles its last point (PX4).
+output), the camera's items, DO_GRIPPER and DO_SET_HOME (``passed_items``) and DO_JUMP act
+at once. After the last item the aircraft circles its last point (PX4).
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ from dataclasses import dataclass, field
 from companion.control.laws.fillet import MIN_TURN_RAD, corner_arc
 from companion.control.mission import approach
 from companion.control.mission.items import (
+    HANDED_ITEMS,
     MAX_JUMPS_PER_STEP,
     PASSED_OVER,
-    PAYLOAD_ITEMS,
     MissionItem,
     change_speed,
     delay_loiter,
@@ -77,7 +77,7 @@ class MissionExecutor:
     finished: bool = False
     reached: list[int] = field(default_factory=list)  # items reached since the last drain
     servo_sets: list[tuple[int, int]] = field(default_factory=list)  # (output, µs) passed
-    payload_items: list[MissionItem] = field(default_factory=list)  # camera, gripper items
+    passed_items: list[MissionItem] = field(default_factory=list)  # HANDED_ITEMS passed
     # (MAV_SEVERITY, text) for the operator; a controller's executors share its landing's.
     said: list[tuple[int, str]] = field(default_factory=list)
 
@@ -116,9 +116,9 @@ class MissionExecutor:
         return out
 
     def take_actions(self) -> tuple[list[tuple[int, int]], list[MissionItem]]:
-        """The servo sets and the camera's and gripper's items passed since the last call."""
-        out = self.servo_sets, self.payload_items
-        self.servo_sets, self.payload_items = [], []
+        """The servo sets and the HANDED_ITEMS passed since the last call."""
+        out = self.servo_sets, self.passed_items
+        self.servo_sets, self.passed_items = [], []
         return out
 
     def alt_of(self, item: MissionItem) -> float:
@@ -182,8 +182,8 @@ class MissionExecutor:
                 self.speed = change_speed(item, self.speed)
             elif cmd == d.MAV_CMD_DO_SET_SERVO:  # the controller hands it to the servo output
                 self.servo_sets.append((round(item.param1), round(item.param2)))
-            elif cmd in PAYLOAD_ITEMS:  # and these to the camera and the gripper
-                self.payload_items.append(item)
+            elif cmd in HANDED_ITEMS:  # and these to its camera, gripper and commander
+                self.passed_items.append(item)
             self._advance(False, self._prev, self._prev_alt)
             return None
         if cmd == d.MAV_CMD_NAV_DELAY:  # its seconds count from its start, on the circle or not

@@ -67,11 +67,13 @@ NOT_CARRIED = frozenset(
 # landing begins).
 SKIPPED = CAMERA_STOPS | NOT_CARRIED | {d.MAV_CMD_DO_LAND_START}
 MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO items
-# What the controller's plug-in works: the camera and a payload gripper (mission/gripper.py).
-PAYLOAD_ITEMS = CAMERA_ITEMS | {d.MAV_CMD_DO_GRIPPER}
+# What the controller's plug-in carries out as the mission passes them: the camera's items,
+# a payload gripper's (mission/gripper.py), a new home (DO_SET_HOME, as ArduPlane and PX4
+# take it in a mission: the aircraft's place, param1 1, or the item's).
+HANDED_ITEMS = CAMERA_ITEMS | {d.MAV_CMD_DO_GRIPPER, d.MAV_CMD_DO_SET_HOME}
 # DO items that act at once and fly nowhere: a speed, a servo output (a payload release),
-# a camera's photos, a gripper.
-ACTIONS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_SET_SERVO}) | PAYLOAD_ITEMS
+# a camera's photos, a gripper, a new home.
+ACTIONS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_SET_SERVO}) | HANDED_ITEMS
 PASSED_OVER = SKIPPED | ACTIONS  # done as they are reached: the next item is current at once
 DO_COMMANDS = PASSED_OVER | {d.MAV_CMD_DO_JUMP}
 SERVO_OUTPUTS = range(1, 9)  # DO_SET_SERVO's param1: the Mini SSC's eight, from 1
@@ -121,6 +123,7 @@ NEEDS_NUMBER = {
     d.MAV_CMD_DO_JUMP: (1, 2),
     d.MAV_CMD_DO_SET_SERVO: (1, 2),
     d.MAV_CMD_DO_GRIPPER: (2,),
+    d.MAV_CMD_DO_SET_HOME: (1,),
     d.MAV_CMD_DO_SET_CAM_TRIGG_DIST: (1,),
     d.MAV_CMD_IMAGE_START_CAPTURE: (2, 3),
     d.MAV_CMD_NAV_LOITER_TURNS: (1,),
@@ -235,6 +238,11 @@ def check_item(item: MissionItem, count: int) -> int:
         return d.MAV_MISSION_ACCEPTED
     if item.command == d.MAV_CMD_NAV_DELAY and item.param1 < 0:  # until a time of day
         return d.MAV_MISSION_INVALID_PARAM1
+    if item.command == d.MAV_CMD_DO_SET_HOME:  # 1: the aircraft's place; 0: the item's
+        if item.param1 not in (0.0, 1.0):
+            return d.MAV_MISSION_INVALID_PARAM1
+        if item.param1 == 1.0:
+            return d.MAV_MISSION_ACCEPTED
     if item.command in POSITIONLESS:
         return d.MAV_MISSION_ACCEPTED
     if item.frame not in GLOBAL_FRAMES:

@@ -28,6 +28,8 @@ from companion.control.mission.camera import CAMERA_PARAMS
 from companion.control.mission.camera_shots import CameraPorts, CameraShots
 from companion.control.mission.fence import Fence
 from companion.control.mission.gripper import GRIPPER_PARAMS, Gripper
+from companion.control.mission.home_items import set_home_command
+from companion.control.mission.items import MissionItem
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
 from companion.control.mission_return import reported_state
@@ -206,11 +208,12 @@ class FixedWingPlugin(Plugin):
             self._disarm(now_us, out, status)
         self._set_servos(now_us, out.servo_sets)
         self._answer_payloads(nav.t_us)
-        if out.payload_items:
-            self.gripper.items(nav.t_us, out.payload_items)
+        if out.passed_items:
+            self.gripper.items(nav.t_us, out.passed_items)
+            self._set_home(nav.t_us, out.passed_items)
         frame = self.controller.frame  # an idle camera costs the step nothing
-        if frame is not None and (out.payload_items or self.camera.trigger.busy):
-            self.camera.step(nav, out.payload_items, frame.ne(nav.lat_deg, nav.lon_deg))
+        if frame is not None and (out.passed_items or self.camera.trigger.busy):
+            self.camera.step(nav, out.passed_items, frame.ne(nav.lat_deg, nav.lon_deg))
         for seq in out.reached:  # each told, however many in one step
             self.recent_reached[self.reached_count % ControlStatus.REACHED_KEPT] = seq
             self.reached_count += 1
@@ -232,6 +235,15 @@ class FixedWingPlugin(Plugin):
             self.commands.publish(
                 VehicleCommand.set_servo(now_us, MISSION_SERVO_SEQ, output, pulse)
             )
+
+    def _set_home(self, t_us: int, items: list[MissionItem]) -> None:
+        """A mission's DO_SET_HOME items, handed to the commander, which keeps home."""
+        for item in items:
+            if item.command == d.MAV_CMD_DO_SET_HOME:
+                self.commands.publish(set_home_command(item, t_us, self.controller.home_alt))
+                where = "here" if round(item.param1) == 1 else "at the plan's point"
+                self.ctx.log.info("mission item %d: home set %s", item.seq, where)
+                self._tell(t_us, d.MAV_SEVERITY_INFO, f"Mission: home set {where}")
 
     def _answer_payloads(self, t_us: int) -> None:
         """A ground station's camera and gripper commands (the link checked their

@@ -154,6 +154,6 @@ def test_the_controller_passes_them_on_in_one_step_only():
     status.home_lat_deg, status.home_lon_deg, status.home_alt_msl_m = -37.9105, 145.134, HOME_ALT
     nav = NavState(flags=int(NavFlags.POSITION_VALID), lat_deg=-37.9105, lon_deg=145.1343)
     nav.alt_msl_m, nav.ve_m_s = HOME_ALT + 100.0, 25.0
-    passed = [controller.step(nav, status, k * 0.02).payload_items for k in range(5)]
+    passed = [controller.step(nav, status, k * 0.02).passed_items for k in range(5)]
     assert [p for p in passed if p] == [[shoot]]
     assert pytest.approx(controller.home_alt) == HOME_ALT
