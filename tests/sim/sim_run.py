@@ -6,14 +6,19 @@ plug-in's ``sim`` fixture instead."""
 
 from __future__ import annotations
 
+import asyncio
 import signal
 import subprocess
 import sys
+from collections.abc import Awaitable, Callable
 from pathlib import Path
+from typing import TypeVar
 
 from companion.bus.namespace import leftover_files
-from companion.testing.processes import LoggedProcess, stop_tree
+from companion.testing.processes import LoggedProcess, free_udp_port, stop_tree
 from tests.support.vehicle import REPO, companion_env, unique_namespace
+
+T = TypeVar("T")
 
 
 class SimRun(LoggedProcess):
@@ -47,3 +52,20 @@ def finish(proc: SimRun, namespace: str, timeout_s: float) -> str:
     assert proc.returncode == 0, out
     assert leftover_files(namespace) == [], "shared memory left behind"
     return out
+
+
+def with_sim(
+    tmp: Path, sim_s: int, script: Callable[[int], Awaitable[T]], aircraft: str = "c172p"
+) -> tuple[T, str, Path]:
+    """Run the asyncio ``script(port)`` (a ground station hearing the vehicle on udpin
+    ``port``) against ``companion sim --speed max`` flying ``sim_s`` simulated seconds;
+    its result, the vehicle's output and the truth file."""
+    port = free_udp_port()
+    proc, namespace, truth_path = start_sim(
+        tmp, f"udpout://127.0.0.1:{port}", "--aircraft", aircraft, "--duration", str(sim_s)
+    )
+    try:
+        result = asyncio.run(script(port))
+    finally:
+        out = finish(proc, namespace, 240)
+    return result, out, truth_path

@@ -11,7 +11,6 @@ command is refused, and MAVSDK says so.
 
 from __future__ import annotations
 
-import asyncio
 import json
 import math
 from pathlib import Path
@@ -25,8 +24,7 @@ from mavsdk.plugins.gripper import GripperError
 from companion.actuators.minissc import position_for_pulse, pulse_us
 from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
-from tests.protocol.mav_client import free_udp_port
-from tests.sim.sim_run import finish, start_sim
+from tests.sim.sim_run import with_sim
 from tests.support.mavsdk_flight import plan_uploaded, until
 from tests.support.qgc_plan import simple_item, write_plan
 
@@ -84,14 +82,7 @@ async def _drop(port: int, plan: str) -> dict:
 @pytest.mark.timeout(300)
 def test_a_mavsdk_script_grabs_and_a_plans_gripper_item_releases_the_payload(tmp_path: Path):
     plan = _plan(tmp_path / "drop.plan")
-    port = free_udp_port()
-    proc, namespace, _truth = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "260"
-    )
-    try:
-        seen = asyncio.run(_drop(port, str(plan)))
-    finally:
-        out = finish(proc, namespace, 240)
+    seen, out, _truth = with_sim(tmp_path, 260, lambda port: _drop(port, str(plan)))
     assert seen["disarmed"] == "FAILED", seen  # MAVSDK's name for DENIED
     assert seen["grabbed_before"] <= 1, seen  # still on the way to A
     # Over A (the c172p flies some 40 m a second; a turn's lead is some 150 m)

@@ -6,7 +6,6 @@ the new home, not to the runway it left."""
 
 from __future__ import annotations
 
-import asyncio
 import math
 from pathlib import Path
 
@@ -16,8 +15,7 @@ import pytest
 from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate as read_truth
 from mavlink_dialect import companion as d
-from tests.protocol.mav_client import free_udp_port
-from tests.sim.sim_run import finish, start_sim
+from tests.sim.sim_run import with_sim
 from tests.support.mavsdk_flight import mission_finished, plan_uploaded, until
 from tests.support.qgc_plan import simple_item, write_plan
 
@@ -59,14 +57,7 @@ async def _fly(port: int, plan: str) -> dict:
 @pytest.mark.timeout(400)
 def test_a_plans_set_home_moves_home_and_return_flies_there(tmp_path):
     plan = _plan(tmp_path / "set_home.plan")
-    port = free_udp_port()
-    proc, namespace, truth_path = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "420"
-    )
-    try:
-        seen = asyncio.run(_fly(port, str(plan)))
-    finally:
-        out = finish(proc, namespace, 240)
+    seen, out, truth_path = with_sim(tmp_path, 420, lambda port: _fly(port, str(plan)))
     assert seen["finished"], out[-3000:]
     # Once: the mission goes on from the item after it, not the commander's last word.
     assert out.count("mission item 2: home set at the plan's point") == 1, out[-3000:]

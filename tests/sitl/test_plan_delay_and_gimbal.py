@@ -9,9 +9,7 @@ MAVSDK's mission plug-in makes the same items of a waypoint's gimbal pitch and l
 
 from __future__ import annotations
 
-import asyncio
 import math
-from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import TypeVar
 
@@ -27,8 +25,7 @@ from mavsdk.plugins.mission import MissionItem, MissionPlan
 from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate as read_truth
 from mavlink_dialect import companion as d
-from tests.protocol.mav_client import free_udp_port
-from tests.sim.sim_run import finish, start_sim
+from tests.sim.sim_run import with_sim
 from tests.support.mavsdk_flight import fly_plan
 from tests.support.qgc_plan import simple_item, write_plan
 
@@ -60,26 +57,12 @@ def _plan(path: Path) -> Path:
     return write_plan(path, items, (-37.9105, 145.134, 126))
 
 
-def _with_sim(tmp_path, sim_s: int, script: Callable[[int], Awaitable[T]]) -> tuple[T, str, Path]:
-    """Run ``script(port)`` against a lockstep c172p flying ``sim_s`` simulated seconds;
-    its result, the vehicle's output and the truth file."""
-    port = free_udp_port()
-    proc, namespace, truth_path = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", str(sim_s)
-    )
-    try:
-        result = asyncio.run(script(port))
-    finally:
-        out = finish(proc, namespace, 240)
-    return result, out, truth_path
-
-
 @pytest.mark.timeout(300)
 def test_a_delay_holds_the_aircraft_round_its_waypoint_and_gimbal_items_change_nothing(
     tmp_path,
 ):
     plan = _plan(tmp_path / "delay_gimbal.plan")
-    seen, out, truth_path = _with_sim(tmp_path, 330, lambda port: fly_plan(port, str(plan), 240.0))
+    seen, out, truth_path = with_sim(tmp_path, 330, lambda port: fly_plan(port, str(plan), 240.0))
     assert seen["finished"], out[-3000:]
     assert "Mission: 2 gimbal/video/yaw items ignored" in out
     truth = read_truth(truth_path)
@@ -121,7 +104,7 @@ async def _upload_as_mavsdk_mission(port: int) -> list[int]:
 def test_a_mavsdk_mission_with_a_gimbal_pitch_and_a_loiter_time_is_taken(tmp_path):
     """MAVSDK turns a gimbal pitch into gimbal-manager items and a loiter time into
     NAV_DELAY: the upload used to be refused whole."""
-    commands, out, _ = _with_sim(tmp_path, 60, _upload_as_mavsdk_mission)
+    commands, out, _ = with_sim(tmp_path, 60, _upload_as_mavsdk_mission)
     gimbal = {d.MAV_CMD_DO_GIMBAL_MANAGER_CONFIGURE, d.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW}
     assert gimbal <= set(commands) and d.MAV_CMD_NAV_DELAY in commands, commands
     assert commands.count(d.MAV_CMD_NAV_WAYPOINT) == 2

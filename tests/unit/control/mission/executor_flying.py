@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import math
 
+from companion.actuators.airframe import load_airframe
+from companion.control.flight.controller import FlightController
+from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.mission.executor import (
     ExecutorConfig,
     Kind,
@@ -12,6 +15,7 @@ from companion.control.mission.executor import (
 )
 from companion.control.mission.items import MissionItem, check_mission
 from companion.geodesy import LocalFrame
+from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 from mavlink_dialect import companion as d
 
 HOME = LocalFrame(-37.9105, 145.1340)
@@ -106,3 +110,15 @@ def sp_alt(setpoints: list[Setpoint]) -> float:
 
 
 # --- take-off ------------------------------------------------------------------------------
+
+
+def cruising(items: list[MissionItem]) -> tuple[FlightController, NavState, VehicleStatus]:
+    """A c172p's controller flying ``items`` in Mission from home, and a solution 100 m up
+    just east of home, flying east at 25 m/s."""
+    decls = control_params(load_airframe("c172p").control)
+    controller = FlightController(flight_config({p.name: p.default for p in decls}), items)
+    status = VehicleStatus(mode=int(FlightMode.MISSION), armed=1, home_valid=1)
+    status.home_lat_deg, status.home_lon_deg, status.home_alt_msl_m = -37.9105, 145.134, HOME_ALT
+    nav = NavState(flags=int(NavFlags.POSITION_VALID), lat_deg=-37.9105, lon_deg=145.1343)
+    nav.alt_msl_m, nav.ve_m_s = HOME_ALT + 100.0, 25.0
+    return controller, nav, status

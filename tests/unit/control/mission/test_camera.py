@@ -11,14 +11,10 @@ from dataclasses import replace
 
 import pytest
 
-from companion.actuators.airframe import load_airframe
-from companion.control.flight.controller import FlightController
-from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.mission.camera import CameraConfig, CameraTrigger
 from companion.control.mission.items import check_item
-from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 from mavlink_dialect import companion as d
-from tests.unit.control.mission.executor_flying import HOME_ALT, executor, item, wp
+from tests.unit.control.mission.executor_flying import HOME_ALT, cruising, executor, item, wp
 
 SERVO = CameraConfig(servo=True, output=7, on_us=1900, off_us=1100, duration_s=0.1)
 STEP_S, SPEED = 0.02, 25.0  # the controller's 50 Hz, a c172p's cruise
@@ -144,16 +140,8 @@ def test_the_executor_hands_camera_items_out_once_as_it_passes_them():
 
 
 def test_the_controller_passes_them_on_in_one_step_only():
-    decls = control_params(load_airframe("c172p").control)
     shoot = item(1, d.MAV_CMD_DO_SET_CAM_TRIGG_DIST, p1=40.0, p3=1.0)
-    controller = FlightController(
-        flight_config({p.name: p.default for p in decls}),
-        [wp(0, (0.0, 30.0)), shoot, wp(2, (0.0, 2000.0))],
-    )
-    status = VehicleStatus(mode=int(FlightMode.MISSION), armed=1, home_valid=1)
-    status.home_lat_deg, status.home_lon_deg, status.home_alt_msl_m = -37.9105, 145.134, HOME_ALT
-    nav = NavState(flags=int(NavFlags.POSITION_VALID), lat_deg=-37.9105, lon_deg=145.1343)
-    nav.alt_msl_m, nav.ve_m_s = HOME_ALT + 100.0, 25.0
+    controller, nav, status = cruising([wp(0, (0.0, 30.0)), shoot, wp(2, (0.0, 2000.0))])
     passed = [controller.step(nav, status, k * 0.02).passed_items for k in range(5)]
     assert [p for p in passed if p] == [[shoot]]
     assert pytest.approx(controller.home_alt) == HOME_ALT

@@ -10,21 +10,14 @@ from dataclasses import replace
 
 import pytest
 
-from companion.actuators.airframe import load_airframe
-from companion.control.flight.controller import FlightController
-from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.mission.home_items import set_home_command
 from companion.control.mission.items import check_item
 from companion.messages import (
     MISSION_HOME_SEQ,
     CommandId,
-    FlightMode,
-    NavFlags,
-    NavState,
-    VehicleStatus,
 )
 from mavlink_dialect import companion as d
-from tests.unit.control.mission.executor_flying import HOME, HOME_ALT, executor, item, wp
+from tests.unit.control.mission.executor_flying import HOME, HOME_ALT, cruising, executor, item, wp
 
 PLACE = (1500.0, -500.0)  # metres north and east of home
 
@@ -71,16 +64,10 @@ def test_home_moved_here_in_the_air_the_mission_goes_on_and_is_not_set_again():
     its frame moves. The mission is taken up at the item after DO_SET_HOME, not at the
     one the commander last heard of (the item itself: home set here once more, a little
     further on each time, for ever)."""
-    decls = control_params(load_airframe("c172p").control)
     here = replace(home_item(1, 1.0), frame=d.MAV_FRAME_MISSION)
-    controller = FlightController(
-        flight_config({p.name: p.default for p in decls}),
-        [wp(0, (0.0, 30.0)), here, wp(2, (0.0, 2000.0)), wp(3, (2000.0, 2000.0))],
+    controller, nav, status = cruising(
+        [wp(0, (0.0, 30.0)), here, wp(2, (0.0, 2000.0)), wp(3, (2000.0, 2000.0))]
     )
-    status = VehicleStatus(mode=int(FlightMode.MISSION), armed=1, home_valid=1)
-    status.home_lat_deg, status.home_lon_deg, status.home_alt_msl_m = -37.9105, 145.134, HOME_ALT
-    nav = NavState(flags=int(NavFlags.POSITION_VALID), lat_deg=-37.9105, lon_deg=145.1343)
-    nav.alt_msl_m, nav.ve_m_s = HOME_ALT + 100.0, 25.0
     passed = [controller.step(nav, status, k * 0.02).passed_items for k in range(5)]
     assert [p for p in passed if p] == [[here]]
     # The commander took it (home is where the aircraft was) and still says item 1.

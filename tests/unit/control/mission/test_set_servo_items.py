@@ -8,14 +8,10 @@ import math
 
 import pytest
 
-from companion.actuators.airframe import load_airframe
-from companion.control.flight.controller import FlightController
-from companion.control.flight.flight_params import control_params, flight_config
 from companion.control.mission.executor import Kind
 from companion.control.mission.items import check_item
-from companion.messages import FlightMode, NavFlags, NavState, VehicleStatus
 from mavlink_dialect import companion as d
-from tests.unit.control.mission.executor_flying import HOME_ALT, executor, item, wp
+from tests.unit.control.mission.executor_flying import HOME_ALT, cruising, executor, item, wp
 
 
 def servo(seq: int, output: float, pulse: float):
@@ -42,14 +38,8 @@ def test_the_executor_hands_it_out_once_as_it_passes_and_flies_on():
 
 
 def test_the_controller_says_it_in_one_step_only():
-    decls = control_params(load_airframe("c172p").control)
-    controller = FlightController(
-        flight_config({p.name: p.default for p in decls}),
-        [wp(0, (0.0, 30.0)), servo(1, 7, 1900), wp(2, (0.0, 2000.0))],
+    controller, nav, status = cruising(
+        [wp(0, (0.0, 30.0)), servo(1, 7, 1900), wp(2, (0.0, 2000.0))]
     )
-    status = VehicleStatus(mode=int(FlightMode.MISSION), armed=1, home_valid=1)
-    status.home_lat_deg, status.home_lon_deg, status.home_alt_msl_m = -37.9105, 145.134, HOME_ALT
-    nav = NavState(flags=int(NavFlags.POSITION_VALID), lat_deg=-37.9105, lon_deg=145.1343)
-    nav.alt_msl_m, nav.ve_m_s = HOME_ALT + 100.0, 25.0
     said = [controller.step(nav, status, k * 0.02).servo_sets for k in range(5)]
     assert [s for s in said if s] == [[(7, 1900)]]
