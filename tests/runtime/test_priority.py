@@ -66,6 +66,9 @@ def thread_policies(pid: int) -> list[tuple[int, ...]]:
 def test_each_plugin_process_runs_at_its_nice_value(vehicle_factory):
     vehicle = vehicle_factory(vehicle_config("prio", *entries()))
     pids = {name: vehicle.wait_running(name) for name in ("imu", "relay", "idle")}
+    # A process sets its own priority before it starts its plug-in: read it once each has
+    # reported its first counters (the health table shows a pid from the fork on).
+    wait_for(lambda: all(vehicle.row(name).counted_us > 0 for name in pids), 60, "counters")
     nices = {name: psutil.Process(pid).nice() for name, pid in pids.items()}
     assert nices == {"imu": expected(FLIGHT_NICE), "relay": 0, "idle": 10}
     assert psutil.Process(vehicle.proc.pid).nice() == 0  # the supervisor keeps its own
