@@ -1,5 +1,5 @@
 """Parameters: declarations beside their owner, a typed store, atomic persistence."""
 
-from companion.params.store import ParamDecl, ParamError, ParamStore
+from companion.params.store import ParamDecl, ParamError, ParamStore, declared_values
 
-__all__ = ["ParamDecl", "ParamError", "ParamStore"]
+__all__ = ["ParamDecl", "ParamError", "ParamStore", "declared_values"]

@@ -99,6 +99,12 @@ class ParamDecl:
         return None
 
 
+def declared_values(decls: Iterable[ParamDecl], values: Mapping[str, float]) -> dict[str, float]:
+    """Each declared parameter's value in ``values`` (name → value), its default where it
+    has none: what a part's config reads its own parameters from."""
+    return {p.name: float(values.get(p.name, p.default)) for p in decls}
+
+
 def bind(decl: ParamDecl, decls: Mapping[str, ParamDecl]) -> ParamDecl:
     """An alias as this vehicle serves it: its default (and a linear one's range) from its
     owners' declarations; a fixed fact at its own default when an owner is not there."""

@@ -16,7 +16,7 @@ from companion.control.flight.flare_aim import flare_run
 from companion.control.laws.attitude import AttitudeGains
 from companion.control.laws.tecs import TecsGains
 from companion.control.mission.executor import ExecutorConfig
-from companion.params import ParamDecl
+from companion.params import ParamDecl, declared_values
 
 
 def _p(name: str, default: float, lo: float, hi: float, unit: str, doc: str) -> ParamDecl:
@@ -207,7 +207,7 @@ class FlightConfig:
 
 def flight_config(values: Mapping[str, float]) -> FlightConfig:
     """Group parameter values (name → value) for the controller."""
-    v = {p.name: float(values.get(p.name, p.default)) for p in CONTROL_PARAMS}
+    v = declared_values(CONTROL_PARAMS, values)
     attitude = AttitudeGains(
         v["RLL_P"], v["RLL_D"], v["RLL_I"], v["RLL_IMAX"],
         v["PTCH_P"], v["PTCH_D"], v["PTCH_I"], v["PTCH_IMAX"],

@@ -36,6 +36,6 @@ class ControlOutput:
     brakes: float = 1.0  # 0 off .. 1 full: held while parked
 
     def held(self) -> ControlOutput:
-        """The same commands without this step's events (items reached, servo sets, payload
-        items, a disarm): what an unusable input keeps, so none is done twice."""
+        """The same commands without this step's events (items reached, servo sets, items
+        handed on, a disarm): what an unusable input keeps, so none is done twice."""
         return replace(self, reached=[], servo_sets=[], passed_items=[], disarm=False)

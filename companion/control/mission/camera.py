@@ -20,7 +20,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from companion.control.mission.items import CAMERA_ITEMS, MissionItem
-from companion.params import ParamDecl
+from companion.params import ParamDecl, declared_values
 from mavlink_dialect import companion as d
 
 TYPE_PARAM = "CAM1_TYPE"
@@ -66,7 +66,7 @@ class CameraConfig:
 
     @classmethod
     def from_params(cls, values: Mapping[str, float]) -> CameraConfig:
-        v = {p.name: float(values.get(p.name, p.default)) for p in CAMERA_PARAMS}
+        v = declared_values(CAMERA_PARAMS, values)
         return cls(
             v[TYPE_PARAM] == SERVO_CAMERA, round(v["CAM1_OUTPUT"]), round(v["CAM1_SERVO_ON"]),
             round(v["CAM1_SERVO_OFF"]), v["CAM1_DURATION"], v["CAM1_INTRVAL_MIN"],

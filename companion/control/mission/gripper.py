@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 from companion.control.mission.items import MissionItem
 from companion.messages import GRIPPER_SEQ, VehicleCommand
-from companion.params import ParamDecl
+from companion.params import ParamDecl, declared_values
 from mavlink_dialect import companion as d
 
 log = logging.getLogger("companion.gripper")
@@ -50,7 +50,7 @@ class GripperConfig:
 
     @classmethod
     def from_params(cls, values: Mapping[str, float]) -> GripperConfig:
-        v = {p.name: float(values.get(p.name, p.default)) for p in GRIPPER_PARAMS}
+        v = declared_values(GRIPPER_PARAMS, values)
         return cls(
             v[ENABLE_PARAM] == 1.0, round(v["GRIP_OUTPUT"]), round(v["GRIP_GRAB"]),
             round(v["GRIP_RELEASE"]),
