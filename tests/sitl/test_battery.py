@@ -29,7 +29,7 @@ SENSORS = {
 }
 
 
-pytestmark = pytest.mark.vehicle(plan=PLAN, duration=1500)
+pytestmark = pytest.mark.vehicle(plan=PLAN)
 
 
 class BatteryStation(Station):

@@ -23,7 +23,7 @@ from tests.support.vehicle import REPO
 PLAN = REPO / "qgc_plans" / "short_leg.plan"
 SPACING_M = 50.0
 LEG_M = 1598.0  # short_leg.plan's second leg, east waypoint to north waypoint, straight
-pytestmark = pytest.mark.vehicle(airframe="c172p", duration=1500)
+pytestmark = pytest.mark.vehicle(airframe="c172p")
 
 
 def _survey(tmp_path: Path) -> Path:

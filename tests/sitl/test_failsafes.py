@@ -23,7 +23,7 @@ from mavlink_dialect import companion as d
 from tests.support.vehicle import REPO
 
 PLAN = str(REPO / "qgc_plans" / "square.plan")
-pytestmark = pytest.mark.vehicle(plan=PLAN, duration=1500)
+pytestmark = pytest.mark.vehicle(plan=PLAN)
 WATCHED = ["HEARTBEAT", "STATUSTEXT", "MISSION_CURRENT", "COMMAND_ACK"]
 
 

@@ -33,7 +33,7 @@ from tests.support.vehicle import REPO, wait_for
 
 log = logging.getLogger(__name__)
 PLAN = REPO / "qgc_plans" / "square.plan"
-pytestmark = pytest.mark.vehicle(airframe="c172p", duration=1500)
+pytestmark = pytest.mark.vehicle(airframe="c172p")
 WALL_S = 1500.0  # a hang guard only: the flight is judged by the vehicle's telemetry
 HOME = LocalFrame(-37.9105, 145.134)  # the plan's home, where the simulation starts
 NEAR_M = 500.0  # Land from Return once this near where it returns to

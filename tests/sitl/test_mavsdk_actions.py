@@ -70,7 +70,7 @@ async def _flight(system) -> dict:
 
 @pytest.mark.asyncio
 @pytest.mark.timeout(900)
-@pytest.mark.vehicle(airframe="c172p", duration=1500)  # lockstep disarmed runs ~33x the wall
+@pytest.mark.vehicle(airframe="c172p")
 async def test_mavsdk_takeoff_goto_hold_and_return_fly_the_aircraft(sim, mavsdk_system):
     sim.wait_ready()  # as the plug-in's users are told (MAVSDK's is_armable came 20 ms early)
     seen = await _flight(mavsdk_system)

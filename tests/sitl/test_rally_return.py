@@ -20,7 +20,7 @@ from mavlink_dialect import companion as d
 from tests.support.vehicle import REPO, wait_for
 
 PLAN = REPO / "qgc_plans" / "square.plan"
-pytestmark = pytest.mark.vehicle(plan=str(PLAN), duration=1500)
+pytestmark = pytest.mark.vehicle(plan=str(PLAN))
 HOME = LocalFrame(-37.9105, 145.134)  # the plan's home, where the simulation starts
 HOME_ALT = 80.0  # the runway, m above sea level
 _RALLY = checked_plan(PLAN)[d.MAV_MISSION_TYPE_RALLY][0]

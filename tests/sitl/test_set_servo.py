@@ -16,7 +16,7 @@ from mavlink_dialect import companion as d
 from tests.support.vehicle import REPO
 
 PLAN = REPO / "qgc_plans" / "short_leg.plan"
-pytestmark = pytest.mark.vehicle(airframe="c172p", duration=1500)
+pytestmark = pytest.mark.vehicle(airframe="c172p")
 
 
 def _with_release(tmp_path: Path) -> Path:

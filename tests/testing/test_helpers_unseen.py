@@ -79,7 +79,7 @@ def test_a_script_hears_the_vehicle_alone_while_the_helpers_work(bench):
 # came from the mission's item, not from the loss (CI on 30d2cf0). Four times real time at
 # most, the loss falls on the first legs, as in tests/sitl/test_failsafes.py.
 @pytest.mark.timeout(420)
-@pytest.mark.vehicle(plan=str(SQUARE), duration=1500)
+@pytest.mark.vehicle(plan=str(SQUARE))
 @pytest.mark.parametrize("sim", [{"speed": 4}], ids=["4x"], indirect=True)
 def test_a_script_that_goes_quiet_in_flight_sends_the_aircraft_home(sim):
     script = GcsScript(sim.pymavlink_url)
