@@ -139,6 +139,12 @@ RULES: dict[int, tuple[Param, ...]] = {
         Param(1, "instance", 0, 255, optional=True, whole=True),
         Param(2, "action", 0, 1, whole=True),
     ),
+    # Actuator sets 1-6 (companion.control.mission.actuator_sets): -1..1, NaN leaves one;
+    # the index must be 0 (the flight controller refuses another with the reason).
+    d.MAV_CMD_DO_SET_ACTUATOR: (
+        *(Param(n, f"actuator {n}", -1, 1, optional=True) for n in range(1, 7)),
+        Param(7, "index", 0, 255, optional=True, whole=True),
+    ),
     # A camera on a servo output (companion.control.mission.camera): a distance between
     # photos (0 stops), an interval and a count, one photo (DIGICAM_CONTROL's param5 1).
     d.MAV_CMD_DO_SET_CAM_TRIGG_DIST: (

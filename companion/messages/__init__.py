@@ -13,6 +13,7 @@ from companion.messages.actuators import ActuatorCommand, CameraCapture, ServoOu
 from companion.messages.base import MAX_PLUGINS, NAME_LEN, NAN, Message
 from companion.messages.channels import CHANNELS, Channel, channel
 from companion.messages.control import (
+    ACTUATOR_SEQ,
     CAMERA_SEQ,
     GRIPPER_SEQ,
     MISSION_HOME_SEQ,
@@ -54,6 +55,7 @@ from companion.messages.system import (
 )
 
 __all__ = [
+    "ACTUATOR_SEQ",
     "CAMERA_SEQ",
     "CHANNELS",
     "GRIPPER_SEQ",

@@ -59,15 +59,17 @@ class CommandId(enum.IntEnum):
     # IMAGE_START_CAPTURE, IMAGE_STOP_CAPTURE), param2..5 = its param1, 2, 3 and 5
     CAMERA = 17
     GRIPPER = 18  # param1 = the action: 0 release, 1 grab (DO_GRIPPER's param2)
+    SET_ACTUATOR = 19  # param1..6 = actuator sets 1-6, -1..1 (NaN: leave), param7 = index
 
 
 # Sequence numbers of commands the flight controller sends the servo output on its own
 # (the link counts its own from 1): a mission's DO_SET_SERVO, the camera's shutter pulses,
-# the gripper's; and the one it sends the commander for a mission's DO_SET_HOME.
+# the gripper's, the actuator sets'; and the one it sends the commander for a mission's DO_SET_HOME.
 MISSION_SERVO_SEQ = (1 << 31) - 2
 CAMERA_SEQ = (1 << 31) - 3
 GRIPPER_SEQ = (1 << 31) - 4
 MISSION_HOME_SEQ = (1 << 31) - 5  # a mission's DO_SET_HOME, for the commander
+ACTUATOR_SEQ = (1 << 31) - 6  # DO_SET_ACTUATOR's, from a mission or a ground station
 
 
 class CommandResult(enum.IntEnum):

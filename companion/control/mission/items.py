@@ -70,9 +70,11 @@ MAX_JUMPS_PER_STEP = 100_000  # a hard stop, far beyond any real mission's DO it
 # What the controller's plug-in carries out as the mission passes them: the camera's items,
 # a payload gripper's (mission/gripper.py), a new home (DO_SET_HOME, as ArduPlane and PX4
 # take it in a mission: the aircraft's place, param1 1, or the item's).
-HANDED_ITEMS = CAMERA_ITEMS | {d.MAV_CMD_DO_GRIPPER, d.MAV_CMD_DO_SET_HOME}
+HANDED_ITEMS = CAMERA_ITEMS | {
+    d.MAV_CMD_DO_GRIPPER, d.MAV_CMD_DO_SET_HOME, d.MAV_CMD_DO_SET_ACTUATOR,
+}  # fmt: skip
 # DO items that act at once and fly nowhere: a speed, a servo output (a payload release),
-# a camera's photos, a gripper, a new home.
+# a camera's photos, a gripper, a new home, actuator sets (mission/actuator_sets.py).
 ACTIONS = frozenset({d.MAV_CMD_DO_CHANGE_SPEED, d.MAV_CMD_DO_SET_SERVO}) | HANDED_ITEMS
 PASSED_OVER = SKIPPED | ACTIONS  # done as they are reached: the next item is current at once
 DO_COMMANDS = PASSED_OVER | {d.MAV_CMD_DO_JUMP}
@@ -106,6 +108,7 @@ POSITIONLESS = (
             d.MAV_CMD_DO_CHANGE_SPEED,
             d.MAV_CMD_DO_SET_SERVO,
             d.MAV_CMD_DO_GRIPPER,
+            d.MAV_CMD_DO_SET_ACTUATOR,
             d.MAV_CMD_DO_JUMP,
             d.MAV_CMD_DO_LAND_START,
             d.MAV_CMD_NAV_DELAY,  # circles the last point flown to (``delay_loiter``)
@@ -231,6 +234,8 @@ def check_item(item: MissionItem, count: int) -> int:
         return _camera_refusal(item)
     if item.command == d.MAV_CMD_DO_GRIPPER and item.param2 not in (0.0, 1.0):  # release, grab
         return d.MAV_MISSION_INVALID_PARAM2
+    if item.command == d.MAV_CMD_DO_SET_ACTUATOR:
+        return _actuator_refusal(item)
     if item.command == d.MAV_CMD_DO_JUMP:
         target = round(item.param1)
         if not 0 <= target < count or target == item.seq:
@@ -265,6 +270,27 @@ def _servo_refusal(item: MissionItem) -> int:
     low, high = SERVO_PULSES_US
     if item.param2 != round(item.param2) or not low <= item.param2 <= high:
         return d.MAV_MISSION_INVALID_PARAM2
+    return d.MAV_MISSION_ACCEPTED
+
+
+INT32_SENTINELS = (2**31 - 1, -(2**31))  # an integer field's "not given"
+SET_5_6_INVALID = (d.MAV_MISSION_INVALID_PARAM5_X, d.MAV_MISSION_INVALID_PARAM6_Y)
+
+
+def actuator_values(item: MissionItem) -> tuple[float, ...]:
+    """A DO_SET_ACTUATOR item's values for actuator sets 1-6 (NaN: leave that set). Sets 5
+    and 6 ride in x and y, scaled by 1e7 as QGroundControl 4.4 scales every item's."""
+    fifth, sixth = (math.nan if v in INT32_SENTINELS else v / 1e7 for v in (item.x, item.y))
+    return (item.param1, item.param2, item.param3, item.param4, fifth, sixth)
+
+
+def _actuator_refusal(item: MissionItem) -> int:
+    """Each set's value within -1..1 or NaN; the index (param7) 0, the only one there is."""
+    for n, value in enumerate(actuator_values(item)):
+        if not (math.isnan(value) or -1.0 <= value <= 1.0):
+            return INVALID_PARAM[n] if n < 4 else SET_5_6_INVALID[n - 4]
+    if item.z != 0.0:
+        return d.MAV_MISSION_INVALID_PARAM7
     return d.MAV_MISSION_ACCEPTED
 
 

@@ -11,9 +11,16 @@ command is refused at once before then, with the reason.
 MAV_CMD_DO_GRIPPER (MAVSDK's Gripper plug-in): param2 0 releases, 1 grabs, the gripper on
 the output ``GRIP_OUTPUT`` (``companion.control.mission.gripper``). The flight controller
 works it and answers, as it does the camera; refused at once while disarmed too.
+
+MAV_CMD_DO_SET_ACTUATOR (MAVSDK's ``Action.set_actuator``, PX4's generic actuator control):
+param1-6 actuator sets 1-6 from -1 to 1 (NaN: leave), param7 the index, 0. The flight
+controller sets the outputs ``ACT_SETn_OUT`` wire them to and answers
+(``companion.control.mission.actuator_sets``); refused at once while disarmed.
 """
 
 from __future__ import annotations
+
+import math
 
 from companion.link.codec import dialect as d
 from companion.link.command_service import CommandArgs, CommandService, Outcome
@@ -25,7 +32,7 @@ CONTROLLER = b"control.fixed_wing"  # and DO_GRIPPER
 
 
 class ServoCommands:
-    """DO_SET_SERVO and DO_GRIPPER."""
+    """DO_SET_SERVO, DO_GRIPPER and DO_SET_ACTUATOR."""
 
     def __init__(self, port: VehiclePort) -> None:
         self.port = port
@@ -36,6 +43,7 @@ class ServoCommands:
         # One line each: the reference page (docs/gen_reference_commands.py) reads them.
         service.register(d.MAV_CMD_DO_SET_SERVO, self.set_servo)
         service.register(d.MAV_CMD_DO_GRIPPER, self.gripper)
+        service.register(d.MAV_CMD_DO_SET_ACTUATOR, self.set_actuator)
 
     def set_servo(self, args: CommandArgs) -> Outcome:
         """A spare output of the servo card to the pulse, answered by the servo output (an
@@ -54,4 +62,15 @@ class ServoCommands:
             return refuse(self.port, self.service, "Gripper: works only while armed")
         action = (round(args.params[1]),)
         seq = self.port.publish_command(CommandId.GRIPPER, action, to=CONTROLLER)
+        return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)
+
+    def set_actuator(self, args: CommandArgs) -> Outcome:
+        """Actuator sets 1-6 to their values, answered by the flight controller (no set
+        wired, or one on a surface's output, DENIED with the reason); DENIED at once while
+        disarmed."""
+        if not plugin_running(self.port, CONTROLLER):
+            return refuse(self.port, self.service, "Set actuator: works only while armed")
+        index = 0.0 if math.isnan(args.params[6]) else args.params[6]
+        params = (*args.params[:6], index)
+        seq = self.port.publish_command(CommandId.SET_ACTUATOR, params, to=CONTROLLER)
         return Outcome(defer_seq=seq, timeout_s=BUS_ACK_TIMEOUT_S)

@@ -24,6 +24,7 @@ from companion.actuators.airframe import AirframeError, load_airframe
 from companion.control.flight.attitude_modes import pilot_sticks
 from companion.control.flight.controller import ControlOutput, FlightController
 from companion.control.flight.flight_params import control_params, flight_config
+from companion.control.mission.actuator_sets import ACTUATOR_PARAMS, ActuatorSets
 from companion.control.mission.camera import CAMERA_PARAMS
 from companion.control.mission.camera_shots import CameraPorts, CameraShots
 from companion.control.mission.fence import Fence
@@ -111,7 +112,7 @@ class FixedWingPlugin(Plugin):
     ) -> tuple[ParamDecl, ...]:
         airframe = load_airframe(vehicle["airframe"])
         control = control_params(airframe.control, f"airframe {Path(airframe.source).name}")
-        return control + CAMERA_PARAMS + GRIPPER_PARAMS
+        return control + CAMERA_PARAMS + GRIPPER_PARAMS + ACTUATOR_PARAMS
 
     def init(self, ctx: PluginContext) -> None:
         super().init(ctx)
@@ -158,16 +159,15 @@ class FixedWingPlugin(Plugin):
                              self._tell, gps.get, self._home_alt)  # fmt: skip
         self.camera = CameraShots(photos, self.surface_outputs)
         self.gripper = Gripper(self.commands.publish, self._tell, self.surface_outputs)
+        self.actuators = ActuatorSets(self.commands.publish, self._tell, self.surface_outputs)
         self.requests = bus.queue_reader("link/commands")  # a ground station's payload's
         self.acks = bus.writer("link/command_acks")
-        self.camera.configure(self.live_params.values)
-        self.gripper.configure(self.live_params.values)
+        self._configure_payloads()
 
     def _follow_changes(self, now_us: int) -> None:
         if self.live_params.poll():
             self.controller.set_config(flight_config(self.live_params.values))
-            self.camera.configure(self.live_params.values)
-            self.gripper.configure(self.live_params.values)
+            self._configure_payloads()
         # Only a different mission restarts it: the same list stored again changes nothing.
         changed = self.follower.follow(self.mission_changes.get())
         if d.MAV_MISSION_TYPE_MISSION in changed:
@@ -210,6 +210,7 @@ class FixedWingPlugin(Plugin):
         self._answer_payloads(nav.t_us)
         if out.passed_items:
             self.gripper.items(nav.t_us, out.passed_items)
+            self.actuators.items(nav.t_us, out.passed_items)
             self._set_home(nav.t_us, out.passed_items)
         frame = self.controller.frame  # an idle camera costs the step nothing
         if frame is not None and (out.passed_items or self.camera.trigger.busy):
@@ -246,7 +247,7 @@ class FixedWingPlugin(Plugin):
                 self._tell(t_us, d.MAV_SEVERITY_INFO, f"Mission: home set {where}")
 
     def _answer_payloads(self, t_us: int) -> None:
-        """A ground station's camera and gripper commands (the link checked their
+        """A ground station's camera, gripper and actuator commands (the link checked their
         parameters), each answered; taken before this step's photos are judged."""
         for request in self.requests.pending():
             if request.command == CommandId.CAMERA:
@@ -254,11 +255,17 @@ class FixedWingPlugin(Plugin):
                 problem = self.camera.command(round(request.param[0]), params)
             elif request.command == CommandId.GRIPPER:
                 problem = self.gripper.act(t_us, round(request.param[0]))
+            elif request.command == CommandId.SET_ACTUATOR:
+                problem = self.actuators.act(t_us, request.param[:6], round(request.param[6]))
             else:
                 continue
             result = CommandResult.DENIED if problem else CommandResult.ACCEPTED
             source = self.ctx.name.encode()
             self.acks.publish(CommandAck.answer(request, t_us, source, result, problem or ""))
+
+    def _configure_payloads(self) -> None:
+        for payload in (self.camera, self.gripper, self.actuators):
+            payload.configure(self.live_params.values)
 
     def _tell(self, t_us: int, severity: int, text: str) -> None:
         if severity <= d.MAV_SEVERITY_WARNING:

@@ -1,0 +1,87 @@
+"""A generic payload output worked as a PX4 user works it: MAVSDK's ``Action.set_actuator``
+and QGroundControl's "Set actuator" mission item (MAV_CMD_DO_SET_ACTUATOR).
+
+``ACT_SET1_OUT`` (set by MAVSDK's Param plug-in, as a user sets it in QGroundControl) wires
+actuator set 1 to output 7 of the c172p's Mini SSC (its spare servo 6). 1 is 2000 µs and -1
+1000 µs, read back from SERVO_OUTPUT_RAW, which the servo output sends after writing the
+card. Disarmed (the servo output runs only armed) the command is refused, and MAVSDK says
+so.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+from mavsdk.asyncio.plugins.mavlink_direct import MavlinkDirectAsync
+from mavsdk.asyncio.plugins.param import ParamAsync
+from mavsdk.plugins.action import ActionError
+
+from companion.actuators.minissc import position_for_pulse, pulse_us
+from companion.geodesy import LocalFrame
+from mavlink_dialect import companion as d
+from tests.sim.sim_run import with_sim
+from tests.support.mavsdk_flight import plan_uploaded, until
+from tests.support.qgc_plan import simple_item, write_plan
+
+HOME = LocalFrame(-37.9105, 145.1340)
+TAKEOFF, A, B = (0.0, 600.0), (0.0, 3000.0), (1500.0, 3000.0)
+
+
+def _plan(path: Path) -> Path:
+    """Take-off, waypoint A, "Set actuator" with actuator 1 at -1 and the others left (as
+    QGroundControl 4.4.5 saves it: frame MISSION, actuators 1-4 in param1-4, null for
+    "unchanged"), waypoint B."""
+
+    def at(ne: tuple[float, float], alt: float) -> list:
+        return [*HOME.latlon(*ne), alt]
+
+    items = [
+        simple_item(d.MAV_CMD_NAV_TAKEOFF, 3, [15, 0, 0, None, *at(TAKEOFF, 60.0)], 1),
+        simple_item(d.MAV_CMD_NAV_WAYPOINT, 3, [0, 0, 0, None, *at(A, 100.0)], 2),
+        simple_item(d.MAV_CMD_DO_SET_ACTUATOR, 2, [-1, None, None, None, 0, 0, 0], 3),
+        simple_item(d.MAV_CMD_NAV_WAYPOINT, 3, [0, 0, 0, None, *at(B, 100.0)], 4),
+    ]
+    return write_plan(path, items, (-37.9105, 145.134, 126))
+
+
+async def _work(port: int, plan: str) -> dict:
+    """Refused disarmed; wired, armed and flying: set 1 to 1 by command, then to -1 by the
+    plan at A. What MAVSDK saw."""
+    seen: dict = {}
+    async with plan_uploaded(port, plan) as flight:
+        try:
+            await flight.action.set_actuator(1, 1.0)
+            seen["disarmed"] = "accepted"
+        except ActionError as exc:
+            seen["disarmed"] = exc.result.name
+        await ParamAsync(flight.system).set_param_float("ACT_SET1_OUT", 7.0)
+        raw = MavlinkDirectAsync(flight.system).subscribe_message("SERVO_OUTPUT_RAW")
+
+        def output_7_at(pulse: int):
+            shown = pulse_us(position_for_pulse(pulse))
+            return lambda m: json.loads(m.fields_json)["servo7_raw"] == shown
+
+        await flight.action.arm()
+        await flight.mission.start_mission()
+        await flight.action.set_actuator(1, 1.0)  # on the runway, kilometres before A
+        await until(raw, output_7_at(2000), "output 7 at 2000 us", 60)
+        progress = flight.mission.subscribe_mission_progress()
+        seen["set_before"] = (await anext(aiter(progress))).current
+        await until(raw, output_7_at(1000), "output 7 at 1000 us", 120)
+        at = await anext(aiter(flight.telemetry.subscribe_position()))
+        seen["moved_from_a_m"] = math.dist(HOME.ne(at.latitude_deg, at.longitude_deg), A)
+    return seen
+
+
+@pytest.mark.timeout(300)
+def test_mavsdk_sets_an_actuator_and_a_plans_set_actuator_item_moves_it_back(tmp_path: Path):
+    plan = _plan(tmp_path / "actuator.plan")
+    seen, out, _truth = with_sim(tmp_path, 260, lambda port: _work(port, str(plan)))
+    assert seen["disarmed"] == "COMMAND_DENIED", seen
+    assert seen["set_before"] <= 1, seen  # still on the way to A
+    assert seen["moved_from_a_m"] < 400.0, seen  # over A (a turn's lead is some 150 m)
+    assert out.count("actuator sets: output 7 2000 us") == 1, out[-3000:]
+    assert "actuator sets: output 7 1000 us" in out
