@@ -10,20 +10,16 @@ so.
 
 from __future__ import annotations
 
-import json
-import math
 from pathlib import Path
 
 import pytest
-from mavsdk.asyncio.plugins.mavlink_direct import MavlinkDirectAsync
 from mavsdk.asyncio.plugins.param import ParamAsync
 from mavsdk.plugins.action import ActionError
 
-from companion.actuators.minissc import position_for_pulse, pulse_us
 from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
 from tests.sim.sim_run import with_sim
-from tests.support.mavsdk_flight import plan_uploaded, until
+from tests.support.mavsdk_flight import payload_worked, plan_uploaded
 from tests.support.qgc_plan import simple_item, write_plan
 
 HOME = LocalFrame(-37.9105, 145.1340)
@@ -58,21 +54,9 @@ async def _work(port: int, plan: str) -> dict:
         except ActionError as exc:
             seen["disarmed"] = exc.result.name
         await ParamAsync(flight.system).set_param_float("ACT_SET1_OUT", 7.0)
-        raw = MavlinkDirectAsync(flight.system).subscribe_message("SERVO_OUTPUT_RAW")
-
-        def output_7_at(pulse: int):
-            shown = pulse_us(position_for_pulse(pulse))
-            return lambda m: json.loads(m.fields_json)["servo7_raw"] == shown
-
-        await flight.action.arm()
-        await flight.mission.start_mission()
-        await flight.action.set_actuator(1, 1.0)  # on the runway, kilometres before A
-        await until(raw, output_7_at(2000), "output 7 at 2000 us", 60)
-        progress = flight.mission.subscribe_mission_progress()
-        seen["set_before"] = (await anext(aiter(progress))).current
-        await until(raw, output_7_at(1000), "output 7 at 1000 us", 120)
-        at = await anext(aiter(flight.telemetry.subscribe_position()))
-        seen["moved_from_a_m"] = math.dist(HOME.ne(at.latitude_deg, at.longitude_deg), A)
+        # Set 1 to 1 on the runway, kilometres before A; the plan's item puts it at -1.
+        act = lambda: flight.action.set_actuator(1, 1.0)  # noqa: E731
+        seen |= await payload_worked(flight, act, 7, (2000, 1000), (HOME, A))
     return seen
 
 
@@ -82,6 +66,6 @@ def test_mavsdk_sets_an_actuator_and_a_plans_set_actuator_item_moves_it_back(tmp
     seen, out, _truth = with_sim(tmp_path, 260, lambda port: _work(port, str(plan)))
     assert seen["disarmed"] == "COMMAND_DENIED", seen
     assert seen["set_before"] <= 1, seen  # still on the way to A
-    assert seen["moved_from_a_m"] < 400.0, seen  # over A (a turn's lead is some 150 m)
+    assert seen["from_point_m"] < 400.0, seen  # over A (a turn's lead is some 150 m)
     assert out.count("actuator sets: output 7 2000 us") == 1, out[-3000:]
     assert "actuator sets: output 7 1000 us" in out

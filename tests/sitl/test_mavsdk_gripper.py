@@ -11,21 +11,17 @@ command is refused, and MAVSDK says so.
 
 from __future__ import annotations
 
-import json
-import math
 from pathlib import Path
 
 import pytest
 from mavsdk.asyncio.plugins.gripper import GripperAsync
-from mavsdk.asyncio.plugins.mavlink_direct import MavlinkDirectAsync
 from mavsdk.asyncio.plugins.param import ParamAsync
 from mavsdk.plugins.gripper import GripperError
 
-from companion.actuators.minissc import position_for_pulse, pulse_us
 from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
 from tests.sim.sim_run import with_sim
-from tests.support.mavsdk_flight import plan_uploaded, until
+from tests.support.mavsdk_flight import payload_worked, plan_uploaded
 from tests.support.qgc_plan import simple_item, write_plan
 
 HOME = LocalFrame(-37.9105, 145.1340)
@@ -61,21 +57,9 @@ async def _drop(port: int, plan: str) -> dict:
         except GripperError as exc:
             seen["disarmed"] = exc.result.name
         await ParamAsync(flight.system).set_param_float("GRIP_ENABLE", 1.0)
-        raw = MavlinkDirectAsync(flight.system).subscribe_message("SERVO_OUTPUT_RAW")
-
-        def output_8_at(pulse: int):
-            shown = pulse_us(position_for_pulse(pulse))
-            return lambda m: json.loads(m.fields_json)["servo8_raw"] == shown
-
-        await flight.action.arm()
-        await flight.mission.start_mission()
-        await gripper.grab(1)  # on the runway or climbing out, kilometres before A
-        await until(raw, output_8_at(GRAB_US), "output 8 at GRIP_GRAB", 60)
-        progress = flight.mission.subscribe_mission_progress()
-        seen["grabbed_before"] = (await anext(aiter(progress))).current
-        await until(raw, output_8_at(RELEASE_US), "output 8 at GRIP_RELEASE", 120)
-        at = await anext(aiter(flight.telemetry.subscribe_position()))
-        seen["released_from_a_m"] = math.dist(HOME.ne(at.latitude_deg, at.longitude_deg), A)
+        # Grabbed on the runway or climbing out, kilometres before A; the plan releases.
+        act = lambda: gripper.grab(1)  # noqa: E731
+        seen |= await payload_worked(flight, act, 8, (GRAB_US, RELEASE_US), (HOME, A))
     return seen
 
 
@@ -84,9 +68,9 @@ def test_a_mavsdk_script_grabs_and_a_plans_gripper_item_releases_the_payload(tmp
     plan = _plan(tmp_path / "drop.plan")
     seen, out, _truth = with_sim(tmp_path, 260, lambda port: _drop(port, str(plan)))
     assert seen["disarmed"] == "FAILED", seen  # MAVSDK's name for DENIED
-    assert seen["grabbed_before"] <= 1, seen  # still on the way to A
+    assert seen["set_before"] <= 1, seen  # still on the way to A
     # Over A (the c172p flies some 40 m a second; a turn's lead is some 150 m)
-    assert seen["released_from_a_m"] < 400.0, seen
+    assert seen["from_point_m"] < 400.0, seen
     # Sent right after arming, before the controller listens, and resent by MAVSDK while
     # it waits: done once.
     assert out.count("gripper: grab (output 8 to 1900 us)") == 1, out[-3000:]

@@ -3,18 +3,24 @@
 from __future__ import annotations
 
 import asyncio
+import json
+import math
 import time
-from collections.abc import AsyncIterator, Callable
+from collections.abc import AsyncIterator, Awaitable, Callable
 from contextlib import asynccontextmanager
 from dataclasses import dataclass
 from typing import Any
 
 from mavsdk.asyncio import Configuration, Mavsdk
 from mavsdk.asyncio.plugins.action import ActionAsync
+from mavsdk.asyncio.plugins.mavlink_direct import MavlinkDirectAsync
 from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
 from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
 from mavsdk.component_type import ComponentType
 from mavsdk.plugins.action import ActionError
+
+from companion.actuators.minissc import position_for_pulse, pulse_us
+from companion.geodesy import LocalFrame
 
 
 @dataclass
@@ -94,3 +100,35 @@ async def until(
         return await asyncio.wait_for(first(), timeout_s)
     except TimeoutError:
         raise AssertionError(f"MAVSDK never saw {what}{detail()}") from None
+
+
+async def payload_worked(
+    flight: PlanSession,
+    act: Callable[[], Awaitable[Any]],
+    output: int,
+    pulses_us: tuple[int, int],
+    over: tuple[LocalFrame, tuple[float, float]],
+) -> dict:
+    """Arm, start the mission and ``act()`` at once (a payload command on the runway); then
+    wait for the servo card's ``output`` at the first pulse, then at the second (the plan's
+    item), as SERVO_OUTPUT_RAW shows them. The mission's current item when the first came
+    (``set_before``), and how far the aircraft was from the point ``over`` gives (a frame,
+    north and east m) when the second came (``from_point_m``)."""
+    raw = MavlinkDirectAsync(flight.system).subscribe_message("SERVO_OUTPUT_RAW")
+    field = f"servo{output}_raw"
+
+    def at(pulse: int) -> Callable[[Any], bool]:
+        shown = pulse_us(position_for_pulse(pulse))  # as the card's steps put it out
+        return lambda m: json.loads(m.fields_json)[field] == shown
+
+    await flight.action.arm()
+    await flight.mission.start_mission()
+    await act()
+    await until(raw, at(pulses_us[0]), f"output {output} at {pulses_us[0]} us", 60)
+    progress = flight.mission.subscribe_mission_progress()
+    seen = {"set_before": (await anext(aiter(progress))).current}
+    await until(raw, at(pulses_us[1]), f"output {output} at {pulses_us[1]} us", 120)
+    where = await anext(aiter(flight.telemetry.subscribe_position()))
+    frame, point = over
+    seen["from_point_m"] = math.dist(frame.ne(where.latitude_deg, where.longitude_deg), point)
+    return seen

@@ -20,10 +20,11 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from companion.control.mission.items import MissionItem, actuator_values
+from companion.control.mission.servo_payload import ServoPayload
 from companion.messages import ACTUATOR_SEQ, VehicleCommand
 from companion.params import ParamDecl, declared_values
 from mavlink_dialect import companion as d
@@ -83,19 +84,11 @@ class ActuatorSetConfig:
         return moves, None
 
 
-class ActuatorSets:
+class ActuatorSets(ServoPayload):
     """DO_SET_ACTUATOR in, the servo output's commands out, the operator told."""
 
-    def __init__(
-        self,
-        command: Callable[[VehicleCommand], None],
-        say: Callable[[int, int, str], None],
-        surface_outputs: Mapping[int, str],
-    ) -> None:
-        self.config = ActuatorSetConfig()
-        self.command = command  # a pulse for the servo output (on link/commands)
-        self.say = say  # (t_us, MAV_SEVERITY, text) for the operator
-        self.surface_outputs = surface_outputs
+    ITEM = d.MAV_CMD_DO_SET_ACTUATOR
+    config = ActuatorSetConfig()
 
     def configure(self, values: Mapping[str, float]) -> None:
         """The ACT_SETn_OUT parameters' values (at start and on every change)."""
@@ -114,12 +107,5 @@ class ActuatorSets:
         self.say(t_us, d.MAV_SEVERITY_INFO, f"Set actuator: {text}")
         return None
 
-    def items(self, t_us: int, items: Sequence[MissionItem]) -> None:
-        """A mission's DO_SET_ACTUATOR items among those it passed: each done, or the
-        operator told why not (the mission flies on)."""
-        for item in items:
-            if item.command == d.MAV_CMD_DO_SET_ACTUATOR:
-                problem = self.act(t_us, actuator_values(item), round(item.z))
-                if problem is not None:
-                    log.warning("mission item %d: %s", item.seq, problem)
-                    self.say(t_us, d.MAV_SEVERITY_WARNING, f"Mission: {problem}")
+    def item_act(self, t_us: int, item: MissionItem) -> str | None:
+        return self.act(t_us, actuator_values(item), round(item.z))

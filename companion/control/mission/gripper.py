@@ -13,10 +13,11 @@ them to the servo output and answers the ground station.
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from companion.control.mission.items import MissionItem
+from companion.control.mission.servo_payload import ServoPayload
 from companion.messages import GRIPPER_SEQ, VehicleCommand
 from companion.params import ParamDecl, declared_values
 from mavlink_dialect import companion as d
@@ -72,19 +73,11 @@ class GripperConfig:
         return None
 
 
-class Gripper:
+class Gripper(ServoPayload):
     """DO_GRIPPER actions in, the servo output's commands out, the operator told."""
 
-    def __init__(
-        self,
-        command: Callable[[VehicleCommand], None],
-        say: Callable[[int, int, str], None],
-        surface_outputs: Mapping[int, str],
-    ) -> None:
-        self.config = GripperConfig()
-        self.command = command  # a pulse for the servo output (on link/commands)
-        self.say = say  # (t_us, MAV_SEVERITY, text) for the operator
-        self.surface_outputs = surface_outputs
+    ITEM = d.MAV_CMD_DO_GRIPPER
+    config = GripperConfig()
 
     def configure(self, values: Mapping[str, float]) -> None:
         """The GRIP_* parameters' values (at start and on every change)."""
@@ -102,12 +95,5 @@ class Gripper:
         self.say(t_us, d.MAV_SEVERITY_INFO, f"Gripper: {ACTION_NAMES[action]}")
         return None
 
-    def items(self, t_us: int, items: Sequence[MissionItem]) -> None:
-        """A mission's DO_GRIPPER items among those it passed: each done, or the operator
-        told why not (the mission flies on, as it does past a servo it may not set)."""
-        for item in items:
-            if item.command == d.MAV_CMD_DO_GRIPPER:
-                problem = self.act(t_us, round(item.param2))
-                if problem is not None:
-                    log.warning("mission item %d: %s", item.seq, problem)
-                    self.say(t_us, d.MAV_SEVERITY_WARNING, f"Mission: {problem}")
+    def item_act(self, t_us: int, item: MissionItem) -> str | None:
+        return self.act(t_us, round(item.param2))
