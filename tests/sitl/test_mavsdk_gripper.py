@@ -18,31 +18,18 @@ from mavsdk.asyncio.plugins.gripper import GripperAsync
 from mavsdk.asyncio.plugins.param import ParamAsync
 from mavsdk.plugins.gripper import GripperError
 
-from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
 from tests.sim.sim_run import with_sim
 from tests.support.mavsdk_flight import payload_worked, plan_uploaded
-from tests.support.qgc_plan import simple_item, write_plan
+from tests.support.qgc_plan import HOME, A, item_at_a_plan
 
-HOME = LocalFrame(-37.9105, 145.1340)
-TAKEOFF, A, B = (0.0, 600.0), (0.0, 3000.0), (1500.0, 3000.0)
 GRAB_US, RELEASE_US = 1900, 1100  # GRIP_GRAB and GRIP_RELEASE as shipped
 
 
 def _plan(path: Path) -> Path:
     """Take-off, waypoint A, "Gripper Mechanism" release (as QGroundControl 4.4.5 saves it:
     frame MISSION, param1 the gripper, 1), waypoint B."""
-
-    def at(ne: tuple[float, float], alt: float) -> list:
-        return [*HOME.latlon(*ne), alt]
-
-    items = [
-        simple_item(d.MAV_CMD_NAV_TAKEOFF, 3, [15, 0, 0, None, *at(TAKEOFF, 60.0)], 1),
-        simple_item(d.MAV_CMD_NAV_WAYPOINT, 3, [0, 0, 0, None, *at(A, 100.0)], 2),
-        simple_item(d.MAV_CMD_DO_GRIPPER, 2, [1, 0, 0, 0, 0, 0, 0], 3),
-        simple_item(d.MAV_CMD_NAV_WAYPOINT, 3, [0, 0, 0, None, *at(B, 100.0)], 4),
-    ]
-    return write_plan(path, items, (-37.9105, 145.134, 126))
+    return item_at_a_plan(path, d.MAV_CMD_DO_GRIPPER, [1, 0, 0, 0, 0, 0, 0])
 
 
 async def _drop(port: int, plan: str) -> dict:
