@@ -49,7 +49,7 @@ async def _work(port: int, plan: str) -> dict:
 @pytest.mark.timeout(300)
 def test_mavsdk_sets_an_actuator_and_a_plans_set_actuator_item_moves_it_back(tmp_path: Path):
     plan = _plan(tmp_path / "actuator.plan")
-    seen, out, _truth = with_sim(tmp_path, 260, lambda port: _work(port, str(plan)))
+    seen, out, _truth = with_sim(tmp_path, lambda port: _work(port, str(plan)))
     assert seen["disarmed"] == "COMMAND_DENIED", seen
     assert seen["set_before"] <= 1, seen  # still on the way to A
     assert seen["from_point_m"] < 400.0, seen  # over A (a turn's lead is some 150 m)

@@ -53,7 +53,7 @@ async def _drop(port: int, plan: str) -> dict:
 @pytest.mark.timeout(300)
 def test_a_mavsdk_script_grabs_and_a_plans_gripper_item_releases_the_payload(tmp_path: Path):
     plan = _plan(tmp_path / "drop.plan")
-    seen, out, _truth = with_sim(tmp_path, 260, lambda port: _drop(port, str(plan)))
+    seen, out, _truth = with_sim(tmp_path, lambda port: _drop(port, str(plan)))
     assert seen["disarmed"] == "FAILED", seen  # MAVSDK's name for DENIED
     assert seen["set_before"] <= 1, seen  # still on the way to A
     # Over A (the c172p flies some 40 m a second; a turn's lead is some 150 m)

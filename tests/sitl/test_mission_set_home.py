@@ -16,7 +16,7 @@ from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate as read_truth
 from mavlink_dialect import companion as d
 from tests.sim.sim_run import with_sim
-from tests.support.mavsdk_flight import mission_finished, plan_uploaded, until
+from tests.support.mavsdk_flight import mission_finished, plan_uploaded, until, vehicle_seconds
 from tests.support.qgc_plan import simple_item, write_plan
 
 HOME = LocalFrame(-37.9105, 145.1340)
@@ -51,13 +51,19 @@ async def _fly(port: int, plan: str) -> dict:
         progress = await anext(aiter(flight.mission.subscribe_mission_progress()))
         seen["current_after_home"] = progress.current
         seen["finished"] = await mission_finished(flight.mission, 200)
+
+        def over_new_home(p) -> bool:  # a MAVSDK Position
+            return math.dist(HOME.ne(p.latitude_deg, p.longitude_deg), NEW_HOME) < 400.0
+
+        await until(flight.telemetry.subscribe_position(), over_new_home, "the new home", 200)
+        await vehicle_seconds(flight, 60.0)  # circling there: the truth's last 40 s
     return seen
 
 
 @pytest.mark.timeout(400)
 def test_a_plans_set_home_moves_home_and_return_flies_there(tmp_path):
     plan = _plan(tmp_path / "set_home.plan")
-    seen, out, truth_path = with_sim(tmp_path, 420, lambda port: _fly(port, str(plan)))
+    seen, out, truth_path = with_sim(tmp_path, lambda port: _fly(port, str(plan)))
     assert seen["finished"], out[-3000:]
     # Once: the mission goes on from the item after it, not the commander's last word.
     assert out.count("mission item 2: home set at the plan's point") == 1, out[-3000:]

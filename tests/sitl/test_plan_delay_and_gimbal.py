@@ -62,7 +62,7 @@ def test_a_delay_holds_the_aircraft_round_its_waypoint_and_gimbal_items_change_n
     tmp_path,
 ):
     plan = _plan(tmp_path / "delay_gimbal.plan")
-    seen, out, truth_path = with_sim(tmp_path, 330, lambda port: fly_plan(port, str(plan), 240.0))
+    seen, out, truth_path = with_sim(tmp_path, lambda port: fly_plan(port, str(plan), 240.0))
     assert seen["finished"], out[-3000:]
     assert "Mission: 2 gimbal/video/yaw items ignored" in out
     truth = read_truth(truth_path)
@@ -104,7 +104,7 @@ async def _upload_as_mavsdk_mission(port: int) -> list[int]:
 def test_a_mavsdk_mission_with_a_gimbal_pitch_and_a_loiter_time_is_taken(tmp_path):
     """MAVSDK turns a gimbal pitch into gimbal-manager items and a loiter time into
     NAV_DELAY: the upload used to be refused whole."""
-    commands, out, _ = with_sim(tmp_path, 60, _upload_as_mavsdk_mission)
+    commands, out, _ = with_sim(tmp_path, _upload_as_mavsdk_mission)
     gimbal = {d.MAV_CMD_DO_GIMBAL_MANAGER_CONFIGURE, d.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW}
     assert gimbal <= set(commands) and d.MAV_CMD_NAV_DELAY in commands, commands
     assert commands.count(d.MAV_CMD_NAV_WAYPOINT) == 2

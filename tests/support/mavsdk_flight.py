@@ -132,3 +132,16 @@ async def payload_worked(
     frame, point = over
     seen["from_point_m"] = math.dist(frame.ne(where.latitude_deg, where.longitude_deg), point)
     return seen
+
+
+async def vehicle_seconds(flight: PlanSession, seconds: float) -> None:
+    """Wait until ``seconds`` of the vehicle's own clock have passed (GLOBAL_POSITION_INT's
+    time since boot): simulated seconds, however fast the simulation runs."""
+    positions = MavlinkDirectAsync(flight.system).subscribe_message("GLOBAL_POSITION_INT")
+    start = json.loads((await anext(aiter(positions))).fields_json)["time_boot_ms"]
+    end_ms = start + seconds * 1000.0
+
+    def passed(m: Any) -> bool:
+        return json.loads(m.fields_json)["time_boot_ms"] >= end_ms
+
+    await until(positions, passed, f"{seconds:g} s of the vehicle's clock", 300)
