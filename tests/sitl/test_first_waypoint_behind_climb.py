@@ -11,7 +11,6 @@ then flies the rest. Lockstep JSBSim through MAVSDK's raw mission import, as a u
 
 from __future__ import annotations
 
-import asyncio
 import json
 
 import numpy as np
@@ -19,8 +18,7 @@ import pytest
 
 from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate as read_truth
-from tests.protocol.mav_client import free_udp_port
-from tests.sim.sim_run import finish, start_sim
+from tests.sim.sim_run import with_sim
 from tests.sitl.test_missions import HOME
 from tests.support.mavsdk_flight import fly_plan
 
@@ -57,14 +55,8 @@ def _plan(path) -> str:
 
 @pytest.mark.timeout(400)
 def test_a_first_waypoint_the_climb_flew_past_is_flown_back_to_at_height(tmp_path):
-    port = free_udp_port()
-    proc, namespace, truth_path = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "420"
-    )
-    try:
-        seen = asyncio.run(fly_plan(port, _plan(tmp_path / "behind.plan"), 300.0))
-    finally:
-        out = finish(proc, namespace, 300)
+    plan = _plan(tmp_path / "behind.plan")
+    seen, out, truth_path = with_sim(tmp_path, lambda port: fly_plan(port, plan, 300.0))
     assert seen["finished"], out[-3000:]
     truth = read_truth(truth_path)
     frame = LocalFrame(*HOME)

@@ -16,7 +16,7 @@ from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate as read_truth
 from mavlink_dialect import companion as d
 from tests.sim.sim_run import with_sim
-from tests.support.mavsdk_flight import mission_finished, plan_uploaded, until, vehicle_seconds
+from tests.support.mavsdk_flight import circled, mission_finished, plan_uploaded, until
 from tests.support.qgc_plan import simple_item, write_plan
 
 HOME = LocalFrame(-37.9105, 145.1340)
@@ -52,11 +52,7 @@ async def _fly(port: int, plan: str) -> dict:
         seen["current_after_home"] = progress.current
         seen["finished"] = await mission_finished(flight.mission, 200)
 
-        def over_new_home(p) -> bool:  # a MAVSDK Position
-            return math.dist(HOME.ne(p.latitude_deg, p.longitude_deg), NEW_HOME) < 400.0
-
-        await until(flight.telemetry.subscribe_position(), over_new_home, "the new home", 200)
-        await vehicle_seconds(flight, 60.0)  # circling there: the truth's last 40 s
+        await circled(flight, (HOME, NEW_HOME), 400.0, 60.0)  # the truth's last 40 s there
     return seen
 
 

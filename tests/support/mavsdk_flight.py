@@ -64,8 +64,14 @@ async def mission_finished(mission: MissionRawAsync, deadline_s: float) -> bool:
     return await mission.is_mission_finished()
 
 
-async def fly_plan(port: int, plan: str, deadline_s: float) -> dict:
-    """Fly ``plan`` with the vehicle heard on udpin ``port``; what MAVSDK saw, as a dict."""
+async def fly_plan(
+    port: int,
+    plan: str,
+    deadline_s: float,
+    then: Callable[[PlanSession], Awaitable[Any]] | None = None,
+) -> dict:
+    """Fly ``plan`` with the vehicle heard on udpin ``port``, and ``then`` (say, wait for
+    the Return's circle) once it has finished; what MAVSDK saw, as a dict."""
     seen: dict = {"reached": []}
     async with plan_uploaded(port, plan) as flight:
         seen["total"] = flight.items
@@ -77,6 +83,8 @@ async def fly_plan(port: int, plan: str, deadline_s: float) -> dict:
             seen["disarm"] = "accepted"
         except ActionError as exc:
             seen["disarm"] = exc.result.name
+        if then is not None:
+            await then(flight)
     return seen
 
 
@@ -145,3 +153,18 @@ async def vehicle_seconds(flight: PlanSession, seconds: float) -> None:
         return json.loads(m.fields_json)["time_boot_ms"] >= end_ms
 
     await until(positions, passed, f"{seconds:g} s of the vehicle's clock", 300)
+
+
+async def circled(
+    flight: PlanSession, over: tuple[LocalFrame, tuple[float, float]], radius_m: float, s: float
+) -> None:
+    """Wait until the aircraft is within ``radius_m`` of the point ``over`` gives (a frame,
+    north and east m), then for ``s`` seconds of the vehicle's clock: the simulation's last
+    seconds are then spent there."""
+    frame, point = over
+
+    def near(p: Any) -> bool:  # a MAVSDK Position
+        return math.dist(frame.ne(p.latitude_deg, p.longitude_deg), point) < radius_m
+
+    await until(flight.telemetry.subscribe_position(), near, f"within {radius_m:g} m", 200)
+    await vehicle_seconds(flight, s)
