@@ -178,8 +178,11 @@ class FixedWingPlugin(Plugin):
 
     def step(self) -> None:
         nav = self.nav.wait(WAIT_S)
-        if nav is None:
-            return  # no navigation: the servo plug-in goes safe when commands stop
+        if nav is None:  # the servo plug-in goes safe when commands stop
+            # A payload command needs no solution: answered now, not when the first one
+            # comes (just after START, in lockstep, some seconds on a loaded machine).
+            self._answer_payloads(self.ctx.clock.now_us())
+            return
         now_us = self.ctx.clock.now_us()
         self._follow_changes(now_us)
         # Started by START, this process joined after the commander last spoke: its mode
