@@ -142,6 +142,8 @@ INVALID_PARAM = (
     d.MAV_MISSION_INVALID_PARAM2,
     d.MAV_MISSION_INVALID_PARAM3,
     d.MAV_MISSION_INVALID_PARAM4,
+    d.MAV_MISSION_INVALID_PARAM5_X,
+    d.MAV_MISSION_INVALID_PARAM6_Y,
 )
 MAX_ALT_M = 100_000.0  # above this an altitude is a broken input, not a target
 MAX_PARAM = 1e7  # no parameter of a supported item means anything beyond this
@@ -274,7 +276,6 @@ def _servo_refusal(item: MissionItem) -> int:
 
 
 INT32_SENTINELS = (2**31 - 1, -(2**31))  # an integer field's "not given"
-SET_5_6_INVALID = (d.MAV_MISSION_INVALID_PARAM5_X, d.MAV_MISSION_INVALID_PARAM6_Y)
 
 
 def actuator_values(item: MissionItem) -> tuple[float, ...]:
@@ -288,7 +289,7 @@ def _actuator_refusal(item: MissionItem) -> int:
     """Each set's value within -1..1 or NaN; the index (param7) 0, the only one there is."""
     for n, value in enumerate(actuator_values(item)):
         if not (math.isnan(value) or -1.0 <= value <= 1.0):
-            return INVALID_PARAM[n] if n < 4 else SET_5_6_INVALID[n - 4]
+            return INVALID_PARAM[n]
     if item.z != 0.0:
         return d.MAV_MISSION_INVALID_PARAM7
     return d.MAV_MISSION_ACCEPTED
