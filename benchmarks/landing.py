@@ -1,7 +1,7 @@
 """Automatic landings of both airframes, scored from the simulator's truth.
 
 Usage: uv run python benchmarks/landing.py [--aircraft c172p] [--plan land_east.plan]
-       [--calm-only] [--seeds N] [--start-at S ...] [--keep DIR]
+       [--calm-only] [--seeds N] [--start-at S ...] [--gps-receiver rtk] [--keep DIR]
 (aircraft and plan repeatable; default: c172p and J3Cub, benchmarks/plans/land_east.plan)
 
 Each airframe, plan and condition (calm; 5 m/s crosswind from the south with light
@@ -20,7 +20,8 @@ turbulence's gusts) and ends with how many passed. Seed 1 flies JSBSim's own gus
 sequence, the one every run flew before the seed picked the gusts. ``--start-at S``
 (repeatable; default 10) starts the mission at another second, so the approach meets
 another part of the sequence (a ground station arms on its own clock: tests/sitl/
-test_landing.py holds the simulation for its arming).
+test_landing.py holds the simulation for its arming). ``--gps-receiver rtk`` flies an RTK
+receiver with a fixed solution instead (about 1 cm; ``companion sim --gps-receiver``).
 Criteria (issue 24, along and across from issue 42 item 8): |along| ≤ 15 m,
 |across| ≤ 2 m, sink ≤ 1.5 m/s, bounce ≤ 1 m, |bank| ≤ 10°, stopped on the runway,
 disarmed. benchmarks/plans/circuit_*.plan are circuits without QGroundControl's pattern
@@ -61,6 +62,7 @@ def main() -> None:
     ap.add_argument("--calm-only", action="store_true")
     ap.add_argument("--seeds", type=int, default=1, help="fly seeds 1..N of each row")
     ap.add_argument("--start-at", type=float, action="append", help="simulated second(s)")
+    ap.add_argument("--gps-receiver", default="standard", choices=("standard", "rtk"))
     ap.add_argument(
         "--keep", type=Path, help="keep each flight's folder (truth, flight log, sim log) here"
     )
@@ -81,7 +83,8 @@ def main() -> None:
             for cond, (wind, turbulence) in conditions.items():
                 for start, seed in product(args.start_at or [START_AT_S], seeds):
                     flight = Flight(str(plan), name, wind, turbulence, (), seed,
-                                    str(SIM_CONFIG), False, 900.0, start)  # fmt: skip
+                                    str(SIM_CONFIG), False, 900.0, start,
+                                    gps_receiver=args.gps_receiver)  # fmt: skip
                     text, ok = fly_whole_vehicle(flight, plan, args.keep)
                     row = f"{name:8} {plan.stem:10} {cond:18} {start:5g} {seed:4d} {text}"
                     print(row, flush=True)

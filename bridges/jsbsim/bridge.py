@@ -68,6 +68,8 @@ def _devices(opts: BridgeOptions) -> EmulatedDevices:
         noise = NoiseModel(scale=opts.noise_scale)
     else:
         noise = NoiseModel.installed(opts.noise_scale, calibrated=opts.mount == "calibrated")
+    if opts.gps == "rtk":
+        noise = noise.with_rtk()
     if opts.gps_wander_m is not None:
         noise = dataclasses.replace(noise, gps_horizontal_m=opts.gps_wander_m)
     errors = SensorErrors(noise, MagneticField(), opts.seed)

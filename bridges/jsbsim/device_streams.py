@@ -42,9 +42,18 @@ def _ddmm(value: float, positive: str, negative: str, width: int) -> tuple[str, 
 
 
 def nmea_epoch(
-    t_s: float, lat: float, lon: float, alt_msl: float, vn: float, ve: float, fix: bool
+    t_s: float,
+    lat: float,
+    lon: float,
+    alt_msl: float,
+    vn: float,
+    ve: float,
+    fix: bool,
+    quality: int = 1,
+    hdop: float = 0.9,
 ) -> bytes:
-    """One receiver epoch: GGA then RMC, CR LF terminated."""
+    """One receiver epoch: GGA (its fix ``quality``: 1 GPS, 4 RTK fixed) then RMC, CR LF
+    terminated."""
     utc = UTC_EPOCH + dt.timedelta(seconds=t_s)
     hhmmss = utc.strftime("%H%M%S.") + f"{utc.microsecond // 10000:02d}"
     date = utc.strftime("%d%m%y")
@@ -61,9 +70,9 @@ def nmea_epoch(
             ns,
             lo,
             ew,
-            "1" if fix else "0",
+            str(quality) if fix else "0",
             "09" if fix else "00",
-            "0.9" if fix else "",
+            f"{hdop:.1f}" if fix else "",
             f"{alt_msl:.1f}" if fix else "",
             "M",
             "0.0",
@@ -87,7 +96,7 @@ def nmea_epoch(
             date,
             "",
             "",
-            "A",
+            "R" if quality == 4 else "A",  # NMEA 2.3's mode: RTK integer, autonomous
         ),
     )
     return f"{gga}\r\n{rmc}\r\n".encode()
@@ -199,4 +208,5 @@ class EmulatedDevices:
         lat, lon, alt, vel = self.errors.gps(s, s.t_s - self.last_gps_s)
         self.last_gps_s = s.t_s
         fix = not any(o.covers(s.t_s) for o in self.outages)
-        return nmea_epoch(s.t_s, lat, lon, alt, vel[0], vel[1], fix)
+        m = self.errors.m
+        return nmea_epoch(s.t_s, lat, lon, alt, vel[0], vel[1], fix, m.gps_fix_quality, m.gps_hdop)

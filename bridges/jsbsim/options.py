@@ -11,6 +11,7 @@ from bridges.jsbsim.conditions import TURBULENCE, Home
 # How the sensors sit in the airframe (bridges/sensor_models/sensor_errors.py NoiseModel):
 # no defects, the residue of a good calibration, or the iron and motor field as they are.
 MOUNTS = ("quiet", "calibrated", "uncalibrated")
+GPS_RECEIVERS = ("standard", "rtk")  # a consumer receiver; RTK fixed (NoiseModel.with_rtk)
 # The aircraft's serial devices, as the bridge names them (hardware in the loop: --gps ...).
 DEVICES = ("gps", "compass", "imu", "rc", "battery", "range", "servos")
 
@@ -69,6 +70,7 @@ class BridgeOptions:
     # The GPS's slowly wandering error, metres per axis before noise_scale; None: the
     # receiver model's own (NoiseModel.gps_horizontal_m). 0 leaves only its white noise.
     gps_wander_m: float | None = None
+    gps: str = "standard"  # the GPS receiver: one of GPS_RECEIVERS
     mount: str = "calibrated"  # the sensors' airframe defects: one of MOUNTS
     seed: int = 1
     duration_s: float | None = None
@@ -86,6 +88,8 @@ class BridgeOptions:
             raise ValueError(f"turbulence must be one of {', '.join(TURBULENCE)}")
         if self.mount not in MOUNTS:
             raise ValueError(f"mount must be one of {', '.join(MOUNTS)}")
+        if self.gps not in GPS_RECEIVERS:
+            raise ValueError(f"gps must be one of {', '.join(GPS_RECEIVERS)}")
         if not -80.0 <= self.airborne_bank_deg <= 80.0:
             raise ValueError("the airborne start's bank must lie within ±80°")
         if self.gps_wander_m is not None and not 0.0 <= self.gps_wander_m <= 100.0:

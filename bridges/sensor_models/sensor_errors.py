@@ -6,6 +6,7 @@ All randomness comes from one seeded numpy Generator, so a seed gives the same e
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -36,6 +37,8 @@ class NoiseModel:
     gps_correlation_s: float = 60.0
     gps_white_m: float = 0.3
     gps_velocity_m_s: float = 0.1
+    gps_fix_quality: int = 1  # what the receiver's GGA says: 1 a GPS fix, 4 RTK fixed
+    gps_hdop: float = 0.9
     # What a real airframe adds (all off here: the VN-100 on a quiet mount; ``installed``
     # gives an airframe's, calibrated or not). Magnetometer: a body-fixed offset (hard
     # iron, a poor calibration or a steel part), per-axis gains (soft iron) and the motor
@@ -88,6 +91,19 @@ class NoiseModel:
             mag_throttle_gauss=motor,
             accel_vibration_m_s2=0.5,
             gyro_vibration_rad_s=0.01,
+        )
+
+    def with_rtk(self) -> NoiseModel:
+        """The same sensors with an RTK receiver holding a fixed solution (ZED-F9P class:
+        1 cm + 1 ppm CEP with its base a few kilometres away), its GGA saying so."""
+        return dataclasses.replace(
+            self,
+            gps_horizontal_m=0.01,
+            gps_vertical_m=0.02,
+            gps_white_m=0.005,
+            gps_velocity_m_s=0.05,
+            gps_fix_quality=4,
+            gps_hdop=0.6,
         )
 
 

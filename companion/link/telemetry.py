@@ -122,7 +122,14 @@ def _gps_raw(mav: Any, s: Snapshot) -> Any:
         u16(g.ground_speed_m_s, 100),
         cog,
         g.satellites,
+        h_acc=_mm(g.eph_m),  # what MAVSDK's RawGps reads as its uncertainty (0: not known)
+        v_acc=_mm(g.epv_m),
     )
+
+
+def _mm(metres: float) -> int:
+    mm = metres * 1000.0
+    return round(max(0.0, min(mm, 2.0**32 - 1))) if math.isfinite(mm) else 0
 
 
 def _vfr_hud(mav: Any, s: Snapshot) -> Any:

@@ -24,6 +24,10 @@ class InsEkfConfig:
     accel_bias_std: float = 0.1  # initial 1-σ
     gyro_bias_std: float = math.radians(0.5)
     gps_pos_std: float = 3.0  # when the fix carries no accuracy
+    # The least position noise a fix is fused with, whatever it claims: an RTK fix's
+    # centimetres are finer than the IMU's propagation between fixes and the measured
+    # lag's error (0.02 s at 30 m/s is 0.6 m), which would then read as the GPS's fault.
+    gps_pos_min_std: float = 0.3
     gps_vel_std: float = 0.3
     baro_std: float = 0.5  # m, barometric height over seconds
     baro_interval_s: float = 0.1
@@ -47,3 +51,8 @@ class InsEkfConfig:
     settle_s: float = 5.0  # GPS is not gated for this long after the alignment
     still_window_s: float = 1.0  # standing still this long measures the gyro biases
     noise_window_s: float = 10.0  # the IMU's sample noise is measured over this
+
+    def fix_pos_std(self, eph_m: float) -> float:
+        """The horizontal position noise a fix claiming ``eph_m`` is fused with."""
+        claimed = eph_m if math.isfinite(eph_m) and eph_m > 0 else self.gps_pos_std
+        return max(claimed, self.gps_pos_min_std)

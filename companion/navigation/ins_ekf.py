@@ -304,7 +304,7 @@ class InsEkf(InsCore):
         self.p = self._fix_position(fix).tolist()
         self.v = np.nan_to_num(vel).tolist()
         self.q = rot.euler_to_quaternion(a.roll, a.pitch, a.yaw)
-        pos_std = fix.eph_m if math.isfinite(fix.eph_m) else self.cfg.gps_pos_std
+        pos_std = self.cfg.fix_pos_std(fix.eph_m)
         c = self.cfg
         diag = [pos_std] * 2 + [pos_std * 1.5] + [max(c.gps_vel_std, 0.5)] * 3
         diag += [a.tilt_std, a.tilt_std, a.yaw_std]
@@ -326,7 +326,7 @@ class InsEkf(InsCore):
             self.lag.observe(fix.t_us, z_v, self.history)
         then = self.history.at(fix.t_us - self.lag.lag_s * 1e6)
         p_then, v_then = then if then is not None else (np.array(self.p), np.array(self.v))
-        std = fix.eph_m if math.isfinite(fix.eph_m) and fix.eph_m > 0 else self.cfg.gps_pos_std
+        std = self.cfg.fix_pos_std(fix.eph_m)
         vstd = fix.epv_m if math.isfinite(fix.epv_m) and fix.epv_m > 0 else 1.5 * std
         if self.baro.fresh(fix.t_us):  # the datum follows GPS on the ground only
             self.baro.follow_gps(z_p[2], self.p[2], fix.t_us, self.last_gps_us)

@@ -49,6 +49,9 @@ from companion.sensors.nmea_fields import GgaData, GsaData, RmcData, VtgData
 
 log = logging.getLogger(__name__)
 UERE_M = 2.5  # user-equivalent range error, 1 σ: eph ≈ UERE × HDOP
+# With RTK corrections the range error is the carrier phase's: centimetres once the
+# ambiguities are fixed, decimetres while they float (u-blox ZED-F9P: 1 cm + 1 ppm CEP).
+RTK_UERE_M = {GpsFixType.RTK_FIXED: 0.02, GpsFixType.RTK_FLOAT: 0.3}
 MAX_VZ_GAP_S = 5.0
 MISSES_TO_FORGET = 3
 _DAY_US = 86_400_000_000
@@ -256,7 +259,8 @@ class NmeaGpsDecoder:
         if math.isnan(fix.hdop) and gsa is not None:
             fix.hdop = gsa.hdop
         fix.vdop = gsa.vdop if gsa is not None else math.nan
-        fix.eph_m, fix.epv_m = self.uere_m * fix.hdop, self.uere_m * fix.vdop
+        uere = RTK_UERE_M.get(fix.fix_type, self.uere_m)
+        fix.eph_m, fix.epv_m = uere * fix.hdop, uere * fix.vdop
         _set_velocity(fix, rmc, epoch.vtg)
         fix.vd_m_s = epoch.vd_m_s
         # NMEA has no vertical speed: this one differences two altitudes, each with metres

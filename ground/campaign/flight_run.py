@@ -200,6 +200,8 @@ def _sim_command(flight: Flight, folder: Path, port: int, namespace: str) -> lis
         cmd += ["--noise", f"{flight.noise:g}"]
     if flight.gps_wander_m is not None:
         cmd += ["--gps-wander", f"{flight.gps_wander_m:g}"]
+    if flight.gps_receiver != "standard":
+        cmd += ["--gps-receiver", flight.gps_receiver]
     if flight.start_at_s is not None:
         cmd += ["--start-at", f"{flight.start_at_s:g}", "--fast" if flight.fast else "--exact"]
     return cmd

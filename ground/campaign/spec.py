@@ -82,6 +82,7 @@ class Flight:
     fast: bool = False  # with start_at_s: fast lockstep instead of exact (to compare the two)
     noise: float = 1.0  # sensor noise scale (0: perfect sensors)
     gps_wander_m: float | None = None  # the GPS's wandering error; None: the model's
+    gps_receiver: str = "standard"  # or "rtk" (companion sim --gps-receiver)
 
     @property
     def condition(self) -> str:
@@ -111,7 +112,8 @@ class Flight:
                *(("fast",) if self.fast else ()))  # fmt: skip
         # Left out at its default so that earlier flights keep their ids.
         key += (self.noise,) if self.noise != 1.0 else ()
-        return key + (("gps_wander", self.gps_wander_m) if self.gps_wander_m is not None else ())
+        key += ("gps_wander", self.gps_wander_m) if self.gps_wander_m is not None else ()
+        return key + (("gps", self.gps_receiver) if self.gps_receiver != "standard" else ())
 
 
 @dataclass(frozen=True)

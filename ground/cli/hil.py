@@ -69,6 +69,9 @@ def hil(
     gps_wander: Annotated[
         float | None, typer.Option(min=0, max=100, help="the GPS's wandering error, m")
     ] = None,
+    gps_receiver: Annotated[
+        str, typer.Option("--gps-receiver", help="standard, rtk (RTK fixed)")
+    ] = "standard",
     mount: Annotated[str, typer.Option(help="calibrated, uncalibrated, quiet")] = "calibrated",
     imu_hz: Annotated[float, typer.Option(min=5, max=400, help="IMU output rate")] = 100.0,
     gps_hz: Annotated[float, typer.Option(min=0.2, max=20, help="GPS fixes a second")] = 5.0,
@@ -95,7 +98,7 @@ def hil(
             airframe=aircraft, home=parse_home(home), airborne=airborne, speed=1.0,
             wind_ned=parse_triple(wind), turbulence=turbulence,
             outages=[parse_outage(o) for o in gps_outage or []], noise_scale=noise,
-            seed=seed, gps_wander_m=gps_wander, mount=mount,
+            seed=seed, gps_wander_m=gps_wander, gps=gps_receiver, mount=mount,
             rates=DeviceRates(imu_hz=imu_hz, gps_hz=gps_hz), duration_s=duration,
             truth_path=str(truth) if truth else None,
             pilot_path=str(pilot) if pilot else None,

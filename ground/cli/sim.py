@@ -149,6 +149,13 @@ def sim(
             "model's 1 m; 0: only its white noise)",
         ),
     ] = None,
+    gps_receiver: Annotated[
+        str,
+        typer.Option(
+            help="the GPS receiver: standard (a consumer receiver, about 1 m of error per"
+            " axis), rtk (RTK fixed: about 1 cm)"
+        ),
+    ] = "standard",
     mount: Annotated[
         str,
         typer.Option(
@@ -206,7 +213,7 @@ def sim(
             speed=_speed(speed),
             wind_ned=_triple(wind), turbulence=turbulence,
             outages=[_outage(o) for o in gps_outage or []], noise_scale=noise, seed=seed,
-            gps_wander_m=gps_wander,
+            gps_wander_m=gps_wander, gps=gps_receiver,
             mount=mount, airborne_bank_deg=airborne_bank,
             rates=DeviceRates(imu_hz=imu_hz),
             exact=exact, start_at_s=start_at, hold_at_s=hold_at,

@@ -30,6 +30,7 @@ def test_every_stream_encodes_whatever_the_sensors_say(ax, gz, roll, lat, vn, al
     nav = NavState(t_us=1, roll_rad=roll, yaw_rad=yaw, lat_deg=lat, vn_m_s=vn, alt_msl_m=alt)
     nav.flags = int(NavFlags.ATTITUDE_VALID | NavFlags.POSITION_VALID | NavFlags.VELOCITY_VALID)
     gps = GpsFix(t_us=1, lat_deg=lat, alt_msl_m=alt, ground_speed_m_s=speed, hdop=speed)
+    gps.eph_m, gps.epv_m = speed, ax
     gps.course_rad = yaw
     snap = Snapshot(time_boot_ms=5, nav=nav, imu=Imu(t_us=1, ax_m_s2=ax, gz_rad_s=gz), gps=gps)
     snap.control = ControlStatus(t_us=1, airspeed_m_s=speed, throttle=roll)
@@ -53,6 +54,15 @@ def test_vfr_hud_shows_the_estimated_airspeed_and_the_throttle_in_flight():
     snap.control = ControlStatus(t_us=1, airspeed_m_s=24.5, throttle=0.62)
     flying = STREAMS[74].build(mav, snap)  # into a 4.5 m/s head wind
     assert (flying.airspeed, flying.groundspeed, flying.throttle) == (24.5, 20.0, 62)
+
+
+def test_gps_raw_int_says_an_rtk_fix_and_its_accuracy_in_millimetres():
+    """QGroundControl's GPS indicator shows the lock ("RTK Fixed") and MAVSDK's RawGps the
+    horizontal and vertical uncertainty."""
+    fix = GpsFix(t_us=1, lat_deg=-37.9, lon_deg=145.1, alt_msl_m=80.0, hdop=0.6, satellites=20)
+    fix.fix_type, fix.eph_m, fix.epv_m = 6, 0.012, float("nan")
+    msg = STREAMS[24].build(new_encoder(1), Snapshot(gps=fix))
+    assert (msg.fix_type, msg.eph, msg.h_acc, msg.v_acc) == (6, 60, 12, 0)  # v_acc 0: not known
 
 
 def _sensors_at(t_us: int) -> dict:

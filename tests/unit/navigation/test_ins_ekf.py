@@ -14,7 +14,7 @@ from companion.navigation.offline import NAVIGATORS, InsEkfRunner, run_navigator
 from ground.simulation.evaluation import messages
 from ground.simulation.synthetic_flight import FlightSpec, Leg
 from ground.simulation.synthetic_log import synthesize
-from tests.unit.navigation.flights import DECLINATION, OUTAGE, flight, fly, perfect_baro
+from tests.unit.navigation.flights import DECLINATION, OUTAGE, SHORT, flight, fly, perfect_baro
 
 
 def test_meets_the_accuracy_targets_and_bridges_a_30_s_outage():
@@ -116,3 +116,39 @@ def test_height_holds_kilometres_from_where_the_frame_was_set():
     errors = [abs(s.alt_msl_m - truth[s.t_us]) for s in states if s.t_us in truth]
     late = errors[len(errors) // 10 :]  # after the start-up
     assert len(late) > 1000 and max(late) < 0.3, max(late)
+
+
+def _rtk_runner(floor_m: float | None = None) -> InsEkfRunner:
+    """The navigator fed fixes as the NMEA driver decodes an RTK-fixed receiver's: 1.2 cm."""
+    config = InsEkfConfig(declination_deg=DECLINATION)
+    if floor_m is not None:
+        config = dataclasses.replace(config, gps_pos_min_std=floor_m)
+    runner = InsEkfRunner(config=config)
+    original = runner.feed
+
+    def feed(sample):
+        if isinstance(sample, GpsFix):
+            sample = GpsFix.from_buffer_copy(sample)
+            sample.eph_m, sample.fix_type = 0.012, 6
+        original(sample)
+
+    runner.feed = feed  # type: ignore[method-assign]
+    return runner
+
+
+def test_an_rtk_receiver_puts_the_solution_within_centimetres_of_the_truth():
+    rtk = synthesize(FlightSpec(legs=SHORT, outage=OUTAGE, seed=5, noise=NoiseModel().with_rtk()))
+    errors, states = fly(_rtk_runner(), rtk)
+    assert errors.pos_rms_m <= 0.1 and errors.vel_rms_m_s <= 0.1
+    assert states[-1].gps_rejected == 0
+    # Fused at the centimetre it claims, the IMU's propagation between fixes reads as the
+    # GPS's error: fixes are refused as outliers and the solution falls apart.
+    errors, states = fly(_rtk_runner(floor_m=0.001), rtk)
+    assert states[-1].gps_rejected > 100 and errors.pos_rms_m > 1.0
+
+
+@pytest.mark.parametrize(
+    ("eph_m", "fused_m"), [(2.25, 2.25), (0.012, 0.3), (math.nan, 3.0), (math.inf, 3.0), (0, 3.0)]
+)
+def test_a_fix_is_fused_with_its_own_accuracy_at_least_the_floor(eph_m, fused_m):
+    assert InsEkfConfig().fix_pos_std(eph_m) == fused_m

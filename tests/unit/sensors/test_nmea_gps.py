@@ -165,6 +165,22 @@ def test_fix_type_comes_from_gga_quality_and_gsa_mode(quality, mode, expected):
     assert fix.fix_type == expected
 
 
+@pytest.mark.parametrize(
+    ("quality", "metres_per_hdop"),
+    [(1, 2.5), (2, 2.5), (5, 0.3), (4, 0.02)],
+    ids=["gps", "dgps", "rtk-float", "rtk-fixed"],
+)
+def test_an_rtk_fix_claims_its_carrier_phase_accuracy(quality, metres_per_hdop):
+    """An RTK receiver's HDOP is its satellites' geometry alone: the fix's accuracy is
+    centimetres once its ambiguities are fixed, not the 2 m a consumer receiver's would be."""
+    dec = NmeaGpsDecoder()
+    timed = [(0, gga("120000.00")), (1, gsa(3, "0.6", "1.2"))]
+    timed.append((2, gga("120001.00", quality=quality, hdop="0.6")))
+    (fix,) = decode_all(dec, timed)
+    assert fix.eph_m == pytest.approx(metres_per_hdop * 0.6)
+    assert fix.epv_m == pytest.approx(metres_per_hdop * 1.2)
+
+
 def test_no_fix_gga_without_position_gives_a_no_fix_message():
     dec = NmeaGpsDecoder()
     empty = nmea("GPGGA,120001.00,,,,,0,00,99.99,,,,,,")

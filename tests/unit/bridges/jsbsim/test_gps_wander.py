@@ -1,8 +1,11 @@
 """``companion sim --gps-wander M`` sets the simulated GPS's slowly wandering error alone: 0
-leaves its white noise, which averages out, and the default wanders by metres."""
+leaves its white noise, which averages out, and the default wanders by metres.
+``--gps-receiver rtk`` is an RTK receiver with a fixed solution: centimetres, and its
+sentences say so to the vehicle's driver."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -12,6 +15,9 @@ from bridges.jsbsim.bridge import _devices
 from bridges.jsbsim.options import BridgeOptions
 from bridges.sensor_models.sensor_errors import EARTH_RADIUS_M
 from bridges.sensor_models.true_state import TrueState
+from companion.messages import GpsFixType
+from companion.sensors.line_framer import LineFramer
+from companion.sensors.nmea_gps import NmeaGpsDecoder
 
 STILL = TrueState(
     t_s=0.0, lat_deg=-37.9, lon_deg=145.1, alt_msl_m=100.0, alt_agl_m=20.0, roll=0.0,
@@ -49,3 +55,20 @@ def test_the_default_receiver_wanders_by_metres_and_the_option_scales_it():
 def test_a_wander_outside_0_to_100_m_is_refused(metres):
     with pytest.raises(ValueError, match="GPS wander"):
         BridgeOptions(gps_wander_m=metres)
+
+
+def test_an_rtk_receiver_stays_within_centimetres_and_its_fix_says_rtk_fixed():
+    opts = BridgeOptions(gps="rtk")
+    assert _smoothed_error_m(opts).max() < 0.05
+    devices, decoder = _devices(opts), NmeaGpsDecoder()
+    fixes = []
+    for k in range(3):  # the driver learns the receiver's order in its first epochs
+        text = devices._gps(dataclasses.replace(STILL, t_s=0.2 * k))
+        fixes += [f for line in LineFramer().feed(text) if (f := decoder.decode(line, k))]
+    assert fixes[-1].fix_type == GpsFixType.RTK_FIXED
+    assert fixes[-1].eph_m == pytest.approx(0.012)  # what the navigator is told (floored)
+
+
+def test_a_receiver_not_modelled_is_refused():
+    with pytest.raises(ValueError, match="gps must be one of standard, rtk"):
+        BridgeOptions(gps="ppk")
