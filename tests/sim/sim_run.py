@@ -7,10 +7,11 @@ plug-in's ``sim`` fixture instead."""
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import signal
 import subprocess
 import sys
-from collections.abc import Awaitable, Callable
+from collections.abc import Awaitable, Callable, Iterator
 from pathlib import Path
 from typing import TypeVar
 
@@ -54,23 +55,28 @@ def finish(proc: SimRun, namespace: str, timeout_s: float) -> str:
     return out
 
 
+@contextlib.contextmanager
+def sim_running(tmp: Path, *args: str) -> Iterator[tuple[int, SimRun, Path]]:
+    """``companion sim --speed max`` with ``args``, a ground station's link on a free port:
+    (that port, the process, the truth file). Stopped as at a terminal when the block ends,
+    and nothing may be left behind. No simulated-time budget: disarmed, the simulation runs
+    as fast as the machine lets it, so a budget is spent by wall time (a loaded machine ran
+    one out before the aircraft was over its point); the test's timeout bounds the run."""
+    port = free_udp_port()
+    proc, namespace, truth_path = start_sim(tmp, f"udpout://127.0.0.1:{port}", *args)
+    try:
+        yield port, proc, truth_path
+    finally:
+        left = stop_tree(proc, namespace, signal.SIGINT)
+    assert left == [], f"{left}\n{proc.output()[-3000:]}"
+
+
 def with_sim(
     tmp: Path, script: Callable[[int], Awaitable[T]], aircraft: str = "c172p"
 ) -> tuple[T, str, Path]:
     """Run the asyncio ``script(port)`` (a ground station hearing the vehicle on udpin
-    ``port``) against ``companion sim --speed max``, stopped as at a terminal once the
-    script is done; its result, the vehicle's output and the truth file. No simulated-time
-    budget: disarmed, the simulation runs as fast as the machine lets it, so a budget is
-    spent by wall time (a loaded machine ran one out before the aircraft was over its
-    point); the test's timeout bounds the run."""
-    port = free_udp_port()
-    proc, namespace, truth_path = start_sim(
-        tmp, f"udpout://127.0.0.1:{port}", "--aircraft", aircraft
-    )
-    try:
+    ``port``) against ``companion sim`` (``sim_running``); its result, the vehicle's output
+    and the truth file."""
+    with sim_running(tmp, "--aircraft", aircraft) as (port, proc, truth_path):
         result = asyncio.run(script(port))
-    finally:
-        left = stop_tree(proc, namespace, signal.SIGINT)
-    out = proc.output()
-    assert left == [], f"{left}\n{out[-3000:]}"
-    return result, out, truth_path
+    return result, proc.output(), truth_path

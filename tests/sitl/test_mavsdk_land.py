@@ -8,7 +8,6 @@ once stopped. Lockstep JSBSim; every wait is on the vehicle's own telemetry.
 
 from __future__ import annotations
 
-import asyncio
 import math
 
 import pytest
@@ -20,8 +19,7 @@ from mavsdk.plugins.telemetry import FlightMode, LandedState
 
 from companion.control.flight.landing_pattern import HOME_TOUCHDOWN_M
 from companion.geodesy import LocalFrame
-from tests.protocol.mav_client import free_udp_port
-from tests.sim.sim_run import finish, start_sim
+from tests.sim.sim_run import with_sim
 from tests.sitl.test_mavsdk_actions import _until
 
 
@@ -56,15 +54,7 @@ async def _takeoff_and_land(port: int) -> dict:
 
 @pytest.mark.timeout(1200)
 def test_mavsdk_land_brings_the_fixed_wing_back_onto_its_runway(tmp_path):
-    port = free_udp_port()
-    proc, namespace, _truth = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "900"
-    )
-    try:
-        seen = asyncio.run(_takeoff_and_land(port))
-    finally:
-        proc.terminate()
-        out = finish(proc, namespace, 60)
+    seen, out, _truth = with_sim(tmp_path, _takeoff_and_land)
     assert seen["mode"] == FlightMode.LAND, out[-2000:]
     # Stopped on the runway line of the take-off, past the touchdown point.
     heading = math.atan2(seen["runway"][1], seen["runway"][0])

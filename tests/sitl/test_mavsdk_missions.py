@@ -36,7 +36,7 @@ from companion.geodesy import LocalFrame
 from companion.navigation.estimate_csv import read_estimate
 from mavlink_dialect import companion as d
 from tests.protocol.mav_client import free_udp_port
-from tests.sim.sim_run import finish, start_sim
+from tests.sim.sim_run import sim_running
 from tests.support.mavsdk_flight import until
 
 WAIT_S = 300.0  # wall seconds for any one stage: generous, for a loaded machine
@@ -155,17 +155,12 @@ async def _flight(port: int) -> dict:
 
 @pytest.mark.timeout(1200)
 def test_mavsdk_mission_without_take_off_flies_and_its_geofence_acts(tmp_path):
-    port, replay = free_udp_port(), free_udp_port()
-    proc, namespace, truth_path = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--link", f"udpout://127.0.0.1:{replay}",
-        "--aircraft", "c172p", "--duration", "900",
-    )  # fmt: skip
-    try:
+    replay = free_udp_port()
+    link = ("--link", f"udpout://127.0.0.1:{replay}", "--aircraft", "c172p")
+    with sim_running(tmp_path, *link) as (port, proc, truth_path):
         fence_texts = upload_fence_as_mavsdk_server(replay)
         seen = asyncio.run(_flight(port))
-    finally:
-        proc.terminate()  # stopped as at a terminal; checked clean
-        out = finish(proc, namespace, 60)
+    out = proc.output()
     texts = seen["texts"]
     assert "Fence item 4 ignored: inclusion circle radius 0" in fence_texts, fence_texts
     assert "Hold: on the ground until Takeoff or Mission" in texts, texts  # at arming (Loiter)

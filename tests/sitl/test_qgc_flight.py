@@ -7,8 +7,10 @@ Lockstep JSBSim; every wait is on the vehicle's telemetry, never on how fast it 
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
+from collections.abc import Iterator
 
 import pytest
 from pymavlink import mavutil
@@ -18,8 +20,7 @@ from companion.control.modes import BY_MODE
 from companion.geodesy import LocalFrame
 from companion.messages import FlightMode
 from mavlink_dialect import companion as d
-from tests.protocol.mav_client import free_udp_port
-from tests.sim.sim_run import finish, start_sim
+from tests.sim.sim_run import sim_running
 from tests.support.vehicle import REPO
 
 NAN = math.nan
@@ -77,14 +78,20 @@ class Qgc:
         return self.mode == BY_MODE[mode].px4
 
 
+@contextlib.contextmanager
+def _qgc_and_sim(tmp_path) -> Iterator[Qgc]:
+    """The c172p on the runway in ``companion sim`` and QGroundControl's link to it."""
+    with sim_running(tmp_path, "--aircraft", "c172p") as (port, _proc, _truth):
+        qgc = Qgc(port)
+        try:
+            yield qgc
+        finally:
+            qgc.conn.close()
+
+
 @pytest.mark.timeout(900)
 def test_qgroundcontrol_takeoff_change_altitude_and_go_to_fly(tmp_path):
-    port = free_udp_port()
-    proc, namespace, _truth = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "900"
-    )
-    qgc = Qgc(port)
-    try:
+    with _qgc_and_sim(tmp_path) as qgc:
         home = qgc.conn.recv_match(type="HOME_POSITION", blocking=True, timeout=60)
         assert home is not None, "no home position"
         home_amsl = home.altitude / 1000.0
@@ -117,10 +124,6 @@ def test_qgroundcontrol_takeoff_change_altitude_and_go_to_fly(tmp_path):
         qgc.pump_until(near, "at the go-to point")
         assert qgc.in_mode(FlightMode.GUIDED)  # it circles there, still Guided
         assert abs(qgc.position.relative_alt / 1000.0 - 100.0) < 20.0
-    finally:
-        proc.terminate()
-        finish(proc, namespace, 60)
-        qgc.conn.close()
 
 
 @pytest.mark.timeout(900)
@@ -131,12 +134,7 @@ def test_qgc_custom_takeoff_and_loiter_actions_fly_and_hold_the_height(tmp_path)
     the return height (RTL_ALT_M, 100 m). "Loiter" (NAV_LOITER_UNLIM), read as 0 m above
     sea level, had the aircraft descending from 99 m to 40 m above the ground in 20 s; now
     it circles here at the height it had."""
-    port = free_udp_port()
-    proc, namespace, _truth = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "900"
-    )
-    qgc = Qgc(port)
-    try:
+    with _qgc_and_sim(tmp_path) as qgc:
         home = qgc.conn.recv_match(type="HOME_POSITION", blocking=True, timeout=60)
         assert home is not None, "no home position"
         qgc.pump_until(lambda: qgc.position is not None, "a position")
@@ -158,10 +156,6 @@ def test_qgc_custom_takeoff_and_loiter_actions_fly_and_hold_the_height(tmp_path)
         qgc.pump_until(watched, "40 s in Hold")
         assert qgc.in_mode(FlightMode.LOITER)
         assert lowest > sent_at - 10.0, (sent_at, lowest)
-    finally:
-        proc.terminate()
-        finish(proc, namespace, 60)
-        qgc.conn.close()
 
 
 def _upload(qgc: Qgc, plan: str) -> None:
@@ -184,12 +178,7 @@ def _upload(qgc: Qgc, plan: str) -> None:
 def test_pause_keeps_the_mission_item_and_continue_mission_resumes_it(tmp_path):
     """MISSION_CURRENT had fallen to item 0 when the aircraft left Mission, so
     QGroundControl showed the plan as not started; now it keeps the item, PAUSED."""
-    port = free_udp_port()
-    proc, namespace, _truth = start_sim(
-        tmp_path, f"udpout://127.0.0.1:{port}", "--aircraft", "c172p", "--duration", "900"
-    )
-    qgc = Qgc(port)
-    try:
+    with _qgc_and_sim(tmp_path) as qgc:
         assert qgc.conn.recv_match(type="HEARTBEAT", blocking=True, timeout=60) is not None
         _upload(qgc, "square.plan")
         mission = BY_MODE[FlightMode.MISSION].px4
@@ -221,7 +210,3 @@ def test_pause_keeps_the_mission_item_and_continue_mission_resumes_it(tmp_path):
         qgc.pump_until(lambda: qgc.mission_current.mission_state == d.MISSION_STATE_ACTIVE,
                        "the mission active again")  # fmt: skip
         assert qgc.mission_current.seq >= at
-    finally:
-        proc.terminate()
-        finish(proc, namespace, 60)
-        qgc.conn.close()
