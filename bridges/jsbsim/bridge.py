@@ -24,6 +24,7 @@ from bridges.jsbsim.lockstep import (
 from bridges.jsbsim.options import BridgeOptions
 from bridges.jsbsim.ptys import PtyPort
 from bridges.jsbsim.rc_receiver import EmulatedReceiver, load_pilot
+from bridges.jsbsim.rtcm_listener import RtcmListener
 from bridges.jsbsim.serial_lines import SerialLine, open_line
 from bridges.jsbsim.servo_card import MiniSscReader
 from bridges.jsbsim.truth_log import ServoLog, TruthLog, WheelLog, wheels_path
@@ -54,6 +55,9 @@ FAST_LAG_PERIODS = 1  # fast lockstep: how many nav/state periods the vehicle ma
 # them over on a worker thread, which a loaded machine may run late)
 SERVO_BYTES_WAIT_S = EXACT_STALL_S
 POLL_S = 50e-6
+# How long a receiver keeps its RTK fix after the last corrections (a u-blox ZED-F9P holds
+# them up to its DGNSS timeout, 60 s by default; the link's radio drops for seconds).
+CORRECTIONS_AGE_S = 10.0
 
 
 def pressure_kpa(alt_msl_m: float) -> float:
@@ -73,7 +77,10 @@ def _devices(opts: BridgeOptions) -> EmulatedDevices:
     if opts.gps_wander_m is not None:
         noise = dataclasses.replace(noise, gps_horizontal_m=opts.gps_wander_m)
     errors = SensorErrors(noise, MagneticField(), opts.seed)
-    return EmulatedDevices(errors, opts.rates, opts.outages, opts.seed)
+    devices = EmulatedDevices(errors, opts.rates, opts.outages, opts.seed)
+    if opts.gps == "rtk-mavlink":  # the same seed: the errors it has while uncorrected
+        devices.rtk_errors = SensorErrors(noise.with_rtk(), MagneticField(), opts.seed)
+    return devices
 
 
 def _flight(opts: BridgeOptions, airframe: SimAirframe) -> Flight:
@@ -127,6 +134,7 @@ class SimBridge:
         self.pending: list[tuple[float, int, str, bytes]] = []  # (release, order, port, data)
         self.order = 0
         self.servo_card = MiniSscReader()
+        self.rtcm = RtcmListener()  # corrections the vehicle passes on to its receiver
         self.servo_bytes_in = 0
         self.servo_late = 0  # exact: answers whose bytes did not all come in time
         self.pacer = RealTime(opts.speed) if opts.speed else None
@@ -262,6 +270,8 @@ class SimBridge:
             if (port := self.ports.get(name)) is not None:  # HIL: not every device is wired
                 port.write(data)
                 written.add(name)
+        if "gps" in written and self.rtcm.feed(self.ports["gps"].read(), s.t_s):
+            self.devices.corrected_until_s = s.t_s + CORRECTIONS_AGE_S
         sampled: set[str] | None = None  # exact: the devices whose samples came this frame
         if self.samples is not None:  # sleeps on the bus: the pty check after is quick
             # A device whose driver stopped reading (or never ran) is not waited for.
@@ -349,6 +359,8 @@ class SimBridge:
 
     def close(self) -> None:
         """Release the ptys, the truth file and the bus."""
+        if self.rtcm.messages or self.rtcm.bad:
+            log.info("%s", self.rtcm.summary())
         if self.truth is not None:
             self.truth.close()
         if self.wheels is not None:

@@ -162,6 +162,10 @@ class EmulatedDevices:
         self.last_battery_s: float | None = None
         self.lidar_rng = np.random.default_rng([seed, 2])  # apart, as the latency's
         self.rest_agl_m = 0.0  # the truth's height above ground standing on the wheels
+        # An RTK receiver fed corrections through the vehicle (--gps-receiver rtk-mavlink):
+        # its errors while they are fresh (until this simulated second), set by the bridge.
+        self.rtk_errors: SensorErrors | None = None
+        self.corrected_until_s = -math.inf
 
     def due(
         self, s: TrueState, pressure_kpa: float, throttle: float = 0.0
@@ -205,8 +209,13 @@ class EmulatedDevices:
         self.last_battery_s = t_s
 
     def _gps(self, s: TrueState) -> bytes:
-        lat, lon, alt, vel = self.errors.gps(s, s.t_s - self.last_gps_s)
+        dt, errors = s.t_s - self.last_gps_s, self.errors
+        lat, lon, alt, vel = errors.gps(s, dt)
+        if self.rtk_errors is not None:  # both advance, so either holds its own sequence
+            corrected = self.rtk_errors.gps(s, dt)
+            if s.t_s < self.corrected_until_s:
+                (lat, lon, alt, vel), errors = corrected, self.rtk_errors
         self.last_gps_s = s.t_s
         fix = not any(o.covers(s.t_s) for o in self.outages)
-        m = self.errors.m
+        m = errors.m
         return nmea_epoch(s.t_s, lat, lon, alt, vel[0], vel[1], fix, m.gps_fix_quality, m.gps_hdop)

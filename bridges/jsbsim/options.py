@@ -11,7 +11,9 @@ from bridges.jsbsim.conditions import TURBULENCE, Home
 # How the sensors sit in the airframe (bridges/sensor_models/sensor_errors.py NoiseModel):
 # no defects, the residue of a good calibration, or the iron and motor field as they are.
 MOUNTS = ("quiet", "calibrated", "uncalibrated")
-GPS_RECEIVERS = ("standard", "rtk")  # a consumer receiver; RTK fixed (NoiseModel.with_rtk)
+# A consumer receiver; one holding an RTK fix on corrections of its own (NoiseModel.with_rtk);
+# one holding it while the vehicle writes it RTCM3 corrections from the ground station.
+GPS_RECEIVERS = ("standard", "rtk", "rtk-mavlink")
 # The aircraft's serial devices, as the bridge names them (hardware in the loop: --gps ...).
 DEVICES = ("gps", "compass", "imu", "rc", "battery", "range", "servos")
 

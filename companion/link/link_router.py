@@ -82,13 +82,14 @@ class LinkRouter:
         signing_encoder(packer, key, link_id=index + 1)
         return packer
 
-    def add_service(self, service: Service) -> None:
-        if service not in self.services:
-            self.services.append(service)
-            if (timer := getattr(service, "next_due", None)) is not None:
-                self._timers.append(timer)
-        for name in service.handles:
-            self.by_type.setdefault(name, []).append(service)
+    def add_service(self, *services: Service) -> None:
+        for service in services:
+            if service not in self.services:
+                self.services.append(service)
+                if (timer := getattr(service, "next_due", None)) is not None:
+                    self._timers.append(timer)
+            for name in service.handles:
+                self.by_type.setdefault(name, []).append(service)
 
     def receive(self, endpoint: Endpoint, fd: int, now_s: float) -> None:
         index = self.endpoints.index(endpoint)

@@ -44,6 +44,7 @@ PROTECTED = frozenset(
         "SET_POSITION_TARGET_GLOBAL_INT",
         "SET_POSITION_TARGET_LOCAL_NED",
         "SET_ATTITUDE_TARGET",
+        "GPS_RTCM_DATA",  # forged corrections would move where the receiver says it is
     )
     if hasattr(d, f"MAVLINK_MSG_ID_{name}")
 )

@@ -30,7 +30,13 @@ from companion.messages.control import (
     VehicleCommand,
     VehicleStatus,
 )
-from companion.messages.link import LinkStatus, MissionChanged, StatusText
+from companion.messages.link import (
+    RTCM_MAX_BYTES,
+    GpsInject,
+    LinkStatus,
+    MissionChanged,
+    StatusText,
+)
 from companion.messages.navigation import NavFlags, NavState
 from companion.messages.pilot import RC_MAX_CHANNELS, PilotFlags, PilotInput, PilotSource
 from companion.messages.sensors import (
@@ -66,6 +72,7 @@ __all__ = [
     "NAN",
     "RC_MAX_CHANNELS",
     "REASON_LEN",
+    "RTCM_MAX_BYTES",
     "ActuatorCommand",
     "Baro",
     "Battery",
@@ -80,6 +87,7 @@ __all__ = [
     "FlightMode",
     "GpsFix",
     "GpsFixType",
+    "GpsInject",
     "Imu",
     "LandPhase",
     "LinkStatus",

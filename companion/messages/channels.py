@@ -8,7 +8,7 @@ from typing import Literal
 from companion.messages.actuators import ActuatorCommand, CameraCapture, ServoOutput
 from companion.messages.base import Message
 from companion.messages.control import CommandAck, ControlStatus, VehicleCommand, VehicleStatus
-from companion.messages.link import LinkStatus, MissionChanged, StatusText
+from companion.messages.link import GpsInject, LinkStatus, MissionChanged, StatusText
 from companion.messages.navigation import NavState
 from companion.messages.pilot import PilotInput
 from companion.messages.sensors import (
@@ -71,6 +71,14 @@ CHANNELS: dict[str, Channel] = _channels(
         unlogged="every receiver frame is in sensors/rc already",
     ),
     Channel("link/manual_control", PilotInput, "latest", KEEP, doc="the ground station's joystick"),
+    Channel(
+        "link/gps_inject",
+        GpsInject,
+        "queue",
+        16,
+        "RTCM corrections from the ground station, for the GPS receiver",
+        unlogged="the base station's own data, up to 720 bytes a message, several a second",
+    ),
     Channel(
         "sensors/battery", Battery, "latest", KEEP, doc="flight battery voltage, current, charge"
     ),

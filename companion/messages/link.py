@@ -54,3 +54,28 @@ class StatusText(Message):
         msg = cls(t_us=t_us, severity=severity)
         msg.text = text.encode()[:199]
         return msg
+
+
+RTCM_MAX_BYTES = 4 * 180  # GPS_RTCM_DATA: at most four fragments of 180 bytes
+
+
+class GpsInject(Message):
+    """One whole RTCM message from the ground station (GPS_RTCM_DATA, its fragments joined),
+    for the GPS receiver's port. Producer: the link; consumer: the GPS driver."""
+
+    _fields_ = [
+        ("t_us", ctypes.c_int64),
+        ("length", ctypes.c_uint16),
+        ("data", ctypes.c_uint8 * RTCM_MAX_BYTES),
+    ]
+
+    @classmethod
+    def of(cls, t_us: int, data: bytes) -> GpsInject:
+        """``data`` (at most RTCM_MAX_BYTES) as one message."""
+        msg = cls(t_us=t_us, length=len(data))
+        ctypes.memmove(msg.data, data, len(data))
+        return msg
+
+    def payload(self) -> bytes:
+        """The message's bytes."""
+        return bytes(self.data[: min(self.length, RTCM_MAX_BYTES)])

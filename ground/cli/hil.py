@@ -70,7 +70,7 @@ def hil(
         float | None, typer.Option(min=0, max=100, help="the GPS's wandering error, m")
     ] = None,
     gps_receiver: Annotated[
-        str, typer.Option("--gps-receiver", help="standard, rtk (RTK fixed)")
+        str, typer.Option("--gps-receiver", help="standard, rtk, rtk-mavlink")
     ] = "standard",
     mount: Annotated[str, typer.Option(help="calibrated, uncalibrated, quiet")] = "calibrated",
     imu_hz: Annotated[float, typer.Option(min=5, max=400, help="IMU output rate")] = 100.0,

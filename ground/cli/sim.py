@@ -153,7 +153,8 @@ def sim(
         str,
         typer.Option(
             help="the GPS receiver: standard (a consumer receiver, about 1 m of error per"
-            " axis), rtk (RTK fixed: about 1 cm)"
+            " axis), rtk (RTK fixed on corrections of its own: about 1 cm), rtk-mavlink (RTK"
+            " fixed while the vehicle passes it the ground station's GPS_RTCM_DATA)"
         ),
     ] = "standard",
     mount: Annotated[

@@ -40,6 +40,7 @@ from companion.link.mode_messages import current_mode
 from companion.link.params_service import ParamsService
 from companion.link.px4_compat import PX4_PARAMS, vehicle_facts
 from companion.link.refusal_texts import RefusalTexts
+from companion.link.rtcm_inject import RtcmInjectService
 from companion.link.shell_service import ShellService
 from companion.link.signing import configured_secret, key_file_problem, key_from
 from companion.link.snapshot import SNAPSHOT_CHANNELS, Snapshot, snapshot_readers
@@ -99,13 +100,8 @@ class MavlinkLink(Plugin):
     )
     # What telemetry shows (the snapshot's channels), and the acks, texts and photos it relays.
     optional_inputs = (*SNAPSHOT_CHANNELS.values(), *RELAYED)
-    outputs = (
-        "link/commands",
-        "params/changes",
-        "link/status",
-        "mission/changed",
-        "link/manual_control",
-    )
+    outputs = ("link/commands", "params/changes", "link/status", "mission/changed",
+               "link/manual_control", "link/gps_inject")  # fmt: skip
 
     @classmethod
     def validate(
@@ -168,7 +164,7 @@ class MavlinkLink(Plugin):
         self.gcs = GcsWatch()
         self.router.add_service(self.gcs)
         self.router.add_service(CameraFeedback(self.mav, bus.queue_reader(CAPTURES).drain))
-        self._serve_joystick(ctx, sysid)
+        self._serve_ground_inputs(ctx, sysid)
         self._serve_params(ctx, sysid)
         self._serve_missions(ctx, sysid)
         self._serve_logs(ctx, sysid)
@@ -184,12 +180,12 @@ class MavlinkLink(Plugin):
         self.nav_at_s = float("-inf")
         self._seq = 0
 
-    def _serve_joystick(self, ctx: PluginContext, sysid: int) -> None:
-        joystick = ctx.bus.writer("link/manual_control")
-        self.manual = ManualControlService(
-            sysid, joystick.publish, ctx.clock.now_us, self.refusal_text
-        )
-        self.router.add_service(self.manual)
+    def _serve_ground_inputs(self, ctx: PluginContext, sysid: int) -> None:
+        """The ground station's joystick, and its RTK base's corrections for the GPS."""
+        joystick, now_us = ctx.bus.writer("link/manual_control"), ctx.clock.now_us
+        self.manual = ManualControlService(sysid, joystick.publish, now_us, self.refusal_text)
+        self.rtcm = RtcmInjectService(ctx.bus.writer("link/gps_inject").publish, now_us)
+        self.router.add_service(self.manual, self.rtcm)
 
     def _serve_missions(self, ctx: PluginContext, sysid: int) -> None:
         store = MissionStore(Path(ctx.vehicle.get("state_dir", ".")) / "missions")

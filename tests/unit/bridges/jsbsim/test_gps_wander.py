@@ -72,3 +72,16 @@ def test_an_rtk_receiver_stays_within_centimetres_and_its_fix_says_rtk_fixed():
 def test_a_receiver_not_modelled_is_refused():
     with pytest.raises(ValueError, match="gps must be one of standard, rtk"):
         BridgeOptions(gps="ppk")
+
+
+def test_an_rtk_receiver_fed_through_the_vehicle_is_fixed_only_while_corrections_are_fresh():
+    devices = _devices(BridgeOptions(gps="rtk-mavlink"))
+
+    def quality(t_s: float) -> str:
+        text = devices._gps(dataclasses.replace(STILL, t_s=t_s)).decode()
+        return text.split(",")[6]  # GGA's fix quality
+
+    assert quality(0.2) == "1"
+    devices.corrected_until_s = 10.0  # the bridge heard corrections at 0 s
+    assert quality(0.4) == "4" and quality(9.8) == "4"
+    assert quality(10.0) == "1"
