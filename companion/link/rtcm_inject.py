@@ -108,5 +108,11 @@ class RtcmInjectService:
                 self.publish(GpsInject.of(self.now_us(), whole))
         return []
 
+    @property
+    def refused(self) -> int:
+        """Messages dropped for a missing or malformed fragment: the ``refused`` column of
+        ``companion status``, beside the commands refused by their rules."""
+        return self.joiner.dropped
+
     def tick(self, now_s: float) -> list[Outgoing]:
         return []

@@ -5,7 +5,9 @@ from __future__ import annotations
 from hypothesis import given
 from hypothesis import strategies as st
 
-from companion.link.rtcm_inject import FRAGMENT_BYTES, RtcmReassembler
+from companion.link.rtcm_inject import FRAGMENT_BYTES, RtcmInjectService, RtcmReassembler
+from companion.messages import GpsInject
+from mavlink_dialect import companion as d
 
 
 def fragments(message: bytes, seq: int) -> list[tuple[int, int, bytes]]:
@@ -93,3 +95,15 @@ def test_any_fragments_at_all_never_raise_and_never_give_more_than_four(stream):
     for flags, length, data in stream:
         for message in joiner.feed(flags, length, data):
             assert len(message) <= 4 * FRAGMENT_BYTES
+
+
+def test_the_link_publishes_whole_messages_and_counts_what_it_refused():
+    published: list[GpsInject] = []
+    service = RtcmInjectService(published.append, lambda: 42)
+    mav = d.MAVLink(None)
+    message = bytes(range(250)) * 2
+    for flags, length, data in fragments(message, 3):
+        service.handle(mav.gps_rtcm_data_encode(flags, length, data), None, 0.0)
+    service.handle(mav.gps_rtcm_data_encode(0, 200, bytes(180)), None, 0.0)  # over 180
+    assert [m.payload() for m in published] == [message] and published[0].t_us == 42
+    assert service.refused == 1
