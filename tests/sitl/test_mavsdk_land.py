@@ -11,24 +11,20 @@ from __future__ import annotations
 import math
 
 import pytest
-from mavsdk.asyncio import Configuration, Mavsdk
 from mavsdk.asyncio.plugins.action import ActionAsync
 from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
-from mavsdk.component_type import ComponentType
 from mavsdk.plugins.telemetry import FlightMode, LandedState
 
 from companion.control.flight.landing_pattern import HOME_TOUCHDOWN_M
 from companion.geodesy import LocalFrame
 from tests.sim.sim_run import with_sim
 from tests.sitl.test_mavsdk_actions import _until
+from tests.support.mavsdk_flight import ground_station
 
 
 async def _takeoff_and_land(port: int) -> dict:
-    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
     seen: dict = {}
-    async with Mavsdk(config) as mavsdk:
-        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
-        system = await mavsdk.first_autopilot(timeout_s=60.0)
+    async with ground_station(port) as system:
         telemetry, action = TelemetryAsync(system), ActionAsync(system)
         home = await _until(telemetry.subscribe_home(), lambda h: h.latitude_deg != 0, "home")
         frame = LocalFrame(home.latitude_deg, home.longitude_deg)

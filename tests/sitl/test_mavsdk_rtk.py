@@ -15,16 +15,14 @@ import base64
 import re
 
 import pytest
-from mavsdk.asyncio import Configuration, Mavsdk
 from mavsdk.asyncio.plugins.rtk import RtkAsync
 from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
-from mavsdk.component_type import ComponentType
 from mavsdk.plugins.rtk import RtcmData
 from mavsdk.plugins.telemetry import FixType
 from pyrtcm import RTCMMessage
 
 from tests.sim.sim_run import sim_running
-from tests.support.mavsdk_flight import until
+from tests.support.mavsdk_flight import ground_station, until
 
 WAIT_S = 120.0
 
@@ -49,11 +47,8 @@ async def _send_corrections(rtk: RtkAsync, stop: asyncio.Event) -> None:
 
 
 async def _fix_types(port: int) -> dict:
-    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
     seen: dict = {}
-    async with Mavsdk(config) as mavsdk:
-        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
-        system = await mavsdk.first_autopilot(timeout_s=60.0)
+    async with ground_station(port) as system:
         telemetry, rtk = TelemetryAsync(system), RtkAsync(system)
         fix = await until(telemetry.subscribe_gps_info(), lambda g: g.fix_type >= FixType.FIX_3D,
                           "a fix", WAIT_S)  # fmt: skip

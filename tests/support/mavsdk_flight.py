@@ -35,16 +35,23 @@ class PlanSession:
 
 
 @asynccontextmanager
+async def ground_station(port: int, connect_s: float = 60.0) -> AsyncIterator[Any]:
+    """MAVSDK as a ground station hearing the vehicle on udpin ``port``: the vehicle's
+    System once it has been heard."""
+    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
+    async with Mavsdk(config) as mavsdk:
+        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
+        yield await mavsdk.first_autopilot(timeout_s=connect_s)
+
+
+@asynccontextmanager
 async def plan_uploaded(
     port: int, plan: str, connect_s: float = 60.0
 ) -> AsyncIterator[PlanSession]:
     """MAVSDK as a ground station hearing the vehicle on udpin ``port``, once the vehicle
     has a home position, says it is armable (its pre-arm checks pass, as a MAVSDK script
     waits for before arming) and ``plan`` is uploaded."""
-    config = Configuration.create_with_component_type(ComponentType.GROUND_STATION)
-    async with Mavsdk(config) as mavsdk:
-        await mavsdk.add_any_connection(f"udpin://127.0.0.1:{port}")
-        system = await mavsdk.first_autopilot(timeout_s=connect_s)
+    async with ground_station(port, connect_s) as system:
         flight = PlanSession(TelemetryAsync(system), ActionAsync(system), MissionRawAsync(system))
         flight.system = system
         async for _home in flight.telemetry.subscribe_home():
