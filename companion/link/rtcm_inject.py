@@ -37,17 +37,18 @@ class RtcmReassembler:
     def feed(self, flags: int, length: int, data: bytes) -> list[bytes]:
         """The whole messages this fragment (``length`` bytes of ``data`` said) completes:
         often none, at most two."""
-        if length > FRAGMENT_BYTES or length > len(data):
-            self._seq, self._parts = None, {}
-            self.dropped += 1
-            return []
-        data = data[:length]
-        if not flags & 1:
-            return [*self._flush(), self._done(data)]
         seq, place = flags >> 3, (flags >> 1) & 3
+        broken = length > FRAGMENT_BYTES or length > len(data)
+        if not flags & 1:  # a message in one piece
+            out, self._dead = self._flush(), None
+            self.dropped += broken
+            return out if broken else [*out, self._done(data[:length])]
         if seq == self._dead:
             return []
         out = self._flush() if seq != self._seq else []
+        if broken:  # a fragment that says more than it holds: its message is lost
+            return [*out, *self._give_up(seq)]
+        data = data[:length]
         self._seq, self._dead = seq, None
         if place in self._parts:  # a place filled twice: not one message
             return [*out, *self._give_up(seq)]

@@ -83,6 +83,18 @@ def test_a_length_over_180_is_refused_and_counted():
     assert (joiner.messages, joiner.dropped) == (0, 2)
 
 
+def test_a_broken_fragment_loses_its_message_once_and_the_message_before_goes_on():
+    two_full = bytes(range(180)) * 2  # whole only once the next message begins
+    joiner = RtcmReassembler()
+    for fragment in fragments(two_full, 1):
+        assert joiner.feed(*fragment) == []
+    first, second, last = fragments(bytes(400), 2)
+    assert joiner.feed(*first) == [two_full]
+    assert joiner.feed(second[0], 200, second[2]) == []  # says 200 bytes of a 180-byte field
+    assert joiner.feed(*last) == []  # the rest of that message: not taken for one
+    assert (joiner.messages, joiner.dropped) == (1, 1)
+
+
 @given(st.lists(st.binary(max_size=720), max_size=12))
 def test_messages_sent_in_order_come_out_whole_and_in_order(messages):
     out = joined(RtcmReassembler(), [*messages, b"end"])
