@@ -92,6 +92,8 @@ class BridgeOptions:
             raise ValueError(f"mount must be one of {', '.join(MOUNTS)}")
         if self.gps not in GPS_RECEIVERS:
             raise ValueError(f"gps must be one of {', '.join(GPS_RECEIVERS)}")
+        if self.gps != "standard" and self.gps_wander_m is not None:
+            raise ValueError("the GPS wander is the standard receiver's (an RTK fix has its own)")
         if not -80.0 <= self.airborne_bank_deg <= 80.0:
             raise ValueError("the airborne start's bank must lie within ±80°")
         if self.gps_wander_m is not None and not 0.0 <= self.gps_wander_m <= 100.0:

@@ -69,9 +69,11 @@ def test_an_rtk_receiver_stays_within_centimetres_and_its_fix_says_rtk_fixed():
     assert fixes[-1].eph_m == pytest.approx(0.012)  # what the navigator is told (floored)
 
 
-def test_a_receiver_not_modelled_is_refused():
-    with pytest.raises(ValueError, match="gps must be one of standard, rtk"):
+def test_a_receiver_not_modelled_or_a_wander_given_to_an_rtk_one_is_refused():
+    with pytest.raises(ValueError, match="gps must be one of standard, rtk, rtk-mavlink"):
         BridgeOptions(gps="ppk")
+    with pytest.raises(ValueError, match="the GPS wander is the standard receiver's"):
+        BridgeOptions(gps="rtk", gps_wander_m=1.0)
 
 
 def test_an_rtk_receiver_fed_through_the_vehicle_is_fixed_only_while_corrections_are_fresh():
