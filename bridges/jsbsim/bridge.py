@@ -270,8 +270,9 @@ class SimBridge:
             if (port := self.ports.get(name)) is not None:  # HIL: not every device is wired
                 port.write(data)
                 written.add(name)
-        if "gps" in written and self.rtcm.feed(self.ports["gps"].read(), s.t_s):
-            self.devices.corrected_until_s = s.t_s + CORRECTIONS_AGE_S
+        if "gps" in written:  # the receiver hears what the vehicle wrote it at its epochs
+            self.rtcm.feed(self.ports["gps"].read(), s.t_s)
+            self.devices.corrected_until_s = self.rtcm.last_good_s + CORRECTIONS_AGE_S
         sampled: set[str] | None = None  # exact: the devices whose samples came this frame
         if self.samples is not None:  # sleeps on the bus: the pty check after is quick
             # A device whose driver stopped reading (or never ran) is not waited for.

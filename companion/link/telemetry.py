@@ -128,8 +128,9 @@ def _gps_raw(mav: Any, s: Snapshot) -> Any:
 
 
 def _mm(metres: float) -> int:
-    mm = metres * 1000.0
-    return round(max(0.0, min(mm, 2.0**32 - 1))) if math.isfinite(mm) else 0
+    """An accuracy in whole millimetres for a uint32 field (0, MAVLink's "not known", when
+    it is not a number), clamped as ``_int32`` clamps."""
+    return max(0, min(2**32 - 1, round(_finite(metres * 1000.0))))
 
 
 def _vfr_hud(mav: Any, s: Snapshot) -> Any:
