@@ -80,6 +80,7 @@ def _devices(opts: BridgeOptions) -> EmulatedDevices:
     devices = EmulatedDevices(errors, opts.rates, opts.outages, opts.seed)
     if opts.gps == "rtk-mavlink":  # the same seed: the errors it has while uncorrected
         devices.rtk_errors = SensorErrors(noise.with_rtk(), MagneticField(), opts.seed)
+        devices.rtk_float_errors = SensorErrors(noise.with_rtk_float(), MagneticField(), opts.seed)
     return devices
 
 

@@ -24,11 +24,15 @@ from bridges.sensor_models.true_state import TrueState
 KNOT_M_S = 0.514444
 _VNIMU_FORMAT = "VNIMU," + ",".join(["%+.4f"] * 9) + ",%+.1f,%+.3f"
 UTC_EPOCH = dt.datetime(2026, 1, 1, tzinfo=dt.UTC)  # simulation time 0
+# An RTK receiver's time from its first fresh corrections to a fixed solution (a ZED-F9P
+# converges in under 10 s under open sky).
+RTK_FLOAT_S = 8.0
 # The lidar looks straight down from under the fuselage, reading this on the wheels (as
 # ArduPilot's default RNGFND1_GNDCLR), and measures 0.1-12 m as a TFmini-S does indoors.
 LIDAR_CLEARANCE_M = 0.1
 LIDAR_RANGE_M = (0.1, 12.0)
 LIDAR_NOISE_M = 0.02
+GpsFix = tuple[float, float, float, np.ndarray]  # lat, lon, alt MSL, NED velocity
 
 
 def _ddmm(value: float, positive: str, negative: str, width: int) -> tuple[str, str]:
@@ -163,9 +167,12 @@ class EmulatedDevices:
         self.lidar_rng = np.random.default_rng([seed, 2])  # apart, as the latency's
         self.rest_agl_m = 0.0  # the truth's height above ground standing on the wheels
         # An RTK receiver fed corrections through the vehicle (--gps-receiver rtk-mavlink):
-        # its errors while they are fresh (until this simulated second), set by the bridge.
+        # its errors while they are fresh (until this simulated second, set by the bridge),
+        # float for its first RTK_FLOAT_S of them, then fixed.
         self.rtk_errors: SensorErrors | None = None
+        self.rtk_float_errors: SensorErrors | None = None
         self.corrected_until_s = -math.inf
+        self.corrected_since_s: float | None = None
 
     def due(
         self, s: TrueState, pressure_kpa: float, throttle: float = 0.0
@@ -197,6 +204,23 @@ class EmulatedDevices:
             self.next_s["range"] += 1.0 / self.rates.range_hz
         return out
 
+    def _corrected(
+        self, s: TrueState, dt: float, plain: GpsFix, errors: SensorErrors
+    ) -> tuple[GpsFix, SensorErrors]:
+        """The RTK receiver's fix and its errors: fixed once corrections have been fresh
+        for RTK_FLOAT_S, float before, the plain fix without them. Every model advances
+        at every epoch, so each holds its own sequence whichever is reported."""
+        assert self.rtk_errors is not None and self.rtk_float_errors is not None
+        fixed, floating = self.rtk_errors.gps(s, dt), self.rtk_float_errors.gps(s, dt)
+        if s.t_s >= self.corrected_until_s:
+            self.corrected_since_s = None
+            return plain, errors
+        if self.corrected_since_s is None:
+            self.corrected_since_s = s.t_s
+        if s.t_s - self.corrected_since_s < RTK_FLOAT_S:
+            return floating, self.rtk_float_errors
+        return fixed, self.rtk_errors
+
     def _gps_latency_s(self) -> float:
         jitter = self.rates.gps_latency_jitter_s
         if jitter == 0.0:
@@ -211,10 +235,8 @@ class EmulatedDevices:
     def _gps(self, s: TrueState) -> bytes:
         dt, errors = s.t_s - self.last_gps_s, self.errors
         lat, lon, alt, vel = errors.gps(s, dt)
-        if self.rtk_errors is not None:  # both advance, so either holds its own sequence
-            corrected = self.rtk_errors.gps(s, dt)
-            if s.t_s < self.corrected_until_s:
-                (lat, lon, alt, vel), errors = corrected, self.rtk_errors
+        if self.rtk_errors is not None:
+            (lat, lon, alt, vel), errors = self._corrected(s, dt, (lat, lon, alt, vel), errors)
         self.last_gps_s = s.t_s
         fix = not any(o.covers(s.t_s) for o in self.outages)
         m = errors.m

@@ -106,6 +106,18 @@ class NoiseModel:
             gps_hdop=0.6,
         )
 
+    def with_rtk_float(self) -> NoiseModel:
+        """The same RTK receiver before it has fixed its carrier-phase ambiguities: a float
+        solution, decimetres off, its GGA saying so (quality 5)."""
+        return dataclasses.replace(
+            self.with_rtk(),
+            gps_horizontal_m=0.15,
+            gps_vertical_m=0.3,
+            gps_white_m=0.03,
+            gps_fix_quality=5,
+            gps_hdop=0.7,
+        )
+
 
 @dataclass(frozen=True)
 class MagneticField:

@@ -154,7 +154,8 @@ def sim(
         typer.Option(
             help="the GPS receiver: standard (a consumer receiver, about 1 m of error per"
             " axis), rtk (RTK fixed on corrections of its own: about 1 cm), rtk-mavlink (RTK"
-            " fixed while the vehicle passes it the ground station's GPS_RTCM_DATA)"
+            " while the vehicle passes it the ground station's GPS_RTCM_DATA: float for its"
+            " first 8 s, then fixed)"
         ),
     ] = "standard",
     mount: Annotated[

@@ -4,8 +4,9 @@ MAVSDK's Rtk plug-in sends each RTCM3 message as QGroundControl does for an RTK 
 station on its computer: GPS_RTCM_DATA, in 180-byte fragments when longer. The link joins
 them and the GPS driver writes each message whole to the receiver's port. The simulated
 receiver (``--gps-receiver rtk-mavlink``) checks every frame's CRC and holds an RTK fix
-while corrections are fresh (10 simulated seconds), a plain 3-D fix otherwise: MAVSDK sees
-the fix type go from 3-D to RTK fixed and back once they stop.
+while corrections are fresh (10 simulated seconds), float for their first 8 s, a plain 3-D
+fix otherwise: MAVSDK sees the fix type go from 3-D through RTK float to RTK fixed, and
+back to 3-D once they stop.
 """
 
 from __future__ import annotations
@@ -56,10 +57,14 @@ async def _fix_types(port: int) -> dict:
         stop = asyncio.Event()
         sender = asyncio.create_task(_send_corrections(rtk, stop))
         try:
-            fixed = FixType.RTK_FIXED
+            fixed, types = FixType.RTK_FIXED, []
             await until(
-                telemetry.subscribe_gps_info(), lambda g: g.fix_type == fixed, "RTK fixed", WAIT_S
+                telemetry.subscribe_gps_info(),
+                lambda g: types.append(g.fix_type) or g.fix_type == fixed,
+                "RTK fixed",
+                WAIT_S,
             )
+            seen["on_the_way"] = types
             raw = await until(telemetry.subscribe_raw_gps(), lambda r: True, "GPS_RAW_INT", WAIT_S)
             seen["uncertainty_m"] = raw.horizontal_uncertainty_m
         finally:
@@ -78,6 +83,9 @@ def test_corrections_sent_by_mavsdk_reach_the_receiver_whole_and_give_an_rtk_fix
     with sim_running(tmp_path, *args) as (port, proc, _truth):
         seen = asyncio.run(_fix_types(port))
     assert seen["before"] == FixType.FIX_3D
+    # A float solution first, while the receiver resolves its ambiguities (8 s), as a real
+    # rover's does; QGroundControl shows "3D RTK GPS Lock (float)", then "(fixed)".
+    assert FixType.RTK_FLOAT in seen["on_the_way"], seen["on_the_way"]
     assert seen["uncertainty_m"] < 0.05  # h_acc: the fix's own 1.2 cm
     assert seen["after"] == FixType.FIX_3D
     out = proc.output()

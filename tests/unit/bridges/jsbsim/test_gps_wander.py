@@ -1,7 +1,8 @@
 """``companion sim --gps-wander M`` sets the simulated GPS's slowly wandering error alone: 0
 leaves its white noise, which averages out, and the default wanders by metres.
 ``--gps-receiver rtk`` is an RTK receiver with a fixed solution: centimetres, and its
-sentences say so to the vehicle's driver."""
+sentences say so to the vehicle's driver; ``rtk-mavlink`` is one fed corrections through
+the vehicle, float (decimetres) for its first seconds of them, then fixed."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import dataclasses
 import math
 
 import numpy as np
+import pynmea2
 import pytest
 
 from bridges.jsbsim.bridge import _devices
@@ -76,14 +78,26 @@ def test_a_receiver_not_modelled_or_a_wander_given_to_an_rtk_one_is_refused():
         BridgeOptions(gps="rtk", gps_wander_m=1.0)
 
 
-def test_an_rtk_receiver_fed_through_the_vehicle_is_fixed_only_while_corrections_are_fresh():
+def test_an_rtk_receiver_fed_through_the_vehicle_floats_then_fixes_while_corrections_last():
     devices = _devices(BridgeOptions(gps="rtk-mavlink"))
 
-    def quality(t_s: float) -> str:
+    def fix(t_s: float) -> tuple[str, float]:
+        """GGA's fix quality and the fix's horizontal error (m)."""
         text = devices._gps(dataclasses.replace(STILL, t_s=t_s)).decode()
-        return text.split(",")[6]  # GGA's fix quality
+        gga = pynmea2.parse(text.splitlines()[0])
+        north = math.radians(gga.latitude - STILL.lat_deg) * EARTH_RADIUS_M
+        cos_lat = math.cos(math.radians(STILL.lat_deg))
+        east = math.radians(gga.longitude - STILL.lon_deg) * EARTH_RADIUS_M * cos_lat
+        return str(gga.gps_qual), math.hypot(north, east)
 
-    assert quality(0.2) == "1"
-    devices.corrected_until_s = 10.0  # the bridge heard corrections at 0 s
-    assert quality(0.4) == "4" and quality(9.8) == "4"
-    assert quality(10.0) == "1"
+    assert fix(0.2)[0] == "1"
+    devices.corrected_until_s = 10.0  # the bridge heard corrections at 0.2 s
+    floating = [fix(0.4 + 0.2 * i) for i in range(40)]  # 8 s from the first fresh epoch
+    assert {q for q, _ in floating} == {"5"}  # RTK float while its ambiguities resolve
+    assert max(e for _, e in floating) < 1.0
+    fixed = [fix(8.4 + 0.2 * i) for i in range(7)]
+    assert {q for q, _ in fixed} == {"4"}
+    assert max(e for _, e in fixed) < 0.1
+    assert fix(10.0)[0] == "1"  # stale: the plain fix
+    devices.corrected_until_s = 30.0  # corrections again: float first, as from a cold start
+    assert fix(20.0)[0] == "5" and fix(28.2)[0] == "4"
