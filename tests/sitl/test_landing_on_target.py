@@ -12,7 +12,7 @@ point, at no more than 1.5 m/s down, stopped, disarmed. Across, the aircraft lan
 The simulated consumer GPS's slow wander (1 m per axis, 60 s correlated, one sequence in
 simulated time) adds its error at that moment, so with it the truth is held to 3 m: in
 benchmarks/landing.py (which prints both) the Cub on circuit_east in the crosswind, its
-mission started at second 45, touched down 0.36 m right by its own solution, 2.36 m in
+mission started at second 45, touched down 0.36 m right by its own solution, 2.41 m in
 truth. The Cub in the crosswind flies an RTK receiver (``--gps-receiver rtk``, about
 1 cm), and with it the truth is held to the issue's 2 m.
 """
