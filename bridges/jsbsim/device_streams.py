@@ -18,7 +18,7 @@ import pynmea2
 
 from bridges.jsbsim.options import DeviceRates, Outage
 from bridges.sensor_models.battery import BatteryModel
-from bridges.sensor_models.sensor_errors import ImuSample, SensorErrors
+from bridges.sensor_models.sensor_errors import GpsMeasurement, ImuSample, SensorErrors
 from bridges.sensor_models.true_state import TrueState
 
 KNOT_M_S = 0.514444
@@ -32,7 +32,6 @@ RTK_FLOAT_S = 8.0
 LIDAR_CLEARANCE_M = 0.1
 LIDAR_RANGE_M = (0.1, 12.0)
 LIDAR_NOISE_M = 0.02
-GpsFix = tuple[float, float, float, np.ndarray]  # lat, lon, alt MSL, NED velocity
 
 
 def _ddmm(value: float, positive: str, negative: str, width: int) -> tuple[str, str]:
@@ -205,8 +204,8 @@ class EmulatedDevices:
         return out
 
     def _corrected(
-        self, s: TrueState, dt: float, plain: GpsFix, errors: SensorErrors
-    ) -> tuple[GpsFix, SensorErrors]:
+        self, s: TrueState, dt: float, plain: GpsMeasurement, errors: SensorErrors
+    ) -> tuple[GpsMeasurement, SensorErrors]:
         """The RTK receiver's fix and its errors: fixed once corrections have been fresh
         for RTK_FLOAT_S, float before, the plain fix without them. Every model advances
         at every epoch, so each holds its own sequence whichever is reported."""

@@ -169,6 +169,10 @@ class ImuSample:
     pressure_kpa: float
 
 
+# What a receiver reports: lat, lon (degrees), altitude MSL (m), NED velocity (m/s).
+GpsMeasurement = tuple[float, float, float, np.ndarray]
+
+
 class SensorErrors:
     """The sensors' error processes, advanced in simulation time."""
 
@@ -236,7 +240,7 @@ class SensorErrors:
         heading += rng.normal(0.0, self.m.compass_heading_deg * k)
         return heading % 360.0, math.degrees(pitch), math.degrees(roll)
 
-    def gps(self, s: TrueState, dt: float) -> tuple[float, float, float, np.ndarray]:
+    def gps(self, s: TrueState, dt: float) -> GpsMeasurement:
         """(lat, lon, alt MSL, NED velocity) with the receiver's error; error evolves by dt."""
         m, rng = self.m, self.rng
         a = math.exp(-dt / m.gps_correlation_s) if m.gps_correlation_s > 0 else 0.0

@@ -29,15 +29,22 @@ STILL = TrueState(
 RATE_HZ = 5.0
 
 
+def _error_ne_m(lat: float, lon: float) -> tuple[float, float]:
+    """A standing receiver's fix's error north and east of the truth, in metres."""
+    cos_lat = math.cos(math.radians(STILL.lat_deg))
+    north = math.radians(lat - STILL.lat_deg) * EARTH_RADIUS_M
+    return north, math.radians(lon - STILL.lon_deg) * EARTH_RADIUS_M * cos_lat
+
+
 def _smoothed_error_m(opts: BridgeOptions, seconds: float = 300.0) -> np.ndarray:
     """The horizontal position error of a standing receiver, averaged over 30 s windows."""
     errors = _devices(opts).errors
     north, east = [], []
     for _ in range(round(seconds * RATE_HZ)):
         lat, lon, _alt, _vel = errors.gps(STILL, 1.0 / RATE_HZ)
-        north.append(math.radians(lat - STILL.lat_deg) * EARTH_RADIUS_M)
-        cos_lat = math.cos(math.radians(STILL.lat_deg))
-        east.append(math.radians(lon - STILL.lon_deg) * EARTH_RADIUS_M * cos_lat)
+        n, e = _error_ne_m(lat, lon)
+        north.append(n)
+        east.append(e)
     window = np.ones(round(30 * RATE_HZ)) / round(30 * RATE_HZ)
     return np.hypot(np.convolve(north, window, "valid"), np.convolve(east, window, "valid"))
 
@@ -85,10 +92,7 @@ def test_an_rtk_receiver_fed_through_the_vehicle_floats_then_fixes_while_correct
         """GGA's fix quality and the fix's horizontal error (m)."""
         text = devices._gps(dataclasses.replace(STILL, t_s=t_s)).decode()
         gga = pynmea2.parse(text.splitlines()[0])
-        north = math.radians(gga.latitude - STILL.lat_deg) * EARTH_RADIUS_M
-        cos_lat = math.cos(math.radians(STILL.lat_deg))
-        east = math.radians(gga.longitude - STILL.lon_deg) * EARTH_RADIUS_M * cos_lat
-        return str(gga.gps_qual), math.hypot(north, east)
+        return str(gga.gps_qual), math.hypot(*_error_ne_m(gga.latitude, gga.longitude))
 
     assert fix(0.2)[0] == "1"
     devices.corrected_until_s = 10.0  # the bridge heard corrections at 0.2 s
