@@ -44,22 +44,24 @@ async def _send_corrections(rtk: RtkAsync, stop: asyncio.Event) -> None:
     while not stop.is_set():  # whole seconds only
         for frame in SECOND:
             await rtk.send_rtcm_data(RtcmData(base64.b64encode(frame).decode()))
-        await asyncio.sleep(0.1)  # the simulation runs 20-30 times the wall clock
+        await asyncio.sleep(0.1)  # five a simulated second at the test's twice real time
 
 
 async def _fix_types(port: int) -> dict:
     seen: dict = {}
     async with ground_station(port) as system:
         telemetry, rtk = TelemetryAsync(system), RtkAsync(system)
-        fix = await until(telemetry.subscribe_gps_info(), lambda g: g.fix_type >= FixType.FIX_3D,
-                          "a fix", WAIT_S)  # fmt: skip
+        # One stream from before the corrections on: a second one, subscribed once they flow,
+        # could begin after the receiver's float seconds (a fraction of a wall second here).
+        gps_info = telemetry.subscribe_gps_info()
+        fix = await until(gps_info, lambda g: g.fix_type >= FixType.FIX_3D, "a fix", WAIT_S)
         seen["before"] = fix.fix_type
         stop = asyncio.Event()
         sender = asyncio.create_task(_send_corrections(rtk, stop))
         try:
             fixed, types = FixType.RTK_FIXED, []
             await until(
-                telemetry.subscribe_gps_info(),
+                gps_info,
                 lambda g: types.append(g.fix_type) or g.fix_type == fixed,
                 "RTK fixed",
                 WAIT_S,
@@ -79,7 +81,10 @@ async def _fix_types(port: int) -> dict:
 
 @pytest.mark.timeout(600)
 def test_corrections_sent_by_mavsdk_reach_the_receiver_whole_and_give_an_rtk_fix(tmp_path):
-    args = ("--aircraft", "c172p", "--gps-receiver", "rtk-mavlink")
+    # Twice real time, not as fast as the machine goes: the receiver's 8 float seconds then
+    # last 4 wall seconds, time for MAVSDK to be told of them (at full speed they passed
+    # in a third of a second, sometimes between two of its GPS reports).
+    args = ("--aircraft", "c172p", "--gps-receiver", "rtk-mavlink", "--speed", "2")
     with sim_running(tmp_path, *args) as (port, proc, _truth):
         seen = asyncio.run(_fix_types(port))
     assert seen["before"] == FixType.FIX_3D
