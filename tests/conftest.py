@@ -67,8 +67,8 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     """``-n auto`` (the addopts): two workers per core the session may run on, and no more
     than one per GiB of memory. A lockstep flight waits on its vehicle's chain of processes
-    most of the time, so two workers on two cores kept them 70 % busy (31 min 16 s); four
-    kept them busy, with every test passing (25 min 02 s, docs/dev/testing.md)."""
+    most of the time, so one worker per core left the cores partly idle (the timings:
+    docs/dev/testing.md)."""
     memory_gib = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") // 2**30
     return max(1, min(2 * len(os.sched_getaffinity(0)), memory_gib))
 
