@@ -58,8 +58,9 @@ SAFETY_ALIASES = (
     _choice("GF_ACTION", ("FENCE_ENABLE",), ((0.0, (0.0,)), (3.0, (1.0,))),
             ((0.0, "None"), (3.0, "Return mode")), "Outside the uploaded fence while flying"),
     _same("RTL_RETURN_ALT", "RTL_ALT_M", "Return altitude above home", "m"),
-    ParamDecl("RTL_DESCEND_ALT", 0.0, unit="m", alias=Alias(("RTL_ALT_M",), writable=False),
-              doc="Altitude of the loiter at home: the return altitude (= RTL_ALT_M)"),
+    _same("RTL_DESCEND_ALT", "RTL_LOITER_ALT_M",
+          "Loiter altitude above home after the return: descended to on arriving, never "
+          "climbed to", "m"),
     # PX4's 0 lands after the return; with RTL_AUTOLAND 2 the aircraft goes to the landing
     # without reaching home first (PX4's RTL_TYPE), which also reads as 0.
     _choice("RTL_LAND_DELAY", ("RTL_AUTOLAND",), ((-1.0, (0.0,)), (0.0, (1.0,)), (0.0, (2.0,))),

@@ -3,12 +3,12 @@ type`` per line, what ``save_params`` writes), and read also as ArduPilot users 
 MAVProxy's ``param save`` (``NAME VALUE``) and Mission Planner's ``.param`` (``NAME,VALUE``).
 
 A file lists every parameter the vehicle serves, so it lists an alias (a PX4 name such as
-RTL_RETURN_ALT, or RTL_DESCEND_ALT, which only reads RTL_ALT_M) beside the parameters it
-follows: ``save_params`` writes them all, as QGroundControl's "Save to file" and MAVProxy's
-``param save`` write every value the vehicle sent. Reading one back, the file's own
-values come first and each alias line is then read against them, not against the
-vehicle's values of the moment: a line that agrees with what it follows sets nothing
-more, one that contradicts it is refused, naming both.
+RTL_RETURN_ALT, which follows RTL_ALT_M) beside the parameters it follows: ``save_params``
+writes them all, as QGroundControl's "Save to file" and MAVProxy's ``param save`` write
+every value the vehicle sent. Reading one back, the file's own values come first and each
+alias line is then read against them, not against the vehicle's values of the moment: a
+line that agrees with what it follows sets nothing more, one that contradicts it is
+refused, naming both.
 """
 
 from __future__ import annotations

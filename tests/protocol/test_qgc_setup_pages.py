@@ -276,13 +276,17 @@ def test_the_safety_page_sets_the_vehicles_own_failsafe_and_return_altitude(
     assert seen["NAV_RCL_ACT"] == 0.0 and seen["THR_FAILSAFE"] == 0.0
     # "Return To Launch Settings: Climb to altitude of 150 m".
     seen = param_set(gcs, "RTL_RETURN_ALT", 150.0)
-    assert seen["RTL_RETURN_ALT"] == seen["RTL_ALT_M"] == seen["RTL_DESCEND_ALT"] == 150.0
+    assert seen["RTL_RETURN_ALT"] == seen["RTL_ALT_M"] == 150.0
+    # "Loiter and do not land", "Loiter altitude 60 m": the loiter at home, a value of its own.
+    seen = param_set(gcs, "RTL_DESCEND_ALT", 60.0)
+    assert seen["RTL_DESCEND_ALT"] == seen["RTL_LOITER_ALT_M"] == 60.0
     # "Data Link Loss: Disabled" and "after 20 s".
     param_set(gcs, "NAV_DLL_ACT", 0.0)
     param_set(gcs, "COM_DL_LOSS_T", 20.0)
     published: dict[str, float] = {}
     deadline = time.monotonic() + 5.0
-    want = {"THR_FAILSAFE": 0.0, "RTL_ALT_M": 150.0, "FS_GCS_ENABLE": 0.0, "FS_GCS_TIMEOUT": 20.0}
+    want = {"THR_FAILSAFE": 0.0, "RTL_ALT_M": 150.0, "RTL_LOITER_ALT_M": 60.0,
+            "FS_GCS_ENABLE": 0.0, "FS_GCS_TIMEOUT": 20.0}  # fmt: skip
     while published != want and time.monotonic() < deadline:
         for change in changes.drain():
             assert isinstance(change, ParamChange)

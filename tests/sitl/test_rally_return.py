@@ -67,17 +67,31 @@ def test_return_from_far_out_circles_the_nearer_rally_point_at_its_height(sim):
 
 
 @pytest.mark.timeout(900)
-def test_return_from_the_last_leg_goes_home_nearer_than_the_rally_point(sim):
+def test_return_from_the_last_leg_goes_home_and_circles_at_the_loiter_altitude(sim):
+    """Home is nearer than the rally point. QGroundControl's Safety page (PX4's) sets the
+    loiter altitude as RTL_DESCEND_ALT: home is flown to at the return altitude
+    (RTL_ALT_M, 100 m) and circled at the loiter altitude, 60 m, as a PX4 user expects."""
     sim.wait_ready()
+    _set(sim, "RTL_DESCEND_ALT", 60.0)
     sim.arm_and_start()
     sim.run_until_item(3)  # on the last leg, back towards home from the north
     sim.watcher.command(d.MAV_CMD_NAV_RETURN_TO_LAUNCH)
     assert _told(sim) == "Return: home, nearer than any rally point"
     t0 = sim.run_until_time(0.0)
-    end = sim.run_until_time(t0 + 40.0 + CIRCLING_S)
+    end = sim.run_until_time(t0 + 60.0 + CIRCLING_S)
     wait_for(lambda: sim.truth()["t"][-1] >= end - 1.0, 120, "the truth file written")
-    north, east, _ = _track(sim, end - CIRCLING_S)
+    north, east, height = _track(sim, end - CIRCLING_S)
     assert math.hypot(float(np.median(north)), float(np.median(east))) < 300.0
+    assert abs(float(np.median(height)) - 60.0) < 10.0, np.median(height)
+    assert height.min() > 45.0, height.min()
+
+
+def _set(sim, name: str, value: float) -> None:
+    """A parameter written as a ground station writes it, and its echo awaited."""
+    w = sim.watcher
+    w.mav.param_set_send(1, 1, name.encode(), value, d.MAV_PARAM_TYPE_REAL32)
+    w.until(lambda m: m.get_type() == "PARAM_VALUE" and m.param_id == name
+            and m.param_value == value, 30, f"{name} = {value}")  # fmt: skip
 
 
 @pytest.mark.timeout(900)

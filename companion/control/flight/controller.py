@@ -1,9 +1,8 @@
 """The fixed-wing flight controller: mode → guidance target → energy and attitude → surfaces.
 
-Pure: a navigation solution, the vehicle status and the time in; surface commands and
-what NAV_CONTROLLER_OUTPUT / MISSION_CURRENT report out. The ``control.fixed_wing``
-plug-in runs it on the bus; tests and benchmarks run it against JSBSim directly.
-"""
+Pure: a navigation solution, the vehicle status and the time in; surface commands and what
+NAV_CONTROLLER_OUTPUT / MISSION_CURRENT report out. The ``control.fixed_wing`` plug-in runs
+it on the bus; tests and benchmarks run it against JSBSim directly."""
 
 from __future__ import annotations
 
@@ -15,7 +14,7 @@ from companion.control.flight.attitude_modes import Sticks
 from companion.control.flight.flight_params import FlightConfig
 from companion.control.flight.landing import landing_flaps
 from companion.control.flight.landing_flight import LandingFlight, MissionRef, Motion
-from companion.control.flight.mode_targets import arrive, mode_target, return_point
+from companion.control.flight.mode_targets import arrive, loiter_alt, mode_target, return_point
 from companion.control.flight.on_ground import landed_now
 from companion.control.flight.output import ControlOutput
 from companion.control.flight.pilot_flight import PilotFlight
@@ -220,8 +219,9 @@ class FlightController:
         if entered or self._mode_setpoint is None:
             home = (self.frame, self.home_alt)
             self._mode_setpoint = mode_target(mode, status, pos, nav, home, self.config)
+        top = loiter_alt(status, self.home_alt, self.config)  # a return's circle at home
         self._mode_setpoint = arrive(
-            self._mode_setpoint, mode, pos, nav.alt_msl_m, self.config, self._turn_radius()
+            self._mode_setpoint, mode, pos, nav.alt_msl_m, self.config, self._turn_radius(), top
         )
         return self._mode_setpoint
 

@@ -143,6 +143,15 @@ CONTROL_PARAMS = (
     _p("WP_RADIUS", 30.0, 1.0, 500.0, "m", "waypoint acceptance radius"),
     _p("WP_LOITER_RAD", 80.0, 10.0, 2000.0, "m", "loiter radius when an item gives none"),
     _p("RTL_ALT_M", 100.0, 10.0, 1000.0, "m", "return altitude above home"),
+    _p(
+        "RTL_LOITER_ALT_M",
+        100.0,
+        10.0,
+        1000.0,
+        "m",
+        "height above home of the circle a return home ends in: the aircraft descends to it "
+        "on arriving when it is below the return altitude, and never climbs to it",
+    ),
     *LANDING_PARAMS,
     *ACRO_PARAMS,
 )

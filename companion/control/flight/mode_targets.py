@@ -66,6 +66,13 @@ def _has_target(status: VehicleStatus) -> bool:
     return math.isfinite(status.target_lat_deg) and math.isfinite(status.target_lon_deg)
 
 
+def loiter_alt(status: VehicleStatus, home_alt: float, config: FlightConfig) -> float:
+    """The height (m MSL) a return ends circling at: ``RTL_LOITER_ALT_M`` above home when
+    it returns home (PX4's RTL_DESCEND_ALT), none (inf) when to a rally point, whose own
+    altitude it keeps."""
+    return math.inf if _has_target(status) else home_alt + config["RTL_LOITER_ALT_M"]
+
+
 def arrive(
     sp: Setpoint,
     mode: FlightMode,
@@ -73,15 +80,19 @@ def arrive(
     alt: float,
     config: FlightConfig,
     turn_radius: float,
+    loiter_msl: float = math.inf,
 ) -> Setpoint:
-    """Return and go-to circle their point on arrival; a take-off circles when high."""
+    """Return and go-to circle their point on arrival (a return home descends to
+    ``loiter_msl`` when lower than its return altitude); a take-off circles when
+    high."""
     radius = config["WP_LOITER_RAD"]
     reach = max(radius, turn_radius) * 1.5
     near = math.hypot(sp.b[0] - pos[0], sp.b[1] - pos[1]) < reach
     # Passing the point counts too: the line goes on past it for ever.
     arrived = near or past_point(sp.a, sp.b, pos)
     if sp.kind == Kind.LINE and mode in (FlightMode.RTL, FlightMode.GUIDED) and arrived:
-        return Setpoint(Kind.CIRCLE, sp.b, sp.b, sp.alt_msl, radius)
+        circle_alt = min(sp.alt_msl, loiter_msl) if mode == FlightMode.RTL else sp.alt_msl
+        return Setpoint(Kind.CIRCLE, sp.b, sp.b, circle_alt, radius)
     if sp.kind == Kind.TAKEOFF and alt >= sp.alt_msl - 5.0:
         return Setpoint(Kind.CIRCLE, pos, pos, sp.alt_msl, radius)
     return sp

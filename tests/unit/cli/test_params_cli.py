@@ -64,18 +64,21 @@ def test_list_diff_set_and_reset_say_where_each_value_comes_from(tmp_path):
 
 
 def test_the_documented_round_trip_keeps_a_changed_return_altitude(tmp_path):
-    # docs/parameters.md: save, reset, load. The file lists RTL_DESCEND_ALT, which only
-    # reads RTL_ALT_M: loading it back was refused once RTL_RETURN_ALT had been changed.
+    # docs/parameters.md: save, reset, load. The file lists the PX4 names beside what they
+    # follow (RTL_RETURN_ALT: RTL_ALT_M; RTL_DESCEND_ALT: RTL_LOITER_ALT_M).
     config, saved = str(shipped_config("hil", tmp_path)), tmp_path / "x.params"
     assert companion("params", "set", "RTL_RETURN_ALT", "120", "-c", config).returncode == 0
+    assert companion("params", "set", "RTL_DESCEND_ALT", "60", "-c", config).returncode == 0
     assert companion("params", "save", str(saved), "-c", config).returncode == 0
-    assert "RTL_DESCEND_ALT\t120.0" in saved.read_text()
+    assert "RTL_RETURN_ALT\t120.0" in saved.read_text()
+    assert "RTL_DESCEND_ALT\t60.0" in saved.read_text()
     assert companion("params", "reset", "-c", config).returncode == 0
     loaded = companion("params", "load", str(saved), "-c", config)
     assert loaded.returncode == 0, loaded.stderr
     listed = rows(companion("params", "list", "-c", config).stdout)
     assert listed["RTL_ALT_M"][:2] == ["120", "stored"]
-    assert listed["RTL_RETURN_ALT"][0] == listed["RTL_DESCEND_ALT"][0] == "120"
+    assert listed["RTL_LOITER_ALT_M"][:2] == ["60", "stored"]
+    assert listed["RTL_RETURN_ALT"][0] == "120" and listed["RTL_DESCEND_ALT"][0] == "60"
 
 
 def test_a_follower_contradicting_what_it_follows_is_refused_naming_both(tmp_path):
@@ -84,14 +87,17 @@ def test_a_follower_contradicting_what_it_follows_is_refused_naming_both(tmp_pat
     companion("params", "save", str(saved), "-c", config)
     companion("params", "reset", "-c", config)
     text = saved.read_text()
-    for edited, said in (
-        ("RTL_DESCEND_ALT\t100", "RTL_DESCEND_ALT 100 contradicts RTL_ALT_M 120"),
-        ("RTL_RETURN_ALT\t90", "RTL_RETURN_ALT 90 contradicts RTL_ALT_M 120"),
-    ):
-        saved.write_text(text.replace(edited.split("\t")[0] + "\t120.0", edited))
+    for line, edited, said in (
+        ("RTL_RETURN_ALT\t120.0", "RTL_RETURN_ALT\t90",
+         "RTL_RETURN_ALT 90 contradicts RTL_ALT_M 120"),
+        ("RTL_DESCEND_ALT\t100.0", "RTL_DESCEND_ALT\t50",
+         "RTL_DESCEND_ALT 50 contradicts RTL_LOITER_ALT_M 100"),
+    ):  # fmt: skip
+        assert line in text
+        saved.write_text(text.replace(line, edited))
         refused = companion("params", "load", str(saved), "-c", config)
         assert refused.returncode == 2 and said in refused.stderr, refused.stderr
-        assert "follows RTL_ALT_M" in refused.stderr
+        assert f"follows {said.split()[-2]}" in refused.stderr
     diff = companion("params", "diff", "-c", config).stdout.strip()
     assert diff == "every parameter at its default", "nothing applied from a refused file"
 

@@ -43,10 +43,10 @@ def test_nav_rcl_act_is_thr_failsafe_and_decides_the_rc_loss(px4, own, mode):
 
 
 # PX4's Hold, Land, Warning-only fence, Land on low battery, a timed loiter, a distance
-# limit, no stick input, a loiter height of its own, another airframe, never disarming.
+# limit, no stick input, another airframe, never disarming.
 CANNOT = (("NAV_RCL_ACT", 1.0), ("NAV_DLL_ACT", 3.0), ("GF_ACTION", 1.0),
           ("COM_LOW_BAT_ACT", 2.0), ("RTL_LAND_DELAY", 60.0), ("GF_MAX_HOR_DIST", 100.0),
-          ("COM_RC_IN_MODE", 4.0), ("RTL_DESCEND_ALT", 30.0), ("SYS_AUTOSTART", 4001.0),
+          ("COM_RC_IN_MODE", 4.0), ("SYS_AUTOSTART", 4001.0),
           ("COM_DISARM_LAND", 0.0))  # fmt: skip
 
 
@@ -131,7 +131,10 @@ def test_rtl_return_alt_is_the_return_altitude_the_controller_flies():
     s = store()
     s.set("RTL_RETURN_ALT", 180.0)
     assert flight_config(s.values).executor == flight_config({"RTL_ALT_M": 180.0}).executor
-    assert s.get("RTL_DESCEND_ALT") == 180.0  # it loiters at home at that altitude
+    # The loiter at home is a parameter of its own (tests/unit/control/test_return_loiter.py).
+    assert s.get("RTL_DESCEND_ALT") == s.get("RTL_LOITER_ALT_M") == 100.0
+    s.set("RTL_DESCEND_ALT", 70.0)
+    assert (s.get("RTL_LOITER_ALT_M"), s.get("RTL_ALT_M")) == (70.0, 180.0)
 
 
 def test_config_facts_follow_the_config():
