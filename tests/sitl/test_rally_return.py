@@ -82,8 +82,8 @@ def test_return_from_the_last_leg_goes_home_and_circles_at_the_loiter_altitude(s
     wait_for(lambda: sim.truth()["t"][-1] >= end - 1.0, 120, "the truth file written")
     north, east, height = _track(sim, end - CIRCLING_S)
     assert math.hypot(float(np.median(north)), float(np.median(east))) < 300.0
-    assert abs(float(np.median(height)) - 60.0) < 10.0, np.median(height)
-    assert height.min() > 45.0, height.min()
+    assert abs(float(np.median(height)) - 60.0) < 5.0, np.median(height)  # 61.2 m flown
+    assert height.min() > 50.0, height.min()
 
 
 def _set(sim, name: str, value: float) -> None:
