@@ -94,6 +94,11 @@ class ActuatorSets(ServoPayload):
         """The ACT_SETn_OUT parameters' values (at start and on every change)."""
         self.config = ActuatorSetConfig.from_params(values)
 
+    def outputs(self) -> dict[int, str]:
+        """The outputs its wired sets drive."""
+        wired = enumerate(self.config.outputs, 1)
+        return {output: f"actuator set {n}" for n, output in wired if output}
+
     def act(self, t_us: int, values: Sequence[float], index: int) -> str | None:
         """Each wired set's output to its pulse, handed to the servo output; or why not
         (nothing moves)."""

@@ -52,6 +52,11 @@ class CameraShots:
         self.trigger.config = CameraConfig.from_params(values)
         self._told = False
 
+    def outputs(self) -> dict[int, str]:
+        """The output its shutter pulses go to, for a servo-triggered camera."""
+        config = self.trigger.config
+        return {config.output: "camera"} if config.servo else {}
+
     def step(self, nav: NavState, items: list[MissionItem], pos: tuple[float, float]) -> None:
         """This control step: the items the mission passed, the photo due, its pulses."""
         # Told only when photos were asked for: a landing pattern's camera stop asks none.

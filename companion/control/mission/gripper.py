@@ -83,6 +83,10 @@ class Gripper(ServoPayload):
         """The GRIP_* parameters' values (at start and on every change)."""
         self.config = GripperConfig.from_params(values)
 
+    def outputs(self) -> dict[int, str]:
+        """The output it drives once set up."""
+        return {self.config.output: "gripper"} if self.config.enabled else {}
+
     def act(self, t_us: int, action: int) -> str | None:
         """Grab or release: the pulse handed to the servo output and the operator told;
         or why not (nothing moves)."""

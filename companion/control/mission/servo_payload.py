@@ -10,13 +10,33 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Mapping, Sequence
-from typing import ClassVar
+from typing import ClassVar, Protocol
 
 from companion.control.mission.items import MissionItem
 from companion.messages import VehicleCommand
 from mavlink_dialect import companion as d
 
 log = logging.getLogger("companion.servo_payload")
+
+
+class DrivesOutputs(Protocol):
+    """A payload that says which outputs its parameters give it."""
+
+    def outputs(self) -> dict[int, str]: ...
+
+
+def outputs_taken(
+    surfaces: Mapping[int, str], payloads: Sequence[DrivesOutputs]
+) -> list[dict[int, str]]:
+    """For each payload, the outputs it must not drive (output: what drives it): the
+    airframe's surfaces and every other payload's. An output drives one thing, as an
+    ArduPilot or PX4 output has one function: a gripper and a light on one output would
+    drop the payload when the light is switched."""
+    claims = [p.outputs() for p in payloads]
+    return [
+        {**{o: what for j, c in enumerate(claims) if j != i for o, what in c.items()}, **surfaces}
+        for i in range(len(payloads))
+    ]
 
 
 class ServoPayload:
