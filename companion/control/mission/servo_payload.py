@@ -20,23 +20,29 @@ log = logging.getLogger("companion.servo_payload")
 
 
 class DrivesOutputs(Protocol):
-    """A payload that says which outputs its parameters give it."""
+    """A payload configured from the parameters, which then says which outputs they give
+    it and is told which it must not drive."""
+
+    surface_outputs: Mapping[int, str]
+
+    def configure(self, values: Mapping[str, float]) -> None: ...
 
     def outputs(self) -> dict[int, str]: ...
 
 
-def outputs_taken(
-    surfaces: Mapping[int, str], payloads: Sequence[DrivesOutputs]
-) -> list[dict[int, str]]:
-    """For each payload, the outputs it must not drive (output: what drives it): the
-    airframe's surfaces and every other payload's. An output drives one thing, as an
-    ArduPilot or PX4 output has one function: a gripper and a light on one output would
-    drop the payload when the light is switched."""
+def configure_payloads(
+    payloads: Sequence[DrivesOutputs], values: Mapping[str, float], surfaces: Mapping[int, str]
+) -> None:
+    """Each payload configured from ``values``, then given the outputs it must not drive
+    (output: what drives it): the airframe's surfaces and every other payload's. An output
+    drives one thing, as an ArduPilot or PX4 output has one function: a gripper and a light
+    on one output would drop the payload when the light is switched."""
+    for payload in payloads:
+        payload.configure(values)
     claims = [p.outputs() for p in payloads]
-    return [
-        {**{o: what for j, c in enumerate(claims) if j != i for o, what in c.items()}, **surfaces}
-        for i in range(len(payloads))
-    ]
+    for i, payload in enumerate(payloads):
+        others = {o: what for j, c in enumerate(claims) if j != i for o, what in c.items()}
+        payload.surface_outputs = {**others, **surfaces}
 
 
 class ServoPayload:
@@ -52,7 +58,8 @@ class ServoPayload:
     ) -> None:
         self.command = command  # a pulse for the servo output (on link/commands)
         self.say = say  # (t_us, MAV_SEVERITY, text) for the operator
-        self.surface_outputs = surface_outputs  # output (from 1): the surface it drives
+        # Output (from 1): the surface or other payload that drives it (configure_payloads).
+        self.surface_outputs = surface_outputs
 
     def item_act(self, t_us: int, item: MissionItem) -> str | None:
         """Carry out one of its mission items; why not (nothing moves)."""

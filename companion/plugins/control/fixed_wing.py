@@ -33,7 +33,7 @@ from companion.control.mission.home_items import set_home_command
 from companion.control.mission.items import MissionItem
 from companion.control.mission.jump_counts import JumpCounts
 from companion.control.mission.mission_files import MissionStore, StoreFollower
-from companion.control.mission.servo_payload import outputs_taken
+from companion.control.mission.servo_payload import configure_payloads
 from companion.control.mission_return import reported_state
 from companion.messages import (
     MISSION_SERVO_SEQ,
@@ -268,15 +268,8 @@ class FixedWingPlugin(Plugin):
             self.acks.publish(CommandAck.answer(request, t_us, source, result, problem or ""))
 
     def _configure_payloads(self) -> None:
-        payloads: list[CameraShots | Gripper | ActuatorSets] = [
-            self.camera, self.gripper, self.actuators
-        ]  # fmt: skip
-        for payload in payloads:
-            payload.configure(self.live_params.values)
-        # Each refused the surfaces' outputs and the others' (one thing on an output).
-        taken = outputs_taken(self.surface_outputs, payloads)
-        for payload, refused in zip(payloads, taken, strict=True):
-            payload.surface_outputs = refused
+        payloads = (self.camera, self.gripper, self.actuators)
+        configure_payloads(payloads, self.live_params.values, self.surface_outputs)
 
     def _tell(self, t_us: int, severity: int, text: str) -> None:
         if severity <= d.MAV_SEVERITY_WARNING:

@@ -4,7 +4,7 @@ refuse an output another of them is set up on, as they refuse a surface's, and s
 gripper's output would otherwise drop the payload when it is switched on.
 
 The payloads are the flight controller's own, wired as its plug-in wires them
-(``outputs_taken``)."""
+(``configure_payloads``)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from companion.control.mission.actuator_sets import ACTUATOR_PARAMS, ActuatorSet
 from companion.control.mission.camera import CAMERA_PARAMS
 from companion.control.mission.camera_shots import CameraPorts, CameraShots
 from companion.control.mission.gripper import GRIPPER_PARAMS, Gripper
-from companion.control.mission.servo_payload import outputs_taken
+from companion.control.mission.servo_payload import configure_payloads
 from companion.messages import GpsFix, VehicleCommand
 from mavlink_dialect import companion as d
 from tests.unit.control.mission.executor_flying import HOME_ALT
@@ -36,10 +36,7 @@ class Payloads:
         self.gripper = Gripper(self.sent.append, say, SURFACES)
         self.actuators = ActuatorSets(self.sent.append, say, SURFACES)
         payloads = (self.camera, self.gripper, self.actuators)
-        for payload in payloads:
-            payload.configure({**DEFAULTS, **params})
-        for payload, taken in zip(payloads, outputs_taken(SURFACES, payloads), strict=True):
-            payload.surface_outputs = taken
+        configure_payloads(payloads, {**DEFAULTS, **params}, SURFACES)
 
 
 def test_a_set_wired_to_the_set_up_grippers_output_is_refused_naming_the_gripper():
