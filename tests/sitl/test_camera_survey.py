@@ -18,7 +18,7 @@ from companion.actuators.minissc import position_for_pulse
 from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
 from tests.support.geotag import camera_feedback, images_tagged
-from tests.support.vehicle import REPO
+from tests.support.vehicle import REPO, set_param
 
 PLAN = REPO / "qgc_plans" / "short_leg.plan"
 SPACING_M = 50.0
@@ -43,13 +43,6 @@ def _survey(tmp_path: Path) -> Path:
     path = tmp_path / "survey.plan"
     path.write_text(json.dumps(plan))
     return path
-
-
-def _set(sim, name: str, value: float) -> None:
-    w = sim.watcher
-    w.mav.param_set_send(1, 1, name.encode(), value, d.MAV_PARAM_TYPE_REAL32)
-    w.until(lambda m: m.get_type() == "PARAM_VALUE" and m.param_id == name
-            and m.param_value == value, 30, f"{name} = {value}")  # fmt: skip
 
 
 def _photos_until(sim, done) -> list:
@@ -100,8 +93,8 @@ def test_a_survey_leg_is_photographed_every_50_m_and_each_photo_logged_for_geota
     sim.wait_ready()
     said = "Camera: photos only while armed"  # QGroundControl's photo button, disarmed
     assert _photo_button(sim, said) == d.MAV_RESULT_DENIED
-    _set(sim, "CAM1_TYPE", 1.0)
-    _set(sim, "CAM1_OUTPUT", 7.0)
+    set_param(sim.watcher, "CAM1_TYPE", 1.0)
+    set_param(sim.watcher, "CAM1_OUTPUT", 7.0)
     sim.upload_plan(_survey(tmp_path))
     sim.arm_and_start()
     leg_end = 3  # the waypoint ending the survey's leg; the stop item follows it

@@ -17,7 +17,7 @@ import pytest
 from companion.control.mission.plan import checked_plan
 from companion.geodesy import LocalFrame
 from mavlink_dialect import companion as d
-from tests.support.vehicle import REPO, wait_for
+from tests.support.vehicle import REPO, set_param, wait_for
 
 PLAN = REPO / "qgc_plans" / "square.plan"
 pytestmark = pytest.mark.vehicle(plan=str(PLAN))
@@ -72,7 +72,7 @@ def test_return_from_the_last_leg_goes_home_and_circles_at_the_loiter_altitude(s
     loiter altitude as RTL_DESCEND_ALT: home is flown to at the return altitude
     (RTL_ALT_M, 100 m) and circled at the loiter altitude, 60 m, as a PX4 user expects."""
     sim.wait_ready()
-    _set(sim, "RTL_DESCEND_ALT", 60.0)
+    set_param(sim.watcher, "RTL_DESCEND_ALT", 60.0)
     sim.arm_and_start()
     sim.run_until_item(3)  # on the last leg, back towards home from the north
     sim.watcher.command(d.MAV_CMD_NAV_RETURN_TO_LAUNCH)
@@ -84,14 +84,6 @@ def test_return_from_the_last_leg_goes_home_and_circles_at_the_loiter_altitude(s
     assert math.hypot(float(np.median(north)), float(np.median(east))) < 300.0
     assert abs(float(np.median(height)) - 60.0) < 5.0, np.median(height)  # 61.2 m flown
     assert height.min() > 50.0, height.min()
-
-
-def _set(sim, name: str, value: float) -> None:
-    """A parameter written as a ground station writes it, and its echo awaited."""
-    w = sim.watcher
-    w.mav.param_set_send(1, 1, name.encode(), value, d.MAV_PARAM_TYPE_REAL32)
-    w.until(lambda m: m.get_type() == "PARAM_VALUE" and m.param_id == name
-            and m.param_value == value, 30, f"{name} = {value}")  # fmt: skip
 
 
 @pytest.mark.timeout(900)

@@ -22,10 +22,14 @@ from companion.bus.node import BusNode
 from companion.messages import SystemHealth
 from companion.testing import processes
 from companion.testing.processes import LoggedProcess, unique_namespace
+from mavlink_dialect import companion as d
 
 REPO = Path(__file__).resolve().parents[2]
 T = TypeVar("T")
-__all__ = ["REPO", "Vehicle", "assert_clean", "companion_env", "unique_namespace", "wait_for"]
+__all__ = [
+    "REPO", "Vehicle", "assert_clean", "companion_env", "set_param", "unique_namespace",
+    "wait_for",
+]  # fmt: skip
 
 
 def wait_for(predicate: Callable[[], T], timeout_s: float, what: str, period_s: float = 0.05) -> T:
@@ -38,6 +42,14 @@ def wait_for(predicate: Callable[[], T], timeout_s: float, what: str, period_s: 
         if time.monotonic() > deadline:
             raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
         time.sleep(period_s)
+
+
+def set_param(watcher: Any, name: str, value: float) -> None:
+    """A parameter written as a ground station writes it (PARAM_SET, REAL32), and its echo
+    with that value awaited (30 s)."""
+    watcher.mav.param_set_send(1, 1, name.encode(), value, d.MAV_PARAM_TYPE_REAL32)
+    watcher.until(lambda m: m.get_type() == "PARAM_VALUE" and m.param_id == name
+                  and m.param_value == value, 30, f"{name} = {value}")  # fmt: skip
 
 
 def companion_env(namespace: str) -> dict[str, str]:
